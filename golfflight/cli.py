@@ -1,0 +1,36 @@
+"""The `golfflight` console command: one subcommand per module in `golfflight.commands`, each a thin layer
+over plain functions of the packages that do the work."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from golfflight import __version__
+from golfflight.commands import COMMANDS
+
+
+class UserError(Exception):
+    """An error the user can fix (a bad file, a bad option): printed as one line, no traceback."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="golfflight", description="Golf ball flight engine (Phys-NN+).")
+    parser.add_argument("--version", action="version", version=f"golfflight {__version__}")
+    subparsers = parser.add_subparsers(dest="command", required=True)
+    for command in COMMANDS:
+        command.register(subparsers)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.run(args) or 0
+    except (UserError, ValueError, FileNotFoundError) as error:
+        print(f"golfflight {args.command}: error: {error}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

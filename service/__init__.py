@@ -1,0 +1,1 @@
+"""Runtime flight engine: NumPy physics, air and wind, the integrator (and, later, the HTTP service)."""

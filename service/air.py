@@ -1,0 +1,74 @@
+"""Air: pressure at altitude, moist-air density and viscosity (NOTES.md section 3).
+
+Every function works on floats or NumPy arrays alike, so a batch of shots can each have their own air.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+SEA_LEVEL_PRESSURE_PA = 101325.0
+DRY_AIR_GAS_CONSTANT = 287.05  # J/(kg K)
+WATER_VAPOUR_GAS_CONSTANT = 461.5  # J/(kg K)
+ZERO_CELSIUS_K = 273.15
+
+
+def pressure_at_altitude(altitude_m: ArrayLike) -> np.ndarray:
+    """Station pressure (Pa) of the US Standard Atmosphere at a height above sea level."""
+    return SEA_LEVEL_PRESSURE_PA * (1.0 - 2.25577e-5 * np.asarray(altitude_m, dtype=float)) ** 5.255876
+
+
+def altitude_for_pressure(pressure_pa: ArrayLike) -> np.ndarray:
+    """Inverse of `pressure_at_altitude`: the standard-atmosphere height (m) of a station pressure."""
+    ratio = np.asarray(pressure_pa, dtype=float) / SEA_LEVEL_PRESSURE_PA
+    return (1.0 - ratio ** (1.0 / 5.255876)) / 2.25577e-5
+
+
+def vapour_pressure(temperature_c: ArrayLike, humidity_pct: ArrayLike) -> np.ndarray:
+    """Partial pressure of water vapour (Pa) from relative humidity (Tetens' saturation formula)."""
+    t = np.asarray(temperature_c, dtype=float)
+    saturation_hpa = 6.1078 * np.exp(17.27 * t / (t + 237.3))
+    return np.asarray(humidity_pct, dtype=float) / 100.0 * saturation_hpa * 100.0
+
+
+def air_density(temperature_c: ArrayLike, pressure_pa: ArrayLike, humidity_pct: ArrayLike = 0.0) -> np.ndarray:
+    """Density (kg/m^3) of moist air: dry-air and vapour partial pressures as two ideal gases."""
+    temperature_k = np.asarray(temperature_c, dtype=float) + ZERO_CELSIUS_K
+    vapour = vapour_pressure(temperature_c, humidity_pct)
+    dry = np.asarray(pressure_pa, dtype=float) - vapour
+    return dry / (DRY_AIR_GAS_CONSTANT * temperature_k) + vapour / (WATER_VAPOUR_GAS_CONSTANT * temperature_k)
+
+
+def dynamic_viscosity(temperature_c: ArrayLike) -> np.ndarray:
+    """Dynamic viscosity of air (Pa s), Sutherland's law."""
+    temperature_k = np.asarray(temperature_c, dtype=float) + ZERO_CELSIUS_K
+    return 1.458e-6 * temperature_k**1.5 / (temperature_k + 110.4)
+
+
+@dataclass(frozen=True)
+class Air:
+    """The air a shot flies through: its density and its kinematic viscosity (for Reynolds numbers)."""
+
+    density_kg_m3: float | np.ndarray
+    kinematic_viscosity_m2_s: float | np.ndarray
+
+    @classmethod
+    def from_conditions(
+        cls,
+        temperature_c: ArrayLike = 15.0,
+        altitude_m: ArrayLike = 0.0,
+        humidity_pct: ArrayLike = 0.0,
+        pressure_pa: ArrayLike | None = None,
+    ) -> "Air":
+        """Air at a temperature, humidity and either a station pressure or (if none given) an altitude."""
+        pressure = pressure_at_altitude(altitude_m) if pressure_pa is None else np.asarray(pressure_pa, dtype=float)
+        density = air_density(temperature_c, pressure, humidity_pct)
+        return cls(density, dynamic_viscosity(temperature_c) / density)
+
+    @classmethod
+    def standard(cls) -> "Air":
+        """ICAO standard air: 15 degC, sea level, dry (rho = 1.225 kg/m^3). The density models are trained at."""
+        return cls.from_conditions(15.0, 0.0, 0.0)

@@ -1,0 +1,36 @@
+"""Physical ranges of every input quantity: one table that the shot records and the HTTP contract both enforce."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+
+class Range(NamedTuple):
+    """Inclusive bounds and the unit they are written in."""
+
+    low: float
+    high: float
+    unit: str
+
+    def describe(self) -> str:
+        return f"{self.low:g} to {self.high:g} {self.unit}".strip()
+
+
+BALL_SPEED_MPS = Range(0.5, 100.0, "m/s")
+LAUNCH_ANGLE_DEG = Range(-10.0, 80.0, "deg")
+LAUNCH_DIRECTION_DEG = Range(-60.0, 60.0, "deg")
+SPIN_RPM = Range(0.0, 15000.0, "rpm")
+SPIN_AXIS_DEG = Range(-90.0, 90.0, "deg")
+
+CARRY_X_M = Range(-300.0, 300.0, "m")
+CARRY_Y_M = Range(-50.0, 450.0, "m")
+APEX_M = Range(0.0, 120.0, "m")
+FLIGHT_TIME_S = Range(0.0, 20.0, "s")
+LANDING_ANGLE_DEG = Range(0.0, 90.0, "deg")
+
+TEMPERATURE_C = Range(-30.0, 55.0, "degC")
+ALTITUDE_M = Range(-500.0, 5000.0, "m")
+PRESSURE_HPA = Range(500.0, 1100.0, "hPa")
+HUMIDITY_PCT = Range(0.0, 100.0, "%")
+WIND_SPEED_MPS = Range(0.0, 30.0, "m/s")
+WIND_FROM_DEG = Range(0.0, 360.0, "deg")

@@ -1,0 +1,104 @@
+"""Equations of motion of a spinning golf ball (paper section 2, with the errata of NOTES.md section 1).
+
+Axes: x to the right of the target line seen from behind the golfer, y towards the target, z up.
+State of a batch of N balls: position r [N,3] (m), velocity v [N,3] (m/s), spin omega [N,3] (rad/s).
+
+Aerodynamic coefficients come from a pluggable model (v_rel, omega) -> [N,4] = C_L, C_D, C_M, C_Q with
+  q     = C_Q rho |v_rel|^2          (C_Q = 0.5 gives the usual dynamic pressure)
+  F_D   = -C_D q A v_rel/|v_rel|
+  F_L   =  C_L q A (omega x v_rel)/|omega x v_rel|   (erratum: the paper's v x omega points down)
+  dw/dt = -C_M q d A omega/|omega| / I               (erratum: spin only ever decays)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from service.constants import (
+    BALL_AREA_M2,
+    BALL_INERTIA_KG_M2,
+    BALL_MASS_KG,
+    BALL_RADIUS_M,
+    GRAVITY_MPS2,
+    RPM_TO_RADPS,
+    TEE_HEIGHT_M,
+)
+from service.wind import CALM, Wind
+
+TINY = 1e-12
+"""Guards the unit vectors of a ball at rest or with no spin."""
+
+
+class CoefficientModel(Protocol):
+    """Aerodynamic coefficients [N,4] = (C_L, C_D, C_M, C_Q) of balls with air-relative velocity and spin [N,3]."""
+
+    def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray: ...
+
+
+@dataclass
+class State:
+    """Position, velocity and spin of a batch of balls, each [N,3]."""
+
+    position: np.ndarray
+    velocity: np.ndarray
+    spin: np.ndarray
+
+
+def initial_state(
+    ball_speed_mps: np.ndarray,
+    launch_angle_deg: np.ndarray,
+    launch_direction_deg: np.ndarray,
+    spin_rpm: np.ndarray,
+    spin_axis_deg: np.ndarray,
+) -> State:
+    """State at impact from launch-monitor values (paper eq. 12; spin axis + tilts right, rifle spin zero)."""
+    speed = np.asarray(ball_speed_mps, dtype=float)
+    gamma = np.radians(launch_angle_deg)
+    phi = np.radians(launch_direction_deg)
+    psi = np.radians(spin_axis_deg)
+    spin = np.asarray(spin_rpm, dtype=float) * RPM_TO_RADPS
+    velocity = np.stack([speed * np.cos(gamma) * np.sin(phi), speed * np.cos(gamma) * np.cos(phi), speed * np.sin(gamma)], -1)
+    omega = np.stack([spin * np.cos(psi), np.zeros_like(spin), -spin * np.sin(psi)], -1)
+    position = np.zeros_like(velocity)
+    position[:, 2] = TEE_HEIGHT_M
+    return State(position, velocity, omega)
+
+
+def spin_ratio(v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """S = R |omega| / |v_rel| [N]: surface speed over air speed, the variable lift and drag depend on."""
+    return BALL_RADIUS_M * np.linalg.norm(omega, axis=-1) / np.maximum(np.linalg.norm(v_rel, axis=-1), TINY)
+
+
+def aerodynamics(v_rel: np.ndarray, omega: np.ndarray, coefficients: np.ndarray, density: np.ndarray | float):
+    """Aerodynamic acceleration [N,3] (drag + Magnus lift) and spin acceleration [N,3] from the coefficients."""
+    c_lift, c_drag, c_moment, c_q = coefficients[:, 0], coefficients[:, 1], coefficients[:, 2], coefficients[:, 3]
+    speed = np.linalg.norm(v_rel, axis=-1)
+    q_area = c_q * density * speed**2 * BALL_AREA_M2
+    magnus = np.cross(omega, v_rel)
+    magnus_unit = magnus / np.maximum(np.linalg.norm(magnus, axis=-1), TINY)[:, None]
+    drag_unit = v_rel / np.maximum(speed, TINY)[:, None]
+    force = q_area[:, None] * (c_lift[:, None] * magnus_unit - c_drag[:, None] * drag_unit)
+    spin_unit = omega / np.maximum(np.linalg.norm(omega, axis=-1), TINY)[:, None]
+    torque = -(c_moment * q_area * 2.0 * BALL_RADIUS_M)[:, None] * spin_unit
+    return force / BALL_MASS_KG, torque / BALL_INERTIA_KG_M2
+
+
+def derivatives(
+    state: State, coefficient_model: CoefficientModel, density: np.ndarray | float, wind: Wind = CALM
+) -> State:
+    """d/dt of (position, velocity, spin): the right-hand side of the equations of motion (paper eq. 14)."""
+    v_rel = state.velocity if wind.is_calm else state.velocity - wind.velocity(state.position[:, 2])
+    coefficients = coefficient_model(v_rel, state.spin)
+    acceleration, spin_acceleration = aerodynamics(v_rel, state.spin, coefficients, density)
+    acceleration[:, 2] -= GRAVITY_MPS2
+    return State(state.velocity, acceleration, spin_acceleration)
+
+
+def mechanical_energy(state: State) -> np.ndarray:
+    """Kinetic (translational + rotational) plus potential energy per ball [N] (J)."""
+    kinetic = 0.5 * BALL_MASS_KG * np.sum(state.velocity**2, axis=-1)
+    rotational = 0.5 * BALL_INERTIA_KG_M2 * np.sum(state.spin**2, axis=-1)
+    return kinetic + rotational + BALL_MASS_KG * GRAVITY_MPS2 * state.position[:, 2]

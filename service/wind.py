@@ -1,0 +1,59 @@
+"""Wind: speed and the direction it blows FROM, uniform or with a logarithmic profile over height.
+
+Direction convention (degrees, clockwise seen from behind the golfer looking at the target):
+0 = from the target (headwind), 90 = from the right, 180 = from behind (tailwind), 270 = from the left.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+STATION_HEIGHT_M = 10.0
+"""Weather stations report wind at 10 m."""
+
+FAIRWAY_ROUGHNESS_M = 0.02
+"""Aerodynamic roughness length z0 of mown grass (0.01-0.03 m)."""
+
+
+def wind_vector(speed_mps: ArrayLike, from_deg: ArrayLike) -> np.ndarray:
+    """Horizontal velocity of the air ([..., 3], m/s, x right, y to the target) for a wind blowing FROM a direction."""
+    theta = np.radians(np.asarray(from_deg, dtype=float))
+    speed = np.asarray(speed_mps, dtype=float)
+    return np.stack([-speed * np.sin(theta), -speed * np.cos(theta), np.zeros_like(speed * theta)], axis=-1)
+
+
+def log_profile_factor(height_m: ArrayLike, reference_height_m: float, roughness_m: float) -> np.ndarray:
+    """V(h)/V(h_ref) of the logarithmic wind profile; zero at and below the roughness length."""
+    h = np.maximum(np.asarray(height_m, dtype=float), roughness_m)
+    return np.log(h / roughness_m) / np.log(reference_height_m / roughness_m)
+
+
+@dataclass(frozen=True)
+class Wind:
+    """A steady wind; speed and direction may be arrays (one per shot of a batch)."""
+
+    speed_mps: float | np.ndarray = 0.0
+    from_deg: float | np.ndarray = 0.0
+    profile: Literal["uniform", "log"] = "uniform"
+    reference_height_m: float = STATION_HEIGHT_M
+    roughness_m: float = FAIRWAY_ROUGHNESS_M
+
+    def velocity(self, height_m: np.ndarray) -> np.ndarray:
+        """Air velocity [N, 3] at the balls' heights [N]."""
+        at_reference = wind_vector(self.speed_mps, self.from_deg)
+        if self.profile == "uniform":
+            return np.broadcast_to(at_reference, np.shape(height_m) + (3,))
+        factor = log_profile_factor(height_m, self.reference_height_m, self.roughness_m)
+        return at_reference * factor[..., None]
+
+    @property
+    def is_calm(self) -> bool:
+        """True when there is no wind anywhere in the batch."""
+        return not np.any(np.asarray(self.speed_mps) != 0.0)
+
+
+CALM = Wind()

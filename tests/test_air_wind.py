@@ -1,0 +1,61 @@
+"""Air density, viscosity and wind against published values (NOTES.md section 3)."""
+
+import numpy as np
+import pytest
+
+from service.air import Air, air_density, altitude_for_pressure, dynamic_viscosity, pressure_at_altitude
+from service.wind import Wind, log_profile_factor, wind_vector
+
+
+def test_standard_sea_level_density():
+    assert air_density(15.0, 101325.0, 0.0) == pytest.approx(1.225, abs=0.001)
+    assert Air.standard().density_kg_m3 == pytest.approx(1.225, abs=0.001)
+
+
+def test_warm_dry_air_is_thinner():
+    assert air_density(25.0, 101325.0, 0.0) == pytest.approx(1.184, abs=0.001)
+
+
+@pytest.mark.parametrize("temperature_c, humidity_pct, change", [(15.0, 50.0, -0.003), (40.0, 100.0, -0.027)])
+def test_humid_air_is_lighter_by_the_published_amount(temperature_c, humidity_pct, change):
+    dry = air_density(temperature_c, 101325.0, 0.0)
+    moist = air_density(temperature_c, 101325.0, humidity_pct)
+    assert moist / dry - 1 == pytest.approx(change, abs=0.001)
+
+
+def test_standard_atmosphere_pressure_and_its_inverse():
+    assert pressure_at_altitude(0.0) == pytest.approx(101325.0)
+    assert pressure_at_altitude(1000.0) == pytest.approx(89874.6, rel=1e-4)
+    assert pressure_at_altitude(7800 * 0.3048) / 101325.0 == pytest.approx(75840.0 / 101325.0, abs=0.002)
+    assert altitude_for_pressure(pressure_at_altitude(np.array([-300.0, 2377.0]))) == pytest.approx([-300.0, 2377.0])
+
+
+def test_station_pressure_overrides_altitude():
+    by_pressure = Air.from_conditions(20.0, altitude_m=0.0, pressure_pa=pressure_at_altitude(1500.0))
+    by_altitude = Air.from_conditions(20.0, altitude_m=1500.0)
+    assert by_pressure.density_kg_m3 == pytest.approx(by_altitude.density_kg_m3)
+
+
+def test_sutherland_viscosity_of_air():
+    assert dynamic_viscosity(15.0) == pytest.approx(1.789e-5, rel=2e-3)
+    assert Air.standard().kinematic_viscosity_m2_s == pytest.approx(1.461e-5, rel=3e-3)
+
+
+@pytest.mark.parametrize("from_deg, direction", [(0.0, (0, -1)), (90.0, (-1, 0)), (180.0, (0, 1)), (270.0, (1, 0))])
+def test_wind_blows_away_from_where_it_comes_from(from_deg, direction):
+    assert wind_vector(4.0, from_deg) == pytest.approx([4.0 * direction[0], 4.0 * direction[1], 0.0], abs=1e-12)
+
+
+def test_log_profile_is_reference_speed_at_reference_height_and_still_at_the_ground():
+    assert log_profile_factor(10.0, 10.0, 0.02) == pytest.approx(1.0)
+    assert log_profile_factor(0.01, 10.0, 0.02) == 0.0
+    heights = np.array([1.0, 5.0, 20.0, 40.0])
+    assert np.all(np.diff(log_profile_factor(heights, 10.0, 0.02)) > 0)
+    wind = Wind(5.0, 0.0, profile="log", reference_height_m=10.0, roughness_m=0.02)
+    assert wind.velocity(np.array([10.0, 0.0]))[:, 1] == pytest.approx([-5.0, 0.0])
+
+
+def test_uniform_wind_is_the_same_at_every_height_and_per_shot_arrays_work():
+    wind = Wind(np.array([3.0, 6.0]), np.array([0.0, 180.0]))
+    assert wind.velocity(np.array([1.0, 30.0]))[:, 1] == pytest.approx([-3.0, 6.0])
+    assert not wind.is_calm and Wind().is_calm
