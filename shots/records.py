@@ -212,11 +212,12 @@ def _format(value: object) -> str:
     return str(value)
 
 
-def _atomic_write(path: Path, header: Iterable[str], rows: Iterable[Iterable[object]]) -> None:
+def write_csv_atomic(path: Path, header: Iterable[str], rows: Iterable[Iterable[object]]) -> None:
     """Write a CSV to a temporary file beside `path`, then rename it: readers never see half a file."""
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
+        os.chmod(tmp, 0o644)
         with os.fdopen(fd, "w", newline="") as handle:
             writer = csv.writer(handle)
             writer.writerow(header)
@@ -230,7 +231,7 @@ def _atomic_write(path: Path, header: Iterable[str], rows: Iterable[Iterable[obj
 
 def write_shots(path: str | os.PathLike, records: Iterable[ShotRecord]) -> None:
     """Write canonical shot records (all columns, blanks for what was not recorded)."""
-    _atomic_write(Path(path), COLUMNS, ([getattr(r, c) for c in COLUMNS] for r in records))
+    write_csv_atomic(Path(path), COLUMNS, ([getattr(r, c) for c in COLUMNS] for r in records))
 
 
 def trajectories_path(path: str | os.PathLike) -> Path:
@@ -242,7 +243,7 @@ def trajectories_path(path: str | os.PathLike) -> Path:
 def write_trajectories(path: str | os.PathLike, trajectories: dict[str, np.ndarray]) -> None:
     """Write {shot_id: array [T,4] of t_s, x_m, y_m, z_m} as the companion file."""
     rows = ([shot_id, *sample] for shot_id, samples in trajectories.items() for sample in np.asarray(samples, dtype=float))
-    _atomic_write(Path(path), TRAJECTORY_COLUMNS, rows)
+    write_csv_atomic(Path(path), TRAJECTORY_COLUMNS, rows)
 
 
 def read_trajectories(path: str | os.PathLike) -> dict[str, np.ndarray]:

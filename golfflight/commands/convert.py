@@ -1,0 +1,66 @@
+"""`golfflight convert`: turn a real launch-monitor export into the canonical shot CSV and print what was dropped."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from shots.records import trajectories_path, write_shots, write_trajectories
+from shots.tourcast import load_tourcast
+from shots.trackman import Conversion, load_trackman
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser("convert", help="convert a real export (TrackMan, TOURCAST) to canonical CSV")
+    formats = parser.add_subparsers(dest="format", required=True)
+
+    trackman = formats.add_parser("trackman", help="a TrackMan CSV export (header row, then a units row)")
+    trackman.add_argument("source", help="the TrackMan CSV export")
+    trackman.add_argument("--out", required=True, help="canonical CSV to write")
+    flights = trackman.add_mutually_exclusive_group()
+    flights.add_argument("--min-tracked-fraction", type=float, default=0.9,
+                         help="keep shots whose radar track covers this fraction of the flight (outdoor, measured)")
+    flights.add_argument("--all-flights", action="store_true",
+                         help="keep indoor shots too (their outcome is TrackMan's model)")
+    trackman.add_argument("--ball", action="extend", nargs="+", help="keep only these ball types, e.g. Premium")
+    trackman.add_argument("--session", help="session id when the file has no Date column (default: the file name)")
+    trackman.set_defaults(run=run_trackman)
+
+    tourcast = formats.add_parser("tourcast", help="PGA TOUR TOURCAST shot_trajectory CSV (+ pbp CSV for spin)")
+    tourcast.add_argument("source", help="the shot_trajectory_*.csv file")
+    tourcast.add_argument("--pbp", help="the event's pbp_*.csv file: spin joined on round/hole/player/shot")
+    tourcast.add_argument("--estimate-spin", action="store_true",
+                          help="estimate missing spin from the initial lift (Ferguson 2022 C_L) instead of dropping")
+    tourcast.add_argument("--sample-interval", type=float, default=0.01, help="trajectory sample spacing, s")
+    tourcast.add_argument("--out", required=True, help="canonical CSV to write (the trajectories go beside it)")
+    tourcast.set_defaults(run=run_tourcast)
+
+
+def _write(conversion: Conversion, out: str) -> int:
+    print(conversion.report.summary())
+    if not conversion.records:
+        print(f"golfflight convert: no shot kept, {out} not written", file=sys.stderr)
+        return 1
+    write_shots(out, conversion.records)
+    print(f"wrote {len(conversion.records)} shots to {out}")
+    if conversion.trajectories:
+        companion = trajectories_path(out)
+        write_trajectories(companion, conversion.trajectories)
+        print(f"wrote {len(conversion.trajectories)} sampled trajectories to {companion}")
+    return 0
+
+
+def run_trackman(args: argparse.Namespace) -> int:
+    fraction = None if args.all_flights else args.min_tracked_fraction
+    if fraction is not None and not 0 < fraction <= 1:
+        raise ValueError(f"--min-tracked-fraction must be in (0, 1], got {fraction}")
+    conversion = load_trackman(args.source, min_tracked_fraction=fraction, balls=args.ball, session=args.session)
+    return _write(conversion, args.out)
+
+
+def run_tourcast(args: argparse.Namespace) -> int:
+    if args.sample_interval <= 0:
+        raise ValueError(f"--sample-interval must be positive, got {args.sample_interval}")
+    conversion = load_tourcast(args.source, args.pbp, estimate_spin=args.estimate_spin,
+                               sample_interval_s=args.sample_interval)
+    return _write(conversion, args.out)

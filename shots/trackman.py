@@ -1,0 +1,249 @@
+"""Loader for TrackMan CSV exports (header row, then a units row such as [mph],[deg],[rpm],[ft],[yds],[s]).
+
+Each column's unit is read from the units row and converted to SI here, at the file edge. Real exports are messy
+(indoor shots whose flight is TrackMan's model, range balls, corrupt cells), so rows are filtered and every
+dropped row is counted under its reason in a `ConversionReport`; nothing is dropped silently.
+
+"Carry Flat - Length" is the straight-line horizontal distance from the tee to the landing point, not the
+distance along the target line: in the shared driver export, TrackMan's own "Curve" column equals
+Side cos(φ) − sqrt(Length² − Side²) sin(φ) (φ = launch direction) to 1e-7 yd on every shot, while reading Length
+as the along-line distance misses by up to 7 yd. So carry_x_m = Side and carry_y_m = sqrt(Length² − Side²).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from collections.abc import Collection
+from dataclasses import dataclass, field
+from datetime import datetime
+from pathlib import Path
+
+import numpy as np
+
+from service.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from shots.records import RANGES, RecordError, ShotRecord
+
+SPEED = {"mph": MPH_TO_MPS, "m/s": 1.0, "km/h": 1.0 / 3.6}
+ANGLE = {"deg": 1.0}
+SPIN = {"rpm": 1.0}
+LENGTH = {"yds": YARD_M, "yd": YARD_M, "ft": FOOT_M, "m": 1.0}
+TIME = {"s": 1.0}
+
+LAUNCH = {
+    "Ball Speed": ("ball_speed_mps", SPEED),
+    "Launch Angle": ("launch_angle_deg", ANGLE),
+    "Launch Direction": ("launch_direction_deg", ANGLE),
+    "Spin Rate": ("spin_rpm", SPIN),
+    "Spin Axis": ("spin_axis_deg", ANGLE),
+}
+"""Required export columns -> (canonical column, accepted units and their factor to SI)."""
+
+OUTCOME = {
+    "Max Height - Height": ("apex_m", LENGTH),
+    "Carry Flat - Time": ("flight_time_s", TIME),
+    "Carry Flat - Land. Angle": ("landing_angle_deg", ANGLE),
+}
+"""Optional export columns copied one-to-one into canonical outcome columns."""
+
+CARRY_LENGTH, CARRY_SIDE = "Carry Flat - Length", "Carry Flat - Side"
+LAST_POINT_TIME, CARRY_TIME = "Last data Point - Time", "Carry Flat - Time"
+DATE_FORMATS = ("%m/%d/%Y %I:%M:%S %p", "%Y-%m-%d %H:%M:%S", "%Y-%m-%dT%H:%M:%S")
+
+
+@dataclass
+class ConversionReport:
+    """What a loader did with each source row: how many came in, were kept, and were dropped for which reason."""
+
+    source: str
+    rows_in: int = 0
+    kept: int = 0
+    dropped: dict[str, list[int]] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    def drop(self, reason: str, line: int) -> None:
+        self.dropped.setdefault(reason, []).append(line)
+
+    @property
+    def n_dropped(self) -> int:
+        return sum(len(lines) for lines in self.dropped.values())
+
+    def count(self, reason_start: str) -> int:
+        """Rows dropped for every reason that starts with `reason_start`."""
+        return sum(len(lines) for reason, lines in self.dropped.items() if reason.startswith(reason_start))
+
+    def summary(self, examples: int = 5) -> str:
+        lines = [f"{self.source}: {self.rows_in} in, {self.kept} kept, {self.n_dropped} dropped"]
+        for reason, where in sorted(self.dropped.items(), key=lambda item: -len(item[1])):
+            shown = ", ".join(str(n) for n in where[:examples]) + (", ..." if len(where) > examples else "")
+            lines.append(f"  dropped {len(where)}: {reason} (lines {shown})")
+        lines.extend(f"  note: {note}" for note in self.notes)
+        return "\n".join(lines)
+
+
+@dataclass
+class Conversion:
+    """Canonical records converted from an export, the filter report, and (where the source has them) flights."""
+
+    records: list[ShotRecord]
+    report: ConversionReport
+    trajectories: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+class _BadRow(Exception):
+    """A row that cannot become a canonical record; the message is the drop reason."""
+
+
+def _read_table(path: Path) -> tuple[list[str], list[str], list[tuple[int, list[str]]]]:
+    """Header, units row and (line number, cells) of each data row; an optional 'sep=,' first line is skipped."""
+    with path.open(newline="", encoding="utf-8-sig") as handle:
+        lines = list(enumerate(csv.reader(handle), start=1))
+    if lines and lines[0][1][:1] == ["sep="]:
+        lines = lines[1:]
+    if len(lines) < 2:
+        raise RecordError(f"{path}: a TrackMan export needs a header row and a units row; it has {len(lines)} rows")
+    (_, header), (units_line, units) = lines[0], lines[1]
+    header = [name.strip() for name in header]
+    cells = [u.strip() for u in units]
+    if not any(cells) or not all(u == "" or (u.startswith("[") and u.endswith("]")) for u in cells):
+        raise RecordError(f"{path} line {units_line}: expected the units row ([mph],[deg],[rpm],...) under the header, "
+                          f"got {units[:6]}")
+    cells += [""] * (len(header) - len(cells))
+    return header, [u.strip("[]") for u in cells], lines[2:]
+
+
+def _column_factors(path: Path, header: list[str], units: list[str], wanted: dict[str, dict[str, float]],
+                    required: Collection[str]) -> dict[str, tuple[int, float]]:
+    """Column index and SI factor of each wanted column present; refuse a missing required column or an unknown unit."""
+    found = {}
+    for name, accepted in wanted.items():
+        if name not in header:
+            if name in required:
+                raise RecordError(f"{path}: required column '{name}' is missing (columns: {header})")
+            continue
+        index = header.index(name)
+        unit = units[index]
+        if unit not in accepted:
+            raise RecordError(f"{path} units row, column '{name}': unit [{unit}] not accepted; "
+                              f"expected one of {['[' + u + ']' for u in accepted]}")
+        found[name] = (index, accepted[unit])
+    return found
+
+
+def _number(cells: list[str], column: str, spec: tuple[int, float]) -> float | None:
+    index, factor = spec
+    text = cells[index].strip() if index < len(cells) else ""
+    if text == "":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise _BadRow(f"'{column}' is not a number") from None
+    if not math.isfinite(value):
+        raise _BadRow(f"'{column}' is not a number")
+    return value * factor
+
+
+def _in_range(column: str, canonical: str, value: float | None) -> float | None:
+    allowed = RANGES[canonical]
+    if value is not None and not allowed.low <= value <= allowed.high:
+        raise _BadRow(f"'{column}' ({canonical}) outside the allowed range {allowed.describe()}")
+    return value
+
+
+def _carry(length: float | None, side: float | None) -> tuple[float | None, float | None]:
+    """(carry_x_m, carry_y_m) from Carry Flat Length (straight-line distance) and Side; see the module docstring."""
+    if length is None or side is None:
+        return None, None
+    if abs(side) > length:
+        raise _BadRow(f"'{CARRY_SIDE}' larger than '{CARRY_LENGTH}' (Length is the straight-line distance)")
+    return side, math.sqrt(length * length - side * side)
+
+
+def _outcome(cells: list[str], specs: dict[str, tuple[int, float]]) -> dict[str, float | None]:
+    """Canonical outcome columns of a row whose flight was recorded."""
+    values = {canonical: _in_range(name, canonical, _number(cells, name, specs[name]))
+              for name, (canonical, _) in OUTCOME.items() if name in specs}
+    carry_x, carry_y = _carry(*(_number(cells, name, specs[name]) if name in specs else None
+                                for name in (CARRY_LENGTH, CARRY_SIDE)))
+    values["carry_x_m"] = _in_range(CARRY_SIDE, "carry_x_m", carry_x)
+    values["carry_y_m"] = _in_range(CARRY_LENGTH, "carry_y_m", carry_y)
+    return values
+
+
+def _when(text: str) -> tuple[str, str]:
+    """(timestamp, session) from a Date cell: ISO time and its day, or the raw text and its first word."""
+    for fmt in DATE_FORMATS:
+        try:
+            moment = datetime.strptime(text, fmt)
+        except ValueError:
+            continue
+        return moment.isoformat(), moment.date().isoformat()
+    return text, text.split()[0] if text.split() else ""
+
+
+def load_trackman(path: str | os.PathLike, *, min_tracked_fraction: float | None = 0.9,
+                  balls: Collection[str] | None = None, session: str | None = None) -> Conversion:
+    """Convert a TrackMan CSV export to canonical records.
+
+    min_tracked_fraction: keep a shot only if the radar tracked it for at least this fraction of its flight
+    ("Last data Point - Time" >= fraction x "Carry Flat - Time"): the rest were indoor shots whose outcome is
+    TrackMan's model. None keeps every flight. balls: keep only these "Ball" types (None keeps all).
+    session: the session id when the file has no "Date" column (default: the file name without extension).
+    shot_id is the line number of the shot in the export. A shot whose "Carry Flat - Time" is blank or 0 has no
+    recorded flight: its outcome columns stay blank (and the tracked-fraction filter drops it).
+    """
+    path = Path(path)
+    header, units, rows = _read_table(path)
+    wanted = {name: accepted for name, (_, accepted) in {**LAUNCH, **OUTCOME}.items()}
+    wanted.update({CARRY_LENGTH: LENGTH, CARRY_SIDE: LENGTH, LAST_POINT_TIME: TIME})
+    required = set(LAUNCH) | ({LAST_POINT_TIME, CARRY_TIME} if min_tracked_fraction is not None else set())
+    specs = _column_factors(path, header, units, wanted, required)
+    if balls is not None and "Ball" not in header:
+        raise RecordError(f"{path}: column 'Ball' is missing, so the ball-type filter {sorted(balls)} cannot apply")
+    keep_balls = None if balls is None else {b.strip().lower() for b in balls}
+    text = {name: header.index(name) for name in ("Club", "Ball", "Date") if name in header}
+
+    def cell(cells: list[str], name: str) -> str:
+        return cells[text[name]].strip() if name in text and text[name] < len(cells) else ""
+
+    report = ConversionReport(str(path), rows_in=len(rows))
+    records = []
+    for line, cells in rows:
+        ball = cell(cells, "Ball")
+        if keep_balls is not None and ball.lower() not in keep_balls:
+            report.drop(f"ball type {ball or '(blank)'!r} not in {sorted(balls)}", line)
+            continue
+        try:
+            flight = _number(cells, CARRY_TIME, specs[CARRY_TIME]) if CARRY_TIME in specs else None
+            if min_tracked_fraction is not None:
+                tracked = _number(cells, LAST_POINT_TIME, specs[LAST_POINT_TIME])
+                if tracked is None or not flight:
+                    report.drop(f"no flight recorded: '{LAST_POINT_TIME}' or '{CARRY_TIME}' blank or 0", line)
+                    continue
+                if tracked < min_tracked_fraction * flight:
+                    report.drop(f"not a measured flight: '{LAST_POINT_TIME}' < {min_tracked_fraction:g} x "
+                                f"'{CARRY_TIME}' (indoor, outcome modelled by TrackMan)", line)
+                    continue
+            values = {}
+            for name, (canonical, _) in LAUNCH.items():
+                value = _number(cells, name, specs[name])
+                if value is None:
+                    raise _BadRow(f"'{name}' is blank")
+                values[canonical] = _in_range(name, canonical, value)
+            if flight:
+                values.update(_outcome(cells, specs))
+        except _BadRow as bad:
+            report.drop(str(bad), line)
+            continue
+        timestamp, day = _when(cell(cells, "Date")) if cell(cells, "Date") else (None, None)
+        records.append(ShotRecord(shot_id=str(line), session=day or session or path.stem, timestamp=timestamp,
+                                  club=cell(cells, "Club") or None, **values))
+    report.kept = len(records)
+    if keep_balls is None and "Ball" in text:
+        kinds = sorted({cell(c, "Ball") for _, c in rows} - {""})
+        report.notes.append(f"no ball-type filter; ball types in the file: {kinds}")
+    if min_tracked_fraction is None:
+        report.notes.append("all flights kept, including indoor shots whose outcome is TrackMan's model")
+    return Conversion(records, report)
