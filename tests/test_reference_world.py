@@ -1,0 +1,182 @@
+"""The reference world: Reynolds-dependent coefficients, spin decay, step convergence and the PGA 2023 calibration."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from service.air import Air
+from service.constants import BALL_RADIUS_M, MPH_TO_MPS, YARD_M
+from service.flight import simulate
+from service.physics import initial_state
+from shots.calibrate_reference import TRACKMAN_SPIN_LOSS_PCT, evaluate, render_markdown
+from shots.paths import shared_data_dir
+from shots.reference_world import (
+    CALIBRATED,
+    CALIBRATION_AIR,
+    REFERENCE_DT_S,
+    REFERENCE_T_MAX_S,
+    ClubAverage,
+    ReferenceAerodynamics,
+    default_tour_averages_path,
+    fly_reference,
+    read_tour_averages,
+)
+
+NU = float(CALIBRATION_AIR.kinematic_viscosity_m2_s)
+LIFT, DRAG, MOMENT, Q = range(4)
+
+# Launches in the spirit of the tour bag (driver, 5-iron, 8-iron, wedge), not the shared table's rows.
+SHOTS = {
+    "driver": (76.0, 10.5, 2600.0),
+    "5-iron": (60.0, 12.0, 5300.0),
+    "8-iron": (52.5, 18.0, 8000.0),
+    "wedge": (45.0, 25.0, 9500.0),
+}
+
+
+def coefficients(spin_ratio, reynolds, params=CALIBRATED) -> np.ndarray:
+    s, re = np.broadcast_arrays(np.atleast_1d(np.asarray(spin_ratio, float)), np.asarray(reynolds, float))
+    return ReferenceAerodynamics(params, NU).coefficients(s, re)
+
+
+def launch(*rows: tuple[float, float, float]):
+    speed, angle, spin = (np.array(column, dtype=float) for column in zip(*rows))
+    zeros = np.zeros(len(rows))
+    return initial_state(speed, angle, zeros, spin, zeros)
+
+
+def test_drag_crisis_raises_drag_below_critical_reynolds():
+    for s in (0.0, 0.1, 0.3):
+        low, high = coefficients(s, 5.0e4)[0, DRAG], coefficients(s, 1.2e5)[0, DRAG]
+        assert low > high + 0.15
+    assert coefficients(0.0, 5.0e4)[0, DRAG] == pytest.approx(0.5, abs=0.03)
+    assert coefficients(0.0, 1.0e5)[0, DRAG] < 0.22
+
+
+def test_lift_collapses_at_low_reynolds():
+    s = np.array([0.1, 0.2, 0.3])
+    assert np.all(coefficients(s, 5.0e4)[:, LIFT] < 0.4 * coefficients(s, 1.2e5)[:, LIFT])
+
+
+def test_lift_grows_with_spin_ratio_and_stays_non_negative():
+    s = np.linspace(0.0, 3.0, 301)
+    lift = coefficients(s, 1.5e5)[:, LIFT]
+    assert np.all(np.diff(lift) > 0)
+    grid_s, grid_re = np.meshgrid(np.linspace(0, 10, 101), np.geomspace(1e3, 5e5, 101))
+    c = coefficients(grid_s.ravel(), grid_re.ravel())
+    assert np.all(np.isfinite(c))
+    assert np.all(c[:, LIFT] >= 0) and np.all(c[:, DRAG] > 0) and np.all(c[:, MOMENT] >= 0)
+    assert np.all(c[:, Q] == 0.5)
+
+
+def test_coefficients_are_smooth_in_reynolds_and_spin_ratio():
+    re = np.linspace(2e4, 3e5, 20001)
+    for s in (0.05, 0.3, 1.0):
+        c = coefficients(s, re)
+        assert np.max(np.abs(np.diff(c[:, :3], axis=0))) < 1e-3
+    c = coefficients(np.linspace(0, 3, 30001), 7.5e4)
+    assert np.max(np.abs(np.diff(c[:, :3], axis=0))) < 1e-3
+
+
+def test_knobs_scale_the_coefficients():
+    s, re = np.array([0.05, 0.2, 0.6]), np.array([6e4, 1e5, 2e5])
+    base = coefficients(s, re)
+    knobs = dataclasses.replace(CALIBRATED, drag_scale=1.2, lift_scale=0.7, spin_decay_scale=1.5)
+    scaled = coefficients(s, re, knobs)
+    np.testing.assert_allclose(scaled[:, LIFT], 0.7 * base[:, LIFT])
+    np.testing.assert_allclose(scaled[:, DRAG], 1.2 * base[:, DRAG])
+    np.testing.assert_allclose(scaled[:, MOMENT], 1.5 * base[:, MOMENT])
+    np.testing.assert_allclose(scaled[:, Q], base[:, Q])
+
+
+def test_reynolds_number_uses_the_air_viscosity():
+    v = np.array([[0.0, 30.0, 0.0]])
+    w = np.array([[300.0, 0.0, 0.0]])
+    thin = ReferenceAerodynamics(CALIBRATED, 1.3 * NU)(v, w)
+    sea = ReferenceAerodynamics(CALIBRATED, NU)(v, w)
+    expected = coefficients(BALL_RADIUS_M * 300.0 / 30.0, 30.0 * 2 * BALL_RADIUS_M / (1.3 * NU))
+    np.testing.assert_allclose(thin, expected)
+    assert thin[0, DRAG] > sea[0, DRAG]
+
+
+def test_spin_decays_monotonically():
+    flight = fly_reference(launch(*SHOTS.values()), CALIBRATION_AIR, keep_states=True)
+    spin = np.stack([np.linalg.norm(s.spin, axis=-1) for s in flight.states])
+    assert np.all(np.diff(spin, axis=0) < 0)
+
+
+def test_spin_loss_matches_trackman_within_two_points():
+    """TrackMan's Pro V1x losses at 1/3/5 s, flown with the tour-like launches: each within 2 percentage points."""
+    flight = fly_reference(launch(SHOTS["driver"], SHOTS["5-iron"], SHOTS["8-iron"]), CALIBRATION_AIR, keep_states=True)
+    spin = np.stack([np.linalg.norm(s.spin, axis=-1) for s in flight.states])
+    index = [int(round(t / REFERENCE_DT_S)) for t in (1.0, 3.0, 5.0)]
+    loss = 100.0 * (1.0 - spin[index].T / spin[0][:, None])
+    target = np.array([TRACKMAN_SPIN_LOSS_PCT[name] for name in ("Driver", "5-iron", "8-iron")])
+    assert np.max(np.abs(loss - target)) < 2.0
+    assert np.mean(np.abs(loss - target)) < 0.7
+
+
+def test_thinner_air_carries_farther_and_flies_lower():
+    shots = launch(*SHOTS.values())
+    sea = fly_reference(shots, Air.from_conditions(25.0, 0.0, 50.0))
+    high = fly_reference(shots, Air.from_conditions(25.0, 1500.0, 50.0))
+    assert np.all(high.carry_m > sea.carry_m * 1.03)
+    assert np.all(high.landing_angle_deg < sea.landing_angle_deg)
+
+
+def test_per_shot_air_matches_shot_by_shot():
+    rows = [SHOTS["driver"], SHOTS["wedge"]]
+    air = Air.from_conditions(np.array([5.0, 35.0]), np.array([0.0, 2500.0]), np.array([20.0, 80.0]))
+    batch = fly_reference(launch(*rows), air)
+    for i, row in enumerate(rows):
+        single = fly_reference(launch(row), Air(air.density_kg_m3[i], air.kinematic_viscosity_m2_s[i]))
+        assert batch.carry_m[i] == pytest.approx(single.carry_m[0], abs=1e-9)
+
+
+def test_step_is_converged_to_a_centimetre():
+    extremes = [(85.0, 12.0, 2000.0), (35.0, 40.0, 11000.0), (22.0, 30.0, 3000.0), (80.0, 30.0, 9000.0)]
+    shots = launch(*SHOTS.values(), *extremes)
+    model = ReferenceAerodynamics(CALIBRATED, NU)
+    rho = CALIBRATION_AIR.density_kg_m3
+    coarse = simulate(shots, model, rho, dt=REFERENCE_DT_S, t_max=REFERENCE_T_MAX_S, method="rk4")
+    fine = simulate(shots, model, rho, dt=REFERENCE_DT_S / 4, t_max=REFERENCE_T_MAX_S, method="rk4")
+    assert np.all(coarse.landed)
+    assert np.max(np.linalg.norm(coarse.landing_position - fine.landing_position, axis=1)) < 0.01
+    assert np.max(np.abs(coarse.apex_m - fine.apex_m)) < 0.01
+
+
+def test_reader_converts_units(tmp_path):
+    path = tmp_path / "averages.csv"
+    header = ",".join(ClubAverage.model_fields)
+    path.write_text(header + "\nTest,100,-1,150,1.5,12,3000,30,40,250\n")
+    (club,) = read_tour_averages(path)
+    assert isinstance(club, ClubAverage) and club.club == "Test"
+    assert club.ball_speed_mps == pytest.approx(150 * MPH_TO_MPS)
+    assert club.carry_m == pytest.approx(250 * YARD_M)
+    assert club.max_height_m == pytest.approx(30 * YARD_M)
+    path.write_text(header + "\nTest,100,-1,fast,1.5,12,3000,30,40,250\n")
+    with pytest.raises(ValueError, match="line 2"):
+        read_tour_averages(path)
+
+
+def test_shared_data_dir_follows_the_environment(monkeypatch, tmp_path):
+    monkeypatch.setenv("GOLFFLIGHT_SHARED_DATA", str(tmp_path))
+    assert shared_data_dir() == tmp_path
+    assert default_tour_averages_path().is_relative_to(tmp_path)
+
+
+def test_calibrated_world_meets_the_pga_2023_targets():
+    path = default_tour_averages_path()
+    if not path.exists():
+        pytest.skip(f"shared data not found at {path}")
+    clubs = read_tour_averages(path)
+    assert len(clubs) == 12
+    result = evaluate(clubs)
+    carry, height, land = result.mean_absolute_error()
+    assert carry <= 3.0 and height <= 2.0 and land <= 2.0
+    for name, target in TRACKMAN_SPIN_LOSS_PCT.items():
+        assert np.max(np.abs(result.spin_loss_pct[name] - np.array(target))) < 2.0
+    assert "**MAE**" in render_markdown(result, CALIBRATED)
