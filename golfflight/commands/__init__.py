@@ -1,5 +1,5 @@
 """Subcommands of the `golfflight` command; each module has `register(subparsers)` and sets `run`."""
 
-from golfflight.commands import calibrate, convert, fly, synth
+from golfflight.commands import calibrate, convert, export, fly, synth, train
 
-COMMANDS = [fly, synth, convert, calibrate]
+COMMANDS = [fly, synth, convert, calibrate, train, export]
