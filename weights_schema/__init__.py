@@ -1,0 +1,9 @@
+"""The model bundle contract (model.onnx + model_card.json): the card's pydantic schema and the bundle loader.
+
+Pure pydantic + hashlib: the serving install imports this without torch.
+"""
+
+from weights_schema.bundle import BundleError, load_bundle
+from weights_schema.model_card import SCHEMA_VERSION, ModelCard
+
+__all__ = ["BundleError", "ModelCard", "SCHEMA_VERSION", "load_bundle"]

@@ -1,0 +1,171 @@
+"""model_card.json: everything a third party needs to re-run a shipped model without reading our code.
+
+The JSON Schema beside this file (model_card.schema.json) is generated from these models by
+`python -m weights_schema`; a test fails when the committed copy is stale.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+SCHEMA_VERSION = "1.0"
+SUPPORTED_SCHEMA_VERSIONS = ("1.0",)
+SCHEMA_PATH = Path(__file__).with_name("model_card.schema.json")
+
+ExportableVariant = Literal["phys-nn", "phys-nn-pm", "phys-nn-pm-cq", "phys-nn+", "phys-q"]
+Sha256 = Annotated[str, Field(pattern=r"^[0-9a-f]{64}$", description="SHA-256, lower-case hex")]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class TensorSpec(_Strict):
+    """One input or output of the ONNX graph."""
+
+    name: str
+    dtype: Literal["float32"]
+    shape: list[int | Literal["N"]] = Field(description="'N' is the dynamic batch dimension")
+    unit: str
+    description: str
+
+
+class OnnxGraph(_Strict):
+    """The coefficient model as an ONNX graph: (v_rel, omega) -> (C_L, C_D, C_M, C_Q) for a batch of balls."""
+
+    file: str
+    sha256: Sha256
+    opset: int = Field(ge=7)
+    inputs: list[TensorSpec] = Field(min_length=2, max_length=2)
+    outputs: list[TensorSpec] = Field(min_length=1, max_length=1)
+    output_columns: list[str]
+    contents: str = Field(description="what the graph computes, so nothing outside it is needed")
+
+
+class Architecture(_Strict):
+    """How the coefficients are computed inside the graph."""
+
+    kind: Literal["mlp", "quadratic-in-spin-ratio"]
+    input_normalisation: str | None
+    hidden_units: list[int]
+    activation: Literal["relu"] | None
+    heads: list[str] = Field(description="raw network outputs in order, before their output transforms")
+    coefficient_equations: list[str]
+    p_m: Positive | None = Field(description="learned C_M = p_M S factor (pM variants)")
+    quadratic_params: list[float] | None = Field(description="Phys-Q p0..p6 as in the equations")
+
+
+class Physics(_Strict):
+    """Constants, conventions and equations of the simulation the model was trained inside."""
+
+    ball_mass_kg: Positive
+    ball_radius_m: Positive
+    ball_area_m2: Positive
+    ball_inertia_kg_m2: Positive
+    gravity_mps2: Positive
+    tee_height_m: NonNegative
+    air_density_kg_m3: Positive = Field(description="reference air density the model was trained at")
+    density_note: str
+    integrator: Literal["forward-euler"]
+    dt_s: Positive
+    t_sim_s: Positive
+    landing_search_start_s: NonNegative
+    axes: str
+    launch_state: str
+    equations: list[str]
+    landing: str
+
+
+class TrainingData(_Strict):
+    """The data the model was trained and validated on."""
+
+    file: str
+    sha256: Sha256
+    n_rows: int = Field(ge=0)
+    n_train: int = Field(ge=1)
+    n_val: int = Field(ge=1)
+    n_landing_targets: int = Field(ge=0)
+    n_apex_targets: int = Field(ge=0)
+    density_min_kg_m3: Positive
+    density_max_kg_m3: Positive
+    n_with_wind: int = Field(ge=0, description="shots with recorded wind, trained as calm air")
+    min_apex_m: NonNegative
+    filters: dict[str, int] = Field(description="shots left out, by reason, in the order applied")
+    split: str
+
+
+class TrainingSettings(_Strict):
+    """How the model was trained."""
+
+    optimizer: Literal["adam"]
+    learning_rate: Positive
+    batch_size: int = Field(ge=1)
+    epochs: int = Field(ge=1)
+    best_epoch: int = Field(ge=1)
+    loss: Literal["lp", "lp+lh"]
+    loss_description: str
+    seed: int
+    grad_clip_norm: Positive
+    soft_argmax_temperature_m: Positive
+    limit: int | None
+
+
+class Validation(_Strict):
+    """Validation metrics of the exported checkpoint (mean over the val split, inference landing)."""
+
+    n_shots: int = Field(ge=1)
+    landing_error_m: NonNegative
+    landing_error_yd: NonNegative
+    max_height_error_m: NonNegative | None
+    max_height_error_yd: NonNegative | None
+
+
+class ExportCheck(_Strict):
+    """ONNX Runtime against the training framework on a probe batch, checked at export."""
+
+    probe_points: int = Field(ge=1)
+    max_abs_coefficient_difference: NonNegative
+
+
+class Producer(_Strict):
+    """Software that produced the bundle."""
+
+    golfflight: str
+    python: str
+    torch: str
+    onnx: str
+    onnxruntime: str
+    numpy: str
+    created_utc: str
+
+
+class ModelCard(_Strict):
+    """model_card.json of a model bundle."""
+
+    schema_version: Literal["1.0"]
+    variant: ExportableVariant
+    architecture: Architecture
+    onnx: OnnxGraph
+    physics: Physics
+    training_data: TrainingData
+    training: TrainingSettings
+    validation: Validation
+    export_check: ExportCheck
+    producer: Producer
+
+
+def schema_text() -> str:
+    """The JSON Schema of `ModelCard`, formatted as committed."""
+    return json.dumps(ModelCard.model_json_schema(), indent=2, sort_keys=True) + "\n"
+
+
+def write_schema(path: Path = SCHEMA_PATH) -> Path:
+    """Regenerate the committed JSON Schema file."""
+    path.write_text(schema_text())
+    return path
