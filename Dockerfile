@@ -1,4 +1,6 @@
-# Serving image: the runtime install only (no torch), run as a non-root user.
+# Serving image: the runtime install only (no torch), the default model inside, run as a non-root user.
+# No Docker engine runs on the project's machines: CI runs these install steps in a clean virtual environment
+# instead (.ci/serving-install).
 FROM python:3.11-slim
 ENV PYTHONDONTWRITEBYTECODE=1 PYTHONUNBUFFERED=1
 WORKDIR /app
@@ -6,7 +8,14 @@ COPY pyproject.toml README.md ./
 COPY golfflight ./golfflight
 COPY service ./service
 COPY shots ./shots
-RUN pip install --no-cache-dir . && useradd --create-home --uid 10001 golfflight
+COPY weights_schema ./weights_schema
+COPY models/default ./models/default
+# `pip install .` puts the bundle in /usr/local/share/golfflight/models/default (pyproject data-files)
+RUN pip install --no-cache-dir . && rm -rf /app/* && useradd --create-home --uid 10001 golfflight
 USER golfflight
+WORKDIR /home/golfflight
+EXPOSE 8000
+HEALTHCHECK --interval=15s --timeout=3s --start-period=10s --retries=3 \
+    CMD ["python", "-c", "import urllib.request, sys; sys.exit(urllib.request.urlopen('http://127.0.0.1:8000/healthz', timeout=2).status != 200)"]
 ENTRYPOINT ["golfflight"]
-CMD ["fly", "--club", "Driver"]
+CMD ["serve", "--host", "0.0.0.0", "--port", "8000"]

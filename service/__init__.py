@@ -1,1 +1,1 @@
-"""Runtime flight engine: NumPy physics, air and wind, the integrator (and, later, the HTTP service)."""
+"""The runtime: NumPy physics, air and wind, integrators, the ONNX flight engine and the HTTP service (`service.api`)."""

@@ -34,3 +34,6 @@ PRESSURE_HPA = Range(500.0, 1100.0, "hPa")
 HUMIDITY_PCT = Range(0.0, 100.0, "%")
 WIND_SPEED_MPS = Range(0.0, 30.0, "m/s")
 WIND_FROM_DEG = Range(0.0, 360.0, "deg")
+
+AIR_DENSITY_KG_M3 = Range(0.5, 1.6, "kg/m^3")
+WIND_REFERENCE_HEIGHT_M = Range(0.5, 100.0, "m")

@@ -8,6 +8,10 @@ Aerodynamic coefficients come from a pluggable model (v_rel, omega) -> [N,4] = C
   F_D   = -C_D q A v_rel/|v_rel|
   F_L   =  C_L q A (omega x v_rel)/|omega x v_rel|   (erratum: the paper's v x omega points down)
   dw/dt = -C_M q d A omega/|omega| / I               (erratum: spin only ever decays)
+
+The equations are written once, component by component (`accelerations`, `euler_step`), with nothing but
++ - * / and ** 0.5, so the same code runs on plain Python floats (one shot, where NumPy's per-call cost would
+dominate) and on NumPy [N] arrays (a batch). The [N,3] functions below (`aerodynamics`, `derivatives`) wrap them.
 """
 
 from __future__ import annotations
@@ -60,7 +64,9 @@ def initial_state(
     phi = np.radians(launch_direction_deg)
     psi = np.radians(spin_axis_deg)
     spin = np.asarray(spin_rpm, dtype=float) * RPM_TO_RADPS
-    velocity = np.stack([speed * np.cos(gamma) * np.sin(phi), speed * np.cos(gamma) * np.cos(phi), speed * np.sin(gamma)], -1)
+    velocity = np.stack(
+        [speed * np.cos(gamma) * np.sin(phi), speed * np.cos(gamma) * np.cos(phi), speed * np.sin(gamma)], -1
+    )
     omega = np.stack([spin * np.cos(psi), np.zeros_like(spin), -spin * np.sin(psi)], -1)
     position = np.zeros_like(velocity)
     position[:, 2] = TEE_HEIGHT_M
@@ -72,18 +78,50 @@ def spin_ratio(v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
     return BALL_RADIUS_M * np.linalg.norm(omega, axis=-1) / np.maximum(np.linalg.norm(v_rel, axis=-1), TINY)
 
 
+def at_least_tiny(x):
+    """max(x, TINY) of a float or an array: the guard of every magnitude in a denominator."""
+    if isinstance(x, np.ndarray):
+        return np.maximum(x, TINY)
+    return max(x, TINY)
+
+
+def accelerations(vx, vy, vz, wx, wy, wz, c_lift, c_drag, c_moment, c_q, density):
+    """Aerodynamic acceleration (ax, ay, az) and spin acceleration (bx, by, bz) of balls with air-relative velocity
+    v and spin w, component by component. Every argument is a float, or all are broadcastable NumPy arrays."""
+    speed_sq = vx * vx + vy * vy + vz * vz
+    q_area = c_q * density * speed_sq * BALL_AREA_M2
+    mx, my, mz = wy * vz - wz * vy, wz * vx - wx * vz, wx * vy - wy * vx
+    lift = c_lift * q_area / (BALL_MASS_KG * at_least_tiny((mx * mx + my * my + mz * mz) ** 0.5))
+    drag = c_drag * q_area / (BALL_MASS_KG * at_least_tiny(speed_sq**0.5))
+    spin = at_least_tiny((wx * wx + wy * wy + wz * wz) ** 0.5)
+    decay = c_moment * q_area * 2.0 * BALL_RADIUS_M / (BALL_INERTIA_KG_M2 * spin)
+    return lift * mx - drag * vx, lift * my - drag * vy, lift * mz - drag * vz, -decay * wx, -decay * wy, -decay * wz
+
+
+def euler_step(x, y, z, vx, vy, vz, wx, wy, wz, coefficients, density, air_vx, air_vy, dt):
+    """One forward-Euler step (paper eq. 13) of position, velocity and spin, component by component.
+
+    `coefficients` = (C_L, C_D, C_M, C_Q) at the current state; (air_vx, air_vy) is the horizontal wind at the
+    ball. Floats for one ball or NumPy [N] arrays for a batch; returns the nine new components in the same order.
+    """
+    ax, ay, az, bx, by, bz = accelerations(vx - air_vx, vy - air_vy, vz, wx, wy, wz, *coefficients, density)
+    return (
+        x + dt * vx,
+        y + dt * vy,
+        z + dt * vz,
+        vx + dt * ax,
+        vy + dt * ay,
+        vz + dt * (az - GRAVITY_MPS2),
+        wx + dt * bx,
+        wy + dt * by,
+        wz + dt * bz,
+    )
+
+
 def aerodynamics(v_rel: np.ndarray, omega: np.ndarray, coefficients: np.ndarray, density: np.ndarray | float):
-    """Aerodynamic acceleration [N,3] (drag + Magnus lift) and spin acceleration [N,3] from the coefficients."""
-    c_lift, c_drag, c_moment, c_q = coefficients[:, 0], coefficients[:, 1], coefficients[:, 2], coefficients[:, 3]
-    speed = np.linalg.norm(v_rel, axis=-1)
-    q_area = c_q * density * speed**2 * BALL_AREA_M2
-    magnus = np.cross(omega, v_rel)
-    magnus_unit = magnus / np.maximum(np.linalg.norm(magnus, axis=-1), TINY)[:, None]
-    drag_unit = v_rel / np.maximum(speed, TINY)[:, None]
-    force = q_area[:, None] * (c_lift[:, None] * magnus_unit - c_drag[:, None] * drag_unit)
-    spin_unit = omega / np.maximum(np.linalg.norm(omega, axis=-1), TINY)[:, None]
-    torque = -(c_moment * q_area * 2.0 * BALL_RADIUS_M)[:, None] * spin_unit
-    return force / BALL_MASS_KG, torque / BALL_INERTIA_KG_M2
+    """Aerodynamic acceleration [N,3] (drag + Magnus lift) and spin acceleration [N,3] from the coefficients [N,4]."""
+    components = accelerations(*v_rel.T, *omega.T, *coefficients.T, density)
+    return np.stack(components[:3], -1), np.stack(components[3:], -1)
 
 
 def derivatives(

@@ -6,6 +6,7 @@ Direction convention (degrees, clockwise seen from behind the golfer looking at 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -26,10 +27,16 @@ def wind_vector(speed_mps: ArrayLike, from_deg: ArrayLike) -> np.ndarray:
     return np.stack([-speed * np.sin(theta), -speed * np.cos(theta), np.zeros_like(speed * theta)], axis=-1)
 
 
-def log_profile_factor(height_m: ArrayLike, reference_height_m: float, roughness_m: float) -> np.ndarray:
-    """V(h)/V(h_ref) of the logarithmic wind profile; zero at and below the roughness length."""
-    h = np.maximum(np.asarray(height_m, dtype=float), roughness_m)
-    return np.log(h / roughness_m) / np.log(reference_height_m / roughness_m)
+def log_profile_factor(height_m: ArrayLike, reference_height_m: ArrayLike, roughness_m: ArrayLike) -> np.ndarray | float:
+    """V(h)/V(h_ref) of the logarithmic wind profile; zero at and below the roughness length.
+
+    A float height gives a float through `math` (the one-shot engine calls this every step); anything else NumPy.
+    """
+    if isinstance(height_m, float):
+        h, log = max(height_m, roughness_m), math.log
+    else:
+        h, log = np.maximum(np.asarray(height_m, dtype=float), roughness_m), np.log
+    return log(h / roughness_m) / log(reference_height_m / roughness_m)
 
 
 @dataclass(frozen=True)

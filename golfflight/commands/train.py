@@ -38,6 +38,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--limit", type=int, help="use at most this many shots (quick runs)")
     parser.add_argument("--resume", action="store_true", help="continue from OUT/last.pt")
+    parser.add_argument("--threads", type=int, default=2, help="torch CPU threads (1 is faster on a busy machine)")
     parser.set_defaults(run=run)
 
 
@@ -46,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
 
     from model_export.training import TrainConfig, train
 
-    torch.set_num_threads(2)
+    torch.set_num_threads(args.threads)
     config = TrainConfig(
         variant=args.variant,
         hidden=args.hidden,

@@ -1,0 +1,157 @@
+"""`golfflight simulate`: fly shots through a model bundle from the command line, as POST /v1/shots/batch does.
+
+Input: JSON (one shot, a list of shots, or {"shots": [...]}, in the HTTP request format) or a CSV of launches
+(one row per shot, the request's launch fields as columns plus optional flat conditions: temperature_c,
+altitude_m, pressure_hpa, humidity_pct, density_kg_m3, wind_speed_mps, wind_from_deg, wind_profile,
+wind_reference_height_m, normalized). A canonical shot file works as is: its identity and outcome columns are
+passed over, its shot_id echoed. Output: {"results": [...]} as JSON, or a flat CSV when --out ends in .csv.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+from pathlib import Path
+
+AIR_COLUMNS = {name: name for name in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct", "density_kg_m3")}
+WIND_COLUMNS = {
+    "wind_speed_mps": "speed_mps",
+    "wind_from_deg": "from_deg",
+    "wind_profile": "profile",
+    "wind_reference_height_m": "reference_height_m",
+}
+LAUNCH_COLUMNS = (
+    "ball_speed_mps",
+    "ball_speed_mph",
+    "launch_angle_deg",
+    "launch_direction_deg",
+    "spin_rpm",
+    "spin_axis_deg",
+    "back_spin_rpm",
+    "side_spin_rpm",
+)
+PASSED_OVER = (
+    "session",
+    "club",
+    "timestamp",
+    "split",
+    "carry_x_m",
+    "carry_y_m",
+    "apex_m",
+    "flight_time_s",
+    "landing_angle_deg",
+)
+"""Canonical shot-record columns that say nothing about the launch or its conditions."""
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser("simulate", help="fly shots from a JSON or CSV file through the model (no server)")
+    parser.add_argument("input", help="JSON or CSV file of shots; - reads JSON from standard input")
+    parser.add_argument("--model", help="model bundle directory (default: the shipped models/default)")
+    parser.add_argument("--out", help="write here instead of standard output (.csv: a flat CSV, else JSON)")
+    parser.set_defaults(run=run)
+
+
+def _number_or_text(text: str):
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def shots_from_csv(path: Path) -> tuple[list[dict], list[str | None]]:
+    """Request dicts and shot ids (None where the file has none) of a launches CSV."""
+    with open(path, newline="") as handle:
+        reader = csv.DictReader(handle)
+        known = {"shot_id", "normalized", *LAUNCH_COLUMNS, *AIR_COLUMNS, *WIND_COLUMNS, *PASSED_OVER}
+        unknown = [c for c in reader.fieldnames or [] if c not in known]
+        if unknown:
+            raise ValueError(f"{path}: unknown columns {unknown}; launch columns are {', '.join(LAUNCH_COLUMNS)}")
+        shots, ids = [], []
+        for row in reader:
+            cells = {k: _number_or_text(v.strip()) for k, v in row.items() if v is not None and v.strip() != ""}
+            shot = {k: cells[k] for k in LAUNCH_COLUMNS if k in cells}
+            air = {AIR_COLUMNS[k]: cells[k] for k in AIR_COLUMNS if k in cells}
+            wind = {WIND_COLUMNS[k]: cells[k] for k in WIND_COLUMNS if k in cells}
+            if air:
+                shot["air"] = air
+            if wind:
+                shot["wind"] = wind
+            if "normalized" in cells:
+                shot["normalized"] = str(cells["normalized"]).lower() in ("1", "1.0", "true", "yes")
+            shots.append(shot)
+            ids.append(row.get("shot_id"))
+    return shots, ids
+
+
+def shots_from_json(text: str, source: str) -> list[dict]:
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise ValueError(f"{source}: not valid JSON ({error})") from None
+    if isinstance(data, dict) and "shots" in data:
+        data = data["shots"]
+    return data if isinstance(data, list) else [data]
+
+
+def flat_row(result: dict) -> dict:
+    """One CSV row of a result: the flight's numbers, then normalized_* ones, or the error."""
+    row = {}
+    for prefix, flight in (("", result), ("normalized_", result.get("normalized"))):
+        if not flight:
+            continue
+        for key, value in flight.items():
+            if key == "landing":
+                row[f"{prefix}landing_x_m"], row[f"{prefix}landing_y_m"] = value["x_m"], value["y_m"]
+            elif key not in ("trajectory", "normalized", "conditions"):
+                row[prefix + key] = value
+    return row
+
+
+def run(args: argparse.Namespace) -> int:
+    from pydantic import TypeAdapter, ValidationError
+
+    from service.api.models import ShotRequest, describe_errors
+    from service.api.shots import fly_shots
+    from service.engine import FlightEngine
+    from service.model_location import model_dir
+
+    ids: list[str | None] = []
+    if args.input == "-":
+        raw = shots_from_json(sys.stdin.read(), "standard input")
+    else:
+        path = Path(args.input)
+        if not path.is_file():
+            raise FileNotFoundError(f"no such file: {path}")
+        if path.suffix.lower() == ".csv":
+            raw, ids = shots_from_csv(path)
+        else:
+            raw = shots_from_json(path.read_text(), str(path))
+    try:
+        shots = TypeAdapter(list[ShotRequest]).validate_python(raw)
+    except ValidationError as error:
+        problems = "; ".join(f"shot {d['message']}" for d in describe_errors(error.errors())[:10])
+        raise ValueError(f"{args.input}: {error.error_count()} invalid values: {problems}") from None
+    engine = FlightEngine(model_dir(args.model))
+    results = [r.model_dump(exclude_none=True) for r in fly_shots(engine, shots)]
+    if args.out and args.out.lower().endswith(".csv"):
+        rows = [
+            {**({"shot_id": i} if i is not None else {}), **flat_row(r)}
+            for i, r in zip(ids or [None] * len(results), results)
+        ]
+        columns = list(dict.fromkeys(key for row in rows for key in row))
+        with open(args.out, "w", newline="") as handle:
+            writer = csv.DictWriter(handle, columns)
+            writer.writeheader()
+            writer.writerows(rows)
+        return 0
+    if ids:
+        results = [{"shot_id": i, **r} for i, r in zip(ids, results)]
+    text = json.dumps({"results": results}, indent=2)
+    if args.out:
+        Path(args.out).write_text(text + "\n")
+    else:
+        print(text)
+    return 0

@@ -1,0 +1,239 @@
+"""The HTTP contract: pydantic request and response models (SI inside, imperial only in fields named for it).
+
+Every number is range-checked against `service.limits` (NaN and infinity refused), unknown fields are refused,
+and each launch quantity comes in exactly one form: ball_speed_mps or ball_speed_mph; spin_rpm (+ spin_axis_deg)
+or back_spin_rpm (+ side_spin_rpm).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from service import limits
+from service.conditions import NORMALIZED_REFERENCE
+from service.constants import MPH_TO_MPS
+from service.limits import Range
+from service.trajectory import MAX_RATE_HZ
+
+MAX_BATCH_SHOTS = 10_000
+"""Most shots one POST /v1/shots/batch may carry."""
+
+BALL_SPEED_MPH = Range(limits.BALL_SPEED_MPS.low / MPH_TO_MPS, limits.BALL_SPEED_MPS.high / MPH_TO_MPS, "mph")
+SIDE_SPIN_RPM = Range(-limits.SPIN_RPM.high, limits.SPIN_RPM.high, "rpm")
+
+RANGES: dict[str, Range] = {
+    "ball_speed_mps": limits.BALL_SPEED_MPS,
+    "ball_speed_mph": BALL_SPEED_MPH,
+    "launch_angle_deg": limits.LAUNCH_ANGLE_DEG,
+    "launch_direction_deg": limits.LAUNCH_DIRECTION_DEG,
+    "spin_rpm": limits.SPIN_RPM,
+    "spin_axis_deg": limits.SPIN_AXIS_DEG,
+    "back_spin_rpm": limits.SPIN_RPM,
+    "side_spin_rpm": SIDE_SPIN_RPM,
+    "temperature_c": limits.TEMPERATURE_C,
+    "altitude_m": limits.ALTITUDE_M,
+    "pressure_hpa": limits.PRESSURE_HPA,
+    "humidity_pct": limits.HUMIDITY_PCT,
+    "density_kg_m3": limits.AIR_DENSITY_KG_M3,
+    "speed_mps": limits.WIND_SPEED_MPS,
+    "from_deg": limits.WIND_FROM_DEG,
+    "reference_height_m": limits.WIND_REFERENCE_HEIGHT_M,
+}
+"""Allowed range of every numeric request field, by name (also quoted in 422 answers)."""
+
+
+def _in(name: str, description: str, optional: bool = False):
+    """A float field bounded by RANGES[name], its range quoted in the OpenAPI description."""
+    bounds = RANGES[name]
+    return Annotated[
+        float | None if optional else float,
+        Field(ge=bounds.low, le=bounds.high, description=f"{description} ({bounds.describe()})"),
+    ]
+
+
+class Strict(BaseModel):
+    """Refuses unknown fields and non-finite numbers."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
+def _exactly_one(model: BaseModel, quantity: str, *names: str) -> None:
+    given = [name for name in names if getattr(model, name) is not None]
+    if len(given) != 1:
+        found = ", ".join(given) if given else "none"
+        raise ValueError(f"{quantity}: give exactly one of {' or '.join(names)} (got {found})")
+
+
+class AirRequest(Strict):
+    """The air: weather values (altitude or station pressure) or an explicit density; omitted = ICAO standard."""
+
+    temperature_c: _in("temperature_c", "air temperature", True) = None
+    altitude_m: _in("altitude_m", "height above sea level, standard atmosphere", True) = None
+    pressure_hpa: _in("pressure_hpa", "station pressure (not reduced to sea level)", True) = None
+    humidity_pct: _in("humidity_pct", "relative humidity", True) = None
+    density_kg_m3: _in("density_kg_m3", "air density, instead of the weather values", True) = None
+
+    @model_validator(mode="after")
+    def _one_source(self) -> AirRequest:
+        if self.altitude_m is not None and self.pressure_hpa is not None:
+            raise ValueError("air: give altitude_m or pressure_hpa, not both")
+        weather = [
+            n for n in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct") if getattr(self, n) is not None
+        ]
+        if self.density_kg_m3 is not None and weather:
+            raise ValueError(f"air: density_kg_m3 replaces the weather values; drop {', '.join(weather)}")
+        return self
+
+
+class ReferenceAir(Strict):
+    """Reference air of the normalized flight (calm); omitted fields take TrackMan's 25 degC, sea level."""
+
+    temperature_c: _in("temperature_c", "air temperature") = NORMALIZED_REFERENCE.air.temperature_c
+    altitude_m: _in("altitude_m", "height above sea level", True) = None
+    pressure_hpa: _in("pressure_hpa", "station pressure", True) = None
+    humidity_pct: _in("humidity_pct", "relative humidity") = NORMALIZED_REFERENCE.air.humidity_pct
+
+    @model_validator(mode="after")
+    def _one_source(self) -> ReferenceAir:
+        if self.altitude_m is not None and self.pressure_hpa is not None:
+            raise ValueError("normalized: give altitude_m or pressure_hpa, not both")
+        return self
+
+
+class WindRequest(Strict):
+    """A steady wind, by the direction it blows FROM: 0 = headwind, 90 = from the right, 180 = tailwind."""
+
+    speed_mps: _in("speed_mps", "wind speed at the reference height")
+    from_deg: _in("from_deg", "direction the wind blows from, clockwise seen from behind the golfer") = 0.0
+    profile: Literal["uniform", "log"] = Field(
+        "uniform", description="uniform: the same at every height; log: V(h) = V_ref ln(h/z0)/ln(h_ref/z0), z0 = 2 cm"
+    )
+    reference_height_m: _in("reference_height_m", "height the speed is measured at (log profile)") = 10.0
+
+
+class TrajectoryRequest(Strict):
+    """{} for the integrator's states, {"rate_hz": 60} for positions resampled at that rate."""
+
+    rate_hz: float | None = Field(None, gt=0, le=MAX_RATE_HZ, description=f"resampling rate (up to {MAX_RATE_HZ:g} Hz)")
+
+
+class ShotRequest(Strict):
+    """One launch, its conditions, and what to return besides the flight."""
+
+    ball_speed_mps: _in("ball_speed_mps", "ball speed", True) = None
+    ball_speed_mph: _in("ball_speed_mph", "ball speed", True) = None
+    launch_angle_deg: _in("launch_angle_deg", "vertical launch angle, + = up")
+    launch_direction_deg: _in("launch_direction_deg", "horizontal launch angle, + = right") = 0.0
+    spin_rpm: _in("spin_rpm", "total spin", True) = None
+    spin_axis_deg: _in("spin_axis_deg", "spin axis tilt, + = right: the ball curves right; with spin_rpm", True) = None
+    back_spin_rpm: _in("back_spin_rpm", "back spin, instead of spin_rpm", True) = None
+    side_spin_rpm: _in("side_spin_rpm", "side spin, + = curves right; with back_spin_rpm", True) = None
+    wind: WindRequest | None = None
+    air: AirRequest | None = None
+    normalized: bool | ReferenceAir = Field(
+        False, description="true (or reference air): also return the flight in calm reference air (TrackMan's)"
+    )
+    trajectory: TrajectoryRequest | None = None
+
+    @model_validator(mode="after")
+    def _one_form_each(self) -> ShotRequest:
+        _exactly_one(self, "ball speed", "ball_speed_mps", "ball_speed_mph")
+        _exactly_one(self, "spin", "spin_rpm", "back_spin_rpm")
+        if self.spin_rpm is not None and self.side_spin_rpm is not None:
+            raise ValueError("spin: side_spin_rpm goes with back_spin_rpm; with spin_rpm give spin_axis_deg")
+        if self.back_spin_rpm is not None and self.spin_axis_deg is not None:
+            raise ValueError("spin: spin_axis_deg goes with spin_rpm; with back_spin_rpm give side_spin_rpm")
+        if self.back_spin_rpm is not None:
+            total = (self.back_spin_rpm**2 + (self.side_spin_rpm or 0.0) ** 2) ** 0.5
+            if total > limits.SPIN_RPM.high:
+                raise ValueError(f"spin: back and side spin make {total:.0f} rpm, over {limits.SPIN_RPM.describe()}")
+        return self
+
+
+class BatchRequest(Strict):
+    """Many shots, flown together; results come back in the same order."""
+
+    shots: list[ShotRequest] = Field(min_length=1, max_length=MAX_BATCH_SHOTS)
+
+
+class Landing(BaseModel):
+    """Where the ball comes down, at the launch elevation."""
+
+    x_m: float = Field(description="right (+) of the target line")
+    y_m: float = Field(description="down the target line")
+
+
+class TrajectoryPoint(BaseModel):
+    t_s: float
+    x_m: float
+    y_m: float
+    z_m: float
+
+
+class FlightResult(BaseModel):
+    """One flight to its landing at the launch elevation ("flat"), metres with yards alongside."""
+
+    landing: Landing
+    carry_m: float = Field(description="horizontal distance from the tee to the landing point")
+    carry_yd: float
+    lateral_m: float = Field(description="landing point right (+) or left (-) of the target line")
+    apex_m: float = Field(description="greatest height")
+    apex_yd: float
+    apex_time_s: float
+    flight_time_s: float
+    landing_angle_deg: float = Field(description="descent angle below the horizontal")
+    landing_speed_mps: float
+    landing_spin_rpm: float
+    trajectory: list[TrajectoryPoint] | None = Field(None, description="only when asked for")
+
+
+class NormalizedFlight(FlightResult):
+    """The same launch flown in calm reference air."""
+
+    conditions: ReferenceAir
+
+
+class ShotResult(FlightResult):
+    """The flight in the conditions given, and in reference conditions when asked for."""
+
+    normalized: NormalizedFlight | None = None
+
+
+class ShotFailure(BaseModel):
+    """A batch shot the engine could not fly (the rest of the batch is unaffected)."""
+
+    error: str
+
+
+class BatchResult(BaseModel):
+    results: list[ShotResult | ShotFailure]
+
+
+def _plain(value):
+    """A request value as JSON can carry it (NaN and infinity as text)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    return value if isinstance(value, (str, int, float, bool)) or value is None else None
+
+
+def describe_errors(errors) -> list[dict]:
+    """422 details naming the field, the value and the allowed range."""
+    details = []
+    for error in errors:
+        path = [str(p) for p in error["loc"] if p != "body"]
+        field = ".".join(path) or "body"
+        message = error["msg"].removeprefix("Value error, ")
+        entry: dict = {"field": field, "message": message}
+        value = _plain(error.get("input")) if error["type"] != "missing" else None
+        if value is not None:
+            entry["value"] = value
+            message += f" (got {value!r})"
+        if path and path[-1] in RANGES and error["type"] not in ("missing", "extra_forbidden"):
+            entry["allowed"] = RANGES[path[-1]].describe()
+            message += f"; allowed {entry['allowed']}"
+        entry["message"] = f"{field}: {message}"
+        details.append(entry)
+    return details

@@ -1,0 +1,135 @@
+"""Plain functions between the contract and the engine: requests in, results out (shared by HTTP and the CLI)."""
+
+from __future__ import annotations
+
+import math
+
+from service.api.models import (
+    AirRequest,
+    Landing,
+    NormalizedFlight,
+    ReferenceAir,
+    ShotFailure,
+    ShotRequest,
+    ShotResult,
+    TrajectoryPoint,
+    TrajectoryRequest,
+    WindRequest,
+)
+from service.conditions import STANDARD, AirConditions, Conditions
+from service.constants import MPH_TO_MPS, YARD_M
+from service.engine import FlightEngine, FlightError, Launch, ShotFlight
+from service.trajectory import resample
+from service.wind import CALM, Wind
+
+
+def spin_from_components(back_spin_rpm: float, side_spin_rpm: float) -> tuple[float, float]:
+    """(total spin rpm, spin axis deg) from back and side spin; + side spin tilts the axis right (a fade)."""
+    return math.hypot(back_spin_rpm, side_spin_rpm), math.degrees(math.atan2(side_spin_rpm, back_spin_rpm))
+
+
+def launch_of(shot: ShotRequest) -> Launch:
+    """The SI launch of a request, whichever unit form it used."""
+    speed = shot.ball_speed_mps if shot.ball_speed_mps is not None else shot.ball_speed_mph * MPH_TO_MPS
+    if shot.spin_rpm is not None:
+        spin, axis = shot.spin_rpm, shot.spin_axis_deg or 0.0
+    else:
+        spin, axis = spin_from_components(shot.back_spin_rpm, shot.side_spin_rpm or 0.0)
+    return Launch(speed, shot.launch_angle_deg, shot.launch_direction_deg, spin, axis)
+
+
+def air_of(air: AirRequest | ReferenceAir | None) -> AirConditions:
+    """Engine air from a request's air; omitted values take ICAO standard air."""
+    if air is None:
+        return AirConditions()
+    given = {name: value for name, value in air.model_dump().items() if value is not None}
+    if "density_kg_m3" in given:
+        return AirConditions(density=given["density_kg_m3"])
+    return AirConditions(**given)
+
+
+def wind_of(wind: WindRequest | None) -> Wind:
+    if wind is None or wind.speed_mps == 0.0:
+        return CALM
+    return Wind(wind.speed_mps, wind.from_deg, wind.profile, wind.reference_height_m)
+
+
+def conditions_of(shot: ShotRequest) -> Conditions:
+    if shot.air is None and shot.wind is None:
+        return STANDARD
+    return Conditions(air_of(shot.air), wind_of(shot.wind))
+
+
+def reference_of(shot: ShotRequest) -> ReferenceAir | None:
+    """The reference air of the normalized flight, or None when none was asked for."""
+    if shot.normalized is False:
+        return None
+    return ReferenceAir() if shot.normalized is True else shot.normalized
+
+
+def _trajectory(flight: ShotFlight, request: TrajectoryRequest) -> list[TrajectoryPoint]:
+    if request.rate_hz is None:
+        times, positions = flight.states.times_s, flight.states.positions
+    else:
+        times, positions = resample(flight.states, request.rate_hz)
+    return [
+        TrajectoryPoint.model_construct(t_s=t, x_m=x, y_m=y, z_m=z)
+        for t, (x, y, z) in zip(times.tolist(), positions.tolist(), strict=True)
+    ]
+
+
+def flight_fields(flight: ShotFlight, trajectory: TrajectoryRequest | None) -> dict:
+    """The FlightResult fields of an engine flight (yards alongside metres)."""
+    return {
+        "landing": Landing.model_construct(x_m=flight.landing_x_m, y_m=flight.landing_y_m),
+        "carry_m": flight.carry_m,
+        "carry_yd": flight.carry_m / YARD_M,
+        "lateral_m": flight.lateral_m,
+        "apex_m": flight.apex_m,
+        "apex_yd": flight.apex_m / YARD_M,
+        "apex_time_s": flight.apex_time_s,
+        "flight_time_s": flight.flight_time_s,
+        "landing_angle_deg": flight.landing_angle_deg,
+        "landing_speed_mps": flight.landing_speed_mps,
+        "landing_spin_rpm": flight.landing_spin_rpm,
+        "trajectory": None if trajectory is None else _trajectory(flight, trajectory),
+    }
+
+
+def result_of(shot: ShotRequest, flight: ShotFlight, normalized: ShotFlight | None = None) -> ShotResult:
+    """The response for one shot from its flight and, if asked for, its normalized flight (built without
+    re-validation: every value comes from the engine)."""
+    extra = None
+    if normalized is not None:
+        fields = flight_fields(normalized, shot.trajectory)
+        extra = NormalizedFlight.model_construct(**fields, conditions=reference_of(shot))
+    return ShotResult.model_construct(**flight_fields(flight, shot.trajectory), normalized=extra)
+
+
+def fly_shot(engine: FlightEngine, shot: ShotRequest) -> ShotResult:
+    """One shot (and its normalized replay) on the engine's single-shot path; FlightError if it cannot land."""
+    launch, keep = launch_of(shot), shot.trajectory is not None
+    flight = engine.fly(launch, conditions_of(shot), keep)
+    reference = reference_of(shot)
+    normalized = None
+    if reference is not None:
+        normalized = engine.fly(launch, Conditions(air_of(reference), CALM), keep)
+    return result_of(shot, flight, normalized)
+
+
+def fly_shots(engine: FlightEngine, shots: list[ShotRequest]) -> list[ShotResult | ShotFailure]:
+    """Many shots in one engine batch (normalized replays ride in the same batch); results in order."""
+    launches = [launch_of(shot) for shot in shots]
+    conditions = [conditions_of(shot) for shot in shots]
+    replays = [i for i, shot in enumerate(shots) if reference_of(shot) is not None]
+    launches += [launches[i] for i in replays]
+    conditions += [Conditions(air_of(reference_of(shots[i])), CALM) for i in replays]
+    keep = any(shot.trajectory is not None for shot in shots)
+    flights = engine.fly_batch(launches, conditions, keep)
+    replayed = dict(zip(replays, flights[len(shots) :], strict=True))
+    results: list[ShotResult | ShotFailure] = []
+    for i, shot in enumerate(shots):
+        flight, normalized = flights[i], replayed.get(i)
+        failure = next((f for f in (flight, normalized) if isinstance(f, FlightError)), None)
+        results.append(ShotFailure(error=str(failure)) if failure else result_of(shot, flight, normalized))
+    return results

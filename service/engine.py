@@ -1,0 +1,293 @@
+"""The runtime simulator: a model bundle's ONNX coefficients inside the equations of `service.physics`.
+
+Forward Euler at the card's step, one ONNX Runtime call per step for everything still in the air. One shot runs
+on plain Python floats with the network's inputs and output bound once to preallocated float32 buffers
+(IOBinding, one thread): per-call overheads, not arithmetic, decide single-shot latency (NOTES.md section 6).
+A batch runs on NumPy [N] arrays and drops each shot from the batch as it lands. Either way a shot stops at its
+landing (first downward crossing of z = 0, the state interpolated linearly to it, exact for Euler's straight
+segments), flies on past the card's t_sim if it is still in the air, and fails alone if it has not landed
+by MAX_FLIGHT_TIME_S.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+import onnxruntime as ort
+
+from service.conditions import STANDARD, Conditions
+from service.constants import RPM_TO_RADPS
+from service.limits import FLIGHT_TIME_S
+from service.physics import euler_step, initial_state
+from service.wind import log_profile_factor
+from weights_schema.bundle import load_bundle
+from weights_schema.model_card import ModelCard
+
+MAX_FLIGHT_TIME_S = FLIGHT_TIME_S.high
+"""Longest flight simulated (20 s, the shot records' limit); a shot still in the air then gets a FlightError."""
+
+
+BATCH_THREADS = 1
+"""ORT threads of a batch step. One: on the 2-core machine, with other work running (a training job, a second
+worker), two threads took 96-120 us a shot against 35-42 for one (docs/benchmarks.md); a quiet machine gains
+about 1.5x from a second thread, so pass batch_threads=2 where the cores are the engine's alone."""
+
+
+class Launch(NamedTuple):
+    """Launch-monitor values of one shot, SI (paper eq. 12's inputs)."""
+
+    ball_speed_mps: float
+    launch_angle_deg: float
+    launch_direction_deg: float
+    spin_rpm: float
+    spin_axis_deg: float
+
+
+class FlightError(Exception):
+    """A shot the engine could not fly to the ground (the message says why); a batch reports it for that shot."""
+
+
+@dataclass(frozen=True)
+class EulerStates:
+    """The integrator's states of one shot up to its landing: times [K], positions and velocities [K,3]; the
+    last row is the interpolated landing."""
+
+    times_s: np.ndarray
+    positions: np.ndarray
+    velocities: np.ndarray
+
+
+@dataclass(frozen=True)
+class ShotFlight:
+    """The outcome of one shot at the launch elevation, SI."""
+
+    landing_x_m: float
+    landing_y_m: float
+    carry_m: float
+    lateral_m: float
+    apex_m: float
+    apex_time_s: float
+    flight_time_s: float
+    landing_angle_deg: float
+    landing_speed_mps: float
+    landing_spin_rpm: float
+    states: EulerStates | None = None
+
+
+def _summary(x, y, vx, vy, vz, wx, wy, wz):
+    """(carry, landing angle, landing speed, landing spin) from a landing state (floats or arrays)."""
+    return (
+        np.hypot(x, y),
+        np.degrees(np.arctan2(-vz, np.hypot(vx, vy))),
+        (vx * vx + vy * vy + vz * vz) ** 0.5,
+        (wx * wx + wy * wy + wz * wz) ** 0.5 / RPM_TO_RADPS,
+    )
+
+
+@lru_cache(maxsize=1024)
+def _physics_inputs(conditions: Conditions) -> tuple[float, float, float, bool, float, float]:
+    """(density, wind x, wind y at the reference height, log profile?, reference height, roughness) of a shot's
+    conditions; cached because a batch or a stream of shots mostly shares a few conditions."""
+    wind_x, wind_y = conditions.wind_at_reference_mps
+    wind = conditions.wind
+    log_profile = wind.profile == "log" and (wind_x != 0.0 or wind_y != 0.0)
+    return conditions.air.density_kg_m3, wind_x, wind_y, log_profile, wind.reference_height_m, wind.roughness_m
+
+
+def _session(path: Path, threads: int) -> ort.InferenceSession:
+    """An ORT session on `threads` cores whose idle threads sleep rather than spin (spinning threads steal the
+    core the step's NumPy physics and other workers need)."""
+    options = ort.SessionOptions()
+    options.intra_op_num_threads = threads
+    options.inter_op_num_threads = 1
+    options.execution_mode = ort.ExecutionMode.ORT_SEQUENTIAL
+    options.add_session_config_entry("session.intra_op.allow_spinning", "0")
+    return ort.InferenceSession(str(path), options, providers=["CPUExecutionProvider"])
+
+
+class FlightEngine:
+    """A loaded model bundle and the two ways to fly shots through it: `fly` (one) and `fly_batch` (many)."""
+
+    def __init__(self, bundle_dir: str | os.PathLike, batch_threads: int = BATCH_THREADS):
+        started = time.perf_counter()
+        self.bundle_dir = Path(bundle_dir)
+        self.card: ModelCard
+        self.card, onnx_path = load_bundle(self.bundle_dir)
+        self.dt = self.card.physics.dt_s
+        self.t_sim = self.card.physics.t_sim_s
+        self.max_steps = math.ceil(max(MAX_FLIGHT_TIME_S, self.t_sim) / self.dt - 1e-9)
+        self._velocity_name, self._spin_name = (spec.name for spec in self.card.onnx.inputs)
+        self._output_name = self.card.onnx.outputs[0].name
+        self._batch_session = _session(onnx_path, batch_threads)
+        self._single_session = _session(onnx_path, 1)
+        self._single_lock = threading.Lock()
+        self._velocity_in = np.zeros((1, 3), np.float32)
+        self._spin_in = np.zeros((1, 3), np.float32)
+        self._coefficients_out = np.zeros((1, 4), np.float32)
+        self._binding = self._single_session.io_binding()
+        for name, buffer in ((self._velocity_name, self._velocity_in), (self._spin_name, self._spin_in)):
+            self._binding.bind_input(name, "cpu", 0, np.float32, list(buffer.shape), buffer.ctypes.data)
+        self._binding.bind_output(
+            self._output_name,
+            "cpu",
+            0,
+            np.float32,
+            list(self._coefficients_out.shape),
+            self._coefficients_out.ctypes.data,
+        )
+        self.fly(Launch(60.0, 12.0, 0.0, 3000.0, 0.0))  # first runs allocate inside ORT: keep them off the clock
+        self.fly_batch([Launch(60.0, 12.0, 0.0, 3000.0, 0.0)] * 8)
+        self.load_seconds = time.perf_counter() - started
+
+    def _cap_message(self) -> str:
+        return f"the ball was still in the air after {self.max_steps * self.dt:g} s (the simulation cap)"
+
+    @property
+    def variant(self) -> str:
+        return self.card.variant
+
+    @property
+    def sha256(self) -> str:
+        """SHA-256 of the ONNX graph (checked against the card at load)."""
+        return self.card.onnx.sha256
+
+    def fly(self, launch: Launch, conditions: Conditions = STANDARD, keep_states: bool = False) -> ShotFlight:
+        """Fly one shot on Python floats; raises FlightError if it has not landed by MAX_FLIGHT_TIME_S."""
+        start = initial_state(*(np.array([value], dtype=float) for value in launch))
+        x, y, z = start.position[0].tolist()
+        vx, vy, vz = start.velocity[0].tolist()
+        wx, wy, wz = start.spin[0].tolist()
+        density, wind_x, wind_y, log_wind, reference_height, roughness = _physics_inputs(conditions)
+        air_x, air_y = wind_x, wind_y
+        dt = self.dt
+        apex, apex_step = z, 0
+        history = [(x, y, z, vx, vy, vz)] if keep_states else None
+        velocity_in, spin_in, out = self._velocity_in[0], self._spin_in[0], self._coefficients_out[0]
+        with self._single_lock:
+            run, binding = self._single_session.run_with_iobinding, self._binding
+            for step in range(1, self.max_steps + 1):
+                if log_wind:
+                    factor = log_profile_factor(z, reference_height, roughness)
+                    air_x, air_y = wind_x * factor, wind_y * factor
+                velocity_in[0], velocity_in[1], velocity_in[2] = vx - air_x, vy - air_y, vz
+                spin_in[0], spin_in[1], spin_in[2] = wx, wy, wz
+                run(binding)
+                old = (x, y, z, vx, vy, vz, wx, wy, wz)
+                x, y, z, vx, vy, vz, wx, wy, wz = euler_step(*old, out.tolist(), density, air_x, air_y, dt)
+                if z > apex:
+                    apex, apex_step = z, step
+                if z <= 0.0 < old[2]:
+                    break
+                if history is not None:
+                    history.append((x, y, z, vx, vy, vz))
+            else:
+                raise FlightError(self._cap_message())
+        frac = old[2] / (old[2] - z)
+        land = [a + frac * (b - a) for a, b in zip(old, (x, y, z, vx, vy, vz, wx, wy, wz))]
+        flight_time = (step - 1 + frac) * dt
+        carry, angle, speed, spin = (float(v) for v in _summary(land[0], land[1], *land[3:]))
+        states = None
+        if history is not None:
+            history.append(tuple(land[:6]))
+            rows = np.array(history)
+            times = np.append(np.round(dt * np.arange(len(history) - 1), 9), flight_time)
+            states = EulerStates(times, rows[:, :3], rows[:, 3:])
+        return ShotFlight(
+            land[0], land[1], carry, land[0], apex, round(apex_step * dt, 9), flight_time, angle, speed, spin, states
+        )
+
+    def fly_batch(
+        self,
+        launches: Sequence[Launch],
+        conditions: Sequence[Conditions] | Conditions = STANDARD,
+        keep_states: bool = False,
+    ) -> list[ShotFlight | FlightError]:
+        """Fly many shots on NumPy arrays, one ONNX Runtime call per step over the shots still in the air.
+
+        Results are in the order of `launches`; a shot that has not landed by MAX_FLIGHT_TIME_S gets a FlightError.
+        """
+        n = len(launches)
+        if n == 0:
+            return []
+        per_shot = [conditions] * n if isinstance(conditions, Conditions) else list(conditions)
+        if len(per_shot) != n:
+            raise ValueError(f"{len(per_shot)} conditions for {n} launches")
+        launch = np.array(launches, dtype=float).reshape(n, 5)
+        start = initial_state(*launch.T)
+        state = np.concatenate([start.position.T, start.velocity.T, start.spin.T])  # [9, n]
+        # per-shot constants, sliced along with the state as shots land: density, wind x/y, log profile, h_ref, z0
+        params = np.array([_physics_inputs(c) for c in per_shot]).T
+        alive = np.arange(n)
+        landing = np.full((9, n), np.nan)
+        flight_time = np.full(n, np.nan)
+        apex, apex_step = state[2].copy(), np.zeros(n, dtype=int)
+        last_step = np.zeros(n, dtype=int)
+        history = [state[:6].copy()] if keep_states else None
+        dt, session = self.dt, self._batch_session
+        outputs, names = [self._output_name], (self._velocity_name, self._spin_name)
+        for step in range(1, self.max_steps + 1):
+            density, air_x, air_y = params[0], params[1], params[2]
+            if params[3].any():
+                factor = np.where(params[3] > 0, log_profile_factor(state[2], params[4], params[5]), 1.0)
+                air_x, air_y = air_x * factor, air_y * factor
+            velocity = np.stack([state[3] - air_x, state[4] - air_y, state[5]], axis=1).astype(np.float32)
+            spin = state[6:9].T.astype(np.float32)
+            coefficients = session.run(outputs, {names[0]: velocity, names[1]: spin})[0]
+            new = np.array(euler_step(*state, coefficients.T, density, air_x, air_y, dt))
+            higher = new[2] > apex[alive]
+            apex[alive[higher]], apex_step[alive[higher]] = new[2, higher], step
+            if history is not None:
+                snapshot = np.full((6, n), np.nan)
+                snapshot[:, alive] = new[:6]
+                history.append(snapshot)
+            crossing = (state[2] > 0.0) & (new[2] <= 0.0)
+            if crossing.any():
+                frac = state[2, crossing] / (state[2, crossing] - new[2, crossing])
+                ids = alive[crossing]
+                landing[:, ids] = state[:, crossing] + frac * (new[:, crossing] - state[:, crossing])
+                flight_time[ids] = (step - 1 + frac) * dt
+                last_step[ids] = step - 1
+                keep = ~crossing
+                new, params, alive = new[:, keep], params[:, keep], alive[keep]
+            state = new
+            if alive.size == 0:
+                break
+        carry, angle, speed, spin = _summary(landing[0], landing[1], *landing[3:])
+        columns = zip(
+            *(
+                a.tolist()
+                for a in (
+                    landing[0],
+                    landing[1],
+                    carry,
+                    apex,
+                    np.round(dt * apex_step, 9),
+                    flight_time,
+                    angle,
+                    speed,
+                    spin,
+                )
+            )
+        )
+        results: list[ShotFlight | FlightError] = []
+        for i, (x, y, c, h, th, tf, a, s, w) in enumerate(columns):
+            if math.isnan(tf):
+                results.append(FlightError(self._cap_message()))
+                continue
+            states = self._batch_states(history, i, last_step[i], landing[:6, i], tf) if history is not None else None
+            results.append(ShotFlight(x, y, c, x, h, th, tf, a, s, w, states))
+        return results
+
+    def _batch_states(self, history: list[np.ndarray], shot: int, last_step: int, landing: np.ndarray, t: float):
+        rows = np.array([history[k][:, shot] for k in range(last_step + 1)] + [landing])
+        times = np.append(np.round(self.dt * np.arange(last_step + 1), 9), t)
+        return EulerStates(times, rows[:, :3], rows[:, 3:])

@@ -1,0 +1,149 @@
+"""The runtime engine with the shipped model: torch parity, single = batch, landing, caps, conditions, trajectories."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import onnxruntime as ort
+import pytest
+from conftest import random_launches
+
+from service.conditions import STANDARD, AirConditions, Conditions
+from service.engine import FlightEngine, FlightError, Launch
+from service.model_location import model_dir
+from service.physics import initial_state
+from service.trajectory import resample
+from service.wind import Wind
+
+PAPER_SINGLE_SHOT_MS = 34.9
+"""Phys-NN+ one shot on a CPU, the paper's Table 2."""
+
+
+@pytest.fixture(scope="module")
+def engine() -> FlightEngine:
+    return FlightEngine(model_dir())
+
+
+def launches(n: int, seed: int) -> list[Launch]:
+    columns = random_launches(n, seed)
+    return [Launch(*row) for row in zip(*(columns[name].tolist() for name in Launch._fields), strict=True)]
+
+
+SEVEN_IRON = Launch(55.0, 16.0, 0.0, 7100.0, 0.0)
+
+
+def test_flights_match_the_torch_simulator_within_a_centimetre(engine):
+    torch = pytest.importorskip("torch")
+    from model_export.torch_physics import euler_rollout, hard_landing
+
+    shots = launches(64, seed=21)
+    session = ort.InferenceSession(str(engine.bundle_dir / engine.card.onnx.file), providers=["CPUExecutionProvider"])
+
+    def coefficients(v_rel, omega):  # the shipped ONNX graph as the torch simulator's coefficient model
+        feeds = {"v_rel": v_rel.numpy().astype(np.float32), "omega": omega.numpy().astype(np.float32)}
+        return torch.from_numpy(session.run(None, feeds)[0])
+
+    start = initial_state(*np.array(shots).T)
+    as_tensor = lambda a: torch.as_tensor(a, dtype=torch.float32)
+    with torch.no_grad():
+        trajectory = euler_rollout(
+            as_tensor(start.position),
+            as_tensor(start.velocity),
+            as_tensor(start.spin),
+            coefficients,
+            engine.card.physics.air_density_kg_m3,
+            engine.dt,
+            engine.t_sim,
+        )
+        landing = hard_landing(trajectory)
+    flights = engine.fly_batch(shots)
+    assert landing.landed.all()
+    got = np.array([[f.landing_x_m, f.landing_y_m] for f in flights])
+    assert np.hypot(*(got - landing.position[:, :2].numpy()).T).max() < 0.01
+    np.testing.assert_allclose([f.apex_m for f in flights], trajectory.apex_m.numpy(), atol=0.01)
+    np.testing.assert_allclose([f.flight_time_s for f in flights], landing.time_s.numpy(), atol=1e-3)
+
+
+def test_single_shots_equal_the_batch(engine):
+    shots = launches(40, seed=4)
+    conditions = [
+        Conditions(
+            AirConditions(temperature_c=5.0 + i, altitude_m=50.0 * i),
+            Wind(0.3 * i, 9.0 * i, "log" if i % 2 else "uniform"),
+        )
+        for i in range(len(shots))
+    ]
+    batch = engine.fly_batch(shots, conditions)
+    for shot, condition, flown in zip(shots, conditions, batch, strict=True):
+        single = engine.fly(shot, condition)
+        assert single.carry_m == pytest.approx(flown.carry_m, abs=1e-6)
+        assert single.apex_m == pytest.approx(flown.apex_m, abs=1e-6)
+        assert single.flight_time_s == pytest.approx(flown.flight_time_s, abs=1e-9)
+        assert single.landing_spin_rpm == pytest.approx(flown.landing_spin_rpm, abs=1e-4)
+
+
+def test_a_long_flight_goes_on_past_t_sim_and_the_cap_fails_only_that_shot(engine):
+    sky_ball = Launch(75.0, 70.0, 0.0, 3000.0, 0.0)
+    flight = engine.fly(sky_ball)
+    assert flight.flight_time_s > engine.t_sim
+    capped = FlightEngine.__new__(FlightEngine)
+    capped.__dict__.update(engine.__dict__, max_steps=int(engine.t_sim / engine.dt))
+    with pytest.raises(FlightError, match="still in the air"):
+        capped.fly(sky_ball)
+    first, second = capped.fly_batch([sky_ball, SEVEN_IRON])
+    assert isinstance(first, FlightError) and second.carry_m == pytest.approx(engine.fly(SEVEN_IRON).carry_m)
+
+
+def test_the_landing_is_on_the_ground_between_two_steps(engine):
+    flight = engine.fly(SEVEN_IRON, keep_states=True)
+    states = flight.states
+    assert states.positions[-1, 2] == pytest.approx(0.0, abs=1e-9)
+    assert (states.positions[:-1, 2] > 0).all()
+    assert (
+        states.times_s[-1] == flight.flight_time_s
+        and states.times_s[-2] < flight.flight_time_s <= states.times_s[-2] + engine.dt
+    )
+    assert (flight.landing_x_m, flight.landing_y_m) == tuple(states.positions[-1, :2])
+    assert states.positions[:, 2].max() == flight.apex_m
+
+
+def test_resampled_trajectory_passes_through_the_states_with_their_velocities(engine):
+    flight = engine.fly(Launch(70.0, 12.0, 2.0, 3000.0, 10.0), keep_states=True)
+    times, positions = resample(flight.states, 60.0)
+    assert np.allclose(np.diff(times[:-1]), 1 / 60) and times[-1] == flight.flight_time_s
+    np.testing.assert_allclose(positions[-1], flight.states.positions[-1], atol=1e-9)
+    at_steps, on_curve = resample(flight.states, 10.0)  # 10 Hz samples fall on the 0.1 s states
+    np.testing.assert_allclose(on_curve[:-1], flight.states.positions[: len(at_steps) - 1], atol=1e-9)
+    # finite differences of the curve at a state give that state's velocity (Hermite end tangents)
+    _, fine = resample(flight.states, 1000.0)
+    k = 1000  # t = 1.0 s, the 10th state
+    np.testing.assert_allclose((fine[k + 1] - fine[k - 1]) / (2e-3), flight.states.velocities[10], rtol=2e-3)
+
+
+def test_headwind_shortens_crosswind_from_the_right_moves_left_altitude_lengthens(engine):
+    calm = engine.fly(SEVEN_IRON)
+    headwind = engine.fly(SEVEN_IRON, Conditions(wind=Wind(5.0, 0.0)))
+    from_right = engine.fly(SEVEN_IRON, Conditions(wind=Wind(5.0, 90.0)))
+    denver = engine.fly(SEVEN_IRON, Conditions(AirConditions(altitude_m=1600.0)))
+    assert headwind.carry_m < calm.carry_m - 3
+    assert from_right.lateral_m < -1.0 and calm.lateral_m == pytest.approx(0.0, abs=1e-9)
+    assert denver.carry_m > calm.carry_m + 5
+    punch = Launch(40.0, 6.0, 0.0, 3000.0, 0.0)  # stays below the 10 m where the log profile's wind is weaker
+    low_calm, low_uniform, low_log = (
+        engine.fly(punch, Conditions(wind=w)) for w in (Wind(), Wind(5.0), Wind(5.0, 0.0, "log"))
+    )
+    assert 0 < abs(low_log.carry_m - low_calm.carry_m) < abs(low_uniform.carry_m - low_calm.carry_m)
+
+
+def test_one_shot_is_far_faster_than_the_paper(engine):
+    timings = []
+    for _ in range(200):
+        started = time.perf_counter()
+        engine.fly(SEVEN_IRON, STANDARD)
+        timings.append(time.perf_counter() - started)
+    p50_ms = float(np.median(timings)) * 1e3
+    print(
+        f"one shot p50 {p50_ms:.3f} ms: {PAPER_SINGLE_SHOT_MS / p50_ms:.0f}x faster than the paper's {PAPER_SINGLE_SHOT_MS} ms"
+    )
+    assert p50_ms < PAPER_SINGLE_SHOT_MS / 5
