@@ -1,0 +1,129 @@
+"""Recordings with a known effect hidden in them: synthetic sessions flown through the reference world.
+
+The base sessions are the synthetic generator's (players and robots, several clubs, realistic launch scatter and
+launch-monitor noise) but in calm air at ICAO standard conditions, the air the shipped model assumes, so the hidden
+effect is the only thing that differs from what the model is told. Launch biases are hidden by recording
+recorded = true - offset (or true / scale) before the noise is added.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from pydantic import ValidationError
+
+from discovery.effects import Context, equivalent_altitude_m
+from discovery.noise import RADAR_NOISE
+from service.air import Air
+from service.flight import Flight
+from service.physics import initial_state
+from service.wind import Wind, wind_vector
+from shots.records import ShotRecord, ShotSet
+from shots.reference_world import CALIBRATED, fly_reference
+from shots.synth import MIN_APEX_M, LaunchTable, MeasurementNoise, SynthConfig, draw_launches, draw_sessions, measure
+
+NOMINAL_AIR = Air.standard()
+"""The air of the base sessions and the air the model is told: 15 degC, sea level, dry (1.225 kg/m^3)."""
+
+NOMINAL_CONTEXT = Context(float(NOMINAL_AIR.density_kg_m3), 15.0)
+
+OUTSIDE_EFFECT = "critical_reynolds"
+"""The effect outside the library that `prove` hides: the ball's drag crisis sits at another Reynolds number
+(a different ball or dimple pattern), which changes drag and lift mostly at low speed, unlike any library effect."""
+
+LAUNCH_BIASES = {
+    "launch_angle_bias": ("launch_angle_deg", "offset_deg", True),
+    "launch_direction_bias": ("launch_direction_deg", "offset_deg", True),
+    "spin_axis_bias": ("spin_axis_deg", "offset_deg", True),
+    "ball_speed_bias": ("ball_speed_mps", "scale", False),
+    "spin_bias": ("spin_rpm", "scale", False),
+}
+KNOBS = {"drag_scale": "drag_scale", "lift_scale": "lift_scale", "spin_decay": "spin_decay_scale"}
+
+
+@dataclass
+class Concealed:
+    """Recordings with hidden effects, and the truth: {effect: {parameter: value}}."""
+
+    shots: ShotSet
+    hidden: dict[str, dict[str, float]]
+    dropped: int
+    trajectories: dict[str, np.ndarray]
+
+
+def conceal(
+    hidden: dict[str, dict[str, float]],
+    n_shots: int,
+    seed: int,
+    noise: MeasurementNoise = RADAR_NOISE,
+    trajectories: bool = False,
+) -> Concealed:
+    """Draw sessions, fly them with the hidden effects through the reference world and record them with noise.
+
+    hidden uses the report's parameter conventions, e.g. {"wind": {"speed_mps": 4, "from_deg": 0}}, plus
+    {"critical_reynolds": {"value": 9e4}} for the effect outside the library.
+    """
+    rng = np.random.default_rng(seed)
+    config = SynthConfig(n_shots=n_shots, seed=seed, calm=True)
+    sessions = draw_sessions(rng, n_shots, config)
+    true = draw_launches(rng, sessions)
+    recorded = LaunchTable(**{k: getattr(true, k).copy() for k in true.__dataclass_fields__})
+    for name, (column, key, offset) in LAUNCH_BIASES.items():
+        if name in hidden:
+            value = hidden[name][key]
+            setattr(recorded, column, getattr(true, column) - value if offset else getattr(true, column) / value)
+    air, wind, ground = NOMINAL_AIR, Wind(), 0.0
+    if "air_density" in hidden:
+        altitude = equivalent_altitude_m(hidden["air_density"]["ratio"], NOMINAL_CONTEXT)
+        air = Air.from_conditions(15.0, altitude, 0.0)
+    if "wind" in hidden:
+        wind = Wind(hidden["wind"]["speed_mps"], hidden["wind"]["from_deg"])
+    if "landing_elevation" in hidden:
+        ground = hidden["landing_elevation"]["height_m"]
+    params = CALIBRATED
+    for name, knob in KNOBS.items():
+        if name in hidden:
+            params = replace(params, **{knob: hidden[name]["scale"]})
+    if OUTSIDE_EFFECT in hidden:
+        params = replace(params, critical_reynolds=hidden[OUTSIDE_EFFECT]["value"])
+    flight = fly_reference(initial_state(**true.launch()), air, wind, ground, keep_states=trajectories, params=params)
+    values = measure(rng, recorded, flight, noise)
+    records, dropped, paths = [], 0, {}
+    order = np.zeros(len(sessions), dtype=int)
+    for i in range(len(true.club)):
+        session = true.session_index[i]
+        if not flight.landed[i] or flight.apex_m[i] < MIN_APEX_M:
+            dropped += 1
+            continue
+        try:
+            records.append(
+                ShotRecord(
+                    shot_id=f"{sessions[session].session}-{order[session]:04d}",
+                    session=sessions[session].session,
+                    club=true.club[i],
+                    **{k: float(v[i]) for k, v in values.items()},
+                )
+            )
+        except ValidationError:
+            dropped += 1
+            continue
+        if trajectories:
+            paths[records[-1].shot_id] = _path(flight, i, rng)
+        order[session] += 1
+    return Concealed(ShotSet(records), hidden, dropped, paths)
+
+
+def _path(flight: Flight, shot: int, rng: np.random.Generator, every: int = 10, noise_m: float = 0.1) -> np.ndarray:
+    """Samples (t, x, y, z) of one reference flight every `every` steps up to its landing, with radar noise."""
+    times = flight.times_s[::every]
+    xyz = np.stack([s.position[shot] for s in flight.states[::every]])
+    inside = times <= flight.flight_time_s[shot]
+    samples = np.column_stack([times[inside], xyz[inside] + rng.normal(0, noise_m, xyz[inside].shape)])
+    return samples
+
+
+def truth_air_velocity(hidden: dict[str, dict[str, float]]) -> np.ndarray:
+    """The hidden wind as the library's internal (x, y) air velocity."""
+    w = hidden["wind"]
+    return wind_vector(w["speed_mps"], w["from_deg"])[:2]

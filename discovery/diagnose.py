@@ -1,0 +1,348 @@
+"""`diagnose`: locate the mismatch, fit every library effect (and combinations, and a learned correction) through
+the simulator, choose by held-out error with a parameter penalty, and assemble the report.
+
+Selection: every single effect is fitted (from a Gauss-Newton start); the best is combined with the other effects
+that most reduce the linearised cost. A candidate
+replaces a simpler one only if its held-out error is lower beyond doubt (the lower end of a session-bootstrap
+interval of the improvement is above zero) and by a material share. The mismatch is called systematic when the
+mismatch exceeds the expected error (model error + launch-monitor noise) by a material share AND some fitted
+correction removes a material share of it on held-out sessions beyond doubt: noise alone satisfies neither.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from discovery import correction as learned
+from discovery.effects import LIBRARY, Context
+from discovery.fit import (
+    Fit,
+    Problem,
+    Scored,
+    cluster_bootstrap,
+    fit,
+    fit_rows,
+    folds,
+    heldout,
+    linear_starts,
+    per_shot,
+)
+from discovery.locate import locate, trajectory_residuals, trajectory_stats
+from discovery.model import FlightModel
+from discovery.noise import RADAR_NOISE, ExpectedError, base_conditions, expected_error
+from discovery.recordings import OBSERVABLES, Recordings
+from discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
+from discovery.schema import Candidate, Heldout, ModelInfo, Report
+from shots.synth import MeasurementNoise
+
+OUTLIER_MAD = 8.0
+"""A residual further than this many robust SDs from the median is a wild reading, left out of the fits."""
+
+MIN_RELATIVE_IMPROVEMENT = MATERIAL
+"""A correction must remove at least this share of the held-out error to count (materiality)."""
+
+SINGLE_LEVEL = 0.995
+"""One-sided bootstrap level for 'a correction beats the model as is' (strict: guards against false alarms)."""
+
+COMBINATION_LEVEL = 0.975
+"""One-sided bootstrap level for 'a richer candidate beats a simpler one'."""
+
+PAIR_ANCHORS = 3
+"""Pairs are built on the best three single effects (greedy selection on the best one alone can be misled)."""
+
+PAIR_FITS = 2
+"""Pairs per anchor fitted through the simulator: the most promising by linearised cost."""
+
+CORRECTION_TRIGGER = 1.1
+"""The learned correction is tried when the best library explanation leaves a held-out error above this (1 = noise)."""
+
+
+@dataclass
+class Diagnosis:
+    """The report plus the arrays the HTML plots need."""
+
+    report: Report
+    recordings: Recordings
+    sigma: np.ndarray
+    before: np.ndarray
+    after: np.ndarray
+    heldout_before: np.ndarray
+    heldout_after: np.ndarray
+    positions_before: np.ndarray | None
+    positions_after: np.ndarray | None
+    dt_s: float
+    chosen: Scored | None
+
+
+def _mean_sq(z: np.ndarray) -> float:
+    return float(np.nanmean(z**2)) if np.isfinite(z).any() else float("nan")
+
+
+def _rms(values: np.ndarray) -> float:
+    return float(np.sqrt(np.nanmean(values**2)))
+
+
+def outlier_mask(residual: np.ndarray) -> np.ndarray:
+    """True where a residual is a wild reading (far outside the bulk of its observable)."""
+    out = np.zeros(residual.shape, dtype=bool)
+    for j in range(residual.shape[1]):
+        r = residual[:, j]
+        finite = np.isfinite(r)
+        if finite.sum() < 10:
+            continue
+        median = np.median(r[finite])
+        mad = 1.4826 * np.median(np.abs(r[finite] - median))
+        out[:, j] = finite & (np.abs(r - median) > OUTLIER_MAD * max(mad, 1e-9))
+    return out
+
+
+class Diagnoser:
+    """Fits and scores candidates on one problem; `run` returns the full diagnosis."""
+
+    def __init__(
+        self,
+        recordings: Recordings,
+        model: FlightModel,
+        noise: MeasurementNoise = RADAR_NOISE,
+        seed: int = 0,
+        with_correction: bool = True,
+    ):
+        self.recordings, self.model, self.library = recordings, model, LIBRARY
+        self.with_correction = with_correction
+        self.rng = np.random.default_rng(seed)
+        self.noise = noise
+
+    def score(self, result: Fit) -> Scored:
+        z = heldout(self.problem, result, self.fold)
+        n = len(self.recordings)
+        error = _mean_sq(z)
+        return Scored(result, z, error, error * result.k * np.log(n) / n)
+
+    def better(self, rich: Scored, simple: Scored, level: float) -> tuple[bool, float, float, float]:
+        """Whether `rich` beats `simple` on held-out error beyond doubt and materially; (flag, gain, low, high)."""
+        a, count = per_shot(simple.heldout_z)
+        b, _ = per_shot(rich.heldout_z)
+        draws = cluster_bootstrap(a - b, count, self.recordings.session, self.rng)
+        gain = float((a - b).sum() / count.sum())
+        low, high = np.quantile(draws, [1 - level, level])
+        material = gain >= MIN_RELATIVE_IMPROVEMENT * simple.error
+        return bool(low > 0 and material and rich.score < simple.score), gain, float(low), float(high)
+
+    def fit_singles(self, rows: np.ndarray) -> list[Scored]:
+        """Every library effect alone, from Gauss-Newton starts out of one Jacobian; best score first."""
+        starts = linear_starts(self.problem, None, self.library, rows)
+        singles = [self.score(fit(self.problem, (e,), start, rows)) for e, (start, _) in zip(self.library, starts)]
+        return sorted(singles, key=lambda s: s.score)
+
+    def fit_pairs(self, singles: list[Scored], rows: np.ndarray) -> list[Scored]:
+        """Each of the best singles with the effects that most reduce its linearised cost; best score first."""
+        pairs, tried = [], set()
+        for anchor in singles[:PAIR_ANCHORS]:
+            others = tuple(e for e in self.library if e not in anchor.fit.effects)
+            screened = sorted(
+                zip(others, linear_starts(self.problem, anchor.fit, others, rows)), key=lambda item: item[1][1]
+            )
+            fresh = [(o, start) for o, (start, _) in screened if frozenset((anchor.fit.name, o.name)) not in tried]
+            for other, start in fresh[:PAIR_FITS]:
+                tried.add(frozenset((anchor.fit.name, other.name)))
+                pairs.append(self.score(fit(self.problem, anchor.fit.effects + (other,), start, rows)))
+        return sorted(pairs, key=lambda s: s.score)
+
+    def choose(self, null: Scored, singles: list[Scored], pairs: list[Scored]) -> tuple[Scored, dict]:
+        """No effect, the best single, or the best pair: each step only when it beats the simpler one."""
+        chosen, test = null, {}
+        flag, gain, low, _ = self.better(singles[0], null, SINGLE_LEVEL)
+        test.update(best_single=singles[0].fit.name, best_single_gain=gain, best_single_gain_low=low)
+        if flag:
+            chosen = singles[0]
+            if pairs:
+                flag, gain, low, _ = self.better(pairs[0], chosen, COMBINATION_LEVEL)
+                test.update(best_pair=pairs[0].fit.name, best_pair_gain_over_single=gain, best_pair_gain_low=low)
+                if flag:
+                    chosen = pairs[0]
+        return chosen, test
+
+    def try_correction(
+        self, null: Scored, chosen: Scored, rows: np.ndarray, scored: list[Scored], test: dict
+    ) -> Scored:
+        """The learned correction on top of the chosen explanation and alone; it replaces the choice if better."""
+        for foundation in {id(chosen): chosen, id(null): null}.values():
+            term = learned.fit_correction(self.problem, rows, foundation.fit)
+            if term is None:
+                continue
+            candidate = self.score(term)
+            scored.append(candidate)
+            level = SINGLE_LEVEL if chosen is null else COMBINATION_LEVEL
+            flag, gain, low, _ = self.better(candidate, chosen, level)
+            test[f"correction_on_{foundation.fit.name}_gain"] = gain
+            test[f"correction_on_{foundation.fit.name}_gain_low"] = low
+            if flag:
+                chosen = candidate
+        return chosen
+
+    def run(self) -> Diagnosis:
+        started = time.perf_counter()
+        recordings, model = self.recordings, self.model
+        base = base_conditions(recordings, model)
+        everyone = np.arange(len(recordings))
+        flown = model.fly(base, keep_positions=bool(recordings.trajectories))
+        predicted = flown.outcomes()
+        expected: ExpectedError = expected_error(model, recordings, base, predicted, self.noise)
+        residual = recordings.observed - predicted
+        wild = outlier_mask(residual)
+        use = np.isfinite(recordings.observed) & ~wild
+        self.problem = Problem(model, recordings, base, expected.sigma, use)
+        self.fold, grouping = folds(recordings.session)
+        rows = fit_rows(recordings, self.rng)
+
+        trajectory_rows = (
+            trajectory_residuals(recordings, flown.positions, flown.dt_s) if flown.positions is not None else []
+        )
+        outliers = {name: int(wild[:, j].sum()) for j, name in enumerate(OBSERVABLES) if wild[:, j].any()}
+        located = locate(recordings, residual, expected.sigma, use, trajectory_stats(trajectory_rows), outliers)
+
+        null_z = self.problem.standardize(predicted, everyone)
+        null = Scored(
+            Fit((), np.zeros(0), null_z, np.zeros(null_z.shape + (0,)), np.zeros((0, 0)), 0),
+            null_z,
+            _mean_sq(null_z),
+            0.0,
+        )
+        singles = self.fit_singles(rows)
+        pairs = self.fit_pairs(singles, rows)
+        scored = singles + pairs
+        chosen, test = self.choose(null, singles, pairs)
+        unlisted = None
+        if self.with_correction and chosen.error > CORRECTION_TRIGGER:
+            library_best = chosen
+            chosen = self.try_correction(null, chosen, rows, scored, test)
+            if chosen is not library_best:
+                unlisted = learned.summary(chosen.fit, chosen.error, library_best.error)
+
+        excess = null.error >= 1.0 + MIN_RELATIVE_IMPROVEMENT
+        systematic = chosen is not null and excess
+        test.update(
+            before_error=null.error,
+            excess_beyond_expected=excess,
+            decision="systematic" if systematic else "consistent with noise and the model's own error",
+        )
+        if not systematic:
+            chosen, unlisted = null, None
+
+        after_fit = chosen.fit
+        after = self.problem.predict(after_fit.effects, after_fit.theta, everyone)[0] if after_fit.k else predicted
+        positions_after = None
+        if recordings.trajectories and after_fit.k:
+            positions_after = self.problem.outcomes(
+                after_fit.effects, np.repeat(after_fit.theta[None], len(everyone), 0), everyone, keep_positions=True
+            ).positions
+        heldout_block = self.heldout_summary(null, chosen, grouping, expected)
+        context = Context(float(np.median(base.density_kg_m3)), model.temperature_c)
+        effects = effect_results(after_fit, context)
+        ambiguities = ambiguity(self.problem, chosen, scored, self.rng) if systematic else []
+        candidates = [
+            Candidate(
+                name=s.fit.name,
+                effects=effect_results(s.fit, context),
+                n_parameters=s.fit.k,
+                heldout_error=s.error,
+                penalty=s.penalty,
+                score=s.score,
+            )
+            for s in sorted([null] + scored, key=lambda s: s.score)
+        ]
+        report = Report(
+            recordings=recordings.source,
+            n_shots=len(recordings),
+            n_sessions=recordings.n_sessions,
+            observables=list(recordings.observed_names),
+            trajectories=len(recordings.trajectories),
+            model=ModelInfo(
+                name=model.name,
+                dt_s=model.dt_s,
+                integrator=model.method,
+                density_kg_m3=context.density_kg_m3,
+                model_error=expected.model,
+                model_error_source=expected.model_source,
+                outcome_noise=expected.outcome_noise,
+                launch_noise=expected.launch_noise,
+            ),
+            systematic=systematic,
+            systematic_test=test,
+            located=located,
+            effects=effects,
+            unlisted=unlisted,
+            candidates=candidates,
+            ambiguities=ambiguities,
+            heldout=heldout_block,
+            statement=statement(systematic, located, effects, unlisted, heldout_block, ambiguities, scored, chosen),
+            service_settings=service_settings(effects, context),
+            seconds=time.perf_counter() - started,
+        )
+        return Diagnosis(
+            report,
+            recordings,
+            expected.sigma,
+            predicted,
+            after,
+            null.heldout_z * expected.sigma,
+            chosen.heldout_z * expected.sigma,
+            flown.positions,
+            positions_after,
+            model.dt_s,
+            chosen if systematic else None,
+        )
+
+    def heldout_summary(self, null: Scored, chosen: Scored, grouping: str, expected: ExpectedError) -> Heldout:
+        sigma = expected.sigma
+        before_r, after_r = null.heldout_z * sigma, chosen.heldout_z * sigma
+        names = [(j, n) for j, n in enumerate(OBSERVABLES) if np.isfinite(null.heldout_z[:, j]).any()]
+        a, count = per_shot(null.heldout_z)
+        b, _ = per_shot(chosen.heldout_z)
+        sessions = self.recordings.session
+        draws = cluster_bootstrap(a - b, count, sessions, self.rng)
+        by_observable = {}
+        for j, name in names:
+            used = np.isfinite(null.heldout_z[:, j]) & np.isfinite(chosen.heldout_z[:, j])
+            d = np.where(used, null.heldout_z[:, j] ** 2 - chosen.heldout_z[:, j] ** 2, 0.0)
+            obs_draws = cluster_bootstrap(d, used.astype(float), sessions, self.rng)
+            by_observable[name] = (
+                float(d.sum() / max(used.sum(), 1)),
+                *map(float, np.quantile(obs_draws, [0.025, 0.975])),
+            )
+        improvement = null.error - chosen.error
+        fraction, fraction_ci = None, None
+        if null.error > 1.0 and chosen is not null:
+            before_draws = cluster_bootstrap(a, count, sessions, np.random.default_rng(1))
+            gain_draws = cluster_bootstrap(a - b, count, sessions, np.random.default_rng(1))
+            fraction = improvement / (null.error - 1.0)
+            ratio = gain_draws / np.maximum(before_draws - 1.0, 1e-9)
+            fraction_ci = tuple(float(q) for q in np.quantile(ratio, [0.025, 0.975]))
+        return Heldout(
+            grouping=grouping,
+            n_folds=int(self.fold.max()) + 1,
+            before={n: _rms(before_r[:, j]) for j, n in names},
+            after={n: _rms(after_r[:, j]) for j, n in names},
+            expected={n: float(np.sqrt(np.mean(sigma[:, j] ** 2))) for j, n in names},
+            before_error=null.error,
+            after_error=chosen.error,
+            improvement=improvement,
+            improvement_ci=tuple(float(q) for q in np.quantile(draws, [0.025, 0.975])),
+            improvement_by_observable=by_observable,
+            explained_fraction=fraction,
+            explained_fraction_ci=fraction_ci,
+        )
+
+
+def diagnose(
+    recordings: Recordings,
+    model: FlightModel,
+    noise: MeasurementNoise = RADAR_NOISE,
+    seed: int = 0,
+    with_correction: bool = True,
+) -> Diagnosis:
+    """Run the whole diagnosis of recordings against a model."""
+    return Diagnoser(recordings, model, noise, seed, with_correction=with_correction).run()

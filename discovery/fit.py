@@ -1,0 +1,269 @@
+"""Fit effects through the full simulator and score them on held-out sessions.
+
+Residuals are standardized (recorded - model) / expected sigma over every observed outcome, so carry, apex,
+time and angle weigh by how well each is known. The optimiser is scipy's bounded least squares with a Jacobian
+built from finite differences flown as ONE stacked batch. Held-out error: folds grouped by session; each fold's
+parameters are one Gauss-Newton step from the all-data fit using only the other folds' residuals and Jacobian
+(exact for a locally linear problem, and cheap), then the held-out shots are flown with them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from discovery.effects import Effect, apply_all
+from discovery.model import FlightModel
+from discovery.recordings import OBSERVABLES, Recordings
+from discovery.simulator import Conditions
+
+MISSED_LANDING_Z = 10.0
+"""Standardized residual given to a shot the model does not land (it cannot be compared)."""
+
+MAX_FIT_SHOTS = 600
+"""Effects are fitted on at most this many shots (spread over sessions); held-out scoring uses every shot."""
+
+MAX_EVALUATIONS = 12
+
+
+@dataclass
+class Problem:
+    """Recordings, the conditions the model assumes for them, expected sigmas and the entries that count."""
+
+    model: FlightModel
+    recordings: Recordings
+    base: Conditions
+    sigma: np.ndarray
+    use: np.ndarray
+
+    @property
+    def observed(self) -> np.ndarray:
+        return self.recordings.observed
+
+    def outcomes(
+        self, effects: tuple[Effect, ...], theta_rows: np.ndarray, rows: np.ndarray, keep_positions: bool = False
+    ):
+        """Fly shots `rows` (may repeat) with per-row parameters theta_rows [M, k]; returns the Flown batch."""
+        conditions = apply_all(effects, theta_rows, self.base.take(rows))
+        correction = next((e.correction for e in effects if getattr(e, "correction", None) is not None), None)
+        return self.model.fly(conditions, correction, keep_positions)
+
+    def predict(self, effects: tuple[Effect, ...], thetas: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """Outcomes [B, len(rows), 5] of B parameter sets [B, k], all flown in one batch."""
+        thetas = np.atleast_2d(thetas)
+        theta_rows = np.repeat(thetas, len(rows), axis=0)
+        flown = self.outcomes(effects, theta_rows, np.tile(rows, len(thetas)))
+        return flown.outcomes().reshape(len(thetas), len(rows), len(OBSERVABLES))
+
+    def standardize(self, predicted: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """(recorded - predicted) / sigma [..., len(rows), 5]; NaN where unused, a large value where not landed."""
+        z = (self.observed[rows] - predicted) / self.sigma[rows]
+        z = np.where(np.isnan(predicted), MISSED_LANDING_Z, z)
+        return np.where(self.use[rows], z, np.nan)
+
+
+@dataclass
+class Fit:
+    """Fitted internal parameters of a candidate with the residuals [N, 5] and Jacobian [N, 5, k] on all shots."""
+
+    effects: tuple[Effect, ...]
+    theta: np.ndarray
+    z: np.ndarray
+    jacobian: np.ndarray
+    covariance: np.ndarray
+    evaluations: int
+
+    @property
+    def name(self) -> str:
+        return "+".join(e.name for e in self.effects) or "none"
+
+    @property
+    def k(self) -> int:
+        return len(self.theta)
+
+
+@dataclass
+class Scored:
+    """A fitted candidate with its held-out standardized residuals [N, 5], held-out error and penalty."""
+
+    fit: Fit
+    heldout_z: np.ndarray
+    error: float
+    penalty: float
+
+    @property
+    def score(self) -> float:
+        return self.error + self.penalty
+
+
+def per_shot(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(sum of z^2, number of used entries) per shot."""
+    used = np.isfinite(z)
+    return np.where(used, z**2, 0.0).sum(axis=1), used.sum(axis=1).astype(float)
+
+
+def _bounds(effects: tuple[Effect, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    params = [p for e in effects for p in e.parameters]
+    return (
+        np.array([p.low for p in params]),
+        np.array([p.high for p in params]),
+        np.array([p.typical for p in params]),
+        np.array([p.step for p in params]),
+    )
+
+
+def residuals_and_jacobian(
+    problem: Problem, effects: tuple[Effect, ...], theta: np.ndarray, rows: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """z [n, 5] at theta and its Jacobian dz/dtheta [n, 5, k] by forward differences, flown as one batch."""
+    _, high, _, step = _bounds(effects)
+    k = len(theta)
+    h = np.where(theta + step <= high, step, -step)
+    thetas = np.vstack([theta, theta + np.diag(h)]) if k else theta[None]
+    z = problem.standardize(problem.predict(effects, thetas, rows), rows)
+    jacobian = np.moveaxis((z[1:] - z[:1]) / h[:, None, None], 0, -1) if k else np.zeros(z.shape[1:] + (0,))
+    return z[0], jacobian
+
+
+def covariance(z: np.ndarray, jacobian: np.ndarray, groups: np.ndarray) -> np.ndarray:
+    """Parameter covariance from the Jacobian: s^2 (J'J)^-1, or the session-clustered sandwich (5+ sessions) when
+    that is larger on average (shots of a session share conditions, so they may not be independent)."""
+    used = np.isfinite(z)
+    k = jacobian.shape[-1]
+    if k == 0:
+        return np.zeros((0, 0))
+    J = np.where(used[..., None], jacobian, 0.0)
+    r = np.where(used, z, 0.0)
+    flat_j = J.reshape(-1, k)
+    bread = np.linalg.pinv(flat_j.T @ flat_j)
+    m = used.sum()
+    codes = np.unique(groups, return_inverse=True)[1]
+    g = codes.max() + 1
+    classical = bread * float(np.sum(r**2) / max(m - k, 1))
+    if g < 5:
+        return classical
+    scores = np.zeros((g, k))
+    np.add.at(scores, codes, np.einsum("nok,no->nk", J, r))
+    sandwich = bread @ (scores.T @ scores * g / (g - 1)) @ bread
+    inflation = np.mean(np.diag(sandwich) / np.maximum(np.diag(classical), 1e-300))
+    return sandwich if inflation >= 1.0 else classical
+
+
+def linear_starts(
+    problem: Problem, base: Fit | None, additions: tuple[Effect, ...], rows: np.ndarray
+) -> list[tuple[np.ndarray, float]]:
+    """For each effect added to `base`: a Gauss-Newton start for base + effect and its linearised cost, all from
+    one Jacobian of base plus every addition at their current values (one stacked batch)."""
+    base_effects = base.effects if base is not None else ()
+    base_theta = base.theta if base is not None else np.zeros(0)
+    effects = base_effects + additions
+    theta = np.concatenate([base_theta] + [e.null for e in additions])
+    z, jacobian = residuals_and_jacobian(problem, effects, theta, rows)
+    used = np.isfinite(z)
+    r, J = z[used], jacobian[used]
+    low, high, _, _ = _bounds(effects)
+    k_base = len(base_theta)
+    out, start = [], k_base
+    for effect in additions:
+        columns = np.r_[np.arange(k_base), np.arange(start, start + effect.size)]
+        step = np.linalg.lstsq(J[:, columns], -r, rcond=None)[0]
+        cost = float(np.sum((r + J[:, columns] @ step) ** 2))
+        guess = np.clip(theta[columns] + step, low[columns], high[columns])
+        out.append((guess, cost))
+        start += effect.size
+    return out
+
+
+def fit_rows(recordings: Recordings, rng: np.random.Generator, limit: int = MAX_FIT_SHOTS) -> np.ndarray:
+    """At most `limit` shots for fitting, the same share of every session."""
+    n = len(recordings)
+    if n <= limit:
+        return np.arange(n)
+    return np.sort(rng.choice(n, size=limit, replace=False))
+
+
+def fit(problem: Problem, effects: tuple[Effect, ...], start: np.ndarray, rows: np.ndarray) -> Fit:
+    """Least-squares fit of the effects' parameters on `rows`, then residuals and Jacobian on every shot."""
+    low, high, typical, _ = _bounds(effects)
+    everyone = np.arange(len(problem.recordings))
+    evaluations = 0
+    theta = np.clip(start, low, high)
+    if len(theta):
+        cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+
+        def evaluate(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            nonlocal evaluations
+            key = x.tobytes()
+            if key not in cache:
+                z, jac = residuals_and_jacobian(problem, effects, x, rows)
+                used = np.isfinite(z)
+                cache.clear()
+                cache[key] = (z[used], jac[used])
+                evaluations += 1
+            return cache[key]
+
+        result = least_squares(
+            lambda x: evaluate(x)[0],
+            theta,
+            jac=lambda x: evaluate(x)[1],
+            bounds=(low, high),
+            x_scale=typical,
+            method="trf",
+            max_nfev=MAX_EVALUATIONS,
+            xtol=1e-3,
+            ftol=1e-4,
+        )
+        theta = result.x
+    z, jacobian = residuals_and_jacobian(problem, effects, theta, everyone)
+    return Fit(effects, theta, z, jacobian, covariance(z, jacobian, problem.recordings.session), evaluations + 1)
+
+
+def folds(groups: np.ndarray, n_folds: int = 5) -> tuple[np.ndarray, str]:
+    """Fold index per shot: whole sessions per fold (balanced greedily) with 3+ sessions, else blocks of shots."""
+    labels, codes, counts = np.unique(groups, return_inverse=True, return_counts=True)
+    if labels.size >= 3:
+        k = min(n_folds, labels.size)
+        load = np.zeros(k)
+        assignment = np.zeros(labels.size, dtype=int)
+        for g in np.argsort(-counts, kind="stable"):
+            assignment[g] = int(np.argmin(load))
+            load[assignment[g]] += counts[g]
+        return assignment[codes], f"session ({k} folds of whole sessions)"
+    n = groups.size
+    k = min(n_folds, n) if n > 20 else n
+    return (np.arange(n) * k // n), ("shot blocks in recorded order" if k < n else "leave one shot out")
+
+
+def heldout(problem: Problem, result: Fit, fold: np.ndarray) -> np.ndarray:
+    """Held-out standardized residuals [N, 5]: each fold flown with parameters fitted without it."""
+    if result.k == 0:
+        return result.z
+    low, high, _, _ = _bounds(result.effects)
+    used = np.isfinite(result.z)
+    theta_rows = np.empty((len(fold), result.k))
+    for f in np.unique(fold):
+        train = used & (fold != f)[:, None]
+        J, r = result.jacobian[train], result.z[train]
+        step = np.linalg.lstsq(J, -r, rcond=None)[0] if len(r) > result.k else np.zeros(result.k)
+        theta_rows[fold == f] = np.clip(result.theta + step, low, high)
+    everyone = np.arange(len(fold))
+    predicted = problem.outcomes(result.effects, theta_rows, everyone).outcomes()
+    return problem.standardize(predicted, everyone)
+
+
+def cluster_bootstrap(
+    numerator: np.ndarray, denominator: np.ndarray, groups: np.ndarray, rng: np.random.Generator, draws: int = 2000
+) -> np.ndarray:
+    """Bootstrap draws of sum(numerator) / sum(denominator), resampling whole groups (shots if only one group)."""
+    codes = np.unique(groups, return_inverse=True)[1]
+    g = codes.max() + 1
+    if g < 5:
+        codes, g = np.arange(len(groups)), len(groups)
+    num = np.bincount(codes, weights=numerator, minlength=g)
+    den = np.bincount(codes, weights=denominator, minlength=g)
+    pick = rng.integers(0, g, size=(draws, g))
+    weights = np.zeros((draws, g))
+    np.add.at(weights, (np.repeat(np.arange(draws), g), pick.ravel()), 1.0)
+    return (weights @ num) / np.maximum(weights @ den, 1e-12)

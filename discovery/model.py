@@ -1,0 +1,105 @@
+"""The model being diagnosed: a coefficient model inside the equations of motion, its integrator and assumed air.
+
+`from_bundle` is what users run (a shipped ONNX bundle, forward Euler at the card's dt, the card's air density);
+`reference` is the reference world itself (RK4 at 0.1 s, within 2 cm of its 0.01 s flights), a perfect model
+of clean synthetic data that `golfflight prove` uses to measure the method apart from any model error.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from discovery.simulator import CoefficientsFor, Conditions, Correction, Flown, fly
+from service.air import Air
+from service.onnx_coefficients import OnnxCoefficients
+from shots.reference_world import CALIBRATED, ReferenceAerodynamics, ReferenceParameters
+
+DEFAULT_BUNDLE = Path(__file__).resolve().parents[1] / "models" / "default"
+REFERENCE = "reference"
+"""`--model reference` diagnoses against the reference world instead of a bundle."""
+
+MIN_T_MAX_S = 15.0
+"""Flights are integrated for at least this long, so a shot the effects lengthen still lands."""
+
+MEAN_TO_SIGMA = math.sqrt(math.pi / 2.0)
+"""Mean |error| of a normal error is sigma sqrt(2/pi); the mean 2-D distance of an isotropic one is sigma sqrt(pi/2)."""
+
+
+@dataclass
+class FlightModel:
+    """A simulator of recorded launches: coefficients, integrator, assumed air and its own expected error."""
+
+    name: str
+    coefficients_for: CoefficientsFor
+    density_kg_m3: float
+    """Air density the model assumes when a shot has no recorded conditions."""
+    dt_s: float
+    method: Literal["euler", "rk4"]
+    t_max_s: float
+    model_error: dict[str, float] = field(default_factory=dict)
+    """1-sigma error of the model itself per observable (from its validation); missing ones are estimated."""
+    error_source: dict[str, str] = field(default_factory=dict)
+    temperature_c: float = 15.0
+    """Temperature of the assumed air (for the equivalent altitude of a density ratio)."""
+
+    def fly(self, conditions: Conditions, correction: Correction | None = None, keep_positions: bool = False) -> Flown:
+        return fly(conditions, self.coefficients_for, self.dt_s, self.t_max_s, self.method, correction, keep_positions)
+
+
+def from_bundle(directory: str | os.PathLike) -> FlightModel:
+    """The shipped model as users run it; its card's validation errors set the expected landing and apex error."""
+    coefficients = OnnxCoefficients(directory)
+    card = coefficients.card
+    validation = card.validation
+    per_axis = validation.landing_error_m / MEAN_TO_SIGMA
+    error = {"carry_y_m": per_axis, "carry_x_m": per_axis}
+    source = {
+        "carry_y_m": "model card: landing error / sqrt(pi/2) per axis",
+        "carry_x_m": "model card: landing error / sqrt(pi/2) per axis",
+    }
+    if validation.max_height_error_m is not None:
+        error["apex_m"] = validation.max_height_error_m * MEAN_TO_SIGMA
+        source["apex_m"] = "model card: max-height error x sqrt(pi/2)"
+    physics = card.physics
+    return FlightModel(
+        f"bundle {Path(directory)} ({card.variant})",
+        lambda ratio: coefficients,
+        physics.air_density_kg_m3,
+        physics.dt_s,
+        "euler",
+        max(physics.t_sim_s, MIN_T_MAX_S),
+        error,
+        source,
+    )
+
+
+def reference(params: ReferenceParameters = CALIBRATED, air: Air | None = None) -> FlightModel:
+    """The reference world as the model (RK4, dt 0.1 s): no model error, only measurement noise is expected."""
+    air = air or Air.standard()
+    viscosity = float(air.kinematic_viscosity_m2_s)
+    zero = {name: 0.0 for name in ("carry_y_m", "carry_x_m", "apex_m", "flight_time_s", "landing_angle_deg")}
+    return FlightModel(
+        "reference world (RK4, dt 0.1 s)",
+        lambda ratio: ReferenceAerodynamics(params, viscosity / np.asarray(ratio, dtype=float)),
+        float(air.density_kg_m3),
+        0.1,
+        "rk4",
+        MIN_T_MAX_S,
+        zero,
+        {k: "the reference world is the model: no model error" for k in zero},
+    )
+
+
+def load_model(spec: str | os.PathLike | None) -> FlightModel:
+    """`reference`, a bundle directory, or None for the shipped default bundle."""
+    if spec is None:
+        return from_bundle(DEFAULT_BUNDLE)
+    if str(spec) == REFERENCE:
+        return reference()
+    return from_bundle(spec)

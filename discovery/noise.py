@@ -1,0 +1,111 @@
+"""What mismatch to expect without any left-out physics: the model's own error plus the launch monitor's noise.
+
+Per shot and observable, sigma^2 = model error^2 + outcome noise^2 + sum over launch values of
+(d outcome / d launch value x launch noise)^2; the launch-noise terms are propagated through the model itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from discovery.model import FlightModel, reference
+from discovery.recordings import OBSERVABLES, Recordings
+from discovery.simulator import Conditions, concatenate
+from shots.synth import MeasurementNoise
+
+RADAR_NOISE = MeasurementNoise()
+"""The launch-monitor noise assumed unless told otherwise (the synthetic generator's)."""
+
+FLOOR = {"carry_y_m": 0.3, "carry_x_m": 0.3, "apex_m": 0.2, "flight_time_s": 0.03, "landing_angle_deg": 0.3}
+"""Smallest sigma allowed per observable, so no shot gets an absurd weight."""
+
+
+@dataclass
+class ExpectedError:
+    """Per-shot 1-sigma scales [N, 5] and their parts (RMS over shots per observable) for the report."""
+
+    sigma: np.ndarray
+    model: dict[str, float]
+    model_source: dict[str, str]
+    outcome_noise: dict[str, float]
+    launch_noise: dict[str, float]
+
+
+def base_conditions(recordings: Recordings, model: FlightModel) -> Conditions:
+    """The conditions the model assumes for the recordings: recorded air and wind where present, else its own air."""
+    n = len(recordings)
+    density = recordings.density_kg_m3 if recordings.density_kg_m3 is not None else np.full(n, model.density_kg_m3)
+    wind = recordings.wind_xy_mps if recordings.wind_xy_mps is not None else np.zeros((n, 2))
+    return Conditions(
+        {k: v.copy() for k, v in recordings.launch.items()},
+        np.ones(n),
+        np.asarray(density, dtype=float),
+        np.asarray(wind, dtype=float),
+        np.zeros(n),
+        np.ones((n, 3)),
+    )
+
+
+def launch_noise_steps(launch: dict[str, np.ndarray], noise: MeasurementNoise) -> dict[str, np.ndarray]:
+    """1-sigma recording noise of each launch value [N] (the synthetic generator's radar assumption)."""
+    n = len(launch["ball_speed_mps"])
+    return {
+        "ball_speed_mps": np.full(n, noise.ball_speed_mps),
+        "launch_angle_deg": np.full(n, noise.launch_angle_deg),
+        "launch_direction_deg": np.full(n, noise.launch_direction_deg),
+        "spin_rpm": np.hypot(noise.spin_rpm_fraction * launch["spin_rpm"], noise.spin_rpm_floor),
+        "spin_axis_deg": np.full(n, noise.spin_axis_deg),
+    }
+
+
+def _rms(values: np.ndarray) -> dict[str, float]:
+    return {name: float(np.sqrt(np.nanmean(values[:, j] ** 2))) for j, name in enumerate(OBSERVABLES)}
+
+
+def expected_error(
+    model: FlightModel,
+    recordings: Recordings,
+    base: Conditions,
+    predicted: np.ndarray,
+    noise: MeasurementNoise = RADAR_NOISE,
+) -> ExpectedError:
+    """Expected 1-sigma mismatch of every shot and observable under the null hypothesis (nothing left out)."""
+    n = len(recordings)
+    steps = launch_noise_steps(base.launch, noise)
+    parts = []
+    for name, step in steps.items():
+        shifted = base.copy()
+        shifted.launch[name] = shifted.launch[name] + step
+        parts.append(shifted)
+    moved = model.fly(concatenate(parts)).outcomes().reshape(len(steps), n, len(OBSERVABLES))
+    launch_var = np.nansum((moved - predicted[None]) ** 2, axis=0)
+
+    carry = np.hypot(predicted[:, 0], predicted[:, 1])
+    carry_noise = noise.carry_m + noise.carry_fraction * np.nan_to_num(carry)
+    outcome = np.stack(
+        [
+            carry_noise,
+            carry_noise,
+            np.full(n, noise.apex_m),
+            np.full(n, noise.flight_time_s),
+            np.full(n, noise.landing_angle_deg),
+        ],
+        axis=1,
+    )
+
+    model_sigma = dict(model.model_error)
+    source = dict(model.error_source)
+    missing = [name for name in OBSERVABLES if name not in model_sigma]
+    if missing:
+        truth = reference().fly(base).outcomes()
+        for j, name in enumerate(OBSERVABLES):
+            if name in missing:
+                model_sigma[name] = float(np.sqrt(np.nanmean((predicted[:, j] - truth[:, j]) ** 2)))
+                source[name] = "estimated: RMS of the model against the reference world on these launches"
+    model_part = np.array([model_sigma[name] for name in OBSERVABLES])
+    floor = np.array([FLOOR[name] for name in OBSERVABLES])
+    sigma = np.sqrt(model_part[None] ** 2 + outcome**2 + launch_var)
+    sigma = np.maximum(np.where(np.isfinite(sigma), sigma, np.nanmax(sigma, axis=0)), floor)
+    return ExpectedError(sigma, model_sigma, source, _rms(outcome), _rms(np.sqrt(launch_var)))

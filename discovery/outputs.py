@@ -1,0 +1,33 @@
+"""Write a diagnosis to its output folder: report.json, report.html and service_settings.json."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from discovery.html import render
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write beside the target, then rename: a reader never sees half a file."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as handle:
+            handle.write(text)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        raise
+
+
+def write_diagnosis(diagnosis, out: str | os.PathLike) -> list[Path]:
+    """The three output files of `golfflight diagnose`, in `out`."""
+    out = Path(out)
+    paths = [out / "report.json", out / "report.html", out / "service_settings.json"]
+    write_text_atomic(paths[0], diagnosis.report.model_dump_json(indent=2) + "\n")
+    write_text_atomic(paths[1], render(diagnosis))
+    write_text_atomic(paths[2], diagnosis.report.service_settings.model_dump_json(indent=2, exclude_none=True) + "\n")
+    return paths

@@ -1,0 +1,230 @@
+"""Diagnose the real data sets (read from the shared folder, never copied) and render a summary for the docs.
+
+python -m discovery.real --out runs/discovery-real [--model DIR|reference]
+
+Sets: the outdoor, radar-tracked TrackMan driver shots (all balls and Premium only), the PGA TOUR TrackMan
+trajectories of the Sentry 2022 (spin from the play-by-play) and the Sony Open 2022 (spin estimated from the initial
+lift), each per event and per round, and TrackMan's PGA TOUR 2023 averages (one row per club).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from discovery import svg
+from discovery.diagnose import Diagnosis, diagnose
+from discovery.model import FlightModel, load_model
+from discovery.outputs import write_diagnosis, write_text_atomic
+from discovery.recordings import LABELS, OBSERVABLES, Recordings, from_shot_set
+from shots.paths import shared_data_dir
+from shots.records import ShotRecord, ShotSet
+from shots.reference_world import default_tour_averages_path, read_tour_averages
+from shots.tourcast import load_tourcast
+from shots.trackman import load_trackman
+
+TOURCAST = Path("real") / "pga_tourcast_trackman"
+TRACKMAN = Path("real") / "trackman_driver_sessions" / "data.csv"
+
+
+def tour_averages(path: str | Path) -> ShotSet:
+    """TrackMan's tour-averages table as canonical records: one straight shot per club, carry, apex, land angle."""
+    records = [
+        ShotRecord(
+            shot_id=row.club,
+            session="PGA TOUR 2023",
+            club=row.club,
+            ball_speed_mps=row.ball_speed_mps,
+            launch_angle_deg=row.launch_angle_deg,
+            launch_direction_deg=0.0,
+            spin_rpm=row.spin_rpm,
+            spin_axis_deg=0.0,
+            carry_y_m=row.carry_m,
+            apex_m=row.max_height_m,
+            landing_angle_deg=row.land_angle_deg,
+        )
+        for row in read_tour_averages(path)
+    ]
+    return ShotSet(records)
+
+
+@dataclass
+class RealSet:
+    """One real data set to diagnose."""
+
+    key: str
+    title: str
+    recordings: Recordings
+    caveat: str
+
+
+def real_sets(shared: Path) -> list[RealSet]:
+    """Every real set, converted in memory by the project's loaders."""
+    sets = []
+    driver = load_trackman(shared / TRACKMAN, skip_bad_rows=True)
+    sets.append(
+        RealSet(
+            "trackman_driver",
+            "TrackMan driver shots, outdoor radar-tracked, all balls",
+            from_shot_set(ShotSet(driver.records), source=str(shared / TRACKMAN)),
+            "one session (no dates): held out in blocks of shots; ball types mixed",
+        )
+    )
+    premium = load_trackman(shared / TRACKMAN, balls=["Premium"], skip_bad_rows=True)
+    sets.append(
+        RealSet(
+            "trackman_driver_premium",
+            "TrackMan driver shots, outdoor radar-tracked, Premium balls",
+            from_shot_set(ShotSet(premium.records), source=str(shared / TRACKMAN) + " (Premium)"),
+            "one session (no dates): held out in blocks of shots",
+        )
+    )
+    trajectories = shared / TOURCAST / "shot_trajectory"
+    events = [
+        (
+            "sentry",
+            "PGA TOUR Sentry 2022 (Kapalua)",
+            "shot_trajectory_2021_016_656.csv",
+            "pbp_2021_016_656.csv",
+            "spin from the play-by-play; spin axis derived from the initial lift",
+        ),
+        (
+            "sony",
+            "PGA TOUR Sony Open 2022 (Waialae)",
+            "shot_trajectory_2021_006_006.csv",
+            None,
+            "spin ESTIMATED from the initial lift (Ferguson C_L): spin and lift effects are circular here",
+        ),
+    ]
+    for key, title, file, pbp, caveat in events:
+        conversion = load_tourcast(
+            trajectories / file,
+            None if pbp is None else shared / TOURCAST / "pbp" / pbp,
+            estimate_spin=pbp is None,
+            sample_interval_s=0.1,
+            skip_bad_rows=True,
+        )
+        whole = from_shot_set(ShotSet(conversion.records), conversion.trajectories, str(trajectories / file))
+        sets.append(
+            RealSet(
+                key,
+                f"{title}, all rounds",
+                whole,
+                caveat + "; every hole faces another way, so a round's wind is not one wind in the shot frame",
+            )
+        )
+        for session in np.unique(whole.session):
+            part = whole.subset(whole.session == session)
+            sets.append(RealSet(f"{key}_{session}", f"{title}, round {session.split('-R')[-1]}", part, caveat))
+    averages = default_tour_averages_path()
+    sets.append(
+        RealSet(
+            "pga_2023_averages",
+            "TrackMan PGA TOUR 2023 averages (12 clubs)",
+            from_shot_set(tour_averages(averages), source=str(averages)),
+            "averages over players, events and weather; straight shots; leave-one-club-out held-out",
+        )
+    )
+    return sets
+
+
+def summary_row(item: RealSet, diagnosis: Diagnosis) -> list[str]:
+    report = diagnosis.report
+    stats = {o.name: o for o in report.located.observables}
+    bias = ", ".join(
+        f"{n.split('_')[0] if n != 'carry_x_m' else 'side'} {stats[n].bias:+.2f} ({stats[n].rms_ratio:.1f}x)"
+        for n in ("carry_y_m", "carry_x_m", "apex_m", "flight_time_s", "landing_angle_deg")
+        if n in stats
+    )
+    effects = (
+        "; ".join(
+            f"{e.name} "
+            + ", ".join(
+                f"{k} {v:.3g} ± {e.uncertainty.get(k, float('nan')):.2g}"
+                for k, v in e.parameters.items()
+                if k != "density_kg_m3"
+            )
+            for e in report.effects
+        )
+        or "-"
+    )
+    held = report.heldout
+    fraction = "-" if held.explained_fraction is None or not report.systematic else f"{held.explained_fraction:.0%}"
+    return [
+        item.title,
+        str(report.n_shots),
+        bias,
+        "yes" if report.systematic else "no",
+        effects,
+        f"{held.before_error:.2f} → {held.after_error:.2f}",
+        fraction,
+        f"{report.seconds:.1f}",
+    ]
+
+
+def figures(diagnosis: Diagnosis) -> dict[str, str]:
+    """Aggregate plots only (binned means, histograms: no individual shot of the real data): name -> SVG."""
+    rec = diagnosis.recordings
+    out = {}
+    speed = rec.launch["ball_speed_mps"]
+    trend = []
+    for j, name in enumerate(OBSERVABLES):
+        if name not in rec.observed_names:
+            continue
+        x, y = svg.binned_means(speed, rec.observed[:, j] - diagnosis.before[:, j])
+        scale = diagnosis.report.heldout.expected[name]
+        trend.append((x, y / scale, name, j, False))
+    out["residual_vs_speed"] = svg.lines(
+        "mean residual / expected sigma vs ball speed (model as is)", "ball speed (m/s)", "residual / sigma", trend
+    )
+    for j, name in enumerate(OBSERVABLES):
+        if name not in ("carry_y_m", "landing_angle_deg") or name not in rec.observed_names:
+            continue
+        series = [(diagnosis.heldout_before[:, j], "held out, model as is")]
+        if diagnosis.chosen is not None:
+            series.append((diagnosis.heldout_after[:, j], "held out, corrected"))
+        out[f"heldout_{name}"] = svg.histogram(f"held-out residual: {name}", LABELS[name], series)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", required=True, help="folder for one report folder per set and summary.md")
+    parser.add_argument("--model", help="bundle directory or 'reference' (default: models/default)")
+    parser.add_argument("--only", help="regular expression on the set keys")
+    parser.add_argument("--figures", help="folder for aggregate SVG figures of each set (e.g. docs/discovery)")
+    args = parser.parse_args(argv)
+    model: FlightModel = load_model(args.model)
+    out = Path(args.out)
+    rows, details = [], {}
+    for item in real_sets(shared_data_dir()):
+        if args.only and not re.search(args.only, item.key):
+            continue
+        diagnosis = diagnose(item.recordings, model)
+        write_diagnosis(diagnosis, out / item.key)
+        if args.figures:
+            for name, text in figures(diagnosis).items():
+                write_text_atomic(Path(args.figures) / f"{item.key}_{name}.svg", text)
+        rows.append(summary_row(item, diagnosis))
+        details[item.key] = {
+            "title": item.title,
+            "caveat": item.caveat,
+            "statement": diagnosis.report.statement,
+            "located": diagnosis.report.located.summary,
+            "ambiguities": [a.note for a in diagnosis.report.ambiguities],
+        }
+        print(f"{item.key}: {diagnosis.report.statement}", flush=True)
+    header = ["set", "shots", "bias (RMS/expected)", "systematic", "named", "held-out error", "excess removed", "s"]
+    table = ["| " + " | ".join(header) + " |", "|---" * len(header) + "|"] + ["| " + " | ".join(r) + " |" for r in rows]
+    write_text_atomic(out / "summary.md", f"Model: {model.name}\n\n" + "\n".join(table) + "\n")
+    write_text_atomic(out / "details.json", json.dumps(details, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

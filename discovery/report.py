@@ -1,0 +1,283 @@
+"""The readable parts of a diagnosis: fitted effects in the report's conventions, the service settings, the
+ambiguities (explanations the data cannot tell apart, and what measurement would) and the plain-words statement."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from discovery.effects import Context
+from discovery.fit import Fit, Problem, Scored, cluster_bootstrap, per_shot
+from discovery.recordings import LABELS, OBSERVABLES
+from discovery.schema import (
+    AirAltitude,
+    AirDensity,
+    Ambiguity,
+    EffectResult,
+    Heldout,
+    Located,
+    ServiceSettings,
+    Unlisted,
+    Wind,
+)
+
+MATERIAL = 0.05
+"""Share above the expected error that counts as a material excess (as in `discovery.diagnose`)."""
+
+CARRY_ALIKE = {"wind", "air_density", "ball_speed_bias", "landing_elevation", "drag_scale"}
+"""Effects that all move carry along the line and need the other observables to be told apart."""
+
+LAUNCH_SETTINGS = {
+    "launch_angle_bias": ("launch_angle_deg_add", "offset_deg"),
+    "launch_direction_bias": ("launch_direction_deg_add", "offset_deg"),
+    "spin_axis_bias": ("spin_axis_deg_add", "offset_deg"),
+    "ball_speed_bias": ("ball_speed_scale", "scale"),
+    "spin_bias": ("spin_rpm_scale", "scale"),
+}
+COEFFICIENT_SETTINGS = {"drag_scale": "drag_scale", "lift_scale": "lift_scale", "spin_decay": "spin_decay_scale"}
+
+
+def effect_results(result: Fit, context: Context) -> list[EffectResult]:
+    """Each effect of a fit with its reported parameters and 1-sigma uncertainties."""
+    out, start = [], 0
+    for effect in result.effects:
+        block = slice(start, start + effect.size)
+        parameters, uncertainty = effect.describe(result.theta[block], result.covariance[block, block], context)
+        out.append(EffectResult(name=effect.name, parameters=parameters, uncertainty=uncertainty))
+        start += effect.size
+    return out
+
+
+def service_settings(effects: list[EffectResult], context: Context) -> ServiceSettings:
+    """The correction as the service's request options (wind, air) plus launch and model corrections."""
+    settings = ServiceSettings()
+    for effect in effects:
+        p = effect.parameters
+        if effect.name == "wind":
+            settings.wind = Wind(speed_mps=p["speed_mps"], from_deg=p["from_deg"])
+        elif effect.name == "air_density":
+            settings.air = AirDensity(density_kg_m3=p["density_kg_m3"])
+            settings.air_as_altitude = AirAltitude(
+                altitude_m=p["equivalent_altitude_m"], temperature_c=context.temperature_c
+            )
+        elif effect.name == "landing_elevation":
+            settings.ground_height_m = p["height_m"]
+        elif effect.name in LAUNCH_SETTINGS:
+            key, parameter = LAUNCH_SETTINGS[effect.name]
+            settings.launch_corrections[key] = p[parameter]
+        elif effect.name in COEFFICIENT_SETTINGS:
+            settings.coefficient_scales[COEFFICIENT_SETTINGS[effect.name]] = p["scale"]
+    return settings
+
+
+def _separation(problem: Problem, a: Fit, b: Fit) -> tuple[str, float, float]:
+    """(observable, RMS difference, the same in expected sigmas) where two fitted explanations differ most."""
+    rows = np.arange(len(problem.recordings))
+    pa = problem.predict(a.effects, a.theta, rows)[0]
+    pb = problem.predict(b.effects, b.theta, rows)[0]
+    diff = pa - pb
+    rms = np.sqrt(np.nanmean(diff**2, axis=0))
+    in_sigma = np.sqrt(np.nanmean((diff / problem.sigma) ** 2, axis=0))
+    j = int(np.nanargmax(in_sigma))
+    return OBSERVABLES[j], float(rms[j]), float(in_sigma[j])
+
+
+def ambiguity(
+    problem: Problem, chosen: Scored, scored: list[Scored], rng: np.random.Generator, limit: int = 3
+) -> list[Ambiguity]:
+    """Candidates with no more effects than the chosen one whose held-out error is not clearly worse."""
+    out = []
+    mine = {e.name for e in chosen.fit.effects}
+    base, count = per_shot(chosen.heldout_z)
+    for other in sorted(scored, key=lambda s: s.score):
+        names = {e.name for e in other.fit.effects}
+        if other is chosen or len(names) > len(mine) or names <= mine or names >= mine:
+            continue
+        theirs, _ = per_shot(other.heldout_z)
+        draws = cluster_bootstrap(theirs - base, count, problem.recordings.session, rng)
+        low, high = (float(q) for q in np.quantile(draws, [0.025, 0.975]))
+        if low > 0:
+            continue
+        observable, rms, in_sigma = _separation(problem, chosen.fit, other.fit)
+        recorded = observable in problem.recordings.observed_names
+        label = LABELS[observable]
+        if in_sigma < 0.5:
+            note = (
+                f"the two explanations predict nearly the same for every outcome of these launches (at most "
+                f"{in_sigma:.2g} expected sigma apart, in {label}): launches they treat differently (other clubs, "
+                "speeds or spins) or recorded trajectories would separate them"
+            )
+        elif recorded:
+            note = (
+                f"on these shots the two explanations differ most in {label}, by {rms:.2g} RMS "
+                f"({in_sigma:.2g} expected sigma per shot): more shots, or clubs with other launches, would separate them"
+            )
+        else:
+            note = (
+                f"{label} is not recorded; the two explanations predict it {rms:.2g} apart RMS "
+                f"({in_sigma:.2g} expected sigma per shot): recording it would separate them"
+            )
+        out.append(
+            Ambiguity(
+                effects=(chosen.fit.name, other.fit.name),
+                score_difference=float(other.score - chosen.score),
+                difference_ci=(low, high),
+                separating_measurement=observable,
+                note=note,
+            )
+        )
+        if len(out) == limit:
+            break
+    return out
+
+
+def plus_minus(value: float, sd: float, unit: str = "") -> str:
+    """'4.03 ± 0.02 unit' with as many decimals as the uncertainty's second significant digit needs."""
+    decimals = int(np.clip(1 - np.floor(np.log10(sd)), 0, 6)) if sd > 0 and np.isfinite(sd) else 2
+    return f"{value:.{decimals}f} ± {sd:.{decimals}f}{unit}"
+
+
+def _phrase(effect: EffectResult) -> str:
+    p, u = effect.parameters, effect.uncertainty
+    name = effect.name
+    if name == "wind":
+        direction = p["from_deg"]
+        kind = (
+            "headwind"
+            if min(direction, 360 - direction) < 30
+            else "tailwind"
+            if abs(direction - 180) < 30
+            else "wind from the right"
+            if direction < 180
+            else "wind from the left"
+        )
+        return (
+            f"a steady {plus_minus(p['speed_mps'], u['speed_mps'], ' m/s')} wind from "
+            f"{plus_minus(direction, u['from_deg'], '°')} (mostly a {kind})"
+        )
+    if name == "air_density":
+        return (
+            f"air {plus_minus(p['ratio'], u['ratio'])} times as dense as assumed "
+            f"(as at about {p['equivalent_altitude_m']:.0f} ± {u['equivalent_altitude_m']:.0f} m)"
+        )
+    if name == "landing_elevation":
+        where = "below" if p["height_m"] < 0 else "above"
+        return f"landing ground {plus_minus(abs(p['height_m']), u['height_m'], ' m')} {where} the tee"
+    if name == "unlisted":
+        return "a learned extra acceleration (see unlisted)"
+    if "offset_deg" in p:
+        return f"a {name.replace('_', ' ')} of {plus_minus(p['offset_deg'], u['offset_deg'], '°')} (true − recorded)"
+    what = {
+        "spin_decay": "spin decay scaled by",
+        "drag_scale": "drag scaled by",
+        "lift_scale": "lift scaled by",
+        "ball_speed_bias": "true/recorded ball speed of",
+        "spin_bias": "true/recorded spin of",
+    }[name]
+    return f"{what} {plus_minus(p['scale'], u['scale'])}"
+
+
+def _mismatch(located: Located) -> str:
+    stats = {o.name: o for o in located.observables}
+    parts = []
+    if "carry_y_m" in stats:
+        b = stats["carry_y_m"].bias
+        parts.append(f"carry about {abs(b):.1f} m {'less' if b < 0 else 'more'} down the line than the model")
+    others = []
+    for name, unit in (("carry_x_m", "m"), ("apex_m", "m"), ("flight_time_s", "s"), ("landing_angle_deg", "°")):
+        if name in stats and stats[name].significant:
+            others.append(f"{name.split('_')[0] if name != 'carry_x_m' else 'side'} {stats[name].bias:+.2f} {unit}")
+    text = "The recordings " + (parts[0] if parts else "depart from the model")
+    return text + (f" ({', '.join(others)})" if others else "")
+
+
+def _contrast(chosen: Scored, scored: list[Scored], ambiguous: set[str]) -> str:
+    """Which observables rule out the closest rival explanation of the same size ("" when they do not)."""
+    mine = {e.name for e in chosen.fit.effects}
+    rivals = [
+        s
+        for s in scored
+        if s is not chosen
+        and len(s.fit.effects) == len(chosen.fit.effects)
+        and not ({e.name for e in s.fit.effects} & mine)
+    ]
+    if not rivals:
+        return ""
+    if mine & CARRY_ALIKE:
+        carry_rivals = [s for s in rivals if {e.name for e in s.fit.effects} & CARRY_ALIKE]
+        rivals = carry_rivals or rivals
+    rival = min(rivals, key=lambda s: s.score)
+    if rival.fit.name in ambiguous:
+        return ""
+    observed = np.isfinite(chosen.heldout_z).any(axis=0) & np.isfinite(rival.heldout_z).any(axis=0)
+    worse = np.full(len(OBSERVABLES), np.nan)
+    worse[observed] = np.nanmean(rival.heldout_z[:, observed] ** 2, axis=0) - np.nanmean(
+        chosen.heldout_z[:, observed] ** 2, axis=0
+    )
+    order = [
+        OBSERVABLES[j] for j in np.argsort(-np.nan_to_num(worse, nan=-np.inf)) if np.isfinite(worse[j]) and worse[j] > 0
+    ]
+    if not order:
+        return ""
+    names = " and ".join(n.replace("_m", "").replace("_s", "").replace("_deg", "").replace("_", " ") for n in order[:2])
+    return (
+        f"{names} say {chosen.fit.name}, not {rival.fit.name} (held-out error {chosen.error:.2f} vs {rival.error:.2f})"
+    )
+
+
+def statement(
+    systematic: bool,
+    located: Located,
+    effects: list[EffectResult],
+    unlisted: Unlisted | None,
+    heldout: Heldout,
+    ambiguities: list[Ambiguity],
+    scored: list[Scored],
+    chosen: Scored,
+) -> str:
+    """One paragraph in plain words."""
+    if not systematic:
+        worst = max(located.observables, key=lambda o: o.rms_ratio, default=None)
+        best = min(scored, key=lambda s: s.score, default=None)
+        gain = (
+            f" The best candidate, {best.fit.name}, would remove {heldout.before_error - best.error:.3g} of a "
+            f"held-out error of {heldout.before_error:.3g} (1 = the expected error)."
+            if best
+            else ""
+        )
+        if heldout.before_error >= 1.0 + MATERIAL:
+            return (
+                f"The recordings depart from the model well beyond its expected error (mean squared standardized "
+                f"residual {heldout.before_error:.3g}; worst {worst.name} at {worst.rms_ratio:.1f}x its expected "
+                "error), but no candidate explains the departure consistently on held-out groups: it varies from "
+                "shot to shot or group to group (changing wind, mixed conditions or noisier measurements than "
+                "assumed) rather than being one systematic effect." + gain
+            )
+        tail = f" The largest departure is {worst.name} at {worst.rms_ratio:.2f}x its expected error." if worst else ""
+        return (
+            "No systematic mismatch: the recordings agree with the model within its own validation error and the "
+            "launch monitor's noise." + tail + gain
+        )
+    sentences = [_mismatch(located) + "."]
+    contrast = _contrast(chosen, scored, {a.effects[1] for a in ambiguities})
+    named = [_phrase(e) for e in effects if e.name != "unlisted"]
+    explains = ""
+    if heldout.explained_fraction is not None:
+        low, high = heldout.explained_fraction_ci or (np.nan, np.nan)
+        explains = (
+            f" explains {100 * heldout.explained_fraction:.0f} % (95 % interval {100 * low:.0f}–{100 * high:.0f} %) "
+            "of the excess error on held-out shots"
+        )
+        if heldout.explained_fraction > 1:
+            explains += " (over 100 %: it also absorbs part of the error the model is expected to have)"
+    if unlisted is not None:
+        lead = (
+            f"No library effect explains it ({' plus '.join(named) + ' leaves' if named else 'the best leaves'} a held-out "
+            f"error of {unlisted.library_heldout_error:.2f}); a learned extra acceleration, {unlisted.expression},"
+        )
+        sentences.append(lead + explains + ", and is reported as unlisted.")
+    else:
+        lead = (contrast[0].upper() + contrast[1:] + ": " if contrast else "") + " plus ".join(named)
+        sentences.append(lead[0].upper() + lead[1:] + explains + ".")
+    for item in ambiguities[:1]:
+        sentences.append(f"The data cannot firmly tell {item.effects[0]} from {item.effects[1]}: {item.note}.")
+    return " ".join(sentences)

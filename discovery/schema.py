@@ -1,0 +1,215 @@
+"""report.json as pydantic models: what `golfflight diagnose` writes (its JSON Schema is generated from these)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+SCHEMA_VERSION = "1.0"
+SCHEMA_PATH = Path(__file__).with_name("report.schema.json")
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class ObservableStat(_Strict):
+    """Mismatch of one observable before any correction: residual = recorded - model."""
+
+    name: str
+    n: int
+    bias: float = Field(description="mean residual, in the observable's unit")
+    bias_se: float = Field(description="standard error of the bias (clustered by session where there are 5+)")
+    bias_p: float
+    spread: float = Field(description="standard deviation of the residuals")
+    rms: float
+    expected: float = Field(description="RMS of the expected 1-sigma mismatch (model error + launch-monitor noise)")
+    rms_ratio: float = Field(description="sqrt(mean (residual / expected sigma)^2): 1 = as the model's error predicts")
+    excess_p: float = Field(description="p-value of 'the mismatch is no larger than expected'")
+    significant: bool = Field(description="bias or excess significant at the family-wise level (Holm)")
+
+
+class CovariateStat(_Strict):
+    """How an observable's residual changes with a launch value or the shot order."""
+
+    observable: str
+    covariate: str
+    slope_per_sd: float = Field(description="residual change per standard deviation of the covariate")
+    t: float
+    p: float
+    significant: bool
+
+
+class GroupStat(_Strict):
+    """Whether residuals differ between clubs or between sessions (one-way ANOVA on standardized residuals)."""
+
+    observable: str
+    grouping: Literal["club", "session"]
+    n_groups: int
+    f: float
+    p: float
+    significant: bool
+    extremes: dict[str, float] = Field(description="mean residual of the groups furthest from the overall mean")
+
+
+class TrajectoryStat(_Strict):
+    """Mean position residual (recorded - model) of trajectory samples in one flight phase and height band."""
+
+    phase: Literal["ascent", "descent"]
+    height_band: str
+    n_samples: int
+    n_shots: int
+    across_m: float
+    along_m: float
+    height_m: float
+    rms_m: float
+
+
+class Located(_Strict):
+    """Where the mismatch is: per observable, against covariates, between groups, along the flight."""
+
+    observables: list[ObservableStat]
+    covariates: list[CovariateStat]
+    groups: list[GroupStat]
+    trajectory: list[TrajectoryStat]
+    outliers: dict[str, int] = Field(description="shots left out of the fits per observable (wild readings)")
+    alpha: float = Field(description="family-wise significance level of the 'significant' flags (Holm)")
+    summary: list[str]
+
+
+class EffectResult(_Strict):
+    """A named effect with its fitted parameters and their 1-sigma uncertainties."""
+
+    name: str
+    parameters: dict[str, float]
+    uncertainty: dict[str, float]
+
+
+class Candidate(_Strict):
+    """One effect (or combination) fitted through the simulator and scored on held-out sessions."""
+
+    name: str
+    effects: list[EffectResult]
+    n_parameters: int
+    heldout_error: float = Field(description="mean squared standardized held-out residual (1 = noise level)")
+    penalty: float = Field(description="held-out error x k ln(n) / n (BIC-like, k parameters, n shots)")
+    score: float = Field(description="heldout_error + penalty: lower is better")
+
+
+class Heldout(_Strict):
+    """Held-out error before (model as is) and after (with the chosen correction), folds grouped by session."""
+
+    grouping: str
+    n_folds: int
+    before: dict[str, float] = Field(description="held-out RMS residual per observable, in its unit")
+    after: dict[str, float]
+    expected: dict[str, float] = Field(description="RMS expected sigma per observable")
+    before_error: float = Field(description="mean squared standardized residual, all observables")
+    after_error: float
+    improvement: float = Field(description="before_error - after_error")
+    improvement_ci: tuple[float, float] = Field(description="95 % session-bootstrap interval of the improvement")
+    improvement_by_observable: dict[str, tuple[float, float, float]] = Field(
+        description="per observable: improvement of the mean squared standardized residual and its 95 % interval"
+    )
+    explained_fraction: float | None = Field(
+        description="share of the excess error (above 1) removed on held-out shots"
+    )
+    explained_fraction_ci: tuple[float, float] | None
+
+
+class Ambiguity(_Strict):
+    """Two explanations the data cannot tell apart, and what would."""
+
+    effects: tuple[str, str]
+    score_difference: float
+    difference_ci: tuple[float, float]
+    separating_measurement: str
+    note: str
+
+
+class Unlisted(_Strict):
+    """A learned extra acceleration, summarised as a readable expression, when no library effect explains enough."""
+
+    expression: str
+    terms: dict[str, float] = Field(description="coefficient of each kept term, SI units")
+    uncertainty: dict[str, float]
+    meaning: dict[str, str]
+    heldout_error: float
+    library_heldout_error: float = Field(description="held-out error of the best library explanation alone")
+
+
+class Wind(_Strict):
+    speed_mps: float
+    from_deg: float
+    profile: Literal["uniform"] = "uniform"
+
+
+class AirDensity(_Strict):
+    density_kg_m3: float
+
+
+class AirAltitude(_Strict):
+    altitude_m: float
+    temperature_c: float
+
+
+class ServiceSettings(_Strict):
+    """The correction in the service's request options where it has one; launch-monitor corrections otherwise."""
+
+    wind: Wind | None = None
+    air: AirDensity | None = None
+    air_as_altitude: AirAltitude | None = Field(default=None, description="the same air as altitude + temperature")
+    ground_height_m: float | None = Field(default=None, description="landing ground relative to the tee")
+    launch_corrections: dict[str, float] = Field(
+        default_factory=dict, description="apply to recorded launches before simulating"
+    )
+    coefficient_scales: dict[str, float] = Field(
+        default_factory=dict, description="model changes (no service option): retrain or rescale"
+    )
+
+
+class ModelInfo(_Strict):
+    name: str
+    dt_s: float
+    integrator: str
+    density_kg_m3: float
+    model_error: dict[str, float]
+    model_error_source: dict[str, str]
+    outcome_noise: dict[str, float]
+    launch_noise: dict[str, float]
+
+
+class Report(_Strict):
+    """report.json of `golfflight diagnose`."""
+
+    schema_version: Literal["1.0"] = SCHEMA_VERSION
+    recordings: str
+    n_shots: int
+    n_sessions: int
+    observables: list[str]
+    trajectories: int = Field(description="shots with a recorded trajectory")
+    model: ModelInfo
+    systematic: bool
+    systematic_test: dict[str, float | bool | str]
+    located: Located
+    effects: list[EffectResult]
+    unlisted: Unlisted | None
+    candidates: list[Candidate]
+    ambiguities: list[Ambiguity]
+    heldout: Heldout
+    statement: str
+    service_settings: ServiceSettings
+    seconds: float
+
+
+def schema_text() -> str:
+    """The JSON Schema of report.json."""
+    return json.dumps(Report.model_json_schema(), indent=2, sort_keys=True) + "\n"
+
+
+if __name__ == "__main__":
+    SCHEMA_PATH.write_text(schema_text())
+    print(f"wrote {SCHEMA_PATH}")

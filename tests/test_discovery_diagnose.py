@@ -1,0 +1,83 @@
+"""Discovery end to end: a concealed wind is found, named and measured through the CLI; clean data raise no alarm."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from discovery.conceal import conceal
+from discovery.diagnose import diagnose
+from discovery.model import reference
+from discovery.recordings import from_shot_set
+from discovery.schema import SCHEMA_PATH, Report, schema_text
+from golfflight.cli import main
+from shots.records import ShotSet, trajectories_path, write_shots, write_trajectories
+
+
+@pytest.fixture(scope="module")
+def windy(tmp_path_factory):
+    """About 120 shots in a steady 4.5 m/s wind from 30 degrees, a dozen with trajectories."""
+    concealed = conceal({"wind": {"speed_mps": 4.5, "from_deg": 30.0}}, 120, seed=7, trajectories=True)
+    path = tmp_path_factory.mktemp("windy") / "windy.csv"
+    write_shots(path, concealed.shots.records)
+    write_trajectories(trajectories_path(path), dict(list(concealed.trajectories.items())[:12]))
+    return path
+
+
+def test_diagnose_names_and_measures_a_concealed_wind(windy, tmp_path):
+    assert main(["diagnose", str(windy), "--model", "reference", "--out", str(tmp_path)]) == 0
+    report = Report.model_validate_json((tmp_path / "report.json").read_text())
+    assert report.systematic
+    assert [e.name for e in report.effects] == ["wind"]
+    wind = report.effects[0].parameters
+    assert wind["speed_mps"] == pytest.approx(4.5, rel=0.1)
+    assert abs((wind["from_deg"] - 30.0 + 180) % 360 - 180) < 10
+    assert report.heldout.explained_fraction > 0.7
+    assert report.heldout.after["carry_y_m"] < report.heldout.before["carry_y_m"]
+    assert report.trajectories == 12 and report.located.trajectory
+    assert "wind" in report.statement and "m/s" in report.statement
+    settings = json.loads((tmp_path / "service_settings.json").read_text())
+    assert settings["wind"]["profile"] == "uniform"
+    assert settings["wind"]["speed_mps"] == pytest.approx(4.5, rel=0.1)
+    html = (tmp_path / "report.html").read_text()
+    assert html.count("<svg") >= 8 and "trajectories: height" in html
+    assert {c.name for c in report.candidates} >= {"none", "wind", "air_density", "drag_scale"}
+
+
+def test_clean_recordings_raise_no_alarm():
+    recordings = from_shot_set(conceal({}, 120, seed=8).shots)
+    report = diagnose(recordings, reference(), seed=0).report
+    assert not report.systematic and report.effects == []
+    assert "No systematic mismatch" in report.statement
+    assert report.service_settings.wind is None
+
+
+def test_report_schema_is_fresh():
+    assert SCHEMA_PATH.read_text() == schema_text(), "regenerate with: python -m discovery.schema"
+
+
+def test_thin_air_is_told_from_headwind():
+    recordings = from_shot_set(conceal({"air_density": {"ratio": 0.85}}, 120, seed=9).shots)
+    report = diagnose(recordings, reference(), seed=0, with_correction=False).report
+    assert [e.name for e in report.effects] == ["air_density"]
+    assert report.effects[0].parameters["ratio"] == pytest.approx(0.85, abs=0.015)
+    names = [c.name for c in report.candidates]
+    assert names.index("air_density") < names.index("wind")
+    assert report.service_settings.air.density_kg_m3 == pytest.approx(0.85 * 1.225, rel=0.02)
+    assert np.isfinite(report.service_settings.air_as_altitude.altitude_m)
+
+
+def test_carry_of_one_club_cannot_tell_headwind_from_a_speed_bias():
+    concealed = conceal({"wind": {"speed_mps": 4.0, "from_deg": 0.0}}, 600, seed=10)
+    carry_only = [
+        r.model_copy(update={"apex_m": None, "flight_time_s": None, "landing_angle_deg": None})
+        for r in concealed.shots.records
+        if r.club == "Driver"
+    ]
+    report = diagnose(from_shot_set(ShotSet(carry_only)), reference(), seed=0, with_correction=False).report
+    assert report.systematic and report.observables == ["carry_y_m", "carry_x_m"]
+    unrecorded = {"apex_m", "flight_time_s", "landing_angle_deg"}
+    assert any(a.separating_measurement in unrecorded and "recording it" in a.note for a in report.ambiguities)
+    assert "cannot firmly tell" in report.statement

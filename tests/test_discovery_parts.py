@@ -1,0 +1,111 @@
+"""Discovery: the learned correction's term selection, the reported conventions and the proof's bookkeeping."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from discovery.correction import TERMS, features, select_terms
+from discovery.effects import EFFECTS, Context, equivalent_altitude_m
+from discovery.prove import Run, cases, draw_effect, expected_label, relative_error, replace_section, tables
+from discovery.report import plus_minus, service_settings
+from discovery.schema import EffectResult
+from service.air import pressure_at_altitude
+
+ICAO = Context(1.225, 15.0)
+
+
+def test_term_selection_keeps_the_terms_that_made_the_data():
+    rng = np.random.default_rng(0)
+    n, k = 400, len(TERMS)
+    jacobian = rng.normal(size=(n, 5, k))
+    truth = np.zeros(k)
+    truth[[1, 5]] = (0.8, -0.5)
+    z = -(jacobian @ truth) + rng.normal(0, 0.3, (n, 5))
+    assert select_terms(z, jacobian) == (1, 5)
+    assert select_terms(rng.normal(size=(n, 5)), jacobian) == ()
+
+
+def test_correction_features_are_accelerations_per_unit_weight():
+    v = np.array([[0.0, 40.0, 10.0], [3.0, 25.0, -8.0]])
+    w = np.array([[300.0, 0.0, 0.0], [250.0, 0.0, -20.0]])
+    f = features(v, w)
+    assert f.shape == (2, len(TERMS), 3)
+    drag = f[:, [t.name for t in TERMS].index("-|v| v")]
+    np.testing.assert_allclose(drag, -np.linalg.norm(v, axis=1)[:, None] * v)
+    lift = f[:, [t.name for t in TERMS].index("m")]
+    np.testing.assert_allclose(np.linalg.norm(lift, axis=1), 1.0)
+    assert lift[0, 2] > 0
+
+
+def test_equivalent_altitude_of_a_density_ratio():
+    assert equivalent_altitude_m(1.0, ICAO) == pytest.approx(0.0, abs=1.0)
+    at_2377_m = float(pressure_at_altitude(2377.0) / pressure_at_altitude(0.0))
+    assert equivalent_altitude_m(at_2377_m, ICAO) == pytest.approx(2377.0, abs=1.0)
+
+
+def test_service_settings_from_effects():
+    effects = [
+        EffectResult(name="wind", parameters={"speed_mps": 4.8, "from_deg": 5.0}, uncertainty={}),
+        EffectResult(
+            name="air_density",
+            parameters={"ratio": 0.9, "equivalent_altitude_m": 880.0, "density_kg_m3": 1.1025},
+            uncertainty={},
+        ),
+        EffectResult(name="ball_speed_bias", parameters={"scale": 1.02}, uncertainty={}),
+        EffectResult(name="drag_scale", parameters={"scale": 0.95}, uncertainty={}),
+        EffectResult(name="landing_elevation", parameters={"height_m": -4.0}, uncertainty={}),
+    ]
+    settings = service_settings(effects, ICAO).model_dump(exclude_none=True)
+    assert settings["wind"] == {"speed_mps": 4.8, "from_deg": 5.0, "profile": "uniform"}
+    assert settings["air"] == {"density_kg_m3": 1.1025}
+    assert settings["air_as_altitude"] == {"altitude_m": 880.0, "temperature_c": 15.0}
+    assert settings["launch_corrections"] == {"ball_speed_scale": 1.02}
+    assert settings["coefficient_scales"] == {"drag_scale": 0.95}
+    assert settings["ground_height_m"] == -4.0
+
+
+def test_plus_minus_uses_the_uncertainty_digits():
+    assert plus_minus(4.8123, 0.41, " m/s") == "4.81 ± 0.41 m/s"
+    assert plus_minus(0.97483, 0.00087) == "0.97483 ± 0.00087"
+
+
+def test_every_case_draws_a_size_and_scores_its_error():
+    rng = np.random.default_rng(1)
+    for case, effects in cases():
+        for name in effects:
+            hidden = draw_effect(name, rng)
+            if name in EFFECTS:
+                assert relative_error(name, hidden, hidden) == 0.0
+    assert expected_label(()) == "none" and expected_label(("wind", "ball_speed_bias")) == "ball_speed_bias+wind"
+    wind = {"speed_mps": 5.0, "from_deg": 0.0}
+    assert relative_error("wind", {"speed_mps": 5.5, "from_deg": 0.0}, wind) == pytest.approx(0.1)
+
+
+def test_tables_and_section_replacement():
+    run = Run(
+        "wind",
+        0,
+        {"wind": {"speed_mps": 4.0, "from_deg": 10.0}},
+        300,
+        4,
+        True,
+        "wind",
+        True,
+        {"wind": {"speed_mps": 4.1, "from_deg": 11.0}},
+        {"wind": {"speed_mps": 0.1, "from_deg": 1.0}},
+        {"wind": 0.03},
+        12.0,
+        1.0,
+        1.0,
+        {"carry_y_m": 9.0},
+        {"carry_y_m": 1.0},
+        [],
+        3.0,
+    )
+    clean = Run("clean", 0, {}, 300, 4, False, "none", True, {}, {}, {}, 1.0, 1.0, None, {}, {}, [], 3.0)
+    text = tables([clean, run], "test model")
+    assert "| false alarms on clean sets | 0 of 1 | 0 |" in text and "| wind | 1/1 | 1/1 |" in text
+    doc = replace_section("# Title\n\nhand text\n", text, "<!-- BEGIN x -->")
+    again = replace_section(doc, "new\n", "<!-- BEGIN x -->")
+    assert "hand text" in again and "new" in again and text not in again
