@@ -4,6 +4,7 @@ over plain functions of the packages that do the work."""
 from __future__ import annotations
 
 import argparse
+import csv
 import sys
 
 from golfflight import __version__
@@ -23,11 +24,16 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+USER_ERRORS = (UserError, ValueError, OSError, csv.Error)
+"""What a bad input can raise: ValueError covers RecordError, BundleError, pydantic's and JSON's errors; OSError a
+missing, unreadable or directory path; csv.Error a file that is not CSV (NUL bytes, runaway fields)."""
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.run(args) or 0
-    except (UserError, ValueError, FileNotFoundError) as error:
+    except USER_ERRORS as error:
         print(f"golfflight {args.command}: error: {error}", file=sys.stderr)
         return 2
 

@@ -61,9 +61,12 @@ class DataSummary:
     n_with_wind: int
     min_apex_m: float
     filters: dict[str, int] = field(default_factory=dict)
+    bad_rows: list[str] = field(default_factory=list)
+    """Each malformed row left out with `skip_bad_rows` (file, line, column, value, reason); counted in filters."""
 
     def as_dict(self) -> dict:
-        return asdict(self)
+        """The fields recorded in checkpoints and the model card (the bad rows themselves are only reported)."""
+        return {k: v for k, v in asdict(self).items() if k != "bad_rows"}
 
 
 def shot_density(shots: ShotSet) -> np.ndarray:
@@ -113,20 +116,23 @@ def load_training_data(
     limit: int | None = None,
     min_apex_m: float = MIN_APEX_M,
     dtype: torch.dtype = torch.float32,
+    skip_bad_rows: bool = False,
 ) -> tuple[ShotTensors, ShotTensors, DataSummary]:
     """Read a canonical CSV and return (train, val, summary).
 
+    A malformed row refuses the file (`RecordError`), or with `skip_bad_rows` is left out, counted as `bad_rows`
+    and listed in `summary.bad_rows`.
     Dropped and counted, in this order: rows with no split mark, shots with neither a landing point nor an
     apex, shots whose recorded apex is under `min_apex_m` (shots with no apex recorded are kept). `limit`
     keeps at most that many shots, the first of each split in the file's train/val proportion (quick runs).
     """
     path = Path(path)
-    shots = read_shots(path)
+    shots = read_shots(path, skip_bad_rows=skip_bad_rows)
     split = shots.column("split")
     landing_known = ~np.isnan(shots.column("carry_x_m")) & ~np.isnan(shots.column("carry_y_m"))
     apex = shots.column("apex_m")
     keep = np.ones(len(shots), dtype=bool)
-    filters = {}
+    filters = {"bad_rows": len({problem.line for problem in shots.skipped})} if shots.skipped else {}
     for name, dropped in (
         ("no_split_mark", np.array([s is None for s in split], dtype=bool)),
         ("no_target", ~landing_known & np.isnan(apex)),
@@ -161,5 +167,6 @@ def load_training_data(
         n_with_wind=int(np.sum((wind > 0) & (is_train | is_val))),
         min_apex_m=min_apex_m,
         filters=filters,
+        bad_rows=[str(problem) for problem in shots.skipped],
     )
     return train, val, summary

@@ -151,10 +151,15 @@ def save_checkpoint(path: Path, payload: dict[str, Any]) -> None:
 
 
 def load_checkpoint(path: str | os.PathLike) -> dict[str, Any]:
-    """A checkpoint written by `save_checkpoint` (tensors and plain values only: weights_only loading)."""
-    payload = torch.load(path, map_location="cpu", weights_only=True)
-    if payload.get("format") != CHECKPOINT_FORMAT:
-        raise ValueError(f"{path}: not a golfflight training checkpoint (format {payload.get('format')!r})")
+    """A checkpoint written by `save_checkpoint` (tensors and plain values only: weights_only loading, which never
+    unpickles code); ValueError naming the file for anything else."""
+    try:
+        payload = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as error:  # noqa: BLE001 - torch's weights-only reader raises many types on a corrupt file
+        raise ValueError(f"{path}: not a readable checkpoint ({type(error).__name__}: {error})") from None
+    if not isinstance(payload, dict) or payload.get("format") != CHECKPOINT_FORMAT:
+        found = payload.get("format") if isinstance(payload, dict) else type(payload).__name__
+        raise ValueError(f"{path}: not a golfflight training checkpoint (format {found!r})")
     return payload
 
 
@@ -243,17 +248,41 @@ def train(
     config: TrainConfig,
     resume: bool = False,
     progress: bool = True,
+    init_state: dict[str, torch.Tensor] | None = None,
+    skip_bad_rows: bool = False,
 ) -> RunResult:
     """Train `config.variant` on the file's train split, validating on its val split after every epoch.
 
-    Turns on flushing of denormal floats for the process: without it the first backward passes through the
-    rollout hit denormals and a CPU batch runs 20-100x slower."""
+    `init_state` starts from these weights instead of a fresh initialisation (fine-tuning; with `resume`, the run's
+    own last.pt wins); `skip_bad_rows` leaves malformed rows of the data file out (listed in the result's data
+    summary) instead of refusing it.
+    Denormal floats are flushed to zero while training (without it the first backward passes through the rollout
+    hit denormals and a CPU batch runs 20-100x slower), and the CPU's normal mode is restored afterwards."""
     torch.set_flush_denormal(True)
+    try:
+        return _train(data_path, out_dir, config, resume, progress, init_state, skip_bad_rows)
+    finally:
+        torch.set_flush_denormal(False)
+
+
+def _train(
+    data_path: str | os.PathLike,
+    out_dir: str | os.PathLike,
+    config: TrainConfig,
+    resume: bool,
+    progress: bool,
+    init_state: dict[str, torch.Tensor] | None,
+    skip_bad_rows: bool,
+) -> RunResult:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    train_set, val_set, data = load_training_data(data_path, config.limit, config.min_apex_m)
+    train_set, val_set, data = load_training_data(
+        data_path, config.limit, config.min_apex_m, skip_bad_rows=skip_bad_rows
+    )
     torch.manual_seed(config.seed)
     model = build_model(config.variant, config.hidden)
+    if init_state is not None:
+        model.load_state_dict(init_state)
     optimizer = torch.optim.Adam(model.parameters(), lr=config.lr)
     history: list[dict[str, Any]] = []
     best: dict[str, Any] | None = None

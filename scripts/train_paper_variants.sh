@@ -13,3 +13,8 @@ train nn 50 lp
 train phys-nn 15 lp+lh
 train phys-nn-pm 15 lp+lh
 train phys-nn-pm-cq 15 lp+lh
+for variant in phys-q nn phys-nn phys-nn-pm phys-nn-pm-cq phys-nn+; do
+  mkdir -p "models/table1/$variant" && cp "runs/$variant/best.pt" "runs/$variant/history.json" "models/table1/$variant/"
+done
+python3 -m golfflight evaluate --data "$data" --runs models/table1/{phys-q,nn,phys-nn,phys-nn-pm,phys-nn-pm-cq,phys-nn+} \
+  --bundle models/default --out docs

@@ -24,6 +24,7 @@ from typing import NamedTuple
 import numpy as np
 import onnxruntime as ort
 
+from service.bundle_check import open_session, verify_session
 from service.conditions import STANDARD, Conditions
 from service.constants import RPM_TO_RADPS
 from service.limits import FLIGHT_TIME_S
@@ -40,6 +41,9 @@ BATCH_THREADS = 1
 """ORT threads of a batch step. One: on the 2-core machine, with other work running (a training job, a second
 worker), two threads took 96-120 us a shot against 35-42 for one (docs/benchmarks.md); a quiet machine gains
 about 1.5x from a second thread, so pass batch_threads=2 where the cores are the engine's alone."""
+
+
+NON_FINITE = "the model gave a non-finite flight for this launch"
 
 
 class Launch(NamedTuple):
@@ -111,13 +115,15 @@ def _session(path: Path, threads: int) -> ort.InferenceSession:
     options.inter_op_num_threads = 1
     options.execution_mode = ort.ExecutionMode.ORT_SEQUENTIAL
     options.add_session_config_entry("session.intra_op.allow_spinning", "0")
-    return ort.InferenceSession(str(path), options, providers=["CPUExecutionProvider"])
+    return open_session(path, options)
 
 
 class FlightEngine:
     """A loaded model bundle and the two ways to fly shots through it: `fly` (one) and `fly_batch` (many)."""
 
     def __init__(self, bundle_dir: str | os.PathLike, batch_threads: int = BATCH_THREADS):
+        """Load and verify a bundle (card, hash, graph interface, finite coefficients on a probe set: BundleError
+        otherwise), then warm both paths up."""
         started = time.perf_counter()
         self.bundle_dir = Path(bundle_dir)
         self.card: ModelCard
@@ -128,6 +134,7 @@ class FlightEngine:
         self._velocity_name, self._spin_name = (spec.name for spec in self.card.onnx.inputs)
         self._output_name = self.card.onnx.outputs[0].name
         self._batch_session = _session(onnx_path, batch_threads)
+        verify_session(self.card, self._batch_session, onnx_path)
         self._single_session = _session(onnx_path, 1)
         self._single_lock = threading.Lock()
         self._velocity_in = np.zeros((1, 3), np.float32)
@@ -151,6 +158,17 @@ class FlightEngine:
     def _cap_message(self) -> str:
         return f"the ball was still in the air after {self.max_steps * self.dt:g} s (the simulation cap)"
 
+    @staticmethod
+    def _finite(flight: ShotFlight) -> ShotFlight | FlightError:
+        """The flight, or a FlightError if any of its numbers is not finite (never sent to a client)."""
+        numbers = [getattr(flight, name) for name in ShotFlight.__dataclass_fields__ if name != "states"]
+        states = flight.states
+        if all(math.isfinite(v) for v in numbers) and (
+            states is None or all(np.isfinite(a).all() for a in (states.times_s, states.positions, states.velocities))
+        ):
+            return flight
+        return FlightError(NON_FINITE)
+
     @property
     def variant(self) -> str:
         return self.card.variant
@@ -161,7 +179,8 @@ class FlightEngine:
         return self.card.onnx.sha256
 
     def fly(self, launch: Launch, conditions: Conditions = STANDARD, keep_states: bool = False) -> ShotFlight:
-        """Fly one shot on Python floats; raises FlightError if it has not landed by MAX_FLIGHT_TIME_S."""
+        """Fly one shot on Python floats; raises FlightError if it has not landed by MAX_FLIGHT_TIME_S (or, from a
+        broken model, if any number of its flight is not finite)."""
         start = initial_state(*(np.array([value], dtype=float) for value in launch))
         x, y, z = start.position[0].tolist()
         vx, vy, vz = start.velocity[0].tolist()
@@ -201,9 +220,13 @@ class FlightEngine:
             rows = np.array(history)
             times = np.append(np.round(dt * np.arange(len(history) - 1), 9), flight_time)
             states = EulerStates(times, rows[:, :3], rows[:, 3:])
-        return ShotFlight(
-            land[0], land[1], carry, land[0], apex, round(apex_step * dt, 9), flight_time, angle, speed, spin, states
+        apex_time = round(apex_step * dt, 9)
+        flight = self._finite(
+            ShotFlight(land[0], land[1], carry, land[0], apex, apex_time, flight_time, angle, speed, spin, states)
         )
+        if isinstance(flight, FlightError):
+            raise flight
+        return flight
 
     def fly_batch(
         self,
@@ -213,7 +236,8 @@ class FlightEngine:
     ) -> list[ShotFlight | FlightError]:
         """Fly many shots on NumPy arrays, one ONNX Runtime call per step over the shots still in the air.
 
-        Results are in the order of `launches`; a shot that has not landed by MAX_FLIGHT_TIME_S gets a FlightError.
+        Results are in the order of `launches`; a shot that has not landed by MAX_FLIGHT_TIME_S (or whose flight is
+        not finite) gets a FlightError.
         """
         n = len(launches)
         if n == 0:
@@ -262,29 +286,19 @@ class FlightEngine:
             if alive.size == 0:
                 break
         carry, angle, speed, spin = _summary(landing[0], landing[1], *landing[3:])
-        columns = zip(
-            *(
-                a.tolist()
-                for a in (
-                    landing[0],
-                    landing[1],
-                    carry,
-                    apex,
-                    np.round(dt * apex_step, 9),
-                    flight_time,
-                    angle,
-                    speed,
-                    spin,
-                )
-            )
-        )
+        numbers = (landing[0], landing[1], carry, apex, np.round(dt * apex_step, 9), flight_time, angle, speed, spin)
+        finite = np.isfinite(np.stack(numbers)).all(axis=0)
         results: list[ShotFlight | FlightError] = []
-        for i, (x, y, c, h, th, tf, a, s, w) in enumerate(columns):
+        for i, (x, y, c, h, th, tf, a, s, w) in enumerate(zip(*(a.tolist() for a in numbers))):
             if math.isnan(tf):
                 results.append(FlightError(self._cap_message()))
-                continue
-            states = self._batch_states(history, i, last_step[i], landing[:6, i], tf) if history is not None else None
-            results.append(ShotFlight(x, y, c, x, h, th, tf, a, s, w, states))
+            elif not finite[i]:
+                results.append(FlightError(NON_FINITE))
+            elif history is None:
+                results.append(ShotFlight(x, y, c, x, h, th, tf, a, s, w))
+            else:
+                states = self._batch_states(history, i, last_step[i], landing[:6, i], tf)
+                results.append(self._finite(ShotFlight(x, y, c, x, h, th, tf, a, s, w, states)))
         return results
 
     def _batch_states(self, history: list[np.ndarray], shot: int, last_step: int, landing: np.ndarray, t: float):

@@ -37,3 +37,4 @@ WIND_FROM_DEG = Range(0.0, 360.0, "deg")
 
 AIR_DENSITY_KG_M3 = Range(0.5, 1.6, "kg/m^3")
 WIND_REFERENCE_HEIGHT_M = Range(0.5, 100.0, "m")
+TRAJECTORY_RATE_HZ = Range(1.0, 1000.0, "Hz")

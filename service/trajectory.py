@@ -10,8 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from service.engine import EulerStates
+from service.limits import TRAJECTORY_RATE_HZ
 
-MAX_RATE_HZ = 1000.0
+MAX_RATE_HZ = TRAJECTORY_RATE_HZ.high
 """Highest resampling rate a request may ask for."""
 
 

@@ -17,9 +17,10 @@ import csv
 import math
 import os
 import tempfile
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Annotated, Iterable, Literal
+from typing import Annotated, Iterable, Iterator, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
@@ -159,10 +160,26 @@ class ShotSet:
         return ShotSet([r for r, keep in zip(self.records, mask) if keep])
 
 
+@contextmanager
+def reading(path: str | os.PathLike) -> Iterator[None]:
+    """Turns a file that is not UTF-8 text, or not CSV at all, into a RecordError naming it (never a traceback)."""
+    try:
+        yield
+    except UnicodeDecodeError as error:
+        raise RecordError(f"{path}: not UTF-8 text (byte {error.start}: {error.reason})") from None
+    except csv.Error as error:
+        raise RecordError(f"{path}: not a CSV file ({error})") from None
+
+
 def read_shots(path: str | os.PathLike, skip_bad_rows: bool = False) -> ShotSet:
-    """Read and validate a canonical CSV. Bad rows raise `RecordError` listing every problem, or with
-    `skip_bad_rows` are left out and reported in `ShotSet.skipped`."""
-    path = Path(path)
+    """Read and validate a canonical CSV. Bad rows (a cell that is not a number or out of its range, an extra cell,
+    a shot_id seen before) raise `RecordError` listing every problem with file, line and column, or with
+    `skip_bad_rows` are left out and reported in `ShotSet.skipped`. A missing or unknown column refuses the file."""
+    with reading(path):
+        return _read_shots(Path(path), skip_bad_rows)
+
+
+def _read_shots(path: Path, skip_bad_rows: bool) -> ShotSet:
     with path.open(newline="") as handle:
         reader = csv.DictReader(handle)
         header = reader.fieldnames or []
@@ -175,7 +192,7 @@ def read_shots(path: str | os.PathLike, skip_bad_rows: bool = False) -> ShotSet:
             if unknown:
                 parts.append(f"unknown columns {unknown} (allowed: {list(COLUMNS)})")
             raise RecordError(f"{path} line 1 (header): " + "; ".join(parts))
-        records, problems = [], []
+        records, problems, first_line = [], [], {}
         for line, row in enumerate(reader, start=2):
             row_problems = []
             values = {}
@@ -189,14 +206,18 @@ def read_shots(path: str | os.PathLike, skip_bad_rows: bool = False) -> ShotSet:
                     row_problems.append(RowProblem(str(path), line, column, text, "is not a number"))
             if not row_problems:
                 try:
-                    records.append(ShotRecord(**values))
+                    record = ShotRecord(**values)
                 except ValidationError as error:
                     row_problems = _row_problems(error, str(path), line, row)
+                else:
+                    if record.shot_id is not None and record.shot_id in first_line:
+                        reason = f"duplicates the shot_id of line {first_line[record.shot_id]}"
+                        row_problems = [RowProblem(str(path), line, "shot_id", record.shot_id, reason)]
+                    else:
+                        records.append(record)
+                        if record.shot_id is not None:
+                            first_line[record.shot_id] = line
             problems.extend(row_problems)
-    ids = [r.shot_id for r in records if r.shot_id is not None]
-    if len(set(ids)) != len(ids):
-        duplicated = sorted({i for i in ids if ids.count(i) > 1})[:10]
-        raise RecordError(f"{path}: duplicate shot_id values {duplicated}")
     if problems and not skip_bad_rows:
         shown = "\n  ".join(str(p) for p in problems[:50])
         more = f"\n  ... and {len(problems) - 50} more" if len(problems) > 50 else ""
@@ -248,7 +269,11 @@ def write_trajectories(path: str | os.PathLike, trajectories: dict[str, np.ndarr
 
 def read_trajectories(path: str | os.PathLike) -> dict[str, np.ndarray]:
     """Read a companion file into {shot_id: array [T,4] of t_s, x_m, y_m, z_m}, samples in time order."""
-    path = Path(path)
+    with reading(path):
+        return _read_trajectories(Path(path))
+
+
+def _read_trajectories(path: Path) -> dict[str, np.ndarray]:
     grouped: dict[str, list[list[float]]] = {}
     with path.open(newline="") as handle:
         reader = csv.DictReader(handle)

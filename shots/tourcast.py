@@ -30,7 +30,7 @@ from numpy.polynomial import Polynomial
 from pydantic import ValidationError
 
 from service.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
-from shots.records import RANGES, RecordError, ShotRecord
+from shots.records import RANGES, RecordError, ShotRecord, reading
 from shots.trackman import Conversion, ConversionReport
 
 FULL_COEFFICIENTS = 7
@@ -169,7 +169,7 @@ def _key(path: Path, line: int, row: dict[str, str]) -> tuple[str, str, str, str
 
 def _groups(path: Path) -> tuple[str, list[tuple[int, tuple, list[dict[str, str]]]]]:
     """Tournament number and the file's rows grouped per shot key, in file order: (first line, key, rows)."""
-    with path.open(newline="", encoding="utf-8-sig") as handle:
+    with reading(path), path.open(newline="", encoding="utf-8-sig") as handle:
         reader = csv.DictReader(handle)
         _require(path, reader.fieldnames, TRAJECTORY_COLUMNS)
         groups: list[tuple[int, tuple, list[dict[str, str]]]] = []
@@ -185,38 +185,55 @@ def _groups(path: Path) -> tuple[str, list[tuple[int, tuple, list[dict[str, str]
     return (tournaments.pop() if tournaments else ""), groups
 
 
-def _number(row: dict[str, str], column: str) -> float:
+class _Malformed(_BadFlight):
+    """A shot whose rows are not what the format holds: refuses the file unless bad rows are skipped."""
+
+    def __init__(self, reason: str, line: int, where: str):
+        super().__init__(reason)
+        self.line, self.where = line, where
+
+
+def _number(row: dict[str, str], column: str, line: int) -> float:
+    text = row[column]
     try:
-        value = float(row[column])
+        value = float(text)
     except (TypeError, ValueError):
-        raise _BadFlight(f"'{column}' is not a number") from None
+        raise _Malformed(f"'{column}' is not a number", line, f"column '{column}': {text!r}") from None
     if not math.isfinite(value):
-        raise _BadFlight(f"'{column}' is not a number")
+        raise _Malformed(f"'{column}' is not a number", line, f"column '{column}': {text!r}")
     return value
 
 
 def _flights(line: int, key: tuple, rows: list[dict[str, str]], n: int, tournament: str) -> list[Flight]:
-    """Split one key's rows into flights of n coefficients each."""
-    max_row = int(_number(rows[0], "max_row"))
-    numbers = [int(_number(r, "row")) for r in rows]
+    """Split one key's rows (consecutive lines from `line`) into flights of n coefficients each."""
+    max_row = int(_number(rows[0], "max_row", line))
+    numbers = [int(_number(r, "row", line + i)) for i, r in enumerate(rows)]
     if numbers != list(range(1, max_row + 1)) or max_row % n:
-        raise _BadFlight(f"rows 'row' = 1..'max_row' incomplete or not a multiple of the {n} coefficients")
+        raise _Malformed(
+            f"rows 'row' = 1..'max_row' incomplete or not a multiple of the {n} coefficients",
+            line,
+            f"column 'row': {numbers} with max_row {max_row}",
+        )
     base = f"{tournament}-R{key[0]}-H{key[1]}-P{key[2]}-S{key[3]}"
     count = max_row // n
     flights = []
     for block in range(count):
         part = rows[block * n:(block + 1) * n]
-        coefficients = np.array([[_number(r, "zFit"), _number(r, "xFit"), _number(r, "yFit")] for r in part])
+        first = line + block * n
+        coefficients = np.array(
+            [[_number(r, axis, first + j) for axis in ("zFit", "xFit", "yFit")] for j, r in enumerate(part)]
+        )
         scale = max_row / ((block + 1) * n)
         shot_id = base + (f"-f{block + 1}" if count > 1 else "")
         flights.append(Flight(shot_id, tournament, f"{tournament}-R{key[0]}", key, line + block * n, coefficients,
-                              _number(part[-1], "timeInterval") * scale,
-                              _number(part[-1], "measuredTimeInterval") * scale))
+                              _number(part[-1], "timeInterval", first + n - 1) * scale,
+                              _number(part[-1], "measuredTimeInterval", first + n - 1) * scale))
     return flights
 
 
-def read_flights(path: str | os.PathLike, report: ConversionReport) -> list[Flight]:
-    """Every flight of a trajectory file; a malformed shot is counted in `report` as one row in, dropped."""
+def read_flights(path: str | os.PathLike, report: ConversionReport, skip_bad_rows: bool = False) -> list[Flight]:
+    """Every flight of a trajectory file. A malformed shot refuses the file (RecordError naming line and column), or
+    with `skip_bad_rows` is counted in `report` as one row in, dropped and listed."""
     path = Path(path)
     tournament, groups = _groups(path)
     n = min((int(rows[0]["max_row"]) for _, _, rows in groups if rows[0]["max_row"].strip().isdigit()), default=0)
@@ -226,12 +243,13 @@ def read_flights(path: str | os.PathLike, report: ConversionReport) -> list[Flig
     for line, key, rows in groups:
         try:
             found = _flights(line, key, rows, n, tournament)
-        except _BadFlight as bad:
+        except _Malformed as bad:
             report.rows_in += 1
-            report.drop(str(bad), line)
+            report.bad_row(f"{path} line {bad.line} {bad.where}: {bad}", str(bad), line, skip_bad_rows)
             continue
         report.rows_in += len(found)
         flights.extend(found)
+    report.refuse_bad_rows(skip_bad_rows)
     return flights
 
 
@@ -239,7 +257,7 @@ def read_pbp_spin(path: str | os.PathLike, tournament: str) -> dict[tuple[str, s
     """radarData.launchSpin (rpm; None where 0 = missing) of each radar-measured pbp row, per shot key in file order."""
     path = Path(path)
     spins: dict[tuple[str, str, str, str], list[float | None]] = {}
-    with path.open(newline="", encoding="utf-8-sig") as handle:
+    with reading(path), path.open(newline="", encoding="utf-8-sig") as handle:
         reader = csv.DictReader(handle)
         _require(path, reader.fieldnames, PBP_COLUMNS)
         for line, row in enumerate(reader, start=2):
@@ -308,13 +326,16 @@ def _record(flight: Flight, spin: float) -> ShotRecord:
 
 
 def load_tourcast(trajectory_path: str | os.PathLike, pbp_path: str | os.PathLike | None = None, *,
-                  estimate_spin: bool = False, sample_interval_s: float = 0.01) -> Conversion:
+                  estimate_spin: bool = False, sample_interval_s: float = 0.01,
+                  skip_bad_rows: bool = False) -> Conversion:
     """Convert a TOURCAST trajectory file (plus its pbp file for spin) to canonical records and sampled flights.
 
     Shots without a measured spin are dropped with the reason, or with `estimate_spin` get `estimate_spin_rpm`.
+    A malformed shot (a cell that is not a number, missing coefficient rows) refuses the file, or with
+    `skip_bad_rows` is left out and listed in the report.
     """
     report = ConversionReport(str(trajectory_path))
-    flights = read_flights(trajectory_path, report)
+    flights = read_flights(trajectory_path, report, skip_bad_rows)
     tournament = flights[0].tournament if flights else ""
     spins = _spin_sources(flights, None if pbp_path is None else read_pbp_spin(pbp_path, tournament))
     records, trajectories, estimated = [], {}, 0

@@ -1,8 +1,10 @@
 """Loader for TrackMan CSV exports (header row, then a units row such as [mph],[deg],[rpm],[ft],[yds],[s]).
 
 Each column's unit is read from the units row and converted to SI here, at the file edge. Real exports are messy
-(indoor shots whose flight is TrackMan's model, range balls, corrupt cells), so rows are filtered and every
-dropped row is counted under its reason in a `ConversionReport`; nothing is dropped silently.
+(indoor shots whose flight is TrackMan's model, range balls, blank launch values), so rows are filtered and every
+dropped row is counted under its reason in a `ConversionReport`; nothing is dropped silently. A malformed cell (not a
+number, out of its physical range, a side carry longer than the carry) refuses the file with its line and column,
+unless `skip_bad_rows` is given: then the row is left out and listed one by one in the report.
 
 "Carry Flat - Length" is the straight-line horizontal distance from the tee to the landing point, not the
 distance along the target line: in the shared driver export, TrackMan's own "Curve" column equals
@@ -23,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from service.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from shots.records import RANGES, RecordError, ShotRecord
+from shots.records import RANGES, RecordError, ShotRecord, reading
 
 SPEED = {"mph": MPH_TO_MPS, "m/s": 1.0, "km/h": 1.0 / 3.6}
 ANGLE = {"deg": 1.0}
@@ -61,9 +63,27 @@ class ConversionReport:
     kept: int = 0
     dropped: dict[str, list[int]] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    bad_rows: list[str] = field(default_factory=list)
 
     def drop(self, reason: str, line: int) -> None:
         self.dropped.setdefault(reason, []).append(line)
+
+    def bad_row(self, problem: str, reason: str, line: int, skip: bool) -> None:
+        """A malformed row: listed in full (`problem` names line, column and value), counted under `reason`; without
+        `skip` it is kept for `refuse_bad_rows`."""
+        self.bad_rows.append(problem)
+        if skip:
+            self.drop(f"bad row: {reason}", line)
+
+    def refuse_bad_rows(self, skip: bool) -> None:
+        """RecordError listing every malformed row, unless they were skipped."""
+        if self.bad_rows and not skip:
+            shown = "\n  ".join(self.bad_rows[:50])
+            more = f"\n  ... and {len(self.bad_rows) - 50} more" if len(self.bad_rows) > 50 else ""
+            raise RecordError(
+                f"{self.source}: {len(self.bad_rows)} malformed rows (--skip-bad-rows leaves them out and lists "
+                f"them):\n  {shown}{more}"
+            )
 
     @property
     def n_dropped(self) -> int:
@@ -78,6 +98,7 @@ class ConversionReport:
         for reason, where in sorted(self.dropped.items(), key=lambda item: -len(item[1])):
             shown = ", ".join(str(n) for n in where[:examples]) + (", ..." if len(where) > examples else "")
             lines.append(f"  dropped {len(where)}: {reason} (lines {shown})")
+        lines.extend(f"  skipped bad row: {problem}" for problem in self.bad_rows)
         lines.extend(f"  note: {note}" for note in self.notes)
         return "\n".join(lines)
 
@@ -95,9 +116,17 @@ class _BadRow(Exception):
     """A row that cannot become a canonical record; the message is the drop reason."""
 
 
+class _Malformed(_BadRow):
+    """A cell that is not what its column must hold; `cell` names the column and quotes the text."""
+
+    def __init__(self, reason: str, column: str, text: str):
+        super().__init__(reason)
+        self.cell = f"column '{column}': {text!r}"
+
+
 def _read_table(path: Path) -> tuple[list[str], list[str], list[tuple[int, list[str]]]]:
     """Header, units row and (line number, cells) of each data row; an optional 'sep=,' first line is skipped."""
-    with path.open(newline="", encoding="utf-8-sig") as handle:
+    with reading(path), path.open(newline="", encoding="utf-8-sig") as handle:
         lines = list(enumerate(csv.reader(handle), start=1))
     if lines and lines[0][1][:1] == ["sep="]:
         lines = lines[1:]
@@ -139,16 +168,17 @@ def _number(cells: list[str], column: str, spec: tuple[int, float]) -> float | N
     try:
         value = float(text)
     except ValueError:
-        raise _BadRow(f"'{column}' is not a number") from None
+        raise _Malformed(f"'{column}' is not a number", column, text) from None
     if not math.isfinite(value):
-        raise _BadRow(f"'{column}' is not a number")
+        raise _Malformed(f"'{column}' is not a number", column, text)
     return value * factor
 
 
 def _in_range(column: str, canonical: str, value: float | None) -> float | None:
     allowed = RANGES[canonical]
     if value is not None and not allowed.low <= value <= allowed.high:
-        raise _BadRow(f"'{column}' ({canonical}) outside the allowed range {allowed.describe()}")
+        reason = f"'{column}' ({canonical}) outside the allowed range {allowed.describe()}"
+        raise _Malformed(reason, column, f"{canonical} = {value:g}")
     return value
 
 
@@ -157,7 +187,11 @@ def _carry(length: float | None, side: float | None) -> tuple[float | None, floa
     if length is None or side is None:
         return None, None
     if abs(side) > length:
-        raise _BadRow(f"'{CARRY_SIDE}' larger than '{CARRY_LENGTH}' (Length is the straight-line distance)")
+        raise _Malformed(
+            f"'{CARRY_SIDE}' larger than '{CARRY_LENGTH}' (Length is the straight-line distance)",
+            CARRY_SIDE,
+            f"{side:g} m against a length of {length:g} m",
+        )
     return side, math.sqrt(length * length - side * side)
 
 
@@ -184,13 +218,15 @@ def _when(text: str) -> tuple[str, str]:
 
 
 def load_trackman(path: str | os.PathLike, *, min_tracked_fraction: float | None = 0.9,
-                  balls: Collection[str] | None = None, session: str | None = None) -> Conversion:
+                  balls: Collection[str] | None = None, session: str | None = None,
+                  skip_bad_rows: bool = False) -> Conversion:
     """Convert a TrackMan CSV export to canonical records.
 
     min_tracked_fraction: keep a shot only if the radar tracked it for at least this fraction of its flight
     ("Last data Point - Time" >= fraction x "Carry Flat - Time"): the rest were indoor shots whose outcome is
     TrackMan's model. None keeps every flight. balls: keep only these "Ball" types (None keeps all).
     session: the session id when the file has no "Date" column (default: the file name without extension).
+    skip_bad_rows: leave malformed rows out (each listed in the report) instead of refusing the file.
     shot_id is the line number of the shot in the export. A shot whose "Carry Flat - Time" is blank or 0 has no
     recorded flight: its outcome columns stay blank (and the tracked-fraction filter drops it).
     """
@@ -234,12 +270,16 @@ def load_trackman(path: str | os.PathLike, *, min_tracked_fraction: float | None
                 values[canonical] = _in_range(name, canonical, value)
             if flight:
                 values.update(_outcome(cells, specs))
+        except _Malformed as bad:
+            report.bad_row(f"{path} line {line} {bad.cell}: {bad}", str(bad), line, skip_bad_rows)
+            continue
         except _BadRow as bad:
             report.drop(str(bad), line)
             continue
         timestamp, day = _when(cell(cells, "Date")) if cell(cells, "Date") else (None, None)
         records.append(ShotRecord(shot_id=str(line), session=day or session or path.stem, timestamp=timestamp,
                                   club=cell(cells, "Club") or None, **values))
+    report.refuse_bad_rows(skip_bad_rows)
     report.kept = len(records)
     if keep_balls is None and "Ball" in text:
         kinds = sorted({cell(c, "Ball") for _, c in rows} - {""})

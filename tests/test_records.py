@@ -58,8 +58,10 @@ def test_missing_and_unknown_columns_are_refused(tmp_path):
 
 def test_duplicate_shot_ids_are_refused(tmp_path):
     write_shots(tmp_path / "a.csv", [ShotRecord(shot_id="7", **LAUNCH), ShotRecord(shot_id="7", **LAUNCH)])
-    with pytest.raises(RecordError, match="duplicate shot_id"):
+    with pytest.raises(RecordError, match="a.csv line 3 column 'shot_id': '7' duplicates the shot_id of line 2"):
         read_shots(tmp_path / "a.csv")
+    shots = read_shots(tmp_path / "a.csv", skip_bad_rows=True)
+    assert len(shots) == 1 and [(p.line, p.column) for p in shots.skipped] == [(3, "shot_id")]
 
 
 def test_skip_bad_rows_keeps_the_good_ones_and_reports_each_bad_one(tmp_path):

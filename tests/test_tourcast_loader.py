@@ -149,10 +149,23 @@ def test_a_landing_time_far_from_the_height_root_drops_the_shot(tmp_path):
     assert report.dropped["no descending crossing of the start height within 0.5 s of timeInterval end"] == [2]
 
 
-def test_incomplete_coefficient_rows_drop_the_shot(tmp_path):
-    report = load_tourcast(_edited(tmp_path, TRAJECTORY, lambda rows: rows[:4] + rows[5:]), PBP).report
-    assert report.count("rows 'row' = 1..'max_row' incomplete") == 1
+def test_incomplete_coefficient_rows_refuse_the_file_or_drop_the_shot(tmp_path):
+    edited = _edited(tmp_path, TRAJECTORY, lambda rows: rows[:4] + rows[5:])
+    with pytest.raises(RecordError, match=r"line 2 column 'row': .*incomplete"):
+        load_tourcast(edited, PBP)
+    report = load_tourcast(edited, PBP, skip_bad_rows=True).report
+    assert report.count("bad row: rows 'row' = 1..'max_row' incomplete") == 1
     assert report.rows_in == report.kept + report.n_dropped
+    assert "skipped bad row: " in report.summary()
+
+
+def test_a_non_number_cell_is_refused_naming_its_line_and_column(tmp_path):
+    def corrupt(rows):
+        rows[3][rows[0].index("xFit")] = "1.2.3"
+        return rows
+
+    with pytest.raises(RecordError, match=r"line 4 column 'xFit': '1.2.3': 'xFit' is not a number"):
+        load_tourcast(_edited(tmp_path, TRAJECTORY, corrupt), PBP)
 
 
 def test_bad_files_are_refused_naming_the_column(tmp_path):

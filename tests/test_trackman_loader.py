@@ -38,22 +38,33 @@ def _set_unit(rows: list[list[str]], column: str, unit: str) -> list[list[str]]:
     return rows
 
 
+def test_a_malformed_row_refuses_the_file_naming_line_column_and_value():
+    with pytest.raises(RecordError) as error:
+        load_trackman(EXPORT)
+    message = str(error.value)
+    assert "1 malformed rows (--skip-bad-rows" in message
+    assert "trackman_export.csv line 7 column 'Spin Rate': 'spin_rpm = -2.14748e+09'" in message
+    assert "outside the allowed range 0 to 15000 rpm" in message
+
+
 def test_default_filters_count_every_dropped_row_with_its_reason():
-    conversion = load_trackman(EXPORT)
+    conversion = load_trackman(EXPORT, skip_bad_rows=True)
     report = conversion.report
     assert (report.rows_in, report.kept, report.n_dropped) == (7, 3, 4)
     assert [r.shot_id for r in conversion.records] == ["3", "4", "6"]
     assert report.dropped == {
         INDOOR.format(0.9): [5],
-        "'Spin Rate' (spin_rpm) outside the allowed range 0 to 15000 rpm": [7],
+        "bad row: 'Spin Rate' (spin_rpm) outside the allowed range 0 to 15000 rpm": [7],
         "'Spin Axis' is blank": [8],
         "no flight recorded: 'Last data Point - Time' or 'Carry Flat - Time' blank or 0": [9],
     }
-    assert "dropped 1: 'Spin Rate' (spin_rpm) outside the allowed range 0 to 15000 rpm (lines 7)" in report.summary()
+    summary = report.summary()
+    assert "dropped 1: bad row: 'Spin Rate' (spin_rpm) outside the allowed range 0 to 15000 rpm (lines 7)" in summary
+    assert "skipped bad row: " in summary and "line 7 column 'Spin Rate'" in summary
 
 
 def test_units_are_converted_to_si_and_columns_mapped():
-    shot = load_trackman(EXPORT).records[0]
+    shot = load_trackman(EXPORT, skip_bad_rows=True).records[0]
     assert shot.ball_speed_mps == pytest.approx(150.0 * MPH_TO_MPS)
     assert (shot.launch_angle_deg, shot.launch_direction_deg) == (12.0, -1.5)
     assert (shot.spin_rpm, shot.spin_axis_deg) == (2500, 4.0)
@@ -66,7 +77,7 @@ def test_units_are_converted_to_si_and_columns_mapped():
 
 def test_carry_flat_length_is_the_straight_line_distance():
     """Side and the along-line distance sqrt(Length² − Side²) reproduce TrackMan's Curve (offset from launch line)."""
-    for shot, length_yd, curve_ft in zip(load_trackman(EXPORT).records[:2], (250.0, 230.0), (49.6, -60.0)):
+    for shot, length_yd, curve_ft in zip(load_trackman(EXPORT, skip_bad_rows=True).records[:2], (250.0, 230.0), (49.6, -60.0)):
         assert math.hypot(shot.carry_x_m, shot.carry_y_m) / YARD_M == pytest.approx(length_yd)
         phi = math.radians(shot.launch_direction_deg)
         curve = (shot.carry_x_m * math.cos(phi) - shot.carry_y_m * math.sin(phi)) / FOOT_M
@@ -74,17 +85,17 @@ def test_carry_flat_length_is_the_straight_line_distance():
 
 
 def test_ball_filter_reports_each_ball_type_dropped():
-    report = load_trackman(EXPORT, balls=["premium"]).report
+    report = load_trackman(EXPORT, skip_bad_rows=True, balls=["premium"]).report
     assert report.kept == 2
     assert report.dropped["ball type 'Medium' not in ['premium']"] == [6]
     assert report.rows_in == report.kept + report.n_dropped
 
 
 def test_tracked_fraction_is_configurable_and_can_be_switched_off():
-    strict = load_trackman(EXPORT, min_tracked_fraction=0.95)
+    strict = load_trackman(EXPORT, skip_bad_rows=True, min_tracked_fraction=0.95)
     assert [r.shot_id for r in strict.records] == ["4"]
     assert strict.report.dropped[INDOOR.format(0.95)] == [3, 5, 6, 8]
-    every = load_trackman(EXPORT, min_tracked_fraction=None)
+    every = load_trackman(EXPORT, skip_bad_rows=True, min_tracked_fraction=None)
     assert [r.shot_id for r in every.records] == ["3", "4", "5", "6", "9"]
     no_flight = every.records[-1]
     assert no_flight.ball_speed_mps == pytest.approx(118.0 * MPH_TO_MPS)
@@ -129,20 +140,22 @@ def test_missing_required_column_is_refused_naming_it(tmp_path):
         load_trackman(_variant(tmp_path, without_ball), balls=["Premium"])
 
 
-def test_a_non_number_is_dropped_naming_the_column(tmp_path):
+def test_a_non_number_is_refused_or_skipped_naming_the_column(tmp_path):
     def corrupt(rows):
         rows[2][rows[0].index("Launch Angle")] = "12.0 deg"
         return rows
 
-    report = load_trackman(_variant(tmp_path, corrupt)).report
-    assert report.dropped["'Launch Angle' is not a number"] == [3]
+    with pytest.raises(RecordError, match=r"line 3 column 'Launch Angle': '12.0 deg': 'Launch Angle' is not a number"):
+        load_trackman(_variant(tmp_path, corrupt), min_tracked_fraction=None, balls=["Premium"])
+    report = load_trackman(_variant(tmp_path, corrupt), skip_bad_rows=True).report
+    assert report.dropped["bad row: 'Launch Angle' is not a number"] == [3]
 
 
 def test_convert_command_writes_canonical_csv_and_prints_the_report(tmp_path, capsys):
     parser = argparse.ArgumentParser()
     convert.register(parser.add_subparsers(dest="command"))
     out = tmp_path / "shots.csv"
-    args = parser.parse_args(["convert", "trackman", str(EXPORT), "--out", str(out), "--ball", "Premium"])
+    args = parser.parse_args(["convert", "trackman", str(EXPORT), "--out", str(out), "--ball", "Premium", "--skip-bad-rows"])
     assert args.run(args) == 0
     printed = capsys.readouterr().out
     assert "7 in, 2 kept, 5 dropped" in printed and "ball type 'Medium'" in printed
@@ -181,17 +194,17 @@ def _agree(records, rows, tolerance: float) -> None:
 
 
 def test_real_export_launch_values_agree_exactly_with_the_source(real_rows, tmp_path):
-    conversion = load_trackman(REAL)
+    conversion = load_trackman(REAL, skip_bad_rows=True)
     report = conversion.report
     assert report.rows_in == len(real_rows) == report.kept + report.n_dropped
     assert 900 < report.kept < 1200
     assert report.count("not a measured flight") > 8000
-    assert report.count("'Spin Rate' (spin_rpm) outside") >= 1
+    assert report.count("bad row: 'Spin Rate' (spin_rpm) outside") >= 1
     _agree(conversion.records, real_rows, 1e-12)
     out = tmp_path / "real.csv"
     parser = argparse.ArgumentParser()
     convert.register(parser.add_subparsers(dest="command"))
-    args = parser.parse_args(["convert", "trackman", str(REAL), "--out", str(out)])
+    args = parser.parse_args(["convert", "trackman", str(REAL), "--out", str(out), "--skip-bad-rows"])
     assert args.run(args) == 0
     written = read_shots(out)
     assert len(written) == report.kept
@@ -200,7 +213,7 @@ def test_real_export_launch_values_agree_exactly_with_the_source(real_rows, tmp_
 
 def test_real_export_curve_confirms_carry_geometry(real_rows):
     """TrackMan's Curve column is reproduced to 1e-3 ft by carry_x cos φ − carry_y sin φ on every converted shot."""
-    for shot in load_trackman(REAL).records:
+    for shot in load_trackman(REAL, skip_bad_rows=True).records:
         curve = real_rows[int(shot.shot_id)]["Curve"]
         if curve:
             phi = math.radians(shot.launch_direction_deg)

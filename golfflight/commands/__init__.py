@@ -1,5 +1,18 @@
 """Subcommands of the `golfflight` command; each module has `register(subparsers)` and sets `run`."""
 
-from golfflight.commands import calibrate, convert, discover, export, fly, serve, simulate, synth, train
+from golfflight.commands import (
+    accuracy,
+    calibrate,
+    convert,
+    discover,
+    evaluate,
+    export,
+    finetune,
+    fly,
+    serve,
+    simulate,
+    synth,
+    train,
+)
 
-COMMANDS = [fly, synth, convert, calibrate, train, export, serve, simulate, discover]
+COMMANDS = [fly, synth, convert, calibrate, train, export, evaluate, finetune, accuracy, serve, simulate, discover]

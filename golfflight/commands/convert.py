@@ -10,6 +10,9 @@ from shots.tourcast import load_tourcast
 from shots.trackman import Conversion, load_trackman
 
 
+SKIP_HELP = "leave out malformed rows (each listed in the report) instead of refusing the file"
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser("convert", help="convert a real export (TrackMan, TOURCAST) to canonical CSV")
     formats = parser.add_subparsers(dest="format", required=True)
@@ -24,6 +27,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="keep indoor shots too (their outcome is TrackMan's model)")
     trackman.add_argument("--ball", action="extend", nargs="+", help="keep only these ball types, e.g. Premium")
     trackman.add_argument("--session", help="session id when the file has no Date column (default: the file name)")
+    trackman.add_argument("--skip-bad-rows", action="store_true", help=SKIP_HELP)
     trackman.set_defaults(run=run_trackman)
 
     tourcast = formats.add_parser("tourcast", help="PGA TOUR TOURCAST shot_trajectory CSV (+ pbp CSV for spin)")
@@ -33,6 +37,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                           help="estimate missing spin from the initial lift (Ferguson 2022 C_L) instead of dropping")
     tourcast.add_argument("--sample-interval", type=float, default=0.01, help="trajectory sample spacing, s")
     tourcast.add_argument("--out", required=True, help="canonical CSV to write (the trajectories go beside it)")
+    tourcast.add_argument("--skip-bad-rows", action="store_true", help=SKIP_HELP)
     tourcast.set_defaults(run=run_tourcast)
 
 
@@ -54,7 +59,8 @@ def run_trackman(args: argparse.Namespace) -> int:
     fraction = None if args.all_flights else args.min_tracked_fraction
     if fraction is not None and not 0 < fraction <= 1:
         raise ValueError(f"--min-tracked-fraction must be in (0, 1], got {fraction}")
-    conversion = load_trackman(args.source, min_tracked_fraction=fraction, balls=args.ball, session=args.session)
+    conversion = load_trackman(args.source, min_tracked_fraction=fraction, balls=args.ball, session=args.session,
+                               skip_bad_rows=args.skip_bad_rows)
     return _write(conversion, args.out)
 
 
@@ -62,5 +68,5 @@ def run_tourcast(args: argparse.Namespace) -> int:
     if args.sample_interval <= 0:
         raise ValueError(f"--sample-interval must be positive, got {args.sample_interval}")
     conversion = load_tourcast(args.source, args.pbp, estimate_spin=args.estimate_spin,
-                               sample_interval_s=args.sample_interval)
+                               sample_interval_s=args.sample_interval, skip_bad_rows=args.skip_bad_rows)
     return _write(conversion, args.out)

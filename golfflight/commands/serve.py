@@ -1,9 +1,20 @@
-"""`golfflight serve`: the HTTP flight service (FastAPI on uvicorn) for a model bundle."""
+"""`golfflight serve`: the HTTP flight service (FastAPI on uvicorn) for a model bundle.
+
+Binds 127.0.0.1 unless told otherwise. The API key comes from $GOLFFLIGHT_API_KEY only (never the command line,
+where `ps` would show it); browser origins for CORS from --cors-origin or $GOLFFLIGHT_CORS_ORIGINS. The bundle is
+verified completely before any worker starts; SIGTERM or Ctrl-C lets in-flight requests finish (up to
+GRACEFUL_SHUTDOWN_S) before the workers exit.
+"""
 
 from __future__ import annotations
 
 import argparse
+import ipaddress
 import os
+import sys
+
+GRACEFUL_SHUTDOWN_S = 30
+"""Longest a shutdown waits for in-flight requests (a full 10,000-shot batch takes about a second)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -12,19 +23,50 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--port", type=int, default=8000)
     parser.add_argument("--workers", type=int, default=1, help="processes, each with its own copy of the model")
     parser.add_argument("--model", help="model bundle directory (default: the shipped models/default)")
+    parser.add_argument(
+        "--cors-origin",
+        action="append",
+        metavar="ORIGIN",
+        help="allow browser calls from this origin, e.g. https://sim.example.com (repeatable; default: CORS off)",
+    )
     parser.set_defaults(run=run)
+
+
+def _loopback(host: str) -> bool:
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
 
 
 def run(args: argparse.Namespace) -> int:
     import uvicorn
 
+    from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
+    from service.bundle_check import verify_bundle
     from service.model_location import MODEL_ENV, model_dir
-    from weights_schema.bundle import load_bundle
 
+    if args.workers < 1:
+        raise ValueError(f"--workers must be at least 1, got {args.workers}")
     bundle = model_dir(args.model).resolve()
-    card, _ = load_bundle(bundle)  # refuse a bad bundle here, before any worker starts
-    os.environ[MODEL_ENV] = str(bundle)  # the factory in every worker process reads it
-    print(f"golfflight serve: {card.variant} model from {bundle} on http://{args.host}:{args.port} (docs at /docs)")
+    card = verify_bundle(bundle)  # refuse a bad bundle here, before any worker starts
+    os.environ[MODEL_ENV] = str(bundle)  # the factory in every worker process reads these
+    if args.cors_origin:
+        os.environ[CORS_ORIGINS_ENV] = ",".join(args.cors_origin)
+    keyed = bool(os.environ.get(API_KEY_ENV))
+    print(
+        f"golfflight serve: {card.variant} model from {bundle} on http://{args.host}:{args.port} (docs at /docs), "
+        f"{args.workers} worker(s), API key {'required' if keyed else 'off'}, "
+        f"CORS {os.environ.get(CORS_ORIGINS_ENV) or 'off'}"
+    )
+    if not keyed and not _loopback(args.host):
+        print(
+            f"golfflight serve: warning: listening on {args.host} without an API key: anyone who can reach the port "
+            f"can use the service (set {API_KEY_ENV})",
+            file=sys.stderr,
+        )
     uvicorn.run(
         "service.api.app:create_app",
         factory=True,
@@ -33,5 +75,6 @@ def run(args: argparse.Namespace) -> int:
         workers=args.workers,
         access_log=False,
         log_level="warning",
+        timeout_graceful_shutdown=GRACEFUL_SHUTDOWN_S,
     )
     return 0

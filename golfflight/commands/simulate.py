@@ -5,6 +5,9 @@ Input: JSON (one shot, a list of shots, or {"shots": [...]}, in the HTTP request
 altitude_m, pressure_hpa, humidity_pct, density_kg_m3, wind_speed_mps, wind_from_deg, wind_profile,
 wind_reference_height_m, normalized). A canonical shot file works as is: its identity and outcome columns are
 passed over, its shot_id echoed. Output: {"results": [...]} as JSON, or a flat CSV when --out ends in .csv.
+
+A bad shot (a value out of range or not a number, an extra cell, a shot_id seen before) refuses the file with its
+line (CSV) or index (JSON) and field; --skip-bad-rows flies the rest and lists each one left out on stderr.
 """
 
 from __future__ import annotations
@@ -14,6 +17,8 @@ import csv
 import json
 import sys
 from pathlib import Path
+
+from shots.records import reading
 
 AIR_COLUMNS = {name: name for name in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct", "density_kg_m3")}
 WIND_COLUMNS = {
@@ -51,6 +56,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("input", help="JSON or CSV file of shots; - reads JSON from standard input")
     parser.add_argument("--model", help="model bundle directory (default: the shipped models/default)")
     parser.add_argument("--out", help="write here instead of standard output (.csv: a flat CSV, else JSON)")
+    parser.add_argument(
+        "--skip-bad-rows", action="store_true", help="fly the valid shots and list each invalid one instead of refusing"
+    )
     parser.set_defaults(run=run)
 
 
@@ -61,16 +69,36 @@ def _number_or_text(text: str):
         return text
 
 
-def shots_from_csv(path: Path) -> tuple[list[dict], list[str | None]]:
-    """Request dicts and shot ids (None where the file has none) of a launches CSV."""
-    with open(path, newline="") as handle:
+REQUEST_TO_COLUMN = {
+    **{f"air.{field}": column for column, field in AIR_COLUMNS.items()},
+    **{f"wind.{field}": column for column, field in WIND_COLUMNS.items()},
+}
+"""Request field -> CSV column, to name the column of a refused value."""
+
+
+def shots_from_csv(path: Path) -> tuple[list[dict], list[str | None], list[str], list[str]]:
+    """Request dicts, shot ids (None where the file has none), where each shot is ("FILE line N") and the problems
+    found while reading (extra cells, repeated shot ids) of a launches CSV."""
+    with reading(path), open(path, newline="") as handle:
         reader = csv.DictReader(handle)
         known = {"shot_id", "normalized", *LAUNCH_COLUMNS, *AIR_COLUMNS, *WIND_COLUMNS, *PASSED_OVER}
         unknown = [c for c in reader.fieldnames or [] if c not in known]
+        if not reader.fieldnames:
+            raise ValueError(f"{path} line 1: no header row; launch columns are {', '.join(LAUNCH_COLUMNS)}")
         if unknown:
             raise ValueError(f"{path}: unknown columns {unknown}; launch columns are {', '.join(LAUNCH_COLUMNS)}")
-        shots, ids = [], []
-        for row in reader:
+        shots, ids, places, problems, seen = [], [], [], [], {}
+        for line, row in enumerate(reader, start=2):
+            place = f"{path} line {line}"
+            if None in row:
+                problems.append(f"{place}: {len(row[None])} cells beyond the header")
+                continue
+            shot_id = row.get("shot_id")
+            if shot_id and shot_id in seen:
+                problems.append(f"{place} column 'shot_id': {shot_id!r} duplicates the shot_id of line {seen[shot_id]}")
+                continue
+            if shot_id:
+                seen[shot_id] = line
             cells = {k: _number_or_text(v.strip()) for k, v in row.items() if v is not None and v.strip() != ""}
             shot = {k: cells[k] for k in LAUNCH_COLUMNS if k in cells}
             air = {AIR_COLUMNS[k]: cells[k] for k in AIR_COLUMNS if k in cells}
@@ -82,8 +110,28 @@ def shots_from_csv(path: Path) -> tuple[list[dict], list[str | None]]:
             if "normalized" in cells:
                 shot["normalized"] = str(cells["normalized"]).lower() in ("1", "1.0", "true", "yes")
             shots.append(shot)
-            ids.append(row.get("shot_id"))
-    return shots, ids
+            ids.append(shot_id)
+            places.append(place)
+    return shots, ids, places, problems
+
+
+def validate(raw: list, places: list[str], csv_columns: bool) -> tuple[list, list[int], list[str]]:
+    """(valid ShotRequests, their indices in `raw`, one problem line per invalid value naming where and which field)."""
+    from pydantic import ValidationError
+
+    from service.api.models import ShotRequest, describe_errors
+
+    shots, kept, problems = [], [], []
+    for index, (item, place) in enumerate(zip(raw, places, strict=True)):
+        try:
+            shots.append(ShotRequest.model_validate(item))
+            kept.append(index)
+        except ValidationError as error:
+            for detail in describe_errors(error.errors()):
+                field = detail["field"]
+                where = f"column '{REQUEST_TO_COLUMN.get(field, field)}'" if csv_columns else f"field '{field}'"
+                problems.append(f"{place} {where}: {detail['message'].split(': ', 1)[-1]}")
+    return shots, kept, problems
 
 
 def shots_from_json(text: str, source: str) -> list[dict]:
@@ -111,29 +159,37 @@ def flat_row(result: dict) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pydantic import TypeAdapter, ValidationError
-
-    from service.api.models import ShotRequest, describe_errors
     from service.api.shots import fly_shots
     from service.engine import FlightEngine
     from service.model_location import model_dir
 
     ids: list[str | None] = []
+    problems: list[str] = []
+    from_csv = False
     if args.input == "-":
         raw = shots_from_json(sys.stdin.read(), "standard input")
+        places = [f"standard input shot {i}" for i in range(len(raw))]
     else:
         path = Path(args.input)
         if not path.is_file():
             raise FileNotFoundError(f"no such file: {path}")
-        if path.suffix.lower() == ".csv":
-            raw, ids = shots_from_csv(path)
+        from_csv = path.suffix.lower() == ".csv"
+        if from_csv:
+            raw, ids, places, problems = shots_from_csv(path)
         else:
-            raw = shots_from_json(path.read_text(), str(path))
-    try:
-        shots = TypeAdapter(list[ShotRequest]).validate_python(raw)
-    except ValidationError as error:
-        problems = "; ".join(f"shot {d['message']}" for d in describe_errors(error.errors())[:10])
-        raise ValueError(f"{args.input}: {error.error_count()} invalid values: {problems}") from None
+            with reading(path):
+                raw = shots_from_json(path.read_text(), str(path))
+            places = [f"{path} shot {i}" for i in range(len(raw))]
+    if not raw and not problems:
+        raise ValueError(f"{args.input}: no shots in it")
+    shots, kept, invalid = validate(raw, places, from_csv)
+    problems += invalid
+    if problems and not args.skip_bad_rows:
+        shown = "\n  ".join(problems[:20]) + (f"\n  ... and {len(problems) - 20} more" if len(problems) > 20 else "")
+        raise ValueError(f"{args.input}: {len(problems)} invalid values (--skip-bad-rows flies the rest):\n  {shown}")
+    for problem in problems:
+        print(f"golfflight simulate: skipped: {problem}", file=sys.stderr)
+    ids = [ids[i] for i in kept] if ids else []
     engine = FlightEngine(model_dir(args.model))
     results = [r.model_dump(exclude_none=True) for r in fly_shots(engine, shots)]
     if args.out and args.out.lower().endswith(".csv"):

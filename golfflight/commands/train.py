@@ -38,6 +38,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--limit", type=int, help="use at most this many shots (quick runs)")
     parser.add_argument("--resume", action="store_true", help="continue from OUT/last.pt")
+    parser.add_argument(
+        "--skip-bad-rows",
+        action="store_true",
+        help="leave out malformed rows of --data (each listed) instead of refusing the file",
+    )
     parser.add_argument("--threads", type=int, default=2, help="torch CPU threads (1 is faster on a busy machine)")
     parser.set_defaults(run=run)
 
@@ -58,8 +63,10 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         limit=args.limit,
     )
-    result = train(args.data, args.out, config, resume=args.resume)
+    result = train(args.data, args.out, config, resume=args.resume, skip_bad_rows=args.skip_bad_rows)
     data = result.data
+    for problem in data.bad_rows:
+        print(f"skipped bad row: {problem}")
     print(f"data: {data.n_train} train, {data.n_val} val shots; left out {data.filters}")
     if result.skipped_batches:
         print(f"skipped {result.skipped_batches} batches with a non-finite loss or gradient")

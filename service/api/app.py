@@ -1,8 +1,12 @@
 """The HTTP service: a FastAPI app factory with thin async routes over `service.api.shots`.
 
-Routes are `async def` and simulate inline: one shot takes well under a millisecond, less than a hop to a
-worker thread would cost, so concurrency comes from `golfflight serve --workers N` (one process, one model each).
-The model loads in a background thread at startup; /healthz answers 503 until it is ready.
+Single shots simulate inline in `async def` routes: one takes well under a millisecond, less than a hop to a
+thread would cost. Batches fly on one batch thread per process, so a fitting studio's thousands of shots do not
+hold up a simulator bay's single shots (ONNX Runtime and NumPy release the GIL for most of a batch step); more
+concurrency comes from `golfflight serve --workers N` (one process, one model each).
+The model loads in a background thread at startup; /healthz answers 503 until it is ready. In front of the routes:
+a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and CORS only for configured origins
+($GOLFFLIGHT_CORS_ORIGINS); every refusal is a 4xx whose body names the field, the value and the allowed range.
 """
 
 from __future__ import annotations
@@ -11,19 +15,26 @@ import asyncio
 import os
 import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import asynccontextmanager
 from pathlib import Path
 
 from fastapi import FastAPI, Request
+from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
+from fastapi.middleware.cors import CORSMiddleware
 from fastapi.responses import JSONResponse, Response
 from pydantic import BaseModel
+from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from golfflight import __version__
-from service.api.gspro import GSProMessage, GSProReply, launch_from_ball_data
+from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
+from service.api.gspro import GSPRO_RANGES, GSProMessage, GSProReply, launch_from_ball_data
 from service.api.latency import RequestTimer, Rolling
 from service.api.models import (
     MAX_BATCH_SHOTS,
+    MAX_BATCH_TRAJECTORIES,
+    RANGES,
     BatchRequest,
     BatchResult,
     ShotRequest,
@@ -50,6 +61,7 @@ class ServiceState:
         self.simulation = Rolling()
         self.requests = Rolling()
         self.loaded = threading.Event()
+        self.batches = ThreadPoolExecutor(max_workers=1, thread_name_prefix="golfflight-batch")
 
     def load(self) -> None:
         try:
@@ -68,15 +80,43 @@ def _json(model: BaseModel, status_code: int = 200) -> Response:
     return Response(model.model_dump_json(exclude_none=True), status_code, media_type="application/json")
 
 
-def create_app(model: str | os.PathLike | None = None) -> FastAPI:
-    """The service for a model bundle (default: `service.model_location.model_dir()`)."""
+def _flight_error(error: FlightError) -> JSONResponse:
+    message = str(error)
+    detail = {"loc": ["body"], "msg": message, "type": "flight_error", "field": "body", "message": message}
+    return JSONResponse({"detail": [detail]}, 422)
+
+
+def _origins(text: str | None) -> list[str]:
+    return [origin.strip() for origin in (text or "").split(",") if origin.strip()]
+
+
+ERROR_RESPONSES = {
+    401: {"description": "the API key is required and was missing or wrong"},
+    413: {"description": f"request body over {MAX_BODY_BYTES:,} bytes"},
+    503: {"description": "the model is still loading, or failed to load (see /healthz)"},
+}
+
+
+def create_app(
+    model: str | os.PathLike | None = None,
+    *,
+    api_key: str | None = None,
+    cors_origins: list[str] | None = None,
+) -> FastAPI:
+    """The service for a model bundle (default: `service.model_location.model_dir()`).
+
+    `api_key` (default $GOLFFLIGHT_API_KEY) makes every route but /healthz require it; `cors_origins` (default the
+    comma-separated $GOLFFLIGHT_CORS_ORIGINS) are the browser origins allowed; none means CORS stays off."""
     state = ServiceState(model_dir(model))
+    api_key = api_key if api_key is not None else os.environ.get(API_KEY_ENV, "")
+    cors_origins = cors_origins if cors_origins is not None else _origins(os.environ.get(CORS_ORIGINS_ENV))
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
         loading = asyncio.get_running_loop().run_in_executor(None, state.load)
         yield
         await loading
+        state.batches.shutdown(wait=True)
 
     app = FastAPI(
         title="golfflight",
@@ -86,6 +126,16 @@ def create_app(model: str | os.PathLike | None = None) -> FastAPI:
     )
     app.state.service = state
     app.add_middleware(RequestTimer, rolling=state.requests, prefixes=("/v1/shots", GSPRO_PATH))
+    if api_key:
+        app.add_middleware(ApiKey, key=api_key)
+    if cors_origins:
+        app.add_middleware(
+            CORSMiddleware,
+            allow_origins=cors_origins,
+            allow_methods=["GET", "POST"],
+            allow_headers=["content-type", "x-api-key", "authorization"],
+        )
+    app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)
 
     def engine() -> FlightEngine:
         if state.engine is None:
@@ -94,11 +144,20 @@ def create_app(model: str | os.PathLike | None = None) -> FastAPI:
 
     @app.exception_handler(RequestValidationError)
     async def invalid_request(request: Request, error: RequestValidationError) -> JSONResponse:
-        details = describe_errors(error.errors())
         if request.url.path == GSPRO_PATH:
-            message = "; ".join(d["message"] for d in details)
-            return JSONResponse(GSProReply(Code=500, Message=message).model_dump(exclude_none=True), 500)
-        return JSONResponse({"detail": details}, 422)
+            message = "; ".join(d["message"] for d in describe_errors(error.errors(), GSPRO_RANGES))
+            return JSONResponse(GSProReply(Code=500, Message=message).model_dump(exclude_none=True), 422)
+        return JSONResponse({"detail": describe_errors(error.errors(), RANGES)}, 422)
+
+    @app.exception_handler(StarletteHTTPException)
+    async def http_error(request: Request, error: StarletteHTTPException) -> Response:
+        if error.status_code != 400:
+            return await http_exception_handler(request, error)
+        message = "the body is not JSON text in UTF-8"  # FastAPI's 400 for a body it cannot even decode
+        if request.url.path == GSPRO_PATH:
+            return JSONResponse(GSProReply(Code=500, Message=message).model_dump(exclude_none=True), 422)
+        detail = {"loc": ["body"], "msg": message, "type": "json_invalid", "field": "body", "message": message}
+        return JSONResponse({"detail": [detail]}, 422)
 
     @app.exception_handler(NotReady)
     async def not_ready(request: Request, error: NotReady) -> JSONResponse:
@@ -110,7 +169,7 @@ def create_app(model: str | os.PathLike | None = None) -> FastAPI:
         "/v1/shots",
         response_model=ShotResult,
         response_model_exclude_none=True,
-        responses={422: {"description": "invalid launch or conditions, or a shot that cannot land"}},
+        responses={422: {"description": "invalid launch or conditions, or a shot that cannot land"}, **ERROR_RESPONSES},
     )
     async def shot(request: ShotRequest) -> Response:
         """Fly one shot: launch in SI or launch-monitor units, optional wind, air, normalized and trajectory."""
@@ -119,7 +178,7 @@ def create_app(model: str | os.PathLike | None = None) -> FastAPI:
         try:
             result = fly_shot(flying, request)
         except FlightError as error:
-            return JSONResponse({"detail": [{"field": "body", "message": str(error)}]}, 422)
+            return _flight_error(error)
         finally:
             state.simulation.add(time.perf_counter() - started)
         return _json(result)
@@ -128,19 +187,34 @@ def create_app(model: str | os.PathLike | None = None) -> FastAPI:
         "/v1/shots/batch",
         response_model=BatchResult,
         response_model_exclude_none=True,
-        description=f"Fly up to {MAX_BATCH_SHOTS:,} shots together in one engine batch; results come back in order "
-        "and a shot that cannot land gets an error entry of its own.",
+        responses=ERROR_RESPONSES,
+        description=f"Fly up to {MAX_BATCH_SHOTS:,} shots together in one engine batch (at most "
+        f"{MAX_BATCH_TRAJECTORIES} of them with a trajectory); results come back in order and a shot that cannot "
+        "land gets an error entry of its own.",
     )
     async def batch(request: BatchRequest) -> Response:
         flying = engine()
-        started = time.perf_counter()
-        results = fly_shots(flying, request.shots)
-        state.simulation.add(time.perf_counter() - started)
-        return _json(BatchResult(results=results))
 
-    @app.post(GSPRO_PATH, response_model=GSProReply, response_model_exclude_none=True)
+        def fly_and_encode() -> Response:
+            started = time.perf_counter()
+            results = fly_shots(flying, request.shots)
+            state.simulation.add(time.perf_counter() - started)
+            return _json(BatchResult(results=results))
+
+        return await asyncio.get_running_loop().run_in_executor(state.batches, fly_and_encode)
+
+    @app.post(
+        GSPRO_PATH,
+        response_model=GSProReply,
+        response_model_exclude_none=True,
+        responses={
+            422: {"model": GSProReply, "description": "an invalid message or a failed flight: Open Connect's Code 500"},
+            **ERROR_RESPONSES,
+        },
+    )
     async def gspro(message: GSProMessage) -> Response:
-        """A GSPro Open Connect v1 message: a shot gets its flight with Code 200, a heartbeat just Code 200."""
+        """A GSPro Open Connect v1 message: a shot gets its flight with Code 200, a heartbeat just Code 200; an
+        invalid message or a failed flight gets HTTP 422 with Open Connect's error reply (Code 500, a Message)."""
         if message.is_heartbeat:
             return _json(GSProReply(Code=200, Message="heartbeat received"))
         if message.BallData is None or not message.ShotDataOptions.ContainsBallData:
@@ -151,7 +225,7 @@ def create_app(model: str | os.PathLike | None = None) -> FastAPI:
             launch = launch_from_ball_data(message.BallData)
             flight = flying.fly(launch)
         except (ValueError, FlightError) as error:
-            return _json(GSProReply(Code=500, Message=str(error), ShotNumber=message.ShotNumber), 500)
+            return _json(GSProReply(Code=500, Message=str(error), ShotNumber=message.ShotNumber), 422)
         finally:
             state.simulation.add(time.perf_counter() - started)
         result = ShotResult.model_construct(**flight_fields(flight, None))
@@ -177,12 +251,12 @@ def create_app(model: str | os.PathLike | None = None) -> FastAPI:
             }
         )
 
-    @app.get("/v1/model", response_model=ModelCard)
+    @app.get("/v1/model", response_model=ModelCard, responses=ERROR_RESPONSES)
     async def model_card() -> Response:
-        """The loaded bundle's model card."""
-        return _json(engine().card)
+        """The loaded bundle's model card (every field, nulls included, as the card's schema requires)."""
+        return Response(engine().card.model_dump_json(), media_type="application/json")
 
-    @app.get("/v1/latency")
+    @app.get("/v1/latency", responses=ERROR_RESPONSES)
     async def latency() -> JSONResponse:
         """Rolling p50/p95/p99 of simulation time and whole requests, and a probe shot timed now."""
         flying = engine()

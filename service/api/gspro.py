@@ -1,7 +1,8 @@
 """GSPro Open Connect v1 shot messages (NOTES.md section 4), as a launch-monitor connector sends them.
 
 The protocol is not ours, so unknown fields are ignored (connectors add their own); the values we use are
-range-checked like every other launch. Speeds are mph, angles degrees (HLA + = right), spins rpm. BackSpin and
+type- and range-checked like every other launch (GSPRO_RANGES, quoted in the error message).
+Speeds are mph, angles degrees (HLA + = right), spins rpm. BackSpin and
 SideSpin are used only when TotalSpin is absent (or zero while they are not); + SideSpin curves the ball right.
 """
 
@@ -20,23 +21,38 @@ from service.limits import Range
 
 
 class _Lenient(BaseModel):
-    model_config = ConfigDict(extra="ignore", allow_inf_nan=False)
+    """Ignores unknown fields; refuses non-finite numbers and values of the wrong JSON type."""
+
+    model_config = ConfigDict(extra="ignore", allow_inf_nan=False, strict=True)
 
 
-def _in(bounds: Range, description: str):
+GSPRO_RANGES: dict[str, Range] = {
+    "Speed": BALL_SPEED_MPH,
+    "SpinAxis": limits.SPIN_AXIS_DEG,
+    "TotalSpin": limits.SPIN_RPM,
+    "BackSpin": limits.SPIN_RPM,
+    "SideSpin": SIDE_SPIN_RPM,
+    "HLA": limits.LAUNCH_DIRECTION_DEG,
+    "VLA": limits.LAUNCH_ANGLE_DEG,
+}
+"""Allowed range of every BallData value used, by field name."""
+
+
+def _in(name: str, description: str):
+    bounds = GSPRO_RANGES[name]
     return Annotated[
         float | None, Field(ge=bounds.low, le=bounds.high, description=f"{description} ({bounds.describe()})")
     ]
 
 
 class GSProBallData(_Lenient):
-    Speed: _in(BALL_SPEED_MPH, "ball speed, mph") = None
-    SpinAxis: _in(limits.SPIN_AXIS_DEG, "spin axis, + = right") = None
-    TotalSpin: _in(limits.SPIN_RPM, "total spin, rpm") = None
-    BackSpin: _in(limits.SPIN_RPM, "back spin, rpm") = None
-    SideSpin: _in(SIDE_SPIN_RPM, "side spin, rpm, + = right") = None
-    HLA: _in(limits.LAUNCH_DIRECTION_DEG, "horizontal launch angle, + = right") = None
-    VLA: _in(limits.LAUNCH_ANGLE_DEG, "vertical launch angle") = None
+    Speed: _in("Speed", "ball speed, mph") = None
+    SpinAxis: _in("SpinAxis", "spin axis, + = right") = None
+    TotalSpin: _in("TotalSpin", "total spin, rpm") = None
+    BackSpin: _in("BackSpin", "back spin, rpm") = None
+    SideSpin: _in("SideSpin", "side spin, rpm, + = right") = None
+    HLA: _in("HLA", "horizontal launch angle, + = right") = None
+    VLA: _in("VLA", "vertical launch angle") = None
     CarryDistance: float | None = Field(None, description="the monitor's own carry; not used")
 
 
@@ -53,7 +69,7 @@ class GSProMessage(_Lenient):
 
     DeviceID: str | None = None
     Units: str | None = None
-    ShotNumber: int | None = None
+    ShotNumber: int | None = Field(None, ge=0, le=2**31 - 1)
     APIversion: str | None = None
     BallData: GSProBallData | None = None
     ClubData: dict | None = None
@@ -65,7 +81,8 @@ class GSProMessage(_Lenient):
 
 
 class GSProReply(BaseModel):
-    """Open Connect's reply: Code 200 with the flight for a shot, 200 for a heartbeat, 5xx with a Message on error."""
+    """Open Connect's reply: Code 200 with the flight for a shot, 200 for a heartbeat, 500 with a Message on error
+    (sent with HTTP 422)."""
 
     Code: int
     Message: str

@@ -1,8 +1,9 @@
 """The HTTP contract: pydantic request and response models (SI inside, imperial only in fields named for it).
 
-Every number is range-checked against `service.limits` (NaN and infinity refused), unknown fields are refused,
-and each launch quantity comes in exactly one form: ball_speed_mps or ball_speed_mph; spin_rpm (+ spin_axis_deg)
-or back_spin_rpm (+ side_spin_rpm).
+Every number is range-checked against `service.limits` (NaN and infinity refused), types are strict (no "55" for
+55), unknown fields are refused, and each launch quantity comes in exactly one form: ball_speed_mps or
+ball_speed_mph; spin_rpm (+ spin_axis_deg) or back_spin_rpm (+ side_spin_rpm). The one-form rules are also written
+into the OpenAPI schema (oneOf / not), so a schema-driven client or fuzzer builds the requests the service takes.
 """
 
 from __future__ import annotations
@@ -16,10 +17,12 @@ from service import limits
 from service.conditions import NORMALIZED_REFERENCE
 from service.constants import MPH_TO_MPS
 from service.limits import Range
-from service.trajectory import MAX_RATE_HZ
 
 MAX_BATCH_SHOTS = 10_000
 """Most shots one POST /v1/shots/batch may carry."""
+
+MAX_BATCH_TRAJECTORIES = 100
+"""Most shots of one batch that may ask for a trajectory (each can be 20,000 points at 1 kHz)."""
 
 BALL_SPEED_MPH = Range(limits.BALL_SPEED_MPS.low / MPH_TO_MPS, limits.BALL_SPEED_MPS.high / MPH_TO_MPS, "mph")
 SIDE_SPIN_RPM = Range(-limits.SPIN_RPM.high, limits.SPIN_RPM.high, "rpm")
@@ -41,6 +44,7 @@ RANGES: dict[str, Range] = {
     "speed_mps": limits.WIND_SPEED_MPS,
     "from_deg": limits.WIND_FROM_DEG,
     "reference_height_m": limits.WIND_REFERENCE_HEIGHT_M,
+    "rate_hz": limits.TRAJECTORY_RATE_HZ,
 }
 """Allowed range of every numeric request field, by name (also quoted in 422 answers)."""
 
@@ -55,9 +59,29 @@ def _in(name: str, description: str, optional: bool = False):
 
 
 class Strict(BaseModel):
-    """Refuses unknown fields and non-finite numbers."""
+    """Refuses unknown fields, non-finite numbers and values of the wrong JSON type."""
 
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, strict=True)
+
+
+def _given(*names: str) -> dict:
+    """JSON Schema: every one of `names` is present and a number (null counts as absent, as in the models)."""
+    return {"required": list(names), "properties": {name: {"type": "number"} for name in names}}
+
+
+def _one_of(*forms: tuple[str, tuple[str, ...]]) -> dict:
+    """JSON Schema: exactly one form is used; each form names its own field and the fields it excludes."""
+    return {
+        "oneOf": [
+            {"required": [field], "properties": {field: {"type": "number"}, **{x: {"type": "null"} for x in excluded}}}
+            for field, excluded in forms
+        ]
+    }
+
+
+def _not_together(*pairs: tuple[str, str]) -> dict:
+    """JSON Schema: no pair is given together."""
+    return {"not": {"anyOf": [_given(*pair) for pair in pairs]}}
 
 
 def _exactly_one(model: BaseModel, quantity: str, *names: str) -> None:
@@ -67,8 +91,15 @@ def _exactly_one(model: BaseModel, quantity: str, *names: str) -> None:
         raise ValueError(f"{quantity}: give exactly one of {' or '.join(names)} (got {found})")
 
 
+WEATHER_FIELDS = ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct")
+
+
 class AirRequest(Strict):
     """The air: weather values (altitude or station pressure) or an explicit density; omitted = ICAO standard."""
+
+    model_config = ConfigDict(
+        json_schema_extra=_not_together(("altitude_m", "pressure_hpa"), *(("density_kg_m3", w) for w in WEATHER_FIELDS))
+    )
 
     temperature_c: _in("temperature_c", "air temperature", True) = None
     altitude_m: _in("altitude_m", "height above sea level, standard atmosphere", True) = None
@@ -80,9 +111,7 @@ class AirRequest(Strict):
     def _one_source(self) -> AirRequest:
         if self.altitude_m is not None and self.pressure_hpa is not None:
             raise ValueError("air: give altitude_m or pressure_hpa, not both")
-        weather = [
-            n for n in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct") if getattr(self, n) is not None
-        ]
+        weather = [n for n in WEATHER_FIELDS if getattr(self, n) is not None]
         if self.density_kg_m3 is not None and weather:
             raise ValueError(f"air: density_kg_m3 replaces the weather values; drop {', '.join(weather)}")
         return self
@@ -90,6 +119,8 @@ class AirRequest(Strict):
 
 class ReferenceAir(Strict):
     """Reference air of the normalized flight (calm); omitted fields take TrackMan's 25 degC, sea level."""
+
+    model_config = ConfigDict(json_schema_extra=_not_together(("altitude_m", "pressure_hpa")))
 
     temperature_c: _in("temperature_c", "air temperature") = NORMALIZED_REFERENCE.air.temperature_c
     altitude_m: _in("altitude_m", "height above sea level", True) = None
@@ -117,11 +148,24 @@ class WindRequest(Strict):
 class TrajectoryRequest(Strict):
     """{} for the integrator's states, {"rate_hz": 60} for positions resampled at that rate."""
 
-    rate_hz: float | None = Field(None, gt=0, le=MAX_RATE_HZ, description=f"resampling rate (up to {MAX_RATE_HZ:g} Hz)")
+    rate_hz: _in("rate_hz", "resampling rate, positions from t = 0 to the landing", True) = None
 
 
 class ShotRequest(Strict):
-    """One launch, its conditions, and what to return besides the flight."""
+    """One launch, its conditions, and what to return besides the flight. Back and side spin together may not
+    exceed the total spin range."""
+
+    model_config = ConfigDict(
+        json_schema_extra={
+            "allOf": [
+                _one_of(("ball_speed_mps", ("ball_speed_mph",)), ("ball_speed_mph", ("ball_speed_mps",))),
+                _one_of(
+                    ("spin_rpm", ("back_spin_rpm", "side_spin_rpm")),
+                    ("back_spin_rpm", ("spin_rpm", "spin_axis_deg")),
+                ),
+            ]
+        }
+    )
 
     ball_speed_mps: _in("ball_speed_mps", "ball speed", True) = None
     ball_speed_mph: _in("ball_speed_mph", "ball speed", True) = None
@@ -156,7 +200,20 @@ class ShotRequest(Strict):
 class BatchRequest(Strict):
     """Many shots, flown together; results come back in the same order."""
 
-    shots: list[ShotRequest] = Field(min_length=1, max_length=MAX_BATCH_SHOTS)
+    shots: list[ShotRequest] = Field(
+        min_length=1,
+        max_length=MAX_BATCH_SHOTS,
+        description=f"1 to {MAX_BATCH_SHOTS:,} shots, at most {MAX_BATCH_TRAJECTORIES} of them with a trajectory",
+    )
+
+    @model_validator(mode="after")
+    def _few_trajectories(self) -> BatchRequest:
+        asked = sum(shot.trajectory is not None for shot in self.shots)
+        if asked > MAX_BATCH_TRAJECTORIES:
+            raise ValueError(
+                f"shots: {asked} shots ask for a trajectory, at most {MAX_BATCH_TRAJECTORIES} may in one batch"
+            )
+        return self
 
 
 class Landing(BaseModel):
@@ -205,7 +262,7 @@ class ShotResult(FlightResult):
 class ShotFailure(BaseModel):
     """A batch shot the engine could not fly (the rest of the batch is unaffected)."""
 
-    error: str
+    error: str = Field(description="why, e.g. the ball was still in the air at the simulation cap")
 
 
 class BatchResult(BaseModel):
@@ -213,27 +270,36 @@ class BatchResult(BaseModel):
 
 
 def _plain(value):
-    """A request value as JSON can carry it (NaN and infinity as text)."""
+    """A request value as JSON can carry it (NaN and infinity as text; objects and lists left out)."""
     if isinstance(value, float) and not math.isfinite(value):
         return str(value)
     return value if isinstance(value, (str, int, float, bool)) or value is None else None
 
 
-def describe_errors(errors) -> list[dict]:
-    """422 details naming the field, the value and the allowed range."""
-    details = []
-    for error in errors:
-        path = [str(p) for p in error["loc"] if p != "body"]
-        field = ".".join(path) or "body"
-        message = error["msg"].removeprefix("Value error, ")
-        entry: dict = {"field": field, "message": message}
-        value = _plain(error.get("input")) if error["type"] != "missing" else None
-        if value is not None:
-            entry["value"] = value
-            message += f" (got {value!r})"
-        if path and path[-1] in RANGES and error["type"] not in ("missing", "extra_forbidden"):
-            entry["allowed"] = RANGES[path[-1]].describe()
-            message += f"; allowed {entry['allowed']}"
-        entry["message"] = f"{field}: {message}"
-        details.append(entry)
-    return details
+def describe_error(error: dict, ranges: dict[str, Range] = RANGES) -> dict:
+    """One 422 detail: FastAPI's own `loc`, `msg` and `type`, plus the field as a dotted path, the value sent, the
+    allowed range (from `ranges`, by field name), the batch index of the shot, and a `message` in plain words that
+    says all of it."""
+    path = [p for p in error["loc"] if p != "body"]
+    field = ".".join(str(p) for p in path) or "body"
+    msg = error["msg"].removeprefix("Value error, ")
+    entry: dict = {"loc": list(error["loc"]), "msg": msg, "type": error["type"], "field": field}
+    parts = [f"{field}: {msg}"]
+    if len(path) >= 2 and path[0] == "shots" and isinstance(path[1], int):
+        entry["shot"] = path[1]
+        parts[0] = f"shot {path[1]}: {'.'.join(str(p) for p in path[2:]) or 'shot'}: {msg}"
+    value = _plain(error.get("input")) if error["type"] != "missing" else None
+    if value is not None:
+        entry["value"] = value
+        parts.append(f"(got {value!r})")
+    name = path[-1] if path else None
+    if isinstance(name, str) and name in ranges and error["type"] != "extra_forbidden":
+        entry["allowed"] = ranges[name].describe()
+        parts.append(f"; allowed {entry['allowed']}")
+    entry["message"] = " ".join(parts).replace(" ;", ";")
+    return entry
+
+
+def describe_errors(errors, ranges: dict[str, Range] = RANGES) -> list[dict]:
+    """422 details naming the field, the value and the allowed range (see `describe_error`)."""
+    return [describe_error(error, ranges) for error in errors]

@@ -117,14 +117,13 @@ def fly_shot(engine: FlightEngine, shot: ShotRequest) -> ShotResult:
     return result_of(shot, flight, normalized)
 
 
-def fly_shots(engine: FlightEngine, shots: list[ShotRequest]) -> list[ShotResult | ShotFailure]:
-    """Many shots in one engine batch (normalized replays ride in the same batch); results in order."""
+def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> list[ShotResult | ShotFailure]:
+    """One engine batch for `shots` and their normalized replays; results in order."""
     launches = [launch_of(shot) for shot in shots]
     conditions = [conditions_of(shot) for shot in shots]
     replays = [i for i, shot in enumerate(shots) if reference_of(shot) is not None]
     launches += [launches[i] for i in replays]
     conditions += [Conditions(air_of(reference_of(shots[i])), CALM) for i in replays]
-    keep = any(shot.trajectory is not None for shot in shots)
     flights = engine.fly_batch(launches, conditions, keep)
     replayed = dict(zip(replays, flights[len(shots) :], strict=True))
     results: list[ShotResult | ShotFailure] = []
@@ -132,4 +131,18 @@ def fly_shots(engine: FlightEngine, shots: list[ShotRequest]) -> list[ShotResult
         flight, normalized = flights[i], replayed.get(i)
         failure = next((f for f in (flight, normalized) if isinstance(f, FlightError)), None)
         results.append(ShotFailure(error=str(failure)) if failure else result_of(shot, flight, normalized))
+    return results
+
+
+def fly_shots(engine: FlightEngine, shots: list[ShotRequest]) -> list[ShotResult | ShotFailure]:
+    """Many shots in engine batches (normalized replays ride along); results in order. Shots asking for a
+    trajectory fly in a batch of their own, so the rest do not keep every integrator state."""
+    traced = [i for i, shot in enumerate(shots) if shot.trajectory is not None]
+    if not traced or len(traced) == len(shots):
+        return _fly_group(engine, shots, keep=bool(traced))
+    plain = [i for i, shot in enumerate(shots) if shot.trajectory is None]
+    results: list[ShotResult | ShotFailure | None] = [None] * len(shots)
+    for indices, keep in ((plain, False), (traced, True)):
+        for i, result in zip(indices, _fly_group(engine, [shots[i] for i in indices], keep), strict=True):
+            results[i] = result
     return results

@@ -1,0 +1,35 @@
+"""`golfflight evaluate`: Table 1 (every trained variant on the validation split), the noise floor, Figures 6 and 7."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "evaluate",
+        help="Table 1 of trained runs on the validation split, with the noise floor and Figures 6-7",
+        description="Evaluate each run's best checkpoint on the file's validation shots, compute the reference "
+        "world's noise floor, write the table into OUT/training.md (generated section) and the figures into "
+        "OUT/figures/.",
+    )
+    parser.add_argument("--data", required=True, help="canonical shot CSV with a split column (the runs' data)")
+    parser.add_argument("--runs", required=True, nargs="+", help="run directories (their best.pt) or checkpoint files")
+    parser.add_argument(
+        "--bundle", help="also fly this model bundle through NumPy + ONNX Runtime and compare with torch"
+    )
+    parser.add_argument("--out", required=True, help="docs directory: OUT/training.md and OUT/figures/ are written")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import torch
+
+    from model_export.evaluate import run_evaluation
+
+    torch.set_num_threads(2)
+    report = run_evaluation(args.data, args.runs, args.out, bundle=args.bundle)
+    print(report.markdown, end="")
+    for path in report.figures:
+        print(f"wrote {path}")
+    return 0

@@ -1,0 +1,105 @@
+"""Pure ASGI guards in front of the routes: a request-body size limit and an optional API key.
+
+Both answer before FastAPI parses anything, so an oversized or unauthenticated request costs the worker a few
+microseconds, not a JSON parse. Neither ever logs a header or the key.
+"""
+
+from __future__ import annotations
+
+import hmac
+import json
+
+API_KEY_ENV = "GOLFFLIGHT_API_KEY"
+"""Environment variable holding the API key; when set (non-empty) every route but /healthz requires it."""
+
+CORS_ORIGINS_ENV = "GOLFFLIGHT_CORS_ORIGINS"
+"""Environment variable with the comma-separated origins allowed to call the service from a browser (CORS)."""
+
+MAX_BODY_BYTES = 8 * 1024 * 1024
+"""Largest request body accepted (a full 10,000-shot batch with every option is about 4.5 MB)."""
+
+OPEN_PATHS = frozenset({"/healthz"})
+"""Routes answered without the API key (load balancers and health checks hold no secret)."""
+
+
+async def _send_json(send, status: int, body: dict, headers: list[tuple[bytes, bytes]] = ()) -> None:
+    payload = json.dumps(body).encode()
+    await send(
+        {
+            "type": "http.response.start",
+            "status": status,
+            "headers": [
+                (b"content-type", b"application/json"),
+                (b"content-length", str(len(payload)).encode()),
+                *headers,
+            ],
+        }
+    )
+    await send({"type": "http.response.body", "body": payload})
+
+
+class BodyLimit:
+    """Refuses a request body over `limit` bytes with 413: at once from Content-Length, else (a chunked body) after
+    reading at most `limit` bytes of it, which are then replayed to the app."""
+
+    def __init__(self, app, limit: int = MAX_BODY_BYTES):
+        self.app, self.limit = app, limit
+
+    async def __call__(self, scope, receive, send):
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        declared = dict(scope["headers"]).get(b"content-length")
+        if declared is not None:
+            if not declared.isdigit() or int(declared) > self.limit:
+                await self._refuse(send, declared.decode("latin-1"))
+                return
+            await self.app(scope, receive, send)
+            return
+        messages, received = [], 0
+        while True:
+            message = await receive()
+            messages.append(message)
+            if message["type"] != "http.request":
+                break
+            received += len(message.get("body", b""))
+            if received > self.limit:
+                await self._refuse(send, f"over {self.limit:,}")
+                return
+            if not message.get("more_body", False):
+                break
+
+        async def replay():
+            return messages.pop(0) if messages else await receive()
+
+        await self.app(scope, replay, send)
+
+    async def _refuse(self, send, size: str) -> None:
+        message = f"request body of {size} bytes refused: the limit is {self.limit:,} bytes"
+        detail = {"loc": ["body"], "msg": message, "type": "body_too_large", "field": "body", "message": message}
+        await _send_json(send, 413, {"detail": [detail]})
+
+
+class ApiKey:
+    """Requires `X-API-Key: KEY` (or `Authorization: Bearer KEY`) on every route except OPEN_PATHS; CORS preflight
+    requests pass (they carry no credentials; the CORS middleware outside answers them)."""
+
+    def __init__(self, app, key: str):
+        self.app, self._key = app, key.encode()
+
+    def _authorised(self, headers: dict[bytes, bytes]) -> bool:
+        given = headers.get(b"x-api-key")
+        if given is None:
+            scheme, _, token = headers.get(b"authorization", b"").partition(b" ")
+            given = token.strip() if scheme.lower() == b"bearer" else b""
+        return hmac.compare_digest(given, self._key)
+
+    async def __call__(self, scope, receive, send):
+        if scope["type"] != "http" or scope["path"] in OPEN_PATHS or scope["method"] == "OPTIONS":
+            await self.app(scope, receive, send)
+            return
+        if self._authorised(dict(scope["headers"])):
+            await self.app(scope, receive, send)
+            return
+        message = "missing or wrong API key: send it in the X-API-Key header (or Authorization: Bearer)"
+        await _send_json(send, 401, {"detail": message}, [(b"www-authenticate", b'Bearer realm="golfflight"')])

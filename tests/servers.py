@@ -1,0 +1,44 @@
+"""A real uvicorn server on 127.0.0.1 in a thread for tests that need one (the service as clients see it)."""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+import httpx
+import uvicorn
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+@contextmanager
+def running(app, ready_path: str = "/healthz", timeout_s: float = 20.0) -> Iterator[httpx.Client]:
+    """Serve `app` on a free loopback port until the block ends; yields a keep-alive client, once `ready_path`
+    answers 200 (or any answer, for apps whose model is meant to fail)."""
+    port = free_port()
+    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    try:
+        with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=30) as http:
+            deadline = time.monotonic() + timeout_s
+            while True:
+                try:
+                    answer = http.get(ready_path)
+                    if answer.status_code == 200 or answer.json().get("status") == "failed":
+                        break
+                except (httpx.TransportError, ValueError):
+                    pass
+                assert time.monotonic() < deadline, "the service did not become ready"
+                time.sleep(0.05)
+            yield http
+    finally:
+        server.should_exit = True
+        thread.join(timeout=10)

@@ -1,0 +1,142 @@
+"""Properties of the flight engine over the whole valid input range (hypothesis): every flight is finite and
+lands, single and batch agree, carry grows with ball speed for a fixed launch in calm air, and the simulation is
+mirror-symmetric (exactly, with a coefficient model that is: Phys-Q depends on speed and spin magnitudes only)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+import torch
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from model_export.export import export_checkpoint
+from model_export.training import TrainConfig, train
+from service import limits
+from service.conditions import AirConditions, Conditions
+from service.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
+from service.model_location import model_dir
+from service.wind import CALM, Wind
+
+torch.set_num_threads(1)
+
+PROPERTY = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+
+
+def bounded(r: limits.Range) -> st.SearchStrategy[float]:
+    return st.floats(r.low, r.high, allow_nan=False, allow_infinity=False)
+
+
+launches = st.builds(
+    Launch,
+    bounded(limits.BALL_SPEED_MPS),
+    bounded(limits.LAUNCH_ANGLE_DEG),
+    bounded(limits.LAUNCH_DIRECTION_DEG),
+    bounded(limits.SPIN_RPM),
+    bounded(limits.SPIN_AXIS_DEG),
+)
+airs = st.one_of(
+    st.builds(
+        AirConditions,
+        temperature_c=bounded(limits.TEMPERATURE_C),
+        altitude_m=bounded(limits.ALTITUDE_M),
+        humidity_pct=bounded(limits.HUMIDITY_PCT),
+    ),
+    st.builds(
+        AirConditions,
+        temperature_c=bounded(limits.TEMPERATURE_C),
+        pressure_hpa=bounded(limits.PRESSURE_HPA),
+        humidity_pct=bounded(limits.HUMIDITY_PCT),
+    ),
+    st.builds(AirConditions, density=bounded(limits.AIR_DENSITY_KG_M3)),
+)
+winds = st.one_of(
+    st.just(CALM),
+    st.builds(
+        Wind,
+        bounded(limits.WIND_SPEED_MPS),
+        bounded(limits.WIND_FROM_DEG),
+        st.sampled_from(["uniform", "log"]),
+        bounded(limits.WIND_REFERENCE_HEIGHT_M),
+    ),
+)
+conditions = st.builds(Conditions, airs, winds)
+
+
+@pytest.fixture(autouse=True)
+def no_flush_to_zero():
+    """Training (here, or in an earlier test module) turns on flushing of denormal floats for the whole process,
+    which breaks hypothesis' float generation; properties run with IEEE floats, as the service does."""
+    torch.set_flush_denormal(False)
+
+
+@pytest.fixture(scope="module")
+def engine() -> FlightEngine:
+    return FlightEngine(model_dir())
+
+
+@pytest.fixture(scope="module")
+def symmetric_engine(tiny_shots, tmp_path_factory) -> FlightEngine:
+    """A Phys-Q bundle (C_L, C_D, C_M functions of the spin ratio: mirror-symmetric by construction)."""
+    run, bundle = tmp_path_factory.mktemp("phys-q-run"), tmp_path_factory.mktemp("phys-q")
+    train(tiny_shots, run, TrainConfig(variant="phys-q", epochs=1, batch_size=32, limit=64), progress=False)
+    torch.set_flush_denormal(False)
+    export_checkpoint(run, bundle)
+    return FlightEngine(bundle)
+
+
+def assert_sound(flight: ShotFlight) -> None:
+    values = [getattr(flight, name) for name in ShotFlight.__dataclass_fields__ if name != "states"]
+    assert all(math.isfinite(v) for v in values), flight
+    assert 0.0 <= flight.flight_time_s <= MAX_FLIGHT_TIME_S and 0.0 <= flight.apex_time_s <= flight.flight_time_s
+    assert flight.carry_m >= 0.0 and flight.apex_m >= 0.0 and flight.landing_speed_mps >= 0.0
+    assert flight.carry_m == pytest.approx(math.hypot(flight.landing_x_m, flight.landing_y_m))
+
+
+@PROPERTY
+@given(launch=launches, where=conditions)
+def test_every_valid_shot_lands_with_finite_numbers(engine, launch, where):
+    flight = engine.fly(launch, where, keep_states=True)
+    assert_sound(flight)
+    assert flight.states.positions[-1][2] == pytest.approx(0.0, abs=1e-9)
+
+
+@PROPERTY
+@given(shots=st.lists(st.tuples(launches, conditions), min_size=1, max_size=12))
+def test_batch_flights_are_the_single_shot_flights(engine, shots):
+    batch = engine.fly_batch([launch for launch, _ in shots], [where for _, where in shots])
+    for (launch, where), flight in zip(shots, batch, strict=True):
+        assert_sound(flight)
+        single = engine.fly(launch, where)
+        assert flight.carry_m == pytest.approx(single.carry_m, abs=1e-6)
+        assert flight.apex_m == pytest.approx(single.apex_m, abs=1e-6)
+
+
+@PROPERTY
+@given(
+    speeds=st.lists(bounded(limits.BALL_SPEED_MPS), min_size=2, max_size=6, unique=True),
+    angle=st.floats(limits.LAUNCH_ANGLE_DEG.low, 30.0),
+    spin=bounded(limits.SPIN_RPM),
+)
+def test_carry_grows_with_ball_speed_for_a_fixed_launch_in_calm_air(engine, speeds, angle, spin):
+    """Up to 30 deg of launch: steeper, faster high-spin shots balloon and may land shorter (docs/reliability.md)."""
+    speeds = sorted(speeds)
+    carries = [f.carry_m for f in engine.fly_batch([Launch(v, angle, 0.0, spin, 0.0) for v in speeds])]
+    assert all(b >= a - 1e-9 for a, b in zip(carries, carries[1:])), list(zip(speeds, carries))
+
+
+def mirrored(launch: Launch) -> Launch:
+    return launch._replace(launch_direction_deg=-launch.launch_direction_deg, spin_axis_deg=-launch.spin_axis_deg)
+
+
+@PROPERTY
+@given(launch=launches, where=conditions)
+def test_mirrored_launch_and_wind_land_mirrored(symmetric_engine, launch, where):
+    wind = dataclasses.replace(where.wind, from_deg=(360.0 - where.wind.from_deg) % 360.0)
+    flight = symmetric_engine.fly(launch, where)
+    mirror = symmetric_engine.fly(mirrored(launch), Conditions(where.air, wind))
+    assert mirror.landing_x_m == pytest.approx(-flight.landing_x_m, abs=1e-6)
+    for name in ("landing_y_m", "carry_m", "apex_m", "flight_time_s", "landing_angle_deg", "landing_spin_rpm"):
+        assert getattr(mirror, name) == pytest.approx(getattr(flight, name), abs=1e-6), name
