@@ -5,10 +5,13 @@ FROM python:3.11-slim
 ENV PYTHONDONTWRITEBYTECODE=1 PYTHONUNBUFFERED=1
 WORKDIR /app
 COPY pyproject.toml README.md ./
+# every package of the distribution: the command line imports them all (none of them imports torch)
 COPY golfflight ./golfflight
 COPY service ./service
 COPY shots ./shots
 COPY weights_schema ./weights_schema
+COPY model_export ./model_export
+COPY discovery ./discovery
 COPY models/default ./models/default
 # `pip install .` puts the bundle in /usr/local/share/golfflight/models/default (pyproject data-files)
 RUN pip install --no-cache-dir . && rm -rf /app/* && useradd --create-home --uid 10001 golfflight
