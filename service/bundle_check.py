@@ -94,6 +94,17 @@ def check_coefficients(card: ModelCard, session: ort.InferenceSession, onnx_path
         )
 
 
+def session_options(threads: int) -> ort.SessionOptions:
+    """ORT options for `threads` cores whose idle threads sleep rather than spin (spinning threads steal the core
+    the step's NumPy physics and other workers need)."""
+    options = ort.SessionOptions()
+    options.intra_op_num_threads = threads
+    options.inter_op_num_threads = 1
+    options.execution_mode = ort.ExecutionMode.ORT_SEQUENTIAL
+    options.add_session_config_entry("session.intra_op.allow_spinning", "0")
+    return options
+
+
 def open_session(onnx_path: Path, options: ort.SessionOptions | None = None) -> ort.InferenceSession:
     """An ORT CPU session, or a BundleError if the file is not a graph ONNX Runtime can run."""
     try:
@@ -109,8 +120,15 @@ def verify_session(card: ModelCard, session: ort.InferenceSession, onnx_path: Pa
     check_coefficients(card, session, onnx_path)
 
 
-def verify_bundle(directory: str | os.PathLike) -> ModelCard:
-    """Load and verify a bundle completely (card, schema version, hash, graph interface, probe); its card."""
+def open_verified(directory: str | os.PathLike, threads: int = 1) -> tuple[ModelCard, Path, ort.InferenceSession]:
+    """Load and verify a bundle completely (card, schema version, hash, graph interface, probe): its card, its ONNX
+    path and the verified session on `threads` cores."""
     card, onnx_path = load_bundle(directory)
-    verify_session(card, open_session(onnx_path), onnx_path)
-    return card
+    session = open_session(onnx_path, session_options(threads))
+    verify_session(card, session, onnx_path)
+    return card, onnx_path, session
+
+
+def verify_bundle(directory: str | os.PathLike) -> ModelCard:
+    """Load and verify a bundle completely; its card."""
+    return open_verified(directory)[0]

@@ -22,15 +22,13 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-import onnxruntime as ort
 
-from service.bundle_check import open_session, verify_session
+from service.bundle_check import open_session, open_verified, session_options
 from service.conditions import STANDARD, Conditions
 from service.constants import RPM_TO_RADPS
 from service.limits import FLIGHT_TIME_S
 from service.physics import euler_step, initial_state
 from service.wind import log_profile_factor
-from weights_schema.bundle import load_bundle
 from weights_schema.model_card import ModelCard
 
 MAX_FLIGHT_TIME_S = FLIGHT_TIME_S.high
@@ -107,17 +105,6 @@ def _physics_inputs(conditions: Conditions) -> tuple[float, float, float, bool, 
     return conditions.air.density_kg_m3, wind_x, wind_y, log_profile, wind.reference_height_m, wind.roughness_m
 
 
-def _session(path: Path, threads: int) -> ort.InferenceSession:
-    """An ORT session on `threads` cores whose idle threads sleep rather than spin (spinning threads steal the
-    core the step's NumPy physics and other workers need)."""
-    options = ort.SessionOptions()
-    options.intra_op_num_threads = threads
-    options.inter_op_num_threads = 1
-    options.execution_mode = ort.ExecutionMode.ORT_SEQUENTIAL
-    options.add_session_config_entry("session.intra_op.allow_spinning", "0")
-    return open_session(path, options)
-
-
 class FlightEngine:
     """A loaded model bundle and the two ways to fly shots through it: `fly` (one) and `fly_batch` (many)."""
 
@@ -127,15 +114,13 @@ class FlightEngine:
         started = time.perf_counter()
         self.bundle_dir = Path(bundle_dir)
         self.card: ModelCard
-        self.card, onnx_path = load_bundle(self.bundle_dir)
+        self.card, onnx_path, self._batch_session = open_verified(self.bundle_dir, batch_threads)
         self.dt = self.card.physics.dt_s
         self.t_sim = self.card.physics.t_sim_s
         self.max_steps = math.ceil(max(MAX_FLIGHT_TIME_S, self.t_sim) / self.dt - 1e-9)
         self._velocity_name, self._spin_name = (spec.name for spec in self.card.onnx.inputs)
         self._output_name = self.card.onnx.outputs[0].name
-        self._batch_session = _session(onnx_path, batch_threads)
-        verify_session(self.card, self._batch_session, onnx_path)
-        self._single_session = _session(onnx_path, 1)
+        self._single_session = open_session(onnx_path, session_options(1))
         self._single_lock = threading.Lock()
         self._velocity_in = np.zeros((1, 3), np.float32)
         self._spin_in = np.zeros((1, 3), np.float32)
