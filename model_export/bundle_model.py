@@ -32,7 +32,7 @@ def _mlp_state(model: PhysNN, weights: dict[str, torch.Tensor], card: ModelCard)
     """The PhysNN state dict from the graph's layer initializers (undoing the lean layout) and the card's p_M."""
     state = {name: weights[name] for name in model.state_dict() if name.startswith("net.")}
     if "head_scale" in weights:
-        input_scale = torch.tensor([VELOCITY_SCALE_MPS] * 3 + [SPIN_SCALE_RADPS] * 3)
+        input_scale = torch.tensor([VELOCITY_SCALE_MPS, SPIN_SCALE_RADPS])
         state["net.0.weight"] = state["net.0.weight"] * input_scale
         rows = [COEFFICIENT_COLUMNS.index(head) for head in model.heads]
         last = f"net.{len(model.net) - 1}"

@@ -81,7 +81,7 @@ class LeanPhysNN(nn.Module):
         super().__init__()
         layers = [copy.deepcopy(layer).float() for layer in model.net]
         first, last = layers[0], layers[-1]
-        scale = torch.tensor([1 / VELOCITY_SCALE_MPS] * 3 + [1 / SPIN_SCALE_RADPS] * 3)
+        scale = torch.tensor([1 / VELOCITY_SCALE_MPS, 1 / SPIN_SCALE_RADPS])
         with torch.no_grad():
             first.weight.mul_(scale)
             padded = nn.Linear(last.in_features, len(COEFFICIENT_COLUMNS))
@@ -103,13 +103,12 @@ class LeanPhysNN(nn.Module):
         self.register_buffer("moment", torch.tensor([0.0, 0.0, BALL_RADIUS_M * p_m, 0.0]))
 
     def forward(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
-        out = torch.sigmoid(self.net(torch.cat([v_rel, omega], dim=-1))) * self.head_scale + self.constant
+        speed = torch.linalg.vector_norm(v_rel, dim=-1, keepdim=True)
+        spin_rate = torch.linalg.vector_norm(omega, dim=-1, keepdim=True)
+        out = torch.sigmoid(self.net(torch.cat([speed, spin_rate], dim=-1))) * self.head_scale + self.constant
         if not self.learned_moment:
             return out
-        ratio = torch.linalg.vector_norm(omega, dim=-1, keepdim=True) / torch.linalg.vector_norm(
-            v_rel, dim=-1, keepdim=True
-        ).clamp_min(TINY)
-        return out + ratio * self.moment
+        return out + spin_rate / speed.clamp_min(TINY) * self.moment
 
 
 def export_onnx(model: nn.Module, path: str | os.PathLike) -> None:
@@ -189,7 +188,7 @@ def describe_architecture(model: nn.Module) -> Architecture:
         equations.append("C_Q = 0.5")
     return Architecture(
         kind="mlp",
-        input_normalisation=f"x = [v_rel / {VELOCITY_SCALE_MPS}, omega / {SPIN_SCALE_RADPS}] (6 values)",
+        input_normalisation=f"x = [|v_rel| / {VELOCITY_SCALE_MPS}, |omega| / {SPIN_SCALE_RADPS}] (2 values: speed and spin rate)",
         hidden_units=list(model.hidden),
         activation="relu",
         heads=[f"h_{head}" for head in model.heads],

@@ -40,8 +40,19 @@ def mlp(n_in: int, hidden: Sequence[int], n_out: int) -> nn.Sequential:
 
 
 def normalised_input(velocity: torch.Tensor, spin: torch.Tensor) -> torch.Tensor:
-    """[v / 89.4, omega / 2094]: the paper's MLP input, bounded by about 1 for golf shots."""
+    """[v / 89.4, omega / 2094]: the paper's MLP input (6 values), bounded by about 1 for golf shots."""
     return torch.cat([velocity / VELOCITY_SCALE_MPS, spin / SPIN_SCALE_RADPS], dim=-1)
+
+
+def speed_and_spin_rate(v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
+    """[|v_rel| / 89.4, |omega| / 2094] (2 values): the coefficient MLP's input.
+
+    A spinning sphere's coefficients depend on the Reynolds number and spin ratio, i.e. on these two magnitudes
+    at a given air, not on the direction of flight. The paper feeds the 6 components instead; that lets the
+    net tell a slice from a hook (mirrored shots landed up to 14.7 m apart), so we feed the invariants."""
+    speed = torch.linalg.vector_norm(v_rel, dim=-1, keepdim=True)
+    spin_rate = torch.linalg.vector_norm(omega, dim=-1, keepdim=True)
+    return torch.cat([speed / VELOCITY_SCALE_MPS, spin_rate / SPIN_SCALE_RADPS], dim=-1)
 
 
 class CoefficientModule(nn.Module):
@@ -57,7 +68,7 @@ class CoefficientModule(nn.Module):
 
 
 class PhysNN(CoefficientModule):
-    """Phys-NN family. Heads are raw features h; C_L = sigma(h)/2, C_D = sigma(h)/2, then either
+    """Phys-NN family: an MLP on |v_rel| and |omega| (`speed_and_spin_rate`). Heads are raw features h; C_L = sigma(h)/2, C_D = sigma(h)/2, then either
     C_M = sigma(h)/50 (own head) or C_M = p_M S (pM), and C_Q = sigma(h) (cQ) or the constant 0.5."""
 
     def __init__(self, variant: str, hidden: Sequence[int] = DEFAULT_HIDDEN):
@@ -71,7 +82,7 @@ class PhysNN(CoefficientModule):
         self.heads = (
             ("C_L", "C_D") + (("C_Q",) if self.learned_pressure else ()) + (() if self.learned_moment else ("C_M",))
         )
-        self.net = mlp(6, self.hidden, len(self.heads))
+        self.net = mlp(2, self.hidden, len(self.heads))
         if self.learned_moment:
             self.log_p_m = nn.Parameter(torch.tensor(math.log(P_M_INIT)))
 
@@ -81,7 +92,7 @@ class PhysNN(CoefficientModule):
         return self.log_p_m.exp()
 
     def coefficients(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
-        out = torch.sigmoid(self.net(normalised_input(v_rel, omega)))
+        out = torch.sigmoid(self.net(speed_and_spin_rate(v_rel, omega)))
         c_lift, c_drag = out[:, 0] / 2, out[:, 1] / 2
         c_moment = self.p_m * spin_ratio(v_rel, omega) if self.learned_moment else out[:, 2] / 50
         c_q = out[:, 2] if self.learned_pressure else torch.full_like(c_lift, BASE_DYNAMIC_PRESSURE)

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Reproduce the Table-1 runs on the paper-sized synthetic set (2-core CPU: about an hour in all).
+# Reproduce the Table-1 runs on the paper-sized synthetic set and ship Phys-NN+ as models/default
+# (2-core CPU: about an hour in all).
 # Phys-NN+ gets the paper's 50 epochs; the ablation variants fewer, to fit the machine (docs/training.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -8,6 +9,7 @@ data=${DATA:-runs/synth90k.csv}
 train() { local variant=$1 epochs=$2 loss=$3; [ -f "runs/$variant/history.json" ] && resume=--resume || resume=;
   python3 -m golfflight train --data "$data" --variant "$variant" --epochs "$epochs" --loss "$loss" --out "runs/$variant" --threads "${THREADS:-2}" $resume; }
 train phys-nn+ 50 lp+lh
+python3 -m golfflight export --checkpoint runs/phys-nn+ --out models/default
 train phys-q 10 lp+lh
 train nn 50 lp
 train phys-nn 15 lp+lh

@@ -5,7 +5,8 @@ import pytest
 
 from golfflight.cli import main
 from shots.records import read_shots
-from shots.synth import MIN_APEX_M, SynthConfig, generate, sessions_path, validation_sessions
+from service.air import Air
+from shots.synth import MIN_APEX_M, SynthConfig, draw_sessions, generate, sessions_path, validation_sessions
 
 N = 400
 
@@ -35,6 +36,16 @@ def test_conditions_are_hidden_but_vary_between_sessions(synthetic):
     assert all(r.wind_speed_mps is None and r.temperature_c is None and r.altitude_m is None for r in synthetic.records)
     assert len({round(s.temperature_c, 3) for s in synthetic.sessions}) == len(synthetic.sessions)
     assert np.ptp([s.wind_from_deg for s in synthetic.sessions]) > 30
+
+
+def test_hidden_air_is_centred_on_the_density_training_assumes():
+    """Training flies shots without recorded air at ICAO standard density, so the hidden air must average to it."""
+    sessions = draw_sessions(np.random.default_rng(3), 60_000, SynthConfig())
+    shots = np.array([s.n_shots for s in sessions], dtype=float)
+    air = Air.from_conditions(*(np.array([getattr(s, k) for s in sessions]) for k in ("temperature_c", "altitude_m", "humidity_pct")))
+    mean_density = np.average(air.density_kg_m3, weights=shots)
+    assert mean_density == pytest.approx(Air.standard().density_kg_m3, rel=0.01)
+    assert np.ptp(air.density_kg_m3) > 0.1
 
 
 def test_flights_are_realistic_per_club(synthetic):

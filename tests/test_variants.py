@@ -37,6 +37,20 @@ def test_coefficients_have_shape_and_range(variant):
             assert (c_lift <= 0.5).all() and (c_drag >= 0).all() and (c_drag <= 0.5).all() and (c_q <= 1).all()
 
 
+@pytest.mark.parametrize("variant", PHYSICS_VARIANTS)
+def test_coefficients_ignore_the_direction_of_flight(variant):
+    """Rotating or mirroring v_rel and omega together (a hook vs the mirrored slice) leaves the coefficients alone."""
+    torch.manual_seed(0)
+    model = build_model(variant, hidden=(16, 8))
+    velocity, spin = _inputs()
+    rotation, _ = torch.linalg.qr(torch.randn(3, 3, generator=torch.Generator().manual_seed(1)))
+    mirror = torch.diag(torch.tensor([-1.0, 1.0, 1.0]))
+    with torch.no_grad():
+        expected = model.coefficients(velocity, spin)
+        for transform in (rotation, mirror):
+            torch.testing.assert_close(model.coefficients(velocity @ transform.T, spin @ transform.T), expected)
+
+
 def test_base_variant_has_own_moment_head_and_base_pressure():
     model = PhysNN("phys-nn", hidden=(16,))
     c = model.coefficients(*_inputs())
