@@ -1,10 +1,10 @@
 """Load and soak test of `golfflight serve` on 127.0.0.1: many keep-alive clients, mixed single shots and batches.
 
-python benchmarks/load_soak.py [--workers 2] [--clients 32] [--duration 60] [--batch-share 0.05] [--batch-size 100]
+python benchmarks/load_soak.py [--workers 2] [--clients 32] [--duration 60] [--load 0.3 0.5 0.7] [--batch-share 0.05]
 
 Three phases, each bounded in time: (1) saturation, every client sending back to back, gives the throughput the
-machine sustains; (2) the measured run, an open-loop schedule at --load (default 70 %) of that rate or at --rate,
-latency counted from each request's scheduled time (so queueing shows); memory of the supervisor and workers is taken
+machine sustains; (2) the measured runs, an open-loop schedule at each --load fraction of that rate (or each
+--rate), latency counted from each request's scheduled time (so queueing shows); memory of the supervisor and workers is taken
 before and after, and sampled through the run; (3) graceful shutdown: batches in flight when SIGTERM arrives must
 all complete. Prints the figures and writes the "load" section of benchmarks/results.json.
 """
@@ -109,7 +109,7 @@ async def client(port: int, stop_at: float, tally: Tally, pool, share: float, rn
             request = rng.choice(batches if kind == "batch" else singles)
             try:
                 status, body = await asyncio.wait_for(exchange(reader, writer, request), 60)
-            except (OSError, asyncio.IncompleteReadError, asyncio.TimeoutError, ValueError) as error:
+            except (TimeoutError, OSError, asyncio.IncompleteReadError, ValueError) as error:
                 tally.errors.append(f"{kind}: {type(error).__name__}: {error}")
                 writer.close()
                 reader, writer = await asyncio.open_connection(serving.HOST, port)
@@ -148,7 +148,7 @@ def shutdown_with_batches_in_flight(running: serving.Server, pool, in_flight: in
         reader, writer = await asyncio.open_connection(serving.HOST, running.port)
         try:
             outcomes.append(check("batch", *await asyncio.wait_for(exchange(reader, writer, request), 120)))
-        except (OSError, asyncio.IncompleteReadError, asyncio.TimeoutError) as error:
+        except (TimeoutError, OSError, asyncio.IncompleteReadError) as error:
             outcomes.append(f"{type(error).__name__}: {error}")
         finally:
             writer.close()
@@ -172,8 +172,9 @@ def main() -> None:
     parser.add_argument("--clients", type=int, default=32, help="concurrent keep-alive connections")
     parser.add_argument("--duration", type=float, default=60.0, help="seconds of the measured run")
     parser.add_argument("--saturation", type=float, default=15.0, help="seconds of the saturation phase")
-    parser.add_argument("--load", type=float, default=0.7, help="measured rate as a fraction of the saturated one")
-    parser.add_argument("--rate", type=float, help="measured rate in requests/s (instead of --load)")
+    parser.add_argument("--load", type=float, nargs="+", default=[0.3, 0.5, 0.7],
+                        help="measured rates as fractions of the saturated one, one run of --duration each")
+    parser.add_argument("--rate", type=float, nargs="+", help="measured rates in requests/s (instead of --load)")
     parser.add_argument("--batch-share", type=float, default=0.05, help="fraction of requests that are batches")
     parser.add_argument("--batch-size", type=int, default=100)
     parser.add_argument("--seed", type=int, default=0)
@@ -189,13 +190,19 @@ def main() -> None:
         saturated = asyncio.run(drive(running.port, args.clients, args.saturation, pool, args.batch_share,
                                       args.seed + 1000, None)).summary(args.saturation)
         total_rate = sum(saturated[k]["per_s"] for k in ("single", "batch") if k in saturated)
-        rate = args.rate or args.load * total_rate
+        rates = args.rate or [load * total_rate for load in args.load]
         samples: list = []
         stop = threading.Event()
-        sampler = threading.Thread(target=sample_memory, args=(running, max(1.0, args.duration / 30), stop, samples))
+        sampler = threading.Thread(
+            target=sample_memory, args=(running, max(1.0, len(rates) * args.duration / 30), stop, samples)
+        )
         sampler.start()
-        measured = asyncio.run(drive(running.port, args.clients, args.duration, pool, args.batch_share,
-                                     args.seed + 2000, rate)).summary(args.duration)
+        measured = []
+        for i, rate in enumerate(rates):
+            tally = asyncio.run(drive(running.port, args.clients, args.duration, pool, args.batch_share,
+                                      args.seed + 2000 + i, rate))
+            measured.append({"rate_per_s": round(rate, 1), "load": round(rate / total_rate, 2),
+                             **tally.summary(args.duration)})
         stop.set()
         sampler.join()
         memory_after = running.rss_mib()
@@ -207,19 +214,20 @@ def main() -> None:
     result = {
         "settings": vars(args),
         "saturated": saturated,
-        "target_rate_per_s": round(rate, 1),
         "measured": measured,
         "memory_mib": {"before": round(memory_before["total"], 1), "after": round(memory_after["total"], 1),
                        "growth": round(growth, 1), "samples": samples},
         "shutdown": shutdown,
-        "single_p99_under_10_ms": measured.get("single", {}).get("p99_ms", float("inf")) < 10.0,
+        "single_p99_under_10_ms_at_load": {
+            str(run["load"]): run.get("single", {}).get("p99_ms", float("inf")) < 10.0 for run in measured
+        },
     }
     print(json.dumps(result, indent=1))
     results = REPO / "benchmarks" / "results.json"
     data = json.loads(results.read_text()) if results.is_file() else {}
     data["load"] = {"machine": machine(), **result}
     results.write_text(json.dumps(data, indent=2) + "\n")
-    ok = saturated["errors"] == 0 and measured["errors"] == 0 and shutdown["clean"]
+    ok = saturated["errors"] == 0 and all(run["errors"] == 0 for run in measured) and shutdown["clean"]
     sys.exit(0 if ok else 1)
 
 

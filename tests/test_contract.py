@@ -5,14 +5,18 @@ alone."""
 from __future__ import annotations
 
 import json
+import time
+from concurrent.futures import ThreadPoolExecutor
 
+import psutil
 import pytest
 from servers import running
 
 from service import limits
 from service.api.app import create_app
 from service.api.guards import MAX_BODY_BYTES
-from service.api.models import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, RANGES
+from service.api.models import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, RANGES, ShotRequest
+from service.api.shots import fly_shots
 
 SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}
 MONITOR = {"ball_speed_mph": 120.0, "launch_angle_deg": 16.0, "back_spin_rpm": 7000.0}
@@ -160,6 +164,30 @@ def test_a_body_over_the_limit_is_refused_with_413_declared_or_streamed(http):
     assert http.post("/v1/shots", json=SEVEN_IRON).status_code == 200  # the server is fine afterwards
 
 
+def test_a_batch_process_that_dies_is_replaced(http):
+    """Batches fly in a child process: killed under a batch, that batch gets a 503 saying to resend; killed
+    between batches, the next batch is flown by a fresh child as if nothing happened."""
+    batch = {"shots": [SEVEN_IRON] * 3}
+    expected = http.post("/v1/shots/batch", json=batch).json()
+
+    def kill_batch_process() -> None:
+        children = [c for c in psutil.Process().children() if "spawn_main" in " ".join(c.cmdline())]
+        assert len(children) == 1
+        children[0].kill()
+        children[0].wait(10)
+
+    kill_batch_process()
+    assert http.post("/v1/shots/batch", json=batch).json() == expected
+    big = {"shots": [SEVEN_IRON] * 5000}
+    with ThreadPoolExecutor(1) as pool:
+        in_flight = pool.submit(http.post, "/v1/shots/batch", json=big)
+        time.sleep(0.3)
+        kill_batch_process()
+        died = in_flight.result()
+    assert died.status_code == 503 and "send the batch again" in died.json()["detail"]
+    assert http.post("/v1/shots/batch", json=batch).json() == expected
+
+
 def test_a_shot_that_does_not_land_in_time_fails_alone(app, http):
     engine = app.state.service.engine
     saved = engine.max_steps
@@ -170,7 +198,8 @@ def test_a_shot_that_does_not_land_in_time_fails_alone(app, http):
         assert single.status_code == 422
         detail = single.json()["detail"][0]
         assert detail["type"] == "flight_error" and "still in the air after 1.2 s" in detail["message"]
-        batch = http.post("/v1/shots/batch", json={"shots": [putt, SEVEN_IRON, putt]}).json()["results"]
+        shots = [ShotRequest(**shot) for shot in (putt, SEVEN_IRON, putt)]  # batches fly in a child process:
+        batch = [result.model_dump(exclude_none=True) for result in fly_shots(engine, shots)]  # same function here
         assert "still in the air" in batch[1]["error"]
         assert batch[0]["carry_m"] > 0 and batch[2] == batch[0]
     finally:

@@ -1,9 +1,9 @@
 """The HTTP service: a FastAPI app factory with thin async routes over `service.api.shots`.
 
 Single shots simulate inline in `async def` routes: one takes well under a millisecond, less than a hop to a
-thread would cost. Batches fly on one batch thread per process, so a fitting studio's thousands of shots do not
-hold up a simulator bay's single shots (ONNX Runtime and NumPy release the GIL for most of a batch step); more
-concurrency comes from `golfflight serve --workers N` (one process, one model each).
+thread would cost. Batches fly in a child process at a lower CPU priority (`batch_process`), so a fitting studio's
+thousands of shots neither hold the GIL nor take a core from a simulator bay's single shots; more concurrency
+comes from `golfflight serve --workers N` (one process, one model and one batch process each).
 The model loads in a background thread at startup; /healthz answers 503 until it is ready. In front of the routes:
 a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and CORS only for configured origins
 ($GOLFFLIGHT_CORS_ORIGINS); every refusal is a 4xx whose body names the field, the value and the allowed range.
@@ -15,7 +15,7 @@ import asyncio
 import os
 import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import asynccontextmanager
 from pathlib import Path
 
@@ -28,8 +28,9 @@ from pydantic import BaseModel
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from golfflight import __version__
-from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
+from service.api.batch_process import BatchProcess
 from service.api.gspro import GSPRO_RANGES, GSProMessage, GSProReply, launch_from_ball_data
+from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
 from service.api.latency import RequestTimer, Rolling
 from service.api.models import (
     MAX_BATCH_SHOTS,
@@ -41,12 +42,13 @@ from service.api.models import (
     ShotResult,
     describe_errors,
 )
-from service.api.shots import flight_fields, fly_shot, fly_shots
+from service.api.shots import flight_fields, fly_shot
 from service.engine import FlightEngine, FlightError
 from service.model_location import model_dir
 from weights_schema.model_card import ModelCard
 
 GSPRO_PATH = "/v1/gspro"
+BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has been restarted): send the batch again"
 PROBE_SHOT = ShotRequest(ball_speed_mps=55.0, launch_angle_deg=16.0, spin_rpm=7100.0)
 """The shot /v1/latency times on demand: a tour-average 7-iron in standard air."""
 
@@ -61,11 +63,15 @@ class ServiceState:
         self.simulation = Rolling()
         self.requests = Rolling()
         self.loaded = threading.Event()
-        self.batches = ThreadPoolExecutor(max_workers=1, thread_name_prefix="golfflight-batch")
+        self.batches = BatchProcess(bundle_dir)
 
     def load(self) -> None:
+        """Load the model here and in the batch process; either failing leaves the service up to say why."""
         try:
-            self.engine = FlightEngine(self.bundle_dir)
+            engine = FlightEngine(self.bundle_dir)
+            if self.batches.start() != engine.sha256:
+                raise RuntimeError("the batch process loaded a different model (the bundle changed during startup)")
+            self.engine = engine
         except Exception as error:  # noqa: BLE001 - reported by /healthz, the service stays up to say so
             self.error = f"{type(error).__name__}: {error}"
         finally:
@@ -116,7 +122,7 @@ def create_app(
         loading = asyncio.get_running_loop().run_in_executor(None, state.load)
         yield
         await loading
-        state.batches.shutdown(wait=True)
+        state.batches.stop()
 
     app = FastAPI(
         title="golfflight",
@@ -192,16 +198,14 @@ def create_app(
         f"{MAX_BATCH_TRAJECTORIES} of them with a trajectory); results come back in order and a shot that cannot "
         "land gets an error entry of its own.",
     )
-    async def batch(request: BatchRequest) -> Response:
-        flying = engine()
-
-        def fly_and_encode() -> Response:
-            started = time.perf_counter()
-            results = fly_shots(flying, request.shots)
-            state.simulation.add(time.perf_counter() - started)
-            return _json(BatchResult(results=results))
-
-        return await asyncio.get_running_loop().run_in_executor(state.batches, fly_and_encode)
+    async def batch(request: BatchRequest, http: Request) -> Response:
+        engine()
+        try:
+            body, seconds = await state.batches.fly(await http.body())
+        except BrokenProcessPool:
+            return JSONResponse({"detail": BATCH_PROCESS_DIED}, 503)
+        state.simulation.add(seconds)
+        return Response(body, media_type="application/json")
 
     @app.post(
         GSPRO_PATH,
