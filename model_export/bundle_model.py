@@ -1,7 +1,7 @@
 """A shipped bundle back into torch, for fine-tuning from a bundle and for evaluating it through the torch path.
 
 An MLP graph's initializers are the network's layers: as exported by `export.LeanPhysNN` (input scaling folded
-into the first layer, the heads padded to the four output columns; recognised by its `head_scale` row) or one to
+into the first layer, the heads padded to the four output columns; recognised by its `tail` layer) or one to
 one with the torch state dict. p_M and Phys-Q's seven parameters come from the card. The rebuilt model is checked
 against ONNX Runtime on probe inputs before it is returned.
 """
@@ -31,7 +31,7 @@ from weights_schema.model_card import ModelCard
 def _mlp_state(model: PhysNN, weights: dict[str, torch.Tensor], card: ModelCard) -> dict[str, torch.Tensor]:
     """The PhysNN state dict from the graph's layer initializers (undoing the lean layout) and the card's p_M."""
     state = {name: weights[name] for name in model.state_dict() if name.startswith("net.")}
-    if "head_scale" in weights:
+    if "tail.weight" in weights:
         input_scale = torch.tensor([VELOCITY_SCALE_MPS, SPIN_SCALE_RADPS])
         state["net.0.weight"] = state["net.0.weight"] * input_scale
         rows = [COEFFICIENT_COLUMNS.index(head) for head in model.heads]

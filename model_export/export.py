@@ -73,17 +73,16 @@ LANDING = (
 
 class LeanPhysNN(nn.Module):
     """A Phys-NN model's coefficient function rearranged for a small graph (the same numbers to float rounding):
-    input scaling folded into the first layer, the heads padded to the four output columns, one sigmoid, one
-    scale row, one constant row and p_M S as one row. For one shot a step pays a fixed cost per graph node, so
-    this halves the ONNX Runtime time of a single-shot step (benchmarks/bench_graph.py)."""
+    input scaling folded into the first layer, the heads padded to the four output columns, then one `tail` Gemm
+    that scales the sigmoids, adds the constant C_Q and p_M S in one go. For one shot a step pays a fixed cost per
+    graph node, so fewer nodes mean a faster single-shot step (benchmarks/bench_graph.py)."""
 
     def __init__(self, model: PhysNN):
         super().__init__()
         layers = [copy.deepcopy(layer).float() for layer in model.net]
         first, last = layers[0], layers[-1]
-        scale = torch.tensor([1 / VELOCITY_SCALE_MPS, 1 / SPIN_SCALE_RADPS])
         with torch.no_grad():
-            first.weight.mul_(scale)
+            first.weight.mul_(torch.tensor([1 / VELOCITY_SCALE_MPS, 1 / SPIN_SCALE_RADPS]))
             padded = nn.Linear(last.in_features, len(COEFFICIENT_COLUMNS))
             padded.weight.zero_()
             padded.bias.zero_()
@@ -91,24 +90,24 @@ class LeanPhysNN(nn.Module):
                 padded.weight[COEFFICIENT_COLUMNS.index(name)] = last.weight[row]
                 padded.bias[COEFFICIENT_COLUMNS.index(name)] = last.bias[row]
         self.net = nn.Sequential(*layers[:-1], padded)
-        head_scale = {"C_L": 0.5, "C_D": 0.5, "C_M": 1 / 50, "C_Q": 1.0}
-        self.register_buffer(
-            "head_scale", torch.tensor([head_scale[c] if c in model.heads else 0.0 for c in COEFFICIENT_COLUMNS])
-        )
-        self.register_buffer(
-            "constant", torch.tensor([0.0, 0.0, 0.0, 0.0 if model.learned_pressure else BASE_DYNAMIC_PRESSURE])
-        )
         self.learned_moment = model.learned_moment
-        p_m = float(model.p_m.detach()) if model.learned_moment else 0.0
-        self.register_buffer("moment", torch.tensor([0.0, 0.0, BALL_RADIUS_M * p_m, 0.0]))
+        head_scale = {"C_L": 0.5, "C_D": 0.5, "C_M": 1 / 50, "C_Q": 1.0}
+        self.tail = nn.Linear(len(COEFFICIENT_COLUMNS) + int(self.learned_moment), len(COEFFICIENT_COLUMNS))
+        with torch.no_grad():
+            self.tail.weight.zero_()
+            for column, name in enumerate(COEFFICIENT_COLUMNS):
+                self.tail.weight[column, column] = head_scale[name] if name in model.heads else 0.0
+            if self.learned_moment:
+                self.tail.weight[COEFFICIENT_COLUMNS.index("C_M"), -1] = BALL_RADIUS_M * float(model.p_m.detach())
+            self.tail.bias.copy_(torch.tensor([0.0, 0.0, 0.0, 0.0 if model.learned_pressure else BASE_DYNAMIC_PRESSURE]))
 
     def forward(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
         speed = torch.linalg.vector_norm(v_rel, dim=-1, keepdim=True)
         spin_rate = torch.linalg.vector_norm(omega, dim=-1, keepdim=True)
-        out = torch.sigmoid(self.net(torch.cat([speed, spin_rate], dim=-1))) * self.head_scale + self.constant
-        if not self.learned_moment:
-            return out
-        return out + spin_rate / speed.clamp_min(TINY) * self.moment
+        heads = torch.sigmoid(self.net(torch.cat([speed, spin_rate], dim=-1)))
+        if self.learned_moment:
+            heads = torch.cat([heads, spin_rate / speed.clamp_min(TINY)], dim=-1)
+        return self.tail(heads)
 
 
 def export_onnx(model: nn.Module, path: str | os.PathLike) -> None:
