@@ -1,88 +1,82 @@
-"""Where a single-shot step's time goes: the bundle's ONNX graph against an equivalent lean graph.
+"""Where a single-shot step's time goes: ONNX Runtime's fixed cost per call, the cost per graph node, the physics.
 
-The exported Phys-NN+ graph is 23 nodes after ONNX Runtime's optimisations: the MLP (3 fused Gemms) plus ~18
-small nodes (input scaling, Split/Squeeze/Unsqueeze/Concat of the heads, p_M S). For one row every node costs
-a fixed dispatch overhead, so those small nodes cost more than the network. This script rebuilds the same
-function from the bundle's weights in 14 nodes, 11 after ORT's fusions (input scaling folded into the first
-Gemm, the heads scaled by one Mul, p_M S added as one row) and times both through IOBinding, as the engine
-calls them. Evidence for the exporter, not used at runtime: the engine serves the bundle's graph as shipped.
+For one row every graph node costs a fixed dispatch overhead, so the node count matters more than the network's
+arithmetic (NOTES.md section 6). This script times, one row through IOBinding as the engine calls them: a one-node
+graph (the per-call floor), the bundle's network alone (its Gemms and sigmoid), the bundle's whole graph, and the
+plain-float Euler step; then a whole 7-iron, to compare the parts with the sum.
 
-python benchmarks/bench_graph.py [--model DIR]   (phys-nn+ bundles only)
+python benchmarks/bench_graph.py [--model DIR]
 """
 
 from __future__ import annotations
 
 import argparse
 import statistics
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 import onnx
 import onnxruntime as ort
-from common import write_results
-from onnx import TensorProto, helper, numpy_helper
+from common import SEVEN_IRON, write_results
+from onnx import TensorProto, helper
 
-from service.constants import BALL_RADIUS_M
+from service.bundle_check import session_options
+from service.engine import FlightEngine
 from service.model_location import model_dir
+from service.physics import euler_step
 from weights_schema.bundle import load_bundle
 
 
-def lean_graph(card, onnx_path) -> onnx.ModelProto:
-    """The phys-nn+ coefficient function of `onnx_path` as a 14-node graph with the same inputs and output."""
-    weights = {i.name: numpy_helper.to_array(i) for i in onnx.load(str(onnx_path)).graph.initializer}
-    scale = np.array([1 / 89.4] * 3 + [1 / 2094.0] * 3, np.float32)
-    head_w, head_b = np.zeros((4, weights["net.4.weight"].shape[1]), np.float32), np.zeros(4, np.float32)
-    head_w[[0, 1, 3]], head_b[[0, 1, 3]] = weights["net.4.weight"], weights["net.4.bias"]
-    constants = {
-        "w0": (weights["net.0.weight"] * scale).astype(np.float32),
-        "b0": weights["net.0.bias"],
-        "w1": weights["net.2.weight"],
-        "b1": weights["net.2.bias"],
-        "w2": head_w,
-        "b2": head_b,
-        "heads": np.array([0.5, 0.5, 0.0, 1.0], np.float32),
-        "moment": np.array([0.0, 0.0, BALL_RADIUS_M * card.architecture.p_m, 0.0], np.float32),
-        "tiny": np.array(1e-12, np.float32),
-        "axes": np.array([-1], np.int64),
-    }
-    node = helper.make_node
-    nodes = [
-        node("Concat", ["v_rel", "omega"], ["x"], axis=-1),
-        node("Gemm", ["x", "w0", "b0"], ["g0"], transB=1),
-        node("Relu", ["g0"], ["r0"]),
-        node("Gemm", ["r0", "w1", "b1"], ["g1"], transB=1),
-        node("Relu", ["g1"], ["r1"]),
-        node("Gemm", ["r1", "w2", "b2"], ["g2"], transB=1),
-        node("Sigmoid", ["g2"], ["s"]),
-        node("Mul", ["s", "heads"], ["c"]),
-        node("ReduceL2", ["omega", "axes"], ["w_norm"], keepdims=1),
-        node("ReduceL2", ["v_rel", "axes"], ["v_norm"], keepdims=1),
-        node("Clip", ["v_norm", "tiny"], ["v_safe"]),
-        node("Div", ["w_norm", "v_safe"], ["ratio"]),
-        node("Mul", ["ratio", "moment"], ["c_m"]),
-        node("Add", ["c", "c_m"], ["coefficients"]),
-    ]
-    inputs = [helper.make_tensor_value_info(n, TensorProto.FLOAT, ["N", 3]) for n in ("v_rel", "omega")]
-    output = helper.make_tensor_value_info("coefficients", TensorProto.FLOAT, ["N", 4])
-    initializers = [numpy_helper.from_array(a, n) for n, a in constants.items()]
-    graph = helper.make_graph(nodes, "lean", inputs, [output], initializers)
-    return helper.make_model(graph, opset_imports=[helper.make_opsetid("", 18)])
+def optimised_node_count(model: onnx.ModelProto) -> int:
+    """Nodes left after ONNX Runtime's graph optimisations (fusions, constant folding), as the engine runs it."""
+    with tempfile.TemporaryDirectory() as folder:
+        options = session_options(1)
+        options.optimized_model_filepath = str(Path(folder) / "optimised.onnx")
+        options.log_severity_level = 3  # ORT warns that the saved graph is machine-specific: that is the point
+        ort.InferenceSession(model.SerializeToString(), options, providers=["CPUExecutionProvider"])
+        return len(onnx.load(options.optimized_model_filepath).graph.node)
 
 
-def one_row_call_us(model: bytes | str, rounds: int = 7, calls: int = 5000) -> float:
-    options = ort.SessionOptions()
-    options.intra_op_num_threads = options.inter_op_num_threads = 1
-    session = ort.InferenceSession(model, options, providers=["CPUExecutionProvider"])
-    buffers = [np.ones((1, 3), np.float32), np.full((1, 3), 300.0, np.float32), np.zeros((1, 4), np.float32)]
+def one_node_graph() -> onnx.ModelProto:
+    """y = x + x: the least work a call can do, so its time is ORT's fixed cost per call."""
+    x = helper.make_tensor_value_info("x", TensorProto.FLOAT, ["N", 2])
+    y = helper.make_tensor_value_info("y", TensorProto.FLOAT, ["N", 2])
+    graph = helper.make_graph([helper.make_node("Add", ["x", "x"], ["y"])], "floor", [x], [y])
+    return helper.make_model(graph, opset_imports=[helper.make_opsetid("", 17)])
+
+
+def network_only(model: onnx.ModelProto) -> onnx.ModelProto:
+    """The bundle's MLP from its 2 features to its sigmoids: the graph minus the norms and the tail."""
+    nodes = model.graph.node
+    first = next(i for i, n in enumerate(nodes) if n.op_type == "Gemm")
+    last = next(i for i, n in enumerate(nodes) if n.op_type == "Sigmoid")
+    inferred = onnx.shape_inference.infer_shapes(model)
+    return onnx.utils.Extractor(inferred).extract_model([nodes[first].input[0]], [nodes[last].output[0]])
+
+
+def one_row_call_us(model: onnx.ModelProto, rounds: int = 9, calls: int = 5000) -> float:
+    """Median time of one single-row call through IOBinding (one thread), in microseconds."""
+    session = ort.InferenceSession(model.SerializeToString(), session_options(1), providers=["CPUExecutionProvider"])
     binding = session.io_binding()
-    for name, buffer in zip(("v_rel", "omega"), buffers[:2]):
-        binding.bind_input(name, "cpu", 0, np.float32, [1, 3], buffer.ctypes.data)
-    binding.bind_output("coefficients", "cpu", 0, np.float32, [1, 4], buffers[2].ctypes.data)
+    buffers = []
+    for spec in (*session.get_inputs(), *session.get_outputs()):
+        width = spec.shape[-1] if isinstance(spec.shape[-1], int) else 2
+        buffers.append(np.full((1, width), 0.5, np.float32))
+        bind = binding.bind_input if len(buffers) <= len(session.get_inputs()) else binding.bind_output
+        bind(spec.name, "cpu", 0, np.float32, [1, width], buffers[-1].ctypes.data)
+    return median_us(lambda: session.run_with_iobinding(binding), rounds, calls)
+
+
+def median_us(call, rounds: int = 9, calls: int = 5000) -> float:
+    for _ in range(calls // 10):
+        call()
     timings = []
     for _ in range(rounds):
         started = time.perf_counter()
         for _ in range(calls):
-            session.run_with_iobinding(binding)
+            call()
         timings.append((time.perf_counter() - started) / calls * 1e6)
     return statistics.median(timings)
 
@@ -91,39 +85,32 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", help="model bundle (default: the shipped one)")
     args = parser.parse_args()
-    card, onnx_path = load_bundle(model_dir(args.model))
-    if card.variant != "phys-nn+":
-        raise SystemExit(f"bench_graph.py rebuilds phys-nn+ graphs only, not {card.variant}")
-    lean = lean_graph(card, onnx_path).SerializeToString()
-    rng = np.random.default_rng(0)
-    feeds = {
-        "v_rel": rng.normal(0, 30, (4096, 3)).astype(np.float32),
-        "omega": rng.normal(0, 300, (4096, 3)).astype(np.float32),
-    }
-    shipped = ort.InferenceSession(str(onnx_path), providers=["CPUExecutionProvider"]).run(None, feeds)[0]
-    rebuilt = ort.InferenceSession(lean, providers=["CPUExecutionProvider"]).run(None, feeds)[0]
-    difference = float(np.abs(shipped - rebuilt).max())
-    bundle_us, lean_us = one_row_call_us(str(onnx_path)), one_row_call_us(lean)
-    print("| graph | nodes (after ORT optimisation) | one-row call, IOBinding |")
+    bundle = model_dir(args.model)
+    card, onnx_path = load_bundle(bundle)
+    graph = onnx.load(str(onnx_path))
+    parts = {"one-node graph (fixed cost per call)": one_node_graph(), "the network alone": network_only(graph),
+             "the bundle's graph": graph}
+    rows = []
+    for name, model in parts.items():
+        rows.append({"name": f"one-row ORT call, {name}", "unit": "us", "p50": one_row_call_us(model),
+                     "nodes": len(model.graph.node), "nodes_after_ort": optimised_node_count(model)})
+    state = (0.0, 30.0, 20.0, 5.0, 50.0, 10.0, 600.0, 0.0, -30.0)
+    rows.append({"name": "plain-float Euler step (service.physics.euler_step)", "unit": "us",
+                 "p50": median_us(lambda: euler_step(*state, (0.2, 0.25, 0.001, 0.5), 1.225, 0.0, 0.0, 0.1))})
+    engine = FlightEngine(bundle)
+    steps = engine.fly(SEVEN_IRON).flight_time_s / card.physics.dt_s
+    shot_us = median_us(lambda: engine.fly(SEVEN_IRON), rounds=9, calls=300)
+    rows.append({"name": f"whole 7-iron, per step ({steps:.0f} steps)", "unit": "us", "p50": shot_us / steps})
+    print("| part of a step | nodes (after ORT) | time |")
     print("|---|---:|---:|")
-    print(f"| the bundle's (as exported) | 23 | {bundle_us:.2f} us |")
-    print(f"| equivalent lean graph (max |diff| {difference:.1g}) | 11 | {lean_us:.2f} us |")
-    print(
-        f"\nper 56-step 7-iron: {56 * (bundle_us - lean_us) / 1e3:.3f} ms of graph overhead"
-        " that a lean export would save"
-    )
-    write_results(
-        "graph_overhead",
-        [
-            {"name": "one-row ORT call, bundle graph", "unit": "us", "p50": bundle_us},
-            {
-                "name": "one-row ORT call, lean equivalent",
-                "unit": "us",
-                "p50": lean_us,
-                "max_abs_difference": difference,
-            },
-        ],
-    )
+    for row in rows:
+        nodes = f"{row['nodes']} ({row['nodes_after_ort']})" if "nodes" in row else ""
+        print(f"| {row['name']} | {nodes} | {row['p50']:.2f} us |")
+    graph_us, floor_us = rows[2]["p50"], rows[0]["p50"]
+    extra_nodes = rows[2]["nodes_after_ort"] - 1
+    print(f"\nper extra node after the first: {(graph_us - floor_us) / extra_nodes:.2f} us; the rest of a step "
+          f"(loop, buffers, landing checks): {rows[4]['p50'] - graph_us - rows[3]['p50']:.2f} us")
+    write_results("graph_overhead", rows)
 
 
 if __name__ == "__main__":
