@@ -1,6 +1,8 @@
 """The model being diagnosed: a coefficient model inside the equations of motion, its integrator and assumed air.
 
-`from_bundle` is what users run (a shipped ONNX bundle, forward Euler at the card's dt, the card's air density);
+`from_bundle` is what users run (a shipped ONNX bundle, forward Euler at the card's dt, the card's air; air
+`ratio` x denser also has 1/ratio the kinematic viscosity, for the reference world's Reynolds numbers as for the
+bundle's input scale);
 `reference` is the reference world itself (RK4 at 0.1 s, within 2 cm of its 0.01 s flights), a perfect model
 of clean synthetic data that `golfflight prove` uses to measure the method apart from any model error.
 """
@@ -69,7 +71,7 @@ def from_bundle(directory: str | os.PathLike) -> FlightModel:
     physics = card.physics
     return FlightModel(
         f"bundle {Path(directory)} ({card.variant})",
-        lambda ratio: coefficients,
+        lambda ratio: coefficients.in_air(physics.kinematic_viscosity_m2_s / np.asarray(ratio, dtype=float)),
         physics.air_density_kg_m3,
         physics.dt_s,
         "euler",

@@ -19,6 +19,7 @@ import numpy as np
 
 from model_export.data import MIN_APEX_M
 from model_export.report import table, write_generated_section
+from service.air import Air
 from service.constants import YARD_M
 from service.flight import Flight, simulate
 from service.onnx_coefficients import OnnxCoefficients
@@ -41,7 +42,7 @@ PGA_TARGETS = (3.0, 2.0, 2.0)
 
 class ModelFlyer:
     """A bundle flown through `service.flight.simulate` with its ONNX coefficient graph, at its card's step and
-    simulated time, calm, in one air density."""
+    simulated time, calm, in one air (its density and, through the graph's Reynolds scale, its viscosity)."""
 
     def __init__(self, bundle: str | os.PathLike) -> None:
         self.bundle = Path(bundle)
@@ -53,14 +54,14 @@ class ModelFlyer:
         """The card's air density: the air the model was trained to treat as nominal."""
         return self.card.physics.air_density_kg_m3
 
-    def fly(
-        self, launch: dict[str, np.ndarray], density_kg_m3: float | None = None, keep_states: bool = False
-    ) -> Flight:
+    def fly(self, launch: dict[str, np.ndarray], air: Air | None = None, keep_states: bool = False) -> Flight:
+        """Fly launches calm in `air` (default: the card's air)."""
         physics = self.card.physics
-        density = self.density_kg_m3 if density_kg_m3 is None else density_kg_m3
+        density = self.density_kg_m3 if air is None else float(air.density_kg_m3)
+        viscosity = physics.kinematic_viscosity_m2_s if air is None else air.kinematic_viscosity_m2_s
         return simulate(
             initial_state(**launch),
-            self.coefficients,
+            self.coefficients.in_air(viscosity),
             density,
             dt=physics.dt_s,
             t_max=physics.t_sim_s,
@@ -89,9 +90,7 @@ class ClubComparison:
         return np.mean(self.model - self.targets, axis=0)
 
 
-def compare_clubs(
-    flyer: ModelFlyer, clubs: Sequence[ClubAverage], density_kg_m3: float | None = None
-) -> ClubComparison:
+def compare_clubs(flyer: ModelFlyer, clubs: Sequence[ClubAverage], air: Air | None = None) -> ClubComparison:
     """Fly each club's average launch (launch direction and spin axis 0) and compare with TrackMan's averages."""
     n = len(clubs)
     launch = {
@@ -101,8 +100,8 @@ def compare_clubs(
         "spin_rpm": np.array([c.spin_rpm for c in clubs]),
         "spin_axis_deg": np.zeros(n),
     }
-    density = flyer.density_kg_m3 if density_kg_m3 is None else density_kg_m3
-    flight = flyer.fly(launch, density)
+    density = flyer.density_kg_m3 if air is None else float(air.density_kg_m3)
+    flight = flyer.fly(launch, air)
     model = np.stack([flight.carry_m / YARD_M, flight.apex_m / YARD_M, flight.landing_angle_deg], axis=1)
     return ClubComparison(list(clubs), model, density)
 
@@ -268,7 +267,7 @@ def finetune_study(
         result = finetune(flyer.bundle, train_file, Path(work) / "bundle", epochs, lr, batch_size, progress=False)
         tuned = ModelFlyer(Path(work) / "bundle") if result.improved else flyer
         after = outcome_errors(tuned.fly(launch), second)
-        pga_after = compare_clubs(tuned, clubs) if clubs else None
+        pga_after = compare_clubs(tuned, clubs, CALIBRATION_AIR) if clubs else None
     return FinetuneStudy(
         n_train=result.run.data.n_train,
         n_val=result.run.data.n_val,
@@ -301,17 +300,17 @@ def _missing(path: Path) -> str:
     return f"_Skipped: `{path}` not found (set `GOLFFLIGHT_SHARED_DATA` or put the shared data beside the repository)._"
 
 
-def _club_lines(comparison: ClubComparison, at_calibration: ClubComparison) -> list[str]:
+def _club_lines(comparison: ClubComparison, at_card_air: ClubComparison) -> list[str]:
     rows = []
     for club, model, target in zip(comparison.clubs, comparison.model, comparison.targets):
         rows.append((club.club, *(f"{m:.1f} / {t:g} / {m - t:+.1f}" for m, t in zip(model, target))))
     mae, bias = comparison.mean_absolute_error, comparison.bias
     rows.append(("**MAE (bias)**", *(f"**{e:.2f}** ({b:+.2f})" for e, b in zip(mae, bias))))
-    other = at_calibration.mean_absolute_error
+    other = at_card_air.mean_absolute_error
     rows.append(
         (
-            f"MAE at rho {at_calibration.density_kg_m3:.3f}",
-            *(f"{e:.2f} ({b:+.2f})" for e, b in zip(other, at_calibration.bias)),
+            f"MAE (bias) at the card's air, rho {at_card_air.density_kg_m3:.3f}",
+            *(f"{e:.2f} ({b:+.2f})" for e, b in zip(other, at_card_air.bias)),
         )
     )
     met = all(e <= t for e, t in zip(mae, PGA_TARGETS))
@@ -321,7 +320,7 @@ def _club_lines(comparison: ClubComparison, at_calibration: ClubComparison) -> l
         "",
         (
             f"Target MAE <= {PGA_TARGETS[0]:g} yd carry, {PGA_TARGETS[1]:g} yd max height, {PGA_TARGETS[2]:g} deg land "
-            f"angle at the card's air: **{verdict}**."
+            f"angle in the table's air (rho {comparison.density_kg_m3:.3f}): **{verdict}**."
         ),
     ]
 
@@ -399,8 +398,10 @@ def run_accuracy(
         (
             f"Model: `{Path(bundle)}` ({card.variant}, trained on `{card.training_data.file}`, checkpoint of epoch "
             f"{card.training.best_epoch}, validation landing error {card.validation.landing_error_yd:.2f} yd). Runtime "
-            f"path: NumPy physics + ONNX Runtime, Euler dt {card.physics.dt_s:g} s. Every shot is flown calm in the "
-            f"card's air, rho {rho:.3f} kg/m^3: none of these sets records its weather."
+            f"path: NumPy physics + ONNX Runtime, Euler dt {card.physics.dt_s:g} s. The PGA averages are flown calm in "
+            f"TrackMan's normalisation air (25 C, sea level, rho {CALIBRATION_AIR.density_kg_m3:.3f} kg/m^3), the air "
+            f"the table stands for; the recorded shots calm in the card's air, rho {rho:.3f} kg/m^3: none of these "
+            "sets records its weather."
         ),
         "",
         "### PGA TOUR 2023 TrackMan averages per club",
@@ -409,8 +410,8 @@ def run_accuracy(
     averages = data_dir / TOUR_AVERAGES_FILE
     clubs = read_tour_averages(averages) if averages.is_file() else None
     if clubs:
-        report.pga = compare_clubs(flyer, clubs)
-        lines += _club_lines(report.pga, compare_clubs(flyer, clubs, float(CALIBRATION_AIR.density_kg_m3)))
+        report.pga = compare_clubs(flyer, clubs, CALIBRATION_AIR)
+        lines += _club_lines(report.pga, compare_clubs(flyer, clubs))
     else:
         lines.append(_missing(averages))
 

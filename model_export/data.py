@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from service.air import Air, air_density, pressure_at_altitude
+from service.air import Air, air_density, dynamic_viscosity, pressure_at_altitude
 from service.constants import YARD_M
-from service.physics import initial_state
+from service.physics import initial_state, reynolds_scale
 from shots.records import ShotSet, read_shots
 from weights_schema.bundle import sha256_of
 
@@ -25,12 +25,14 @@ MIN_APEX_M = 8 * YARD_M
 
 @dataclass
 class ShotTensors:
-    """One split as tensors [N,...]: initial state, targets (NaN-free, with masks) and air density."""
+    """One split as tensors [N,...]: initial state, targets (NaN-free, with masks), air density and the Reynolds
+    scale of the network's inputs (`service.physics.reynolds_scale`; 1 in standard air)."""
 
     position: torch.Tensor
     velocity: torch.Tensor
     spin: torch.Tensor
     density: torch.Tensor
+    reynolds_scale: torch.Tensor
     landing: torch.Tensor
     landing_mask: torch.Tensor
     apex: torch.Tensor
@@ -69,17 +71,23 @@ class DataSummary:
         return {k: v for k, v in asdict(self).items() if k != "bad_rows"}
 
 
-def shot_density(shots: ShotSet) -> np.ndarray:
-    """Air density per shot from its recorded conditions; ICAO standard values fill what was not recorded."""
-    standard = float(Air.standard().density_kg_m3)
+def shot_air(shots: ShotSet) -> Air:
+    """Air (density, kinematic viscosity) per shot from its recorded conditions; ICAO standard values fill what
+    was not recorded."""
+    standard = Air.standard()
     temperature = shots.column("temperature_c")
     altitude = shots.column("altitude_m")
     pressure_hpa = shots.column("pressure_hpa")
     humidity = shots.column("humidity_pct")
     recorded = ~(np.isnan(temperature) & np.isnan(altitude) & np.isnan(pressure_hpa) & np.isnan(humidity))
     pressure = np.where(np.isnan(pressure_hpa), pressure_at_altitude(np.nan_to_num(altitude)), pressure_hpa * 100.0)
-    density = air_density(np.where(np.isnan(temperature), 15.0, temperature), pressure, np.nan_to_num(humidity))
-    return np.where(recorded, density, standard)
+    temperature = np.where(np.isnan(temperature), 15.0, temperature)
+    density = air_density(temperature, pressure, np.nan_to_num(humidity))
+    viscosity = dynamic_viscosity(temperature) / density
+    return Air(
+        np.where(recorded, density, standard.density_kg_m3),
+        np.where(recorded, viscosity, standard.kinematic_viscosity_m2_s),
+    )
 
 
 def to_tensors(shots: ShotSet, dtype: torch.dtype = torch.float32) -> ShotTensors:
@@ -93,11 +101,13 @@ def to_tensors(shots: ShotSet, dtype: torch.dtype = torch.float32) -> ShotTensor
     def tensor(array: np.ndarray) -> torch.Tensor:
         return torch.as_tensor(np.nan_to_num(array), dtype=dtype)
 
+    air = shot_air(shots)
     return ShotTensors(
         tensor(state.position),
         tensor(state.velocity),
         tensor(state.spin),
-        tensor(shot_density(shots)),
+        tensor(air.density_kg_m3),
+        tensor(reynolds_scale(air.kinematic_viscosity_m2_s, Air.standard().kinematic_viscosity_m2_s)),
         tensor(landing),
         torch.as_tensor(landing_mask),
         tensor(apex),

@@ -148,6 +148,7 @@ def check_bundle(bundle_dir: str | os.PathLike, val: ValidationSet) -> BundleChe
 
     coefficients = OnnxCoefficients(bundle_dir)
     physics = coefficients.card.physics
+    coefficients = coefficients.in_air(physics.kinematic_viscosity_m2_s / val.tensors.reynolds_scale.double().numpy())
     flight = simulate(
         initial_state(**val.shots.launch()),
         coefficients,
@@ -190,14 +191,16 @@ def coefficient_samples(model: nn.Module, config: TrainConfig, val: ValidationSe
     states: list[tuple[np.ndarray, np.ndarray]] = []
     for start in range(0, len(val), VALIDATION_BATCH):
         batch = val.tensors.take(torch.arange(start, min(start + VALIDATION_BATCH, len(val))))
+        scale = batch.reynolds_scale.double()
         trajectory = euler_rollout(
-            batch.position, batch.velocity, batch.spin, model, batch.density, config.dt_s, config.t_sim_s
+            batch.position, batch.velocity, batch.spin, model, batch.density, config.dt_s, config.t_sim_s, scale[:, None]
         )
         landing_time = hard_landing(trajectory).time_s
         times = torch.arange(trajectory.positions.shape[0], dtype=torch.float64)[:, None] * config.dt_s
         flying = times < landing_time[None, :]
         velocity, spin = trajectory.velocities[flying], trajectory.spins[flying]
-        values = model(velocity, spin)
+        k = scale.expand(flying.shape)[flying][:, None]
+        values = model(velocity * k, spin * k)
         ratio = spin_ratio(velocity, spin)
         for part, value in zip(parts, (ratio, values[:, 0], values[:, 1], values[:, 3])):
             part.append(value.numpy())

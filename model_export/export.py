@@ -52,8 +52,10 @@ LAUNCH_STATE = (
     "rpm * 2 pi / 60 and psi the spin axis (positive = tilted right: the ball curves right); rifle spin is zero."
 )
 EQUATIONS = [
-    "v_rel = v - v_wind (v_wind = 0 in training); the ONNX inputs are v_rel and omega",
-    "(C_L, C_D, C_M, C_Q) = graph(v_rel, omega), evaluated once per step",
+    "v_rel = v - v_wind (v_wind = 0 in training)",
+    "(C_L, C_D, C_M, C_Q) = graph(k v_rel, k omega), evaluated once per step, k = nu_0 / nu with nu the kinematic "
+    "viscosity of the air (dynamic viscosity / density) and nu_0 = physics.kinematic_viscosity_m2_s: the same spin "
+    "ratio at the Reynolds number of the actual air (k = 1 in the card's air)",
     "q = C_Q * rho * |v_rel|^2 (C_Q = 0.5 is the usual dynamic pressure 1/2 rho |v|^2)",
     "F_drag = -C_D * q * A * v_rel / |v_rel|, A = pi R^2",
     "F_lift = C_L * q * A * (omega x v_rel) / |omega x v_rel| (Magnus force along omega x v: back spin lifts the ball, "
@@ -260,8 +262,10 @@ def build_card(
                 "gravity_mps2": GRAVITY_MPS2,
                 "tee_height_m": TEE_HEIGHT_M,
                 "air_density_kg_m3": float(Air.standard().density_kg_m3),
+                "kinematic_viscosity_m2_s": float(Air.standard().kinematic_viscosity_m2_s),
                 "density_note": "ICAO standard air (15 degC, sea level, dry). Shots with recorded conditions were "
-                "trained with their own density (range in training_data); simulate a shot with the density of its air.",
+                "trained with their own density and viscosity (density range in training_data); simulate a shot "
+                "with the density and viscosity of its air.",
                 "integrator": "forward-euler",
                 "dt_s": config.dt_s,
                 "t_sim_s": config.t_sim_s,

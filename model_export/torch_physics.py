@@ -90,9 +90,12 @@ def derivatives(
     spin: torch.Tensor,
     coefficients: Coefficients,
     density: torch.Tensor | float,
+    reynolds_scale: torch.Tensor | float = 1.0,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """d/dt of (position, velocity, spin) in calm air (paper eq. 14 with the errata)."""
-    acceleration, spin_acceleration = aerodynamics(velocity, spin, coefficients(velocity, spin), density)
+    """d/dt of (position, velocity, spin) in calm air (paper eq. 14 with the errata); the coefficient model is fed
+    (k v, k omega) with k = `reynolds_scale` [N,1] (`service.physics.reynolds_scale`)."""
+    coefficient_values = coefficients(velocity * reynolds_scale, spin * reynolds_scale)
+    acceleration, spin_acceleration = aerodynamics(velocity, spin, coefficient_values, density)
     return velocity, acceleration - acceleration.new_tensor([0.0, 0.0, GRAVITY_MPS2]), spin_acceleration
 
 
@@ -104,11 +107,12 @@ def euler_rollout(
     density: torch.Tensor | float,
     dt: float = DT_S,
     t_sim: float = T_SIM_S,
+    reynolds_scale: torch.Tensor | float = 1.0,
 ) -> Trajectory:
     """Forward Euler over the whole t_sim for every shot (no early stop: fixed shapes stay batched, differentiable)."""
     positions, velocities, spins = [position], [velocity], [spin]
     for _ in range(int(round(t_sim / dt))):
-        d_position, d_velocity, d_spin = derivatives(position, velocity, spin, coefficients, density)
+        d_position, d_velocity, d_spin = derivatives(position, velocity, spin, coefficients, density, reynolds_scale)
         position, velocity, spin = position + dt * d_position, velocity + dt * d_velocity, spin + dt * d_spin
         positions.append(position)
         velocities.append(velocity)

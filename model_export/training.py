@@ -91,7 +91,14 @@ def predict(
     if config.variant == "nn":
         return model(shots.velocity, shots.spin), None
     trajectory = euler_rollout(
-        shots.position, shots.velocity, shots.spin, model, shots.density, config.dt_s, config.t_sim_s
+        shots.position,
+        shots.velocity,
+        shots.spin,
+        model,
+        shots.density,
+        config.dt_s,
+        config.t_sim_s,
+        shots.reynolds_scale[:, None],
     )
     if soft:
         landing = soft_landing(trajectory, config.soft_argmax_temperature_m)

@@ -1,7 +1,8 @@
 """The conditions a shot flies in (air and wind), as the engine needs them, and the normalized reference.
 
 Requests describe air the way people know it (temperature, altitude or station pressure, humidity) or give a
-density outright; `AirConditions.density_kg_m3` turns that into the one number the equations use. Anything
+density outright; `AirConditions` turns that into the two numbers the equations use: the density (dynamic
+pressure) and the kinematic viscosity (Reynolds number, `service.physics.reynolds_scale`). Anything
 left out takes the ICAO standard value (15 degC, sea level, dry: 1.225 kg/m^3), the air the models were trained
 in, so a request without conditions reproduces the training simulator.
 """
@@ -10,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from service.air import air_density, pressure_at_altitude
+from service.air import air_density, dynamic_viscosity, pressure_at_altitude
 from service.wind import CALM, Wind, wind_vector
 
 STANDARD_TEMPERATURE_C = 15.0
@@ -34,6 +35,11 @@ class AirConditions:
             return self.density
         pressure_pa = pressure_at_altitude(self.altitude_m) if self.pressure_hpa is None else self.pressure_hpa * 100.0
         return float(air_density(self.temperature_c, pressure_pa, self.humidity_pct))
+
+    @property
+    def kinematic_viscosity_m2_s(self) -> float:
+        """mu(temperature) / density: what sets a ball's Reynolds number at a given speed."""
+        return float(dynamic_viscosity(self.temperature_c)) / self.density_kg_m3
 
 
 @dataclass(frozen=True)

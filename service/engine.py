@@ -1,6 +1,7 @@
 """The runtime simulator: a model bundle's ONNX coefficients inside the equations of `service.physics`.
 
-Forward Euler at the card's step, one ONNX Runtime call per step for everything still in the air. One shot runs
+Forward Euler at the card's step, one ONNX Runtime call per step for everything still in the air, fed v_rel and
+omega times the air's Reynolds scale (`service.physics.reynolds_scale`, 1 in the card's air). One shot runs
 on plain Python floats with the network's inputs and output bound once to preallocated float32 buffers
 (IOBinding, one thread): per-call overheads, not arithmetic, decide single-shot latency (NOTES.md section 6).
 A batch runs on NumPy [N] arrays and drops each shot from the batch as it lands. Either way a shot stops at its
@@ -27,7 +28,7 @@ from service.bundle_check import open_session, open_verified, session_options
 from service.conditions import STANDARD, Conditions
 from service.constants import RPM_TO_RADPS
 from service.limits import FLIGHT_TIME_S
-from service.physics import euler_step, initial_state
+from service.physics import euler_step, initial_state, reynolds_scale
 from service.wind import log_profile_factor
 from weights_schema.model_card import ModelCard
 
@@ -96,13 +97,21 @@ def _summary(x, y, vx, vy, vz, wx, wy, wz):
 
 
 @lru_cache(maxsize=1024)
-def _physics_inputs(conditions: Conditions) -> tuple[float, float, float, bool, float, float]:
-    """(density, wind x, wind y at the reference height, log profile?, reference height, roughness) of a shot's
-    conditions; cached because a batch or a stream of shots mostly shares a few conditions."""
+def _physics_inputs(conditions: Conditions) -> tuple[float, float, float, bool, float, float, float]:
+    """(density, wind x, wind y at the reference height, log profile?, reference height, roughness, kinematic
+    viscosity) of a shot's conditions; cached because a batch or a stream of shots mostly shares a few."""
     wind_x, wind_y = conditions.wind_at_reference_mps
-    wind = conditions.wind
+    wind, air = conditions.wind, conditions.air
     log_profile = wind.profile == "log" and (wind_x != 0.0 or wind_y != 0.0)
-    return conditions.air.density_kg_m3, wind_x, wind_y, log_profile, wind.reference_height_m, wind.roughness_m
+    return (
+        air.density_kg_m3,
+        wind_x,
+        wind_y,
+        log_profile,
+        wind.reference_height_m,
+        wind.roughness_m,
+        air.kinematic_viscosity_m2_s,
+    )
 
 
 class FlightEngine:
@@ -117,6 +126,7 @@ class FlightEngine:
         self.card, onnx_path, self._batch_session = open_verified(self.bundle_dir, batch_threads)
         self.dt = self.card.physics.dt_s
         self.t_sim = self.card.physics.t_sim_s
+        self.nominal_viscosity = self.card.physics.kinematic_viscosity_m2_s
         self.max_steps = math.ceil(max(MAX_FLIGHT_TIME_S, self.t_sim) / self.dt - 1e-9)
         self._velocity_name, self._spin_name = (spec.name for spec in self.card.onnx.inputs)
         self._output_name = self.card.onnx.outputs[0].name
@@ -170,7 +180,8 @@ class FlightEngine:
         x, y, z = start.position[0].tolist()
         vx, vy, vz = start.velocity[0].tolist()
         wx, wy, wz = start.spin[0].tolist()
-        density, wind_x, wind_y, log_wind, reference_height, roughness = _physics_inputs(conditions)
+        density, wind_x, wind_y, log_wind, reference_height, roughness, viscosity = _physics_inputs(conditions)
+        k = reynolds_scale(viscosity, self.nominal_viscosity)
         air_x, air_y = wind_x, wind_y
         dt = self.dt
         apex, apex_step = z, 0
@@ -182,8 +193,8 @@ class FlightEngine:
                 if log_wind:
                     factor = log_profile_factor(z, reference_height, roughness)
                     air_x, air_y = wind_x * factor, wind_y * factor
-                velocity_in[0], velocity_in[1], velocity_in[2] = vx - air_x, vy - air_y, vz
-                spin_in[0], spin_in[1], spin_in[2] = wx, wy, wz
+                velocity_in[0], velocity_in[1], velocity_in[2] = (vx - air_x) * k, (vy - air_y) * k, vz * k
+                spin_in[0], spin_in[1], spin_in[2] = wx * k, wy * k, wz * k
                 run(binding)
                 old = (x, y, z, vx, vy, vz, wx, wy, wz)
                 x, y, z, vx, vy, vz, wx, wy, wz = euler_step(*old, out.tolist(), density, air_x, air_y, dt)
@@ -233,8 +244,10 @@ class FlightEngine:
         launch = np.array(launches, dtype=float).reshape(n, 5)
         start = initial_state(*launch.T)
         state = np.concatenate([start.position.T, start.velocity.T, start.spin.T])  # [9, n]
-        # per-shot constants, sliced along with the state as shots land: density, wind x/y, log profile, h_ref, z0
+        # per-shot constants, sliced along with the state as shots land: density, wind x/y, log profile, h_ref, z0,
+        # and (replacing the kinematic viscosity) the Reynolds scale of the network's inputs
         params = np.array([_physics_inputs(c) for c in per_shot]).T
+        params[6] = reynolds_scale(params[6], self.nominal_viscosity)
         alive = np.arange(n)
         landing = np.full((9, n), np.nan)
         flight_time = np.full(n, np.nan)
@@ -248,9 +261,11 @@ class FlightEngine:
             if params[3].any():
                 factor = np.where(params[3] > 0, log_profile_factor(state[2], params[4], params[5]), 1.0)
                 air_x, air_y = air_x * factor, air_y * factor
-            velocity = np.stack([state[3] - air_x, state[4] - air_y, state[5]], axis=1).astype(np.float32)
-            spin = state[6:9].T.astype(np.float32)
-            coefficients = session.run(outputs, {names[0]: velocity, names[1]: spin})[0]
+            k = params[6]
+            velocity = np.stack([(state[3] - air_x) * k, (state[4] - air_y) * k, state[5] * k], axis=1)
+            spin = (state[6:9] * k).T
+            feeds = {names[0]: velocity.astype(np.float32), names[1]: spin.astype(np.float32)}
+            coefficients = session.run(outputs, feeds)[0]
             new = np.array(euler_step(*state, coefficients.T, density, air_x, air_y, dt))
             higher = new[2] > apex[alive]
             apex[alive[higher]], apex_step[alive[higher]] = new[2, higher], step

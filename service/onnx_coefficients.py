@@ -2,15 +2,19 @@
 
 model = OnnxCoefficients(path); card = model.card
 simulate(state, model, density=card.physics.air_density_kg_m3, dt=card.physics.dt_s, t_max=card.physics.t_sim_s)
+In other air: `model.in_air(air.kinematic_viscosity_m2_s)` (the same graph, inputs at that air's Reynolds scale) and
+that air's density.
 """
 
 from __future__ import annotations
 
+import copy
 import os
 
 import numpy as np
 
 from service.bundle_check import open_verified
+from service.physics import reynolds_scale
 
 
 class OnnxCoefficients:
@@ -21,10 +25,20 @@ class OnnxCoefficients:
         self.card, self.onnx_path, self.session = open_verified(bundle_dir, intra_op_threads)
         self.velocity_name, self.spin_name = (spec.name for spec in self.card.onnx.inputs)
         self.output_name = self.card.onnx.outputs[0].name
+        self.input_scale: float | np.ndarray = 1.0
+
+    def in_air(self, kinematic_viscosity_m2_s: float | np.ndarray) -> OnnxCoefficients:
+        """This model (sharing its ONNX session) for air of this kinematic viscosity: a float, or one per ball in
+        the order the simulator passes them."""
+        nominal = self.card.physics.kinematic_viscosity_m2_s
+        scale = reynolds_scale(np.asarray(kinematic_viscosity_m2_s, dtype=float), nominal)
+        other = copy.copy(self)
+        other.input_scale = float(scale) if scale.ndim == 0 else scale[:, None]
+        return other
 
     def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
         feeds = {
-            self.velocity_name: np.ascontiguousarray(v_rel, dtype=np.float32),
-            self.spin_name: np.ascontiguousarray(omega, dtype=np.float32),
+            self.velocity_name: np.ascontiguousarray(v_rel * self.input_scale, dtype=np.float32),
+            self.spin_name: np.ascontiguousarray(omega * self.input_scale, dtype=np.float32),
         }
         return self.session.run([self.output_name], feeds)[0].astype(np.float64)

@@ -78,6 +78,13 @@ def spin_ratio(v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
     return BALL_RADIUS_M * np.linalg.norm(omega, axis=-1) / np.maximum(np.linalg.norm(v_rel, axis=-1), TINY)
 
 
+def reynolds_scale(kinematic_viscosity, nominal_kinematic_viscosity):
+    """k = nu_0 / nu (float or array). A coefficient model trained in air of viscosity nu_0 and fed (k v_rel, k omega)
+    sees the Reynolds number of the actual air, |v| d / nu, at the same spin ratio: hot or thin air lowers Re,
+    which a model of |v| and |omega| alone would otherwise not know."""
+    return nominal_kinematic_viscosity / kinematic_viscosity
+
+
 def at_least_tiny(x):
     """max(x, TINY) of a float or an array: the guard of every magnitude in a denominator."""
     if isinstance(x, np.ndarray):

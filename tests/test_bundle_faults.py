@@ -52,7 +52,7 @@ def _edit_graph(bundle: Path, edit) -> None:
 
 
 def card_not_json(bundle):
-    (bundle / "model_card.json").write_text('{"schema_version": "1.0", "variant": ')
+    (bundle / "model_card.json").write_text('{"schema_version": "1.1", "variant": ')
 
 
 def card_invalid(bundle):

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from golfflight.cli import main
-from shots.records import read_shots
 from service.air import Air
+from shots.records import read_shots
 from shots.synth import MIN_APEX_M, SynthConfig, draw_sessions, generate, sessions_path, validation_sessions
 
 N = 400

@@ -12,8 +12,9 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-SCHEMA_VERSION = "1.0"
-SUPPORTED_SCHEMA_VERSIONS = ("1.0",)
+SCHEMA_VERSION = "1.1"
+SUPPORTED_SCHEMA_VERSIONS = ("1.1",)
+"""1.1 added physics.kinematic_viscosity_m2_s (the Reynolds scale of the graph's inputs); 1.0 cards lack it."""
 SCHEMA_PATH = Path(__file__).with_name("model_card.schema.json")
 
 ExportableVariant = Literal["phys-nn", "phys-nn-pm", "phys-nn-pm-cq", "phys-nn+", "phys-q"]
@@ -71,6 +72,10 @@ class Physics(_Strict):
     gravity_mps2: Positive
     tee_height_m: NonNegative
     air_density_kg_m3: Positive = Field(description="reference air density the model was trained at")
+    kinematic_viscosity_m2_s: Positive = Field(
+        description="kinematic viscosity nu_0 of that air; in air of viscosity nu the graph is fed v_rel * nu_0/nu "
+        "and omega * nu_0/nu (the same spin ratio at the actual Reynolds number)"
+    )
     density_note: str
     integrator: Literal["forward-euler"]
     dt_s: Positive
@@ -148,7 +153,7 @@ class Producer(_Strict):
 class ModelCard(_Strict):
     """model_card.json of a model bundle."""
 
-    schema_version: Literal["1.0"]
+    schema_version: Literal["1.1"]
     variant: ExportableVariant
     architecture: Architecture
     onnx: OnnxGraph
