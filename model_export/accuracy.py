@@ -267,7 +267,7 @@ def finetune_study(
         result = finetune(flyer.bundle, train_file, Path(work) / "bundle", epochs, lr, batch_size, progress=False)
         tuned = ModelFlyer(Path(work) / "bundle") if result.improved else flyer
         after = outcome_errors(tuned.fly(launch), second)
-        pga_after = compare_clubs(tuned, clubs, CALIBRATION_AIR) if clubs else None
+        pga_after = compare_clubs(tuned, clubs) if clubs else None
     return FinetuneStudy(
         n_train=result.run.data.n_train,
         n_val=result.run.data.n_val,
@@ -300,17 +300,17 @@ def _missing(path: Path) -> str:
     return f"_Skipped: `{path}` not found (set `GOLFFLIGHT_SHARED_DATA` or put the shared data beside the repository)._"
 
 
-def _club_lines(comparison: ClubComparison, at_card_air: ClubComparison) -> list[str]:
+def _club_lines(comparison: ClubComparison, at_table_air: ClubComparison) -> list[str]:
     rows = []
     for club, model, target in zip(comparison.clubs, comparison.model, comparison.targets):
         rows.append((club.club, *(f"{m:.1f} / {t:g} / {m - t:+.1f}" for m, t in zip(model, target))))
     mae, bias = comparison.mean_absolute_error, comparison.bias
     rows.append(("**MAE (bias)**", *(f"**{e:.2f}** ({b:+.2f})" for e, b in zip(mae, bias))))
-    other = at_card_air.mean_absolute_error
+    other = at_table_air.mean_absolute_error
     rows.append(
         (
-            f"MAE (bias) at the card's air, rho {at_card_air.density_kg_m3:.3f}",
-            *(f"{e:.2f} ({b:+.2f})" for e, b in zip(other, at_card_air.bias)),
+            f"MAE (bias) in TrackMan's normalisation air, rho {at_table_air.density_kg_m3:.3f}",
+            *(f"{e:.2f} ({b:+.2f})" for e, b in zip(other, at_table_air.bias)),
         )
     )
     met = all(e <= t for e, t in zip(mae, PGA_TARGETS))
@@ -320,7 +320,8 @@ def _club_lines(comparison: ClubComparison, at_card_air: ClubComparison) -> list
         "",
         (
             f"Target MAE <= {PGA_TARGETS[0]:g} yd carry, {PGA_TARGETS[1]:g} yd max height, {PGA_TARGETS[2]:g} deg land "
-            f"angle in the table's air (rho {comparison.density_kg_m3:.3f}): **{verdict}**."
+            f"angle in the card's air (rho {comparison.density_kg_m3:.3f}), what the service flies a shot without "
+            f"conditions in: **{verdict}**."
         ),
     ]
 
@@ -398,10 +399,10 @@ def run_accuracy(
         (
             f"Model: `{Path(bundle)}` ({card.variant}, trained on `{card.training_data.file}`, checkpoint of epoch "
             f"{card.training.best_epoch}, validation landing error {card.validation.landing_error_yd:.2f} yd). Runtime "
-            f"path: NumPy physics + ONNX Runtime, Euler dt {card.physics.dt_s:g} s. The PGA averages are flown calm in "
-            f"TrackMan's normalisation air (25 C, sea level, rho {CALIBRATION_AIR.density_kg_m3:.3f} kg/m^3), the air "
-            f"the table stands for; the recorded shots calm in the card's air, rho {rho:.3f} kg/m^3: none of these "
-            "sets records its weather."
+            f"path: NumPy physics + ONNX Runtime, Euler dt {card.physics.dt_s:g} s. Every shot is flown calm in the "
+            f"card's air, rho {rho:.3f} kg/m^3 (none of these sets records its weather); the PGA table also in "
+            f"TrackMan's normalisation air (25 C, sea level, rho {CALIBRATION_AIR.density_kg_m3:.3f} kg/m^3), where the "
+            "reference world was calibrated to it."
         ),
         "",
         "### PGA TOUR 2023 TrackMan averages per club",
@@ -410,8 +411,8 @@ def run_accuracy(
     averages = data_dir / TOUR_AVERAGES_FILE
     clubs = read_tour_averages(averages) if averages.is_file() else None
     if clubs:
-        report.pga = compare_clubs(flyer, clubs, CALIBRATION_AIR)
-        lines += _club_lines(report.pga, compare_clubs(flyer, clubs))
+        report.pga = compare_clubs(flyer, clubs)
+        lines += _club_lines(report.pga, compare_clubs(flyer, clubs, CALIBRATION_AIR))
     else:
         lines.append(_missing(averages))
 
