@@ -191,10 +191,14 @@ class Diagnoser:
         flown = model.fly(base, keep_positions=bool(recordings.trajectories))
         predicted = flown.outcomes()
         expected: ExpectedError = expected_error(model, recordings, base, predicted, self.noise)
+        offset = np.zeros_like(predicted)
+        if model.control is not None:  # the model's known error on these launches, taken out of every prediction
+            offset = np.nan_to_num(model.control.fly(base).outcomes() - predicted)
+            predicted = predicted + offset
         residual = recordings.observed - predicted
         wild = outlier_mask(residual)
         use = np.isfinite(recordings.observed) & ~wild
-        self.problem = Problem(model, recordings, base, expected.sigma, use)
+        self.problem = Problem(model, recordings, base, expected.sigma, use, offset)
         self.fold, grouping = folds(recordings.session)
         rows = fit_rows(recordings, self.rng)
 
@@ -269,6 +273,10 @@ class Diagnoser:
                 model_error_source=expected.model_source,
                 outcome_noise=expected.outcome_noise,
                 launch_noise=expected.launch_noise,
+                control=None if model.control is None else model.control.name,
+                known_model_error=None
+                if model.control is None
+                else {name: float(-np.mean(offset[:, j])) for j, name in enumerate(OBSERVABLES)},
             ),
             systematic=systematic,
             systematic_test=test,
@@ -278,7 +286,8 @@ class Diagnoser:
             candidates=candidates,
             ambiguities=ambiguities,
             heldout=heldout_block,
-            statement=statement(systematic, located, effects, unlisted, heldout_block, ambiguities, scored, chosen),
+            statement=statement(systematic, located, effects, unlisted, heldout_block, ambiguities, scored, chosen)
+            + control_sentence(model, offset),
             service_settings=service_settings(effects, context),
             seconds=time.perf_counter() - started,
         )
@@ -346,3 +355,15 @@ def diagnose(
 ) -> Diagnosis:
     """Run the whole diagnosis of recordings against a model."""
     return Diagnoser(recordings, model, noise, seed, with_correction=with_correction).run()
+
+
+def control_sentence(model: FlightModel, offset: np.ndarray) -> str:
+    """What the control took out, in words (empty without one)."""
+    if model.control is None:
+        return ""
+    known = -np.mean(offset, axis=0)
+    return (
+        f" Before fitting, the model's own error on these launches was taken out: against {model.control.name}, the "
+        f"physics it was trained to imitate, it carries {known[0]:+.1f} m along the line and {known[1]:+.1f} m across "
+        f"it, peaks {known[2]:+.1f} m and lands {known[4]:+.1f} deg steeper."
+    )

@@ -30,13 +30,15 @@ MAX_EVALUATIONS = 12
 
 @dataclass
 class Problem:
-    """Recordings, the conditions the model assumes for them, expected sigmas and the entries that count."""
+    """Recordings, the conditions the model assumes for them, expected sigmas, the entries that count and the
+    model's known error on each shot (`offset` [N, 5], added to every prediction; zero without a control)."""
 
     model: FlightModel
     recordings: Recordings
     base: Conditions
     sigma: np.ndarray
     use: np.ndarray
+    offset: np.ndarray
 
     @property
     def observed(self) -> np.ndarray:
@@ -55,7 +57,7 @@ class Problem:
         thetas = np.atleast_2d(thetas)
         theta_rows = np.repeat(thetas, len(rows), axis=0)
         flown = self.outcomes(effects, theta_rows, np.tile(rows, len(thetas)))
-        return flown.outcomes().reshape(len(thetas), len(rows), len(OBSERVABLES))
+        return flown.outcomes().reshape(len(thetas), len(rows), len(OBSERVABLES)) + self.offset[rows]
 
     def standardize(self, predicted: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """(recorded - predicted) / sigma [..., len(rows), 5]; NaN where unused, a large value where not landed."""
@@ -249,7 +251,7 @@ def heldout(problem: Problem, result: Fit, fold: np.ndarray) -> np.ndarray:
         step = np.linalg.lstsq(J, -r, rcond=None)[0] if len(r) > result.k else np.zeros(result.k)
         theta_rows[fold == f] = np.clip(result.theta + step, low, high)
     everyone = np.arange(len(fold))
-    predicted = problem.outcomes(result.effects, theta_rows, everyone).outcomes()
+    predicted = problem.outcomes(result.effects, theta_rows, everyone).outcomes() + problem.offset
     return problem.standardize(predicted, everyone)
 
 

@@ -17,6 +17,7 @@ from typing import Literal
 
 import numpy as np
 
+from discovery.recordings import OBSERVABLES
 from discovery.simulator import CoefficientsFor, Conditions, Correction, Flown, fly
 from service.air import Air
 from service.onnx_coefficients import OnnxCoefficients
@@ -49,25 +50,35 @@ class FlightModel:
     error_source: dict[str, str] = field(default_factory=dict)
     temperature_c: float = 15.0
     """Temperature of the assumed air (for the equivalent altitude of a density ratio)."""
+    control: FlightModel | None = None
+    """The physics the model was trained to imitate. When set, diagnose flies the recorded launches through it
+    too and adds the difference to every prediction: the model's own known error on these launches is taken out
+    before anything is fitted, so it is not mistaken for left-out physics."""
 
     def fly(self, conditions: Conditions, correction: Correction | None = None, keep_positions: bool = False) -> Flown:
         return fly(conditions, self.coefficients_for, self.dt_s, self.t_max_s, self.method, correction, keep_positions)
 
 
-def from_bundle(directory: str | os.PathLike) -> FlightModel:
-    """The shipped model as users run it; its card's validation errors set the expected landing and apex error."""
+def from_bundle(directory: str | os.PathLike, controlled: bool = True) -> FlightModel:
+    """The shipped model as users run it. Controlled (the default), its difference from the reference world on the
+    recorded launches is taken out first and no model error is left to expect; uncontrolled, its card's validation
+    errors set the expected landing and apex error."""
     coefficients = OnnxCoefficients(directory)
     card = coefficients.card
-    validation = card.validation
-    per_axis = validation.landing_error_m / MEAN_TO_SIGMA
-    error = {"carry_y_m": per_axis, "carry_x_m": per_axis}
-    source = {
-        "carry_y_m": "model card: landing error / sqrt(pi/2) per axis",
-        "carry_x_m": "model card: landing error / sqrt(pi/2) per axis",
-    }
-    if validation.max_height_error_m is not None:
-        error["apex_m"] = validation.max_height_error_m * MEAN_TO_SIGMA
-        source["apex_m"] = "model card: max-height error x sqrt(pi/2)"
+    if controlled:
+        error = {name: 0.0 for name in OBSERVABLES}
+        source = {name: "taken out: the model's difference from the reference world on these launches" for name in error}
+    else:
+        validation = card.validation
+        per_axis = validation.landing_error_m / MEAN_TO_SIGMA
+        error = {"carry_y_m": per_axis, "carry_x_m": per_axis}
+        source = {
+            "carry_y_m": "model card: landing error / sqrt(pi/2) per axis",
+            "carry_x_m": "model card: landing error / sqrt(pi/2) per axis",
+        }
+        if validation.max_height_error_m is not None:
+            error["apex_m"] = validation.max_height_error_m * MEAN_TO_SIGMA
+            source["apex_m"] = "model card: max-height error x sqrt(pi/2)"
     physics = card.physics
     return FlightModel(
         f"bundle {Path(directory)} ({card.variant})",
@@ -78,6 +89,7 @@ def from_bundle(directory: str | os.PathLike) -> FlightModel:
         max(physics.t_sim_s, MIN_T_MAX_S),
         error,
         source,
+        control=reference() if controlled else None,
     )
 
 
@@ -85,7 +97,7 @@ def reference(params: ReferenceParameters = CALIBRATED, air: Air | None = None) 
     """The reference world as the model (RK4, dt 0.1 s): no model error, only measurement noise is expected."""
     air = air or Air.standard()
     viscosity = float(air.kinematic_viscosity_m2_s)
-    zero = {name: 0.0 for name in ("carry_y_m", "carry_x_m", "apex_m", "flight_time_s", "landing_angle_deg")}
+    zero = {name: 0.0 for name in OBSERVABLES}
     return FlightModel(
         "reference world (RK4, dt 0.1 s)",
         lambda ratio: ReferenceAerodynamics(params, viscosity / np.asarray(ratio, dtype=float)),

@@ -180,6 +180,12 @@ class ModelInfo(_Strict):
     model_error_source: dict[str, str]
     outcome_noise: dict[str, float]
     launch_noise: dict[str, float]
+    control: str | None = Field(
+        None, description="the physics the model imitates; its difference from the model is taken out first"
+    )
+    known_model_error: dict[str, float] | None = Field(
+        None, description="mean model - control per observable on the recorded launches (taken out before fitting)"
+    )
 
 
 class Report(_Strict):
