@@ -54,6 +54,23 @@ def test_clean_recordings_raise_no_alarm():
     assert report.service_settings.wind is None
 
 
+def test_the_bundle_is_diagnosed_with_its_own_error_taken_out(windy):
+    """The shipped bundle is controlled by the reference world: its known error on these launches is reported and
+    subtracted, so the concealed wind is still the one thing named."""
+    from discovery.model import DEFAULT_BUNDLE, from_bundle
+    from discovery.recordings import read_recordings
+
+    model = from_bundle(DEFAULT_BUNDLE)
+    assert model.control is not None and set(model.model_error.values()) == {0.0}
+    report = diagnose(read_recordings(windy), model, seed=0, with_correction=False).report
+    assert report.model.control == model.control.name
+    known = report.model.known_model_error
+    assert 0.0 < abs(known["carry_y_m"]) < 5.0, "the bundle differs from its physics by metres, not tens"
+    assert [e.name for e in report.effects] == ["wind"]
+    assert report.effects[0].parameters["speed_mps"] == pytest.approx(4.5, rel=0.15)
+    assert "taken out" in report.statement
+
+
 def test_report_schema_is_fresh():
     assert SCHEMA_PATH.read_text() == schema_text(), "regenerate with: python -m discovery.schema"
 
