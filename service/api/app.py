@@ -199,6 +199,7 @@ def create_app(
         "land gets an error entry of its own.",
     )
     async def batch(request: BatchRequest, http: Request) -> Response:
+        """FastAPI has validated `request` (a 422 otherwise); the batch process flies its raw body."""
         engine()
         try:
             body, seconds = await state.batches.fly(await http.body())
