@@ -1,6 +1,6 @@
 """Properties of the flight engine over the whole valid input range (hypothesis): every flight is finite and
 lands, single and batch agree, carry grows with ball speed for a fixed launch in calm air, and the simulation is
-mirror-symmetric (exactly, with a coefficient model that is: Phys-Q depends on speed and spin magnitudes only)."""
+mirror-symmetric (exactly: the shipped network sees the speed and spin magnitudes only)."""
 
 from __future__ import annotations
 
@@ -12,8 +12,6 @@ import torch
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from model_export.export import export_checkpoint
-from model_export.training import TrainConfig, train
 from service import limits
 from service.conditions import AirConditions, Conditions
 from service.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
@@ -77,16 +75,6 @@ def engine() -> FlightEngine:
     return FlightEngine(model_dir())
 
 
-@pytest.fixture(scope="module")
-def symmetric_engine(tiny_shots, tmp_path_factory) -> FlightEngine:
-    """A Phys-Q bundle (C_L, C_D, C_M functions of the spin ratio: mirror-symmetric by construction)."""
-    run, bundle = tmp_path_factory.mktemp("phys-q-run"), tmp_path_factory.mktemp("phys-q")
-    train(tiny_shots, run, TrainConfig(variant="phys-q", epochs=1, batch_size=32, limit=64), progress=False)
-    torch.set_flush_denormal(False)
-    export_checkpoint(run, bundle)
-    return FlightEngine(bundle)
-
-
 def assert_sound(flight: ShotFlight) -> None:
     values = [getattr(flight, name) for name in ShotFlight.__dataclass_fields__ if name != "states"]
     assert all(math.isfinite(v) for v in values), flight
@@ -133,10 +121,10 @@ def mirrored(launch: Launch) -> Launch:
 
 @PROPERTY
 @given(launch=launches, where=conditions)
-def test_mirrored_launch_and_wind_land_mirrored(symmetric_engine, launch, where):
+def test_mirrored_launch_and_wind_land_mirrored(engine, launch, where):
     wind = dataclasses.replace(where.wind, from_deg=(360.0 - where.wind.from_deg) % 360.0)
-    flight = symmetric_engine.fly(launch, where)
-    mirror = symmetric_engine.fly(mirrored(launch), Conditions(where.air, wind))
+    flight = engine.fly(launch, where)
+    mirror = engine.fly(mirrored(launch), Conditions(where.air, wind))
     assert mirror.landing_x_m == pytest.approx(-flight.landing_x_m, abs=1e-6)
     for name in ("landing_y_m", "carry_m", "apex_m", "flight_time_s", "landing_angle_deg", "landing_spin_rpm"):
         assert getattr(mirror, name) == pytest.approx(getattr(flight, name), abs=1e-6), name
