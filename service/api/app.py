@@ -12,6 +12,7 @@ a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and CORS only for 
 from __future__ import annotations
 
 import asyncio
+import gc
 import os
 import threading
 import time
@@ -72,6 +73,7 @@ class ServiceState:
             if self.batches.start() != engine.sha256:
                 raise RuntimeError("the batch process loaded a different model (the bundle changed during startup)")
             self.engine = engine
+            gc.freeze()  # the app and the model are here for good: keep them out of every later collection's scan
         except Exception as error:  # noqa: BLE001 - reported by /healthz, the service stays up to say so
             self.error = f"{type(error).__name__}: {error}"
         finally:
