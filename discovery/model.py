@@ -110,10 +110,8 @@ def reference(params: ReferenceParameters = CALIBRATED, air: Air | None = None) 
     )
 
 
-def load_model(spec: str | os.PathLike | None) -> FlightModel:
-    """`reference`, a bundle directory, or None for the shipped default bundle."""
-    if spec is None:
-        return from_bundle(DEFAULT_BUNDLE)
+def load_model(spec: str | os.PathLike | None, controlled: bool = True) -> FlightModel:
+    """`reference`, a bundle directory, or None for the shipped default bundle (`controlled`: see `from_bundle`)."""
     if str(spec) == REFERENCE:
         return reference()
-    return from_bundle(spec)
+    return from_bundle(DEFAULT_BUNDLE if spec is None else spec, controlled)

@@ -71,6 +71,15 @@ def test_the_bundle_is_diagnosed_with_its_own_error_taken_out(windy):
     assert "taken out" in report.statement
 
 
+def test_no_control_diagnoses_the_bundle_against_its_card_error(windy, tmp_path):
+    """--no-control (a bundle fine-tuned on real shots no longer imitates the reference world) expects the card's
+    error instead of taking the reference world's difference out."""
+    assert main(["diagnose", str(windy), "--out", str(tmp_path), "--no-control"]) == 0
+    report = Report.model_validate_json((tmp_path / "report.json").read_text())
+    assert report.model.control is None and report.model.known_model_error is None
+    assert report.model.model_error["carry_y_m"] > 1.0 and "model card" in report.model.model_error_source["carry_y_m"]
+
+
 def test_report_schema_is_fresh():
     assert SCHEMA_PATH.read_text() == schema_text(), "regenerate with: python -m discovery.schema"
 

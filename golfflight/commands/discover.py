@@ -21,6 +21,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--out", required=True, help="folder for report.json, report.html, service_settings.json")
     parser.add_argument("--seed", type=int, default=0, help="seed of the fitting subsample and the bootstraps")
+    parser.add_argument(
+        "--no-control",
+        action="store_true",
+        help="do not take the bundle's difference from the reference world out first (for a bundle fine-tuned on "
+        "real shots, which no longer imitates the reference world); its card's error is expected instead",
+    )
     parser.set_defaults(run=run_diagnose)
 
     prove = subparsers.add_parser("prove", help="hide effects in synthetic recordings, diagnose them blind, score")
@@ -38,7 +44,7 @@ def run_diagnose(args: argparse.Namespace) -> int:
     recordings = read_recordings(args.recordings)
     if len(recordings) < 3:
         raise ValueError(f"{args.recordings}: {len(recordings)} shots with an observed outcome; at least 3 are needed")
-    diagnosis = diagnose(recordings, load_model(args.model), seed=args.seed)
+    diagnosis = diagnose(recordings, load_model(args.model, controlled=not args.no_control), seed=args.seed)
     paths = write_diagnosis(diagnosis, args.out)
     print(diagnosis.report.statement)
     print(f"wrote {', '.join(str(p) for p in paths)} ({diagnosis.report.seconds:.1f} s)")
