@@ -25,25 +25,24 @@ from service.engine import BATCH_THREADS, FlightEngine
 from service.model_location import model_dir
 
 
-def time_single(engine: FlightEngine, launch, shots: int) -> dict:
-    for _ in range(100):
-        engine.fly(launch)
-    timings = []
-    for _ in range(shots):
-        started = time.perf_counter()
-        engine.fly(launch)
-        timings.append(time.perf_counter() - started)
-    return percentiles_ms(timings)
-
-
-def time_batch(engine: FlightEngine, launches, repeats: int) -> list[float]:
-    engine.fly_batch(launches)
+def timed(call, repeats: int, warmup: int = 1) -> list[float]:
+    """Wall-clock seconds of `repeats` calls, after `warmup` untimed ones."""
+    for _ in range(warmup):
+        call()
     timings = []
     for _ in range(repeats):
         started = time.perf_counter()
-        engine.fly_batch(launches)
+        call()
         timings.append(time.perf_counter() - started)
     return timings
+
+
+def time_single(engine: FlightEngine, launch, shots: int) -> dict:
+    return percentiles_ms(timed(lambda: engine.fly(launch), shots, warmup=100))
+
+
+def time_batch(engine: FlightEngine, launches, repeats: int) -> list[float]:
+    return timed(lambda: engine.fly_batch(launches), repeats)
 
 
 def main() -> None:

@@ -1,9 +1,9 @@
 """A shipped bundle back into torch, for fine-tuning from a bundle and for evaluating it through the torch path.
 
-An MLP graph's initializers are the network's layers: as exported by `export.LeanPhysNN` (input scaling folded
-into the first layer, the heads padded to the four output columns; recognised by its `tail` layer) or one to
-one with the torch state dict. p_M and Phys-Q's seven parameters come from the card. The rebuilt model is checked
-against ONNX Runtime on probe inputs before it is returned.
+An MLP graph's initializers are the network's layers as exported by `export.LeanPhysNN` (input scaling folded
+into the first layer, the heads padded to the four output columns; the tail's scales follow from the variant).
+p_M and Phys-Q's seven parameters come from the card. The rebuilt model is checked against ONNX Runtime on probe
+inputs before it is returned.
 """
 
 from __future__ import annotations
@@ -31,13 +31,11 @@ from weights_schema.model_card import ModelCard
 def _mlp_state(model: PhysNN, weights: dict[str, torch.Tensor], card: ModelCard) -> dict[str, torch.Tensor]:
     """The PhysNN state dict from the graph's layer initializers (undoing the lean layout) and the card's p_M."""
     state = {name: weights[name] for name in model.state_dict() if name.startswith("net.")}
-    if "tail.weight" in weights:
-        input_scale = torch.tensor([VELOCITY_SCALE_MPS, SPIN_SCALE_RADPS])
-        state["net.0.weight"] = state["net.0.weight"] * input_scale
-        rows = [COEFFICIENT_COLUMNS.index(head) for head in model.heads]
-        last = f"net.{len(model.net) - 1}"
-        state[f"{last}.weight"] = state[f"{last}.weight"][rows]
-        state[f"{last}.bias"] = state[f"{last}.bias"][rows]
+    state["net.0.weight"] = state["net.0.weight"] * torch.tensor([VELOCITY_SCALE_MPS, SPIN_SCALE_RADPS])
+    rows = [COEFFICIENT_COLUMNS.index(head) for head in model.heads]
+    last = f"net.{len(model.net) - 1}"
+    state[f"{last}.weight"] = state[f"{last}.weight"][rows]
+    state[f"{last}.bias"] = state[f"{last}.bias"][rows]
     if model.learned_moment:
         state["log_p_m"] = torch.tensor(math.log(card.architecture.p_m))
     return state

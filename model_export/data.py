@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from service.air import Air, air_density, dynamic_viscosity, pressure_at_altitude
+from service.air import Air, pressure_at_altitude
 from service.constants import YARD_M
 from service.physics import initial_state, reynolds_scale
 from shots.records import ShotSet, read_shots
@@ -72,21 +72,15 @@ class DataSummary:
 
 
 def shot_air(shots: ShotSet) -> Air:
-    """Air (density, kinematic viscosity) per shot from its recorded conditions; ICAO standard values fill what
-    was not recorded."""
-    standard = Air.standard()
-    temperature = shots.column("temperature_c")
-    altitude = shots.column("altitude_m")
+    """Air (density, kinematic viscosity) per shot from its recorded conditions. What was not recorded takes the
+    ICAO standard value (15 degC, sea-level pressure, dry), so a shot without conditions flies in standard air."""
+    altitude = np.nan_to_num(shots.column("altitude_m"))
     pressure_hpa = shots.column("pressure_hpa")
-    humidity = shots.column("humidity_pct")
-    recorded = ~(np.isnan(temperature) & np.isnan(altitude) & np.isnan(pressure_hpa) & np.isnan(humidity))
-    pressure = np.where(np.isnan(pressure_hpa), pressure_at_altitude(np.nan_to_num(altitude)), pressure_hpa * 100.0)
-    temperature = np.where(np.isnan(temperature), 15.0, temperature)
-    density = air_density(temperature, pressure, np.nan_to_num(humidity))
-    viscosity = dynamic_viscosity(temperature) / density
-    return Air(
-        np.where(recorded, density, standard.density_kg_m3),
-        np.where(recorded, viscosity, standard.kinematic_viscosity_m2_s),
+    temperature = shots.column("temperature_c")
+    return Air.from_conditions(
+        np.where(np.isnan(temperature), 15.0, temperature),
+        humidity_pct=np.nan_to_num(shots.column("humidity_pct")),
+        pressure_pa=np.where(np.isnan(pressure_hpa), pressure_at_altitude(altitude), pressure_hpa * 100.0),
     )
 
 

@@ -18,6 +18,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from model_export.data import shot_air
 from model_export.noise_floor import Floor, noise_floors, nominal_conditions
 from model_export.report import metres_yards, table, write_generated_section
 from model_export.torch_physics import euler_rollout, hard_landing, spin_ratio
@@ -148,11 +149,11 @@ def check_bundle(bundle_dir: str | os.PathLike, val: ValidationSet) -> BundleChe
 
     coefficients = OnnxCoefficients(bundle_dir)
     physics = coefficients.card.physics
-    coefficients = coefficients.in_air(physics.kinematic_viscosity_m2_s / val.tensors.reynolds_scale.double().numpy())
+    air = shot_air(val.shots)
     flight = simulate(
         initial_state(**val.shots.launch()),
-        coefficients,
-        val.tensors.density.numpy(),
+        coefficients.in_air(air.kinematic_viscosity_m2_s),
+        air.density_kg_m3,
         dt=physics.dt_s,
         t_max=physics.t_sim_s,
     )
