@@ -4,7 +4,8 @@ the simulator, choose by held-out error with a parameter penalty, and assemble t
 Selection: every single effect is fitted (from a Gauss-Newton start); the best is combined with the other effects
 that most reduce the linearised cost. A candidate
 replaces a simpler one only if its held-out error is lower beyond doubt (the lower end of a session-bootstrap
-interval of the improvement is above zero) and by a material share. The mismatch is called systematic when the
+interval of the improvement is above zero) and by a material share, and, against a controlled model, by more than
+the model's own error of response to the simpler explanation (`Diagnoser.response_error`). The mismatch is called systematic when the
 mismatch exceeds the expected error (model error + launch-monitor noise) by a material share AND some fitted
 correction removes a material share of it on held-out sessions beyond doubt: noise alone satisfies neither.
 """
@@ -17,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from discovery import correction as learned
-from discovery.effects import LIBRARY, Context
+from discovery.effects import LIBRARY, Context, apply_all
 from discovery.fit import (
     Fit,
     Problem,
@@ -32,10 +33,18 @@ from discovery.fit import (
 )
 from discovery.locate import locate, trajectory_residuals, trajectory_stats
 from discovery.model import FlightModel
-from discovery.noise import RADAR_NOISE, ExpectedError, base_conditions, expected_error
-from discovery.recordings import OBSERVABLES, Recordings
+from discovery.noise import (
+    RADAR_NOISE,
+    ExpectedError,
+    Scatter,
+    base_conditions,
+    expected_error,
+    recording_scatter,
+    with_scatter,
+)
+from discovery.recordings import LABELS, OBSERVABLES, Recordings
 from discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
-from discovery.schema import Candidate, Heldout, ModelInfo, Report
+from discovery.schema import Candidate, Heldout, ModelInfo, Report, ScatterStat
 from shots.synth import MeasurementNoise
 
 OUTLIER_MAD = 8.0
@@ -109,10 +118,11 @@ class Diagnoser:
         noise: MeasurementNoise = RADAR_NOISE,
         seed: int = 0,
         with_correction: bool = True,
+        estimate_scatter: bool = True,
     ):
         self.recordings, self.model, self.library = recordings, model, LIBRARY
-        self.with_correction = with_correction
-        self.rng = np.random.default_rng(seed)
+        self.with_correction, self.estimate_scatter = with_correction, estimate_scatter
+        self.seed, self.rng = seed, np.random.default_rng(seed)
         self.noise = noise
 
     def score(self, result: Fit) -> Scored:
@@ -121,15 +131,39 @@ class Diagnoser:
         error = _mean_sq(z)
         return Scored(result, z, error, error * result.k * np.log(n) / n)
 
-    def better(self, rich: Scored, simple: Scored, level: float) -> tuple[bool, float, float, float]:
-        """Whether `rich` beats `simple` on held-out error beyond doubt and materially; (flag, gain, low, high)."""
+    def better(
+        self, rich: Scored, simple: Scored, level: float, tolerance: float = 0.0
+    ) -> tuple[bool, float, float, float]:
+        """Whether `rich` beats `simple` on held-out error beyond doubt, materially and by more than `tolerance`
+        (the model's own error of response to `simple`, see `response_error`); (flag, gain, low, high)."""
         a, count = per_shot(simple.heldout_z)
         b, _ = per_shot(rich.heldout_z)
         draws = cluster_bootstrap(a - b, count, self.recordings.session, self.rng)
         gain = float((a - b).sum() / count.sum())
         low, high = np.quantile(draws, [1 - level, level])
-        material = gain >= MIN_RELATIVE_IMPROVEMENT * simple.error
+        material = gain >= max(MIN_RELATIVE_IMPROVEMENT * simple.error, tolerance)
         return bool(low > 0 and material and rich.score < simple.score), gain, float(low), float(high)
+
+    def response_error(self, candidate: Scored) -> float:
+        """How much of the candidate's remaining error is the model's own: the mean squared standardized
+        difference between the model (plus its known error at the assumed conditions) and its control, both
+        flown with the candidate's effects. Zero without a control or without effects.
+
+        The control takes out the model's error at the assumed conditions only; once an effect changes them, the
+        model responds to it a little differently from the physics it imitates (e.g. the bundle gains more carry
+        in thin air than the reference world). A richer explanation that removes no more than that difference is
+        fitting the model's error, not left-out physics."""
+        control, result = self.model.control, candidate.fit
+        if control is None or result.k == 0:
+            return 0.0
+        everyone = np.arange(len(self.recordings))
+        theta_rows = np.repeat(result.theta[None], len(everyone), 0)
+        conditions = apply_all(result.effects, theta_rows, self.problem.base)
+        correction = next((e.correction for e in result.effects if e.correction is not None), None)
+        truth = control.fly(conditions, correction).outcomes()
+        model = self.problem.predict(result.effects, result.theta, everyone)[0]
+        z = np.where(self.problem.use, (model - truth) / self.problem.sigma, np.nan)
+        return _mean_sq(z)
 
     def fit_singles(self, rows: np.ndarray) -> list[Scored]:
         """Every library effect alone, from Gauss-Newton starts out of one Jacobian; best score first."""
@@ -159,8 +193,14 @@ class Diagnoser:
         if flag:
             chosen = singles[0]
             if pairs:
-                flag, gain, low, _ = self.better(pairs[0], chosen, COMBINATION_LEVEL)
-                test.update(best_pair=pairs[0].fit.name, best_pair_gain_over_single=gain, best_pair_gain_low=low)
+                tolerance = self.response_error(chosen)
+                flag, gain, low, _ = self.better(pairs[0], chosen, COMBINATION_LEVEL, tolerance)
+                test.update(
+                    best_pair=pairs[0].fit.name,
+                    best_pair_gain_over_single=gain,
+                    best_pair_gain_low=low,
+                    **{f"model_response_error_of_{chosen.fit.name}": tolerance},
+                )
                 if flag:
                     chosen = pairs[0]
         return chosen, test
@@ -169,6 +209,9 @@ class Diagnoser:
         self, null: Scored, chosen: Scored, rows: np.ndarray, scored: list[Scored], test: dict
     ) -> Scored:
         """The learned correction on top of the chosen explanation and alone; it replaces the choice if better."""
+        tolerance = self.response_error(chosen)
+        if tolerance:
+            test[f"model_response_error_of_{chosen.fit.name}"] = tolerance
         for foundation in {id(chosen): chosen, id(null): null}.values():
             term = learned.fit_correction(self.problem, rows, foundation.fit)
             if term is None:
@@ -176,7 +219,7 @@ class Diagnoser:
             candidate = self.score(term)
             scored.append(candidate)
             level = SINGLE_LEVEL if chosen is null else COMBINATION_LEVEL
-            flag, gain, low, _ = self.better(candidate, chosen, level)
+            flag, gain, low, _ = self.better(candidate, chosen, level, tolerance)
             test[f"correction_on_{foundation.fit.name}_gain"] = gain
             test[f"correction_on_{foundation.fit.name}_gain_low"] = low
             if flag:
@@ -198,6 +241,10 @@ class Diagnoser:
         residual = recordings.observed - predicted
         wild = outlier_mask(residual)
         use = np.isfinite(recordings.observed) & ~wild
+        own_rng = np.random.default_rng([self.seed, 1])  # its own stream: the fits' draws stay as they were
+        scatter = recording_scatter(recordings, np.where(use, residual / expected.sigma, np.nan), own_rng)
+        if self.estimate_scatter:
+            expected = with_scatter(expected, scatter)
         self.problem = Problem(model, recordings, base, expected.sigma, use, offset)
         self.fold, grouping = folds(recordings.session)
         rows = fit_rows(recordings, self.rng)
@@ -273,6 +320,14 @@ class Diagnoser:
                 model_error_source=expected.model_source,
                 outcome_noise=expected.outcome_noise,
                 launch_noise=expected.launch_noise,
+                scatter={
+                    name: ScatterStat(
+                        ratio=ratio,
+                        low=scatter.low[name],
+                        applied=self.estimate_scatter and name in scatter.applied,
+                    )
+                    for name, ratio in scatter.ratio.items()
+                },
                 control=None if model.control is None else model.control.name,
                 known_model_error=None
                 if model.control is None
@@ -287,7 +342,8 @@ class Diagnoser:
             ambiguities=ambiguities,
             heldout=heldout_block,
             statement=statement(systematic, located, effects, unlisted, heldout_block, ambiguities, scored, chosen)
-            + control_sentence(model, offset),
+            + control_sentence(model, offset, self.response_error(chosen))
+            + (scatter_sentence(scatter) if self.estimate_scatter else ""),
             service_settings=service_settings(effects, context),
             seconds=time.perf_counter() - started,
         )
@@ -352,18 +408,38 @@ def diagnose(
     noise: MeasurementNoise = RADAR_NOISE,
     seed: int = 0,
     with_correction: bool = True,
+    estimate_scatter: bool = True,
 ) -> Diagnosis:
     """Run the whole diagnosis of recordings against a model."""
-    return Diagnoser(recordings, model, noise, seed, with_correction=with_correction).run()
+    return Diagnoser(recordings, model, noise, seed, with_correction, estimate_scatter).run()
 
 
-def control_sentence(model: FlightModel, offset: np.ndarray) -> str:
-    """What the control took out, in words (empty without one)."""
+def scatter_sentence(scatter: Scatter) -> str:
+    """Where the recordings' own scatter replaced the assumed noise, in words (empty where it did not)."""
+    if not scatter.applied:
+        return ""
+    parts = ", ".join(f"{LABELS[name].split(' (')[0]} {ratio:.1f}x" for name, ratio in scatter.applied.items())
+    return (
+        f" The recordings scatter more from shot to shot than the assumed launch-monitor noise ({parts}, about a "
+        "linear trend in the launch within each session and club), so that scatter is what they are expected to "
+        "miss by."
+    )
+
+
+def control_sentence(model: FlightModel, offset: np.ndarray, response: float) -> str:
+    """What the control took out, and how differently the model responds to the chosen effect, in words (empty
+    without a control)."""
     if model.control is None:
         return ""
     known = -np.mean(offset, axis=0)
-    return (
+    text = (
         f" Before fitting, the model's own error on these launches was taken out: against {model.control.name}, the "
         f"physics it was trained to imitate, it carries {known[0]:+.1f} m along the line and {known[1]:+.1f} m across "
         f"it, peaks {known[2]:+.1f} m and lands {known[4]:+.1f} deg steeper."
     )
+    if response > 0:
+        text += (
+            f" With the fitted effect the model responds differently from that physics by {response:.2f} in mean "
+            "squared standardized error; finer explanations that remove no more than that are not claimed."
+        )
+    return text

@@ -2,17 +2,21 @@
 
 Per shot and observable, sigma^2 = model error^2 + outcome noise^2 + sum over launch values of
 (d outcome / d launch value x launch noise)^2; the launch-noise terms are propagated through the model itself.
+Real recordings are often far noisier than a radar (gusts, players, mixed balls): their own shot-to-shot scatter is
+measured, and where it is larger than assumed beyond doubt it replaces the assumption (`recording_scatter`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from discovery.fit import cluster_bootstrap
 from discovery.model import FlightModel, reference
 from discovery.recordings import OBSERVABLES, Recordings
 from discovery.simulator import Conditions, concatenate
+from shots.records import LAUNCH_COLUMNS
 from shots.synth import MeasurementNoise
 
 RADAR_NOISE = MeasurementNoise()
@@ -109,3 +113,67 @@ def expected_error(
     sigma = np.sqrt(model_part[None] ** 2 + outcome**2 + launch_var)
     sigma = np.maximum(np.where(np.isfinite(sigma), sigma, np.nanmax(sigma, axis=0)), floor)
     return ExpectedError(sigma, model_sigma, source, _rms(outcome), _rms(np.sqrt(launch_var)))
+
+
+SCATTER_MATERIAL = 1.5
+"""The recordings' own scatter replaces the assumed noise only when it is at least this many times larger..."""
+
+SCATTER_LEVEL = 0.975
+"""...and larger than assumed beyond doubt (the lower end of this one-sided session-bootstrap bound is above 1)."""
+
+
+@dataclass
+class Scatter:
+    """Shot-to-shot scatter of the residuals, in units of the expected sigma, per observable (1 = as noisy as
+    assumed) with the lower end of its bootstrap interval. `applied` observables have their expected sigma scaled by
+    it."""
+
+    ratio: dict[str, float]
+    low: dict[str, float]
+    degrees_of_freedom: int
+    applied: dict[str, float]
+
+
+MIN_GROUP_SHOTS = 12
+"""Session-club groups smaller than this are left out of the scatter estimate (too few shots for the trend)."""
+
+
+def recording_scatter(recordings: Recordings, z: np.ndarray, rng: np.random.Generator, draws: int = 1000) -> Scatter:
+    """How noisy the recordings are, from themselves: within each session and club, the standardized residuals
+    z [N, 5] are fitted linearly on the five launch values, and the scatter about that fit (with its degrees of
+    freedom) is the noise, whatever its source (monitor, gusts, the player). A left-out effect changes smoothly with
+    the launch, so within one club and session the linear trend takes it out."""
+    values = np.stack([recordings.launch[name] for name in LAUNCH_COLUMNS], axis=1)
+    keys = [f"{s}\x00{c}" for s, c in zip(recordings.session, recordings.club)]
+    groups = np.unique(keys, return_inverse=True)[1]
+    squares = np.zeros(z.shape)
+    dof = np.zeros(z.shape)  # per shot: its share of its group's degrees of freedom
+    for g in range(groups.max() + 1):
+        members = np.flatnonzero(groups == g)
+        x = values[members]
+        x = (x - x.mean(axis=0)) / np.maximum(x.std(axis=0), 1e-9)
+        design = np.column_stack([np.ones(members.size), x])
+        for j in range(z.shape[1]):
+            used = np.isfinite(z[members, j])
+            if used.sum() < MIN_GROUP_SHOTS:
+                continue
+            rows = members[used]
+            fitted = design[used] @ np.linalg.lstsq(design[used], z[rows, j], rcond=None)[0]
+            squares[rows, j] = (z[rows, j] - fitted) ** 2
+            dof[rows, j] = 1.0 - np.linalg.matrix_rank(design[used]) / used.sum()
+    ratio, low, applied = {}, {}, {}
+    for j, name in enumerate(OBSERVABLES):
+        if dof[:, j].sum() < 10:
+            continue
+        ratio[name] = float(np.sqrt(squares[:, j].sum() / dof[:, j].sum()))
+        bootstrap = cluster_bootstrap(squares[:, j], dof[:, j], recordings.session, rng, draws)
+        low[name] = float(np.sqrt(np.quantile(bootstrap, 1.0 - SCATTER_LEVEL)))
+        if low[name] > 1.0 and ratio[name] >= SCATTER_MATERIAL:
+            applied[name] = ratio[name]
+    return Scatter(ratio, low, round(float(dof.max(axis=1).sum())), applied)
+
+
+def with_scatter(expected: ExpectedError, scatter: Scatter) -> ExpectedError:
+    """The expected error with each `applied` observable's sigma scaled by the recordings' own scatter."""
+    scale = np.array([scatter.applied.get(name, 1.0) for name in OBSERVABLES])
+    return replace(expected, sigma=expected.sigma * scale[None])

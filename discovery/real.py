@@ -153,11 +153,15 @@ def summary_row(item: RealSet, diagnosis: Diagnosis) -> list[str]:
         )
         or "-"
     )
+    scatter = ", ".join(
+        f"{n.split('_')[0] if n != 'carry_x_m' else 'side'} {s.ratio:.1f}" for n, s in report.model.scatter.items()
+    )
     held = report.heldout
     fraction = "-" if held.explained_fraction is None or not report.systematic else f"{held.explained_fraction:.0%}"
     return [
         item.title,
         str(report.n_shots),
+        scatter or "-",
         bias,
         "yes" if report.systematic else "no",
         effects,
@@ -219,7 +223,7 @@ def main(argv: list[str] | None = None) -> int:
             "ambiguities": [a.note for a in diagnosis.report.ambiguities],
         }
         print(f"{item.key}: {diagnosis.report.statement}", flush=True)
-    header = ["set", "shots", "bias (RMS/expected)", "systematic", "named", "held-out error", "excess removed", "s"]
+    header = ["set", "shots", "scatter (x assumed noise)", "bias (RMS/expected)", "systematic", "named", "held-out error", "excess removed", "s"]
     table = ["| " + " | ".join(header) + " |", "|---" * len(header) + "|"] + ["| " + " | ".join(r) + " |" for r in rows]
     write_text_atomic(out / "summary.md", f"Model: {model.name}\n\n" + "\n".join(table) + "\n")
     write_text_atomic(out / "details.json", json.dumps(details, indent=1) + "\n")

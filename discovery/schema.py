@@ -171,6 +171,17 @@ class ServiceSettings(_Strict):
     )
 
 
+class ScatterStat(_Strict):
+    """The recordings' own shot-to-shot scatter of one observable, in units of the expected error."""
+
+    ratio: float = Field(
+        description="RMS of the standardized residuals about a linear trend in the launch within each session and "
+        "club (1 = as noisy as assumed)"
+    )
+    low: float = Field(description="lower end of its one-sided 97.5 % session-bootstrap bound")
+    applied: bool = Field(description="the expected error of this observable was scaled by `ratio`")
+
+
 class ModelInfo(_Strict):
     name: str
     dt_s: float
@@ -180,6 +191,11 @@ class ModelInfo(_Strict):
     model_error_source: dict[str, str]
     outcome_noise: dict[str, float]
     launch_noise: dict[str, float]
+    scatter: dict[str, ScatterStat] = Field(
+        default_factory=dict,
+        description="the recordings' own scatter per observable; where it is larger than assumed beyond doubt (and "
+        "by half again or more) it replaces the assumed noise",
+    )
     control: str | None = Field(
         None, description="the physics the model imitates; its difference from the model is taken out first"
     )

@@ -27,6 +27,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="do not take the bundle's difference from the reference world out first (for a bundle fine-tuned on "
         "real shots, which no longer imitates the reference world); its card's error is expected instead",
     )
+    parser.add_argument(
+        "--assumed-noise",
+        action="store_true",
+        help="expect only the assumed launch-monitor noise, even where the recordings scatter more than that from "
+        "shot to shot (by default their own scatter replaces it there)",
+    )
     parser.set_defaults(run=run_diagnose)
 
     prove = subparsers.add_parser("prove", help="hide effects in synthetic recordings, diagnose them blind, score")
@@ -44,7 +50,8 @@ def run_diagnose(args: argparse.Namespace) -> int:
     recordings = read_recordings(args.recordings)
     if len(recordings) < 3:
         raise ValueError(f"{args.recordings}: {len(recordings)} shots with an observed outcome; at least 3 are needed")
-    diagnosis = diagnose(recordings, load_model(args.model, controlled=not args.no_control), seed=args.seed)
+    model = load_model(args.model, controlled=not args.no_control)
+    diagnosis = diagnose(recordings, model, seed=args.seed, estimate_scatter=not args.assumed_noise)
     paths = write_diagnosis(diagnosis, args.out)
     print(diagnosis.report.statement)
     print(f"wrote {', '.join(str(p) for p in paths)} ({diagnosis.report.seconds:.1f} s)")
