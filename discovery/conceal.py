@@ -9,6 +9,7 @@ recorded = true - offset (or true / scale) before the noise is added.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Literal
 
 import numpy as np
 from pydantic import ValidationError
@@ -18,7 +19,7 @@ from discovery.noise import RADAR_NOISE
 from service.air import Air
 from service.flight import Flight
 from service.physics import initial_state
-from service.wind import Wind, wind_vector
+from service.wind import Wind, uniform_equivalent_factor, wind_vector
 from shots.records import ShotRecord, ShotSet
 from shots.reference_world import CALIBRATED, fly_reference
 from shots.synth import MIN_APEX_M, LaunchTable, MeasurementNoise, SynthConfig, draw_launches, draw_sessions, measure
@@ -50,6 +51,9 @@ class Concealed:
     hidden: dict[str, dict[str, float]]
     dropped: int
     trajectories: dict[str, np.ndarray]
+    wind_factor: float = 1.0
+    """Mean over the recorded flights of the hidden wind's speed along each flight over its stated speed: 1 for a
+    uniform wind; for a log profile (stated at 10 m) the factor that turns it into its uniform equivalent."""
 
 
 def conceal(
@@ -58,6 +62,7 @@ def conceal(
     seed: int,
     noise: MeasurementNoise = RADAR_NOISE,
     trajectories: bool = False,
+    wind_profile: Literal["uniform", "log"] = "uniform",
 ) -> Concealed:
     """Draw sessions, fly them with the hidden effects through the reference world and record them with noise.
 
@@ -78,7 +83,7 @@ def conceal(
         altitude = equivalent_altitude_m(hidden["air_density"]["ratio"], NOMINAL_CONTEXT)
         air = Air.from_conditions(15.0, altitude, 0.0)
     if "wind" in hidden:
-        wind = Wind(hidden["wind"]["speed_mps"], hidden["wind"]["from_deg"])
+        wind = Wind(hidden["wind"]["speed_mps"], hidden["wind"]["from_deg"], profile=wind_profile)
     if "landing_elevation" in hidden:
         ground = hidden["landing_elevation"]["height_m"]
     params = CALIBRATED
@@ -87,9 +92,10 @@ def conceal(
             params = replace(params, **{knob: hidden[name]["scale"]})
     if OUTSIDE_EFFECT in hidden:
         params = replace(params, critical_reynolds=hidden[OUTSIDE_EFFECT]["value"])
-    flight = fly_reference(initial_state(**true.launch()), air, wind, ground, keep_states=trajectories, params=params)
+    keep = trajectories or wind_profile == "log"
+    flight = fly_reference(initial_state(**true.launch()), air, wind, ground, keep_states=keep, params=params)
     values = measure(rng, recorded, flight, noise)
-    records, dropped, paths = [], 0, {}
+    records, dropped, paths, kept = [], 0, {}, []
     order = np.zeros(len(sessions), dtype=int)
     for i in range(len(true.club)):
         session = true.session_index[i]
@@ -110,8 +116,17 @@ def conceal(
             continue
         if trajectories:
             paths[records[-1].shot_id] = _path(flight, i, rng)
+        kept.append(i)
         order[session] += 1
-    return Concealed(ShotSet(records), hidden, dropped, paths)
+    factor = _mean_wind_factor(flight, wind, np.array(kept, dtype=int)) if wind.profile == "log" else 1.0
+    return Concealed(ShotSet(records), hidden, dropped, paths, factor)
+
+
+def _mean_wind_factor(flight: Flight, wind: Wind, shots: np.ndarray) -> float:
+    """The hidden log profile's uniform-equivalent factor along the recorded shots' flights."""
+    heights = np.stack([state.position[shots, 2] for state in flight.states])
+    heights[flight.times_s[:, None] > flight.flight_time_s[shots][None, :]] = np.nan
+    return uniform_equivalent_factor(heights, wind.reference_height_m, wind.roughness_m)
 
 
 def _path(flight: Flight, shot: int, rng: np.random.Generator, every: int = 10, noise_m: float = 0.1) -> np.ndarray:

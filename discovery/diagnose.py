@@ -45,6 +45,7 @@ from discovery.noise import (
 from discovery.recordings import LABELS, OBSERVABLES, Recordings
 from discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
 from discovery.schema import Candidate, Heldout, ModelInfo, Report, ScatterStat
+from service.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
 from shots.synth import MeasurementNoise
 
 OUTLIER_MAD = 8.0
@@ -285,11 +286,14 @@ class Diagnoser:
 
         after_fit = chosen.fit
         after = self.problem.predict(after_fit.effects, after_fit.theta, everyone)[0] if after_fit.k else predicted
-        positions_after = None
-        if recordings.trajectories and after_fit.k:
+        positions_after, wind_factor = None, None
+        has_wind = any(e.name == "wind" for e in after_fit.effects)
+        if (recordings.trajectories or has_wind) and after_fit.k:
             positions_after = self.problem.outcomes(
                 after_fit.effects, np.repeat(after_fit.theta[None], len(everyone), 0), everyone, keep_positions=True
             ).positions
+            if has_wind:
+                wind_factor = uniform_equivalent_factor(positions_after[..., 2], STATION_HEIGHT_M, FAIRWAY_ROUGHNESS_M)
         heldout_block = self.heldout_summary(null, chosen, grouping, expected)
         context = Context(float(np.median(base.density_kg_m3)), model.temperature_c)
         effects = effect_results(after_fit, context)
@@ -344,7 +348,7 @@ class Diagnoser:
             statement=statement(systematic, located, effects, unlisted, heldout_block, ambiguities, scored, chosen)
             + control_sentence(model, offset, self.response_error(chosen))
             + (scatter_sentence(scatter) if self.estimate_scatter else ""),
-            service_settings=service_settings(effects, context),
+            service_settings=service_settings(effects, context, wind_factor),
             seconds=time.perf_counter() - started,
         )
         return Diagnosis(

@@ -28,6 +28,11 @@ from shots.reference_world import CALIBRATED
 COMBINATION = ("wind", "ball_speed_bias")
 """The two-effect case: a carry-alike pair that only the other observables can separate."""
 
+LOG_WIND = "wind, log profile"
+"""A wind stated at 10 m that follows the log profile (slower low down, faster high up): `wind` must be named with
+its uniform-equivalent speed (the stated speed x the profile's mean factor along the flights), and the service
+settings must give back the stated 10 m speed."""
+
 END = "<!-- END generated -->"
 
 
@@ -70,6 +75,7 @@ def cases() -> list[tuple[str, tuple[str, ...]]]:
     return (
         [("clean", ())]
         + [(e.name, (e.name,)) for e in LIBRARY]
+        + [(LOG_WIND, ("wind",))]
         + [("+".join(COMBINATION), COMBINATION)]
         + [(f"outside: {OUTSIDE_EFFECT}", (OUTSIDE_EFFECT,))]
     )
@@ -127,12 +133,19 @@ def run_case(model: FlightModel, case: str, effects: tuple[str, ...], seed: int,
     """Conceal, diagnose blind, score."""
     rng = np.random.default_rng(10_000 + seed)
     hidden = {name: draw_effect(name, rng) for name in effects}
-    concealed = conceal(hidden, n_shots, seed)
+    profile = "log" if case == LOG_WIND else "uniform"
+    concealed = conceal(hidden, n_shots, seed, wind_profile=profile)
     recordings = from_shot_set(concealed.shots, source=f"concealed {case} seed {seed}")
     started = time.perf_counter()
     report = diagnose(recordings, model, seed=seed).report
     seconds = time.perf_counter() - started
-    fitted = {e.name: e.parameters for e in report.effects}
+    fitted = {e.name: dict(e.parameters) for e in report.effects}
+    if profile == "log":
+        stated = hidden["wind"]["speed_mps"]
+        hidden["wind"] = {**hidden["wind"], "speed_mps": stated * concealed.wind_factor, "speed_10m_mps": stated}
+        station = report.service_settings.wind_at_station
+        if "wind" in fitted and station is not None:
+            fitted["wind"]["speed_10m_mps"] = station.speed_mps
     names = sorted(fitted)
     named = "+".join(names) if report.systematic else "none"
     if "unlisted" in fitted:

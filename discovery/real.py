@@ -223,7 +223,17 @@ def main(argv: list[str] | None = None) -> int:
             "ambiguities": [a.note for a in diagnosis.report.ambiguities],
         }
         print(f"{item.key}: {diagnosis.report.statement}", flush=True)
-    header = ["set", "shots", "scatter (x assumed noise)", "bias (RMS/expected)", "systematic", "named", "held-out error", "excess removed", "s"]
+    header = [
+        "set",
+        "shots",
+        "scatter (x assumed noise)",
+        "bias (RMS/expected)",
+        "systematic",
+        "named",
+        "held-out error",
+        "excess removed",
+        "s",
+    ]
     table = ["| " + " | ".join(header) + " |", "|---" * len(header) + "|"] + ["| " + " | ".join(r) + " |" for r in rows]
     write_text_atomic(out / "summary.md", f"Model: {model.name}\n\n" + "\n".join(table) + "\n")
     write_text_atomic(out / "details.json", json.dumps(details, indent=1) + "\n")

@@ -19,6 +19,7 @@ from discovery.schema import (
     Unlisted,
     Wind,
 )
+from service.wind import STATION_HEIGHT_M
 
 MATERIAL = 0.05
 """Share above the expected error that counts as a material excess (as in `discovery.diagnose`)."""
@@ -47,13 +48,24 @@ def effect_results(result: Fit, context: Context) -> list[EffectResult]:
     return out
 
 
-def service_settings(effects: list[EffectResult], context: Context) -> ServiceSettings:
-    """The correction as the service's request options (wind, air) plus launch and model corrections."""
+def service_settings(
+    effects: list[EffectResult], context: Context, wind_factor: float | None = None
+) -> ServiceSettings:
+    """The correction as the service's request options (wind, air) plus launch and model corrections.
+    `wind_factor` (the log profile's uniform-equivalent factor along the corrected flights) adds the fitted wind as
+    a 10 m station reading with the log profile."""
     settings = ServiceSettings()
     for effect in effects:
         p = effect.parameters
         if effect.name == "wind":
             settings.wind = Wind(speed_mps=p["speed_mps"], from_deg=p["from_deg"])
+            if wind_factor:
+                settings.wind_at_station = Wind(
+                    speed_mps=p["speed_mps"] / wind_factor,
+                    from_deg=p["from_deg"],
+                    profile="log",
+                    reference_height_m=STATION_HEIGHT_M,
+                )
         elif effect.name == "air_density":
             settings.air = AirDensity(density_kg_m3=p["density_kg_m3"])
             settings.air_as_altitude = AirAltitude(

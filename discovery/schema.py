@@ -144,7 +144,8 @@ class Unlisted(_Strict):
 class Wind(_Strict):
     speed_mps: float
     from_deg: float
-    profile: Literal["uniform"] = "uniform"
+    profile: Literal["uniform", "log"] = "uniform"
+    reference_height_m: float | None = Field(default=None, description="height the speed is stated at (log profile)")
 
 
 class AirDensity(_Strict):
@@ -160,6 +161,11 @@ class ServiceSettings(_Strict):
     """The correction in the service's request options where it has one; launch-monitor corrections otherwise."""
 
     wind: Wind | None = None
+    wind_at_station: Wind | None = Field(
+        default=None,
+        description="the same wind as a weather station's 10 m reading with the log profile (the uniform speed over "
+        "the profile's mean speed factor along the corrected flights of these shots)",
+    )
     air: AirDensity | None = None
     air_as_altitude: AirAltitude | None = Field(default=None, description="the same air as altitude + temperature")
     ground_height_m: float | None = Field(default=None, description="landing ground relative to the tee")

@@ -27,7 +27,9 @@ def wind_vector(speed_mps: ArrayLike, from_deg: ArrayLike) -> np.ndarray:
     return np.stack([-speed * np.sin(theta), -speed * np.cos(theta), np.zeros_like(speed * theta)], axis=-1)
 
 
-def log_profile_factor(height_m: ArrayLike, reference_height_m: ArrayLike, roughness_m: ArrayLike) -> np.ndarray | float:
+def log_profile_factor(
+    height_m: ArrayLike, reference_height_m: ArrayLike, roughness_m: ArrayLike
+) -> np.ndarray | float:
     """V(h)/V(h_ref) of the logarithmic wind profile; zero at and below the roughness length.
 
     A float height gives a float through `math` (the one-shot engine calls this every step); anything else NumPy.
@@ -37,6 +39,16 @@ def log_profile_factor(height_m: ArrayLike, reference_height_m: ArrayLike, rough
     else:
         h, log = np.maximum(np.asarray(height_m, dtype=float), roughness_m), np.log
     return log(h / roughness_m) / log(reference_height_m / roughness_m)
+
+
+def uniform_equivalent_factor(heights_m: np.ndarray, reference_height_m: float, roughness_m: float) -> float:
+    """Log-profile speed at the ball over the stated speed, averaged over each flight's time aloft and then over
+    the flights ([T, N] heights at equal time steps, NaN once landed): a uniform wind of this factor x the stated
+    speed moves these flights about as the profile does."""
+    aloft = np.isfinite(heights_m)
+    factor = np.where(aloft, log_profile_factor(np.nan_to_num(heights_m), reference_height_m, roughness_m), 0.0)
+    per_flight = factor.sum(axis=0) / np.maximum(aloft.sum(axis=0), 1)
+    return float(np.mean(per_flight[aloft.any(axis=0)]))
 
 
 @dataclass(frozen=True)

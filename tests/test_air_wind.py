@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from service.air import Air, air_density, altitude_for_pressure, dynamic_viscosity, pressure_at_altitude
-from service.wind import Wind, log_profile_factor, wind_vector
+from service.wind import Wind, log_profile_factor, uniform_equivalent_factor, wind_vector
 
 
 def test_standard_sea_level_density():
@@ -53,6 +53,16 @@ def test_log_profile_is_reference_speed_at_reference_height_and_still_at_the_gro
     assert np.all(np.diff(log_profile_factor(heights, 10.0, 0.02)) > 0)
     wind = Wind(5.0, 0.0, profile="log", reference_height_m=10.0, roughness_m=0.02)
     assert wind.velocity(np.array([10.0, 0.0]))[:, 1] == pytest.approx([-5.0, 0.0])
+
+
+def test_uniform_equivalent_of_a_log_profile_averages_over_time_aloft():
+    """Two flights sampled at equal steps: one at 10 m for four steps (factor 1), one at 40 m for two steps then
+    landed (factor ln(2000)/ln(500) = 1.2231): the mean of the two time averages."""
+    nan = np.nan
+    heights = np.array([[10.0, 40.0], [10.0, 40.0], [10.0, nan], [10.0, nan]])
+    expected = (1.0 + np.log(40.0 / 0.02) / np.log(10.0 / 0.02)) / 2
+    assert uniform_equivalent_factor(heights, 10.0, 0.02) == pytest.approx(expected, rel=1e-12)
+    assert expected == pytest.approx(1.1115, abs=1e-4)
 
 
 def test_uniform_wind_is_the_same_at_every_height_and_per_shot_arrays_work():

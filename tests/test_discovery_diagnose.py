@@ -138,3 +138,17 @@ def test_a_model_is_its_own_perfect_control():
         diagnoser = Diagnoser(recordings, model, seed=0, with_correction=False)
         diagnosis = diagnoser.run()
         assert diagnoser.response_error(diagnosis.chosen) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_a_log_profile_wind_is_named_with_its_uniform_equivalent_and_its_station_reading():
+    """A 5 m/s wind stated at 10 m with the log profile: `wind` reports the uniform equivalent (the stated speed x
+    the profile's mean factor along the flights), and the service settings give back about 5 m/s at 10 m."""
+    concealed = conceal({"wind": {"speed_mps": 5.0, "from_deg": 120.0}}, 200, seed=1, wind_profile="log")
+    assert 1.0 < concealed.wind_factor < 1.1, "tour flights spend most of their time above the 10 m reference"
+    report = diagnose(from_shot_set(concealed.shots), reference(), seed=0, with_correction=False).report
+    assert [e.name for e in report.effects] == ["wind"]
+    wind = report.effects[0].parameters
+    assert wind["speed_mps"] == pytest.approx(5.0 * concealed.wind_factor, rel=0.05)
+    station = report.service_settings.wind_at_station
+    assert station.profile == "log" and station.reference_height_m == 10.0
+    assert station.speed_mps == pytest.approx(5.0, rel=0.05) and station.from_deg == wind["from_deg"]

@@ -63,6 +63,20 @@ def test_service_settings_from_effects():
     assert settings["launch_corrections"] == {"ball_speed_scale": 1.02}
     assert settings["coefficient_scales"] == {"drag_scale": 0.95}
     assert settings["ground_height_m"] == -4.0
+    assert "wind_at_station" not in settings
+
+
+def test_a_fitted_wind_as_a_station_reading_is_a_wind_the_service_accepts():
+    """With the log profile's mean factor along the flights (1.2 here), the uniform 4.8 m/s is a 4.0 m/s 10 m
+    reading; both validate as the service's wind option."""
+    from service.api.models import WindRequest
+
+    wind = EffectResult(name="wind", parameters={"speed_mps": 4.8, "from_deg": 5.0}, uncertainty={})
+    settings = service_settings([wind], ICAO, wind_factor=1.2)
+    station = settings.wind_at_station.model_dump(exclude_none=True)
+    assert station == {"speed_mps": pytest.approx(4.0), "from_deg": 5.0, "profile": "log", "reference_height_m": 10.0}
+    assert WindRequest.model_validate(station).profile == "log"
+    assert WindRequest.model_validate(settings.wind.model_dump(exclude_none=True)).profile == "uniform"
 
 
 def test_plus_minus_uses_the_uncertainty_digits():
