@@ -2,12 +2,12 @@
 the simulator, choose by held-out error with a parameter penalty, and assemble the report.
 
 Selection: every single effect is fitted (from a Gauss-Newton start); the best is combined with the other effects
-that most reduce the linearised cost. A candidate
-replaces a simpler one only if its held-out error is lower beyond doubt (the lower end of a session-bootstrap
-interval of the improvement is above zero) and by a material share, and, against a controlled model, by more than
-the model's own error of response to the simpler explanation (`Diagnoser.response_error`). The mismatch is called systematic when the
-mismatch exceeds the expected error (model error + launch-monitor noise) by a material share AND some fitted
-correction removes a material share of it on held-out sessions beyond doubt: noise alone satisfies neither.
+that most reduce the linearised cost. A candidate replaces a simpler one only if its held-out error is lower beyond
+doubt (the lower end of a session-bootstrap interval of the improvement is above zero) and by a material share, and,
+against a controlled model, by more than the model's own error of response to the simpler explanation
+(`Diagnoser.response_error`). The mismatch is called systematic when it exceeds the expected error (model error +
+launch-monitor noise, or the recordings' own scatter where that is clearly larger) by a material share AND some
+fitted correction removes a material share of it on held-out sessions beyond doubt: noise alone satisfies neither.
 """
 
 from __future__ import annotations

@@ -225,7 +225,15 @@ def render(diagnosis) -> str:
         + "</pre>",
         "<h2>Expected error</h2>"
         + _table(
-            ["observable", "model error", "source", "outcome noise", "launch noise"],
+            [
+                "observable",
+                "model error",
+                "source",
+                "outcome noise",
+                "launch noise",
+                "recordings' scatter (x expected)",
+                "scatter used",
+            ],
             [
                 [
                     n,
@@ -233,6 +241,8 @@ def render(diagnosis) -> str:
                     report.model.model_error_source.get(n, ""),
                     report.model.outcome_noise[n],
                     report.model.launch_noise[n],
+                    report.model.scatter[n].ratio if n in report.model.scatter else "",
+                    report.model.scatter[n].applied if n in report.model.scatter else "",
                 ]
                 for n in OBSERVABLES
             ],

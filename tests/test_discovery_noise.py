@@ -78,6 +78,7 @@ def test_a_noisy_monitor_is_expected_to_miss_by_its_own_scatter(tmp_path):
     assumed = Report.model_validate_json((tmp_path / "report.json").read_text())
     assert assumed.heldout.before_error > 4.0 and not any(s.applied for s in assumed.model.scatter.values())
     assert "scatter more" not in assumed.statement
+    assert "scatter used" in (tmp_path / "report.html").read_text()
 
 
 def test_an_effect_in_noisy_recordings_is_measured_against_their_scatter():
