@@ -121,6 +121,9 @@ SCATTER_MATERIAL = 1.5
 SCATTER_LEVEL = 0.975
 """...and larger than assumed beyond doubt (the lower end of this one-sided session-bootstrap bound is above 1)."""
 
+MIN_GROUP_SHOTS = 12
+"""Session-club groups smaller than this are left out of the scatter estimate (too few shots for the trend)."""
+
 
 @dataclass
 class Scatter:
@@ -130,12 +133,7 @@ class Scatter:
 
     ratio: dict[str, float]
     low: dict[str, float]
-    degrees_of_freedom: int
     applied: dict[str, float]
-
-
-MIN_GROUP_SHOTS = 12
-"""Session-club groups smaller than this are left out of the scatter estimate (too few shots for the trend)."""
 
 
 def recording_scatter(recordings: Recordings, z: np.ndarray, rng: np.random.Generator, draws: int = 1000) -> Scatter:
@@ -170,7 +168,7 @@ def recording_scatter(recordings: Recordings, z: np.ndarray, rng: np.random.Gene
         low[name] = float(np.sqrt(np.quantile(bootstrap, 1.0 - SCATTER_LEVEL)))
         if low[name] > 1.0 and ratio[name] >= SCATTER_MATERIAL:
             applied[name] = ratio[name]
-    return Scatter(ratio, low, round(float(dof.max(axis=1).sum())), applied)
+    return Scatter(ratio, low, applied)
 
 
 def with_scatter(expected: ExpectedError, scatter: Scatter) -> ExpectedError:

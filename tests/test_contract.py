@@ -170,19 +170,26 @@ def test_a_batch_process_that_dies_is_replaced(http):
     batch = {"shots": [SEVEN_IRON] * 3}
     expected = http.post("/v1/shots/batch", json=batch).json()
 
-    def kill_batch_process() -> None:
+    def batch_process() -> psutil.Process:
         children = [c for c in psutil.Process().children() if "spawn_main" in " ".join(c.cmdline())]
         assert len(children) == 1
-        children[0].kill()
-        children[0].wait(10)
+        return children[0]
 
-    kill_batch_process()
+    def kill(child: psutil.Process) -> None:
+        child.kill()
+        child.wait(10)
+
+    kill(batch_process())
     assert http.post("/v1/shots/batch", json=batch).json() == expected
-    big = {"shots": [SEVEN_IRON] * 5000}
+    big = {"shots": [SEVEN_IRON] * 10_000}
+    child = batch_process()
+    idle = sum(child.cpu_times()[:2])
     with ThreadPoolExecutor(1) as pool:
         in_flight = pool.submit(http.post, "/v1/shots/batch", json=big)
-        time.sleep(0.3)
-        kill_batch_process()
+        deadline = time.monotonic() + 30
+        while sum(child.cpu_times()[:2]) < idle + 0.02 and time.monotonic() < deadline:
+            time.sleep(0.002)  # killed once it is busy with the batch, however fast this machine flies it
+        kill(child)
         died = in_flight.result()
     assert died.status_code == 503 and "send the batch again" in died.json()["detail"]
     assert http.post("/v1/shots/batch", json=batch).json() == expected
