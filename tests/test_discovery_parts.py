@@ -123,3 +123,18 @@ def test_tables_and_section_replacement():
     doc = replace_section("# Title\n\nhand text\n", text, "<!-- BEGIN x -->")
     again = replace_section(doc, "new\n", "<!-- BEGIN x -->")
     assert "hand text" in again and "new" in again and text not in again
+
+
+def test_prove_runs_only_the_cases_asked_for_into_their_own_section(tmp_path):
+    """`prove --cases '^clean$'` (a false-alarm campaign) writes a section of its own, with the false-alarm row and
+    none of the rows about hidden effects; a filter that matches nothing is an error naming the cases."""
+    from golfflight.cli import main
+
+    out = tmp_path / "discovery.md"
+    out.write_text("# Discovery\n\nhand-written\n")
+    args = ["prove", "--model", "reference", "--cases", "^clean$", "--seeds", "1", "--shots", "40", "--out", str(out)]
+    assert main(args) == 0
+    page = out.read_text()
+    assert "hand-written" in page and "--cases '^clean$' --seeds 1" in page
+    assert "| false alarms on clean sets | 0 of 1 | 0 |" in page and "detection" not in page and "nan" not in page
+    assert main(["prove", "--cases", "^nothing$", "--out", str(out)]) == 2

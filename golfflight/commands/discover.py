@@ -8,7 +8,7 @@ from pathlib import Path
 from discovery.diagnose import diagnose
 from discovery.model import REFERENCE, load_model
 from discovery.outputs import write_diagnosis
-from discovery.prove import prove, write_tables
+from discovery.prove import begin_marker, cases, prove, write_tables
 from discovery.recordings import read_recordings
 
 
@@ -43,6 +43,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     prove.add_argument("--shots", type=int, default=300, help="shots per concealed set")
     prove.add_argument("--out", default="docs/discovery.md", help="markdown file whose generated section is replaced")
     prove.add_argument("--json", help="also write every run's truth and findings to this JSON file")
+    prove.add_argument(
+        "--cases", help="only the cases whose name matches this regular expression (e.g. '^clean$' for false alarms)"
+    )
     prove.set_defaults(run=run_prove)
 
 
@@ -60,7 +63,10 @@ def run_diagnose(args: argparse.Namespace) -> int:
 
 def run_prove(args: argparse.Namespace) -> int:
     model = load_model(args.model)
-    results = prove(model, seeds=args.seeds, n_shots=args.shots, progress=print)
-    write_tables(results, Path(args.out), Path(args.json) if args.json else None, args.model, model.name)
+    results = prove(model, seeds=args.seeds, n_shots=args.shots, progress=print, only=args.cases)
+    if not results:
+        raise ValueError(f"--cases {args.cases!r} matches none of: {', '.join(name for name, _ in cases())}")
+    begin = begin_marker(args.model, args.cases, args.seeds if args.cases else None)
+    write_tables(results, Path(args.out), Path(args.json) if args.json else None, args.model, model.name, begin)
     print(f"wrote the tables to {args.out}")
     return 0
