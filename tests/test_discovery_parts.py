@@ -138,3 +138,4 @@ def test_prove_runs_only_the_cases_asked_for_into_their_own_section(tmp_path):
     assert "hand-written" in page and "--cases '^clean$' --seeds 1" in page
     assert "| false alarms on clean sets | 0 of 1 | 0 |" in page and "detection" not in page and "nan" not in page
     assert main(["prove", "--cases", "^nothing$", "--out", str(out)]) == 2
+    assert main(["prove", "--cases", "clean(", "--out", str(out)]) == 2

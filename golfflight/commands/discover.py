@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 from discovery.diagnose import diagnose
@@ -62,6 +63,11 @@ def run_diagnose(args: argparse.Namespace) -> int:
 
 
 def run_prove(args: argparse.Namespace) -> int:
+    if args.cases is not None:
+        try:
+            re.compile(args.cases)
+        except re.error as error:
+            raise ValueError(f"--cases {args.cases!r} is not a regular expression: {error}") from None
     model = load_model(args.model)
     results = prove(model, seeds=args.seeds, n_shots=args.shots, progress=print, only=args.cases)
     if not results:
