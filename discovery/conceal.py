@@ -19,7 +19,7 @@ from discovery.noise import RADAR_NOISE
 from service.air import Air
 from service.flight import Flight
 from service.physics import initial_state
-from service.wind import Wind, uniform_equivalent_factor, wind_vector
+from service.wind import Wind, uniform_equivalent_factor
 from shots.records import ShotRecord, ShotSet
 from shots.reference_world import CALIBRATED, fly_reference
 from shots.synth import MIN_APEX_M, LaunchTable, MeasurementNoise, SynthConfig, draw_launches, draw_sessions, measure
@@ -137,8 +137,3 @@ def _path(flight: Flight, shot: int, rng: np.random.Generator, every: int = 10, 
     samples = np.column_stack([times[inside], xyz[inside] + rng.normal(0, noise_m, xyz[inside].shape)])
     return samples
 
-
-def truth_air_velocity(hidden: dict[str, dict[str, float]]) -> np.ndarray:
-    """The hidden wind as the library's internal (x, y) air velocity."""
-    w = hidden["wind"]
-    return wind_vector(w["speed_mps"], w["from_deg"])[:2]

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from discovery import correction as learned
-from discovery.effects import LIBRARY, Context, apply_all
+from discovery.effects import LIBRARY, Context
 from discovery.fit import (
     Fit,
     Problem,
@@ -76,14 +76,12 @@ class Diagnosis:
 
     report: Report
     recordings: Recordings
-    sigma: np.ndarray
     before: np.ndarray
     after: np.ndarray
     heldout_before: np.ndarray
     heldout_after: np.ndarray
     positions_before: np.ndarray | None
     positions_after: np.ndarray | None
-    dt_s: float
     chosen: Scored | None
 
 
@@ -124,6 +122,7 @@ class Diagnoser:
         self.recordings, self.model, self.library = recordings, model, LIBRARY
         self.with_correction, self.estimate_scatter = with_correction, estimate_scatter
         self.seed, self.rng = seed, np.random.default_rng(seed)
+        self._response_errors: dict[tuple[str, bytes], float] = {}  # memo: asked up to three times
         self.noise = noise
 
     def score(self, result: Fit) -> Scored:
@@ -157,14 +156,15 @@ class Diagnoser:
         control, result = self.model.control, candidate.fit
         if control is None or result.k == 0:
             return 0.0
-        everyone = np.arange(len(self.recordings))
-        theta_rows = np.repeat(result.theta[None], len(everyone), 0)
-        conditions = apply_all(result.effects, theta_rows, self.problem.base)
-        correction = next((e.correction for e in result.effects if e.correction is not None), None)
-        truth = control.fly(conditions, correction).outcomes()
-        model = self.problem.predict(result.effects, result.theta, everyone)[0]
-        z = np.where(self.problem.use, (model - truth) / self.problem.sigma, np.nan)
-        return _mean_sq(z)
+        key = (result.name, result.theta.tobytes())
+        if key not in self._response_errors:
+            everyone = np.arange(len(self.recordings))
+            theta_rows = np.repeat(result.theta[None], len(everyone), 0)
+            truth = self.problem.outcomes(result.effects, theta_rows, everyone, model=control).outcomes()
+            model = self.problem.predict(result.effects, result.theta, everyone)[0]
+            z = np.where(self.problem.use, (model - truth) / self.problem.sigma, np.nan)
+            self._response_errors[key] = _mean_sq(z)
+        return self._response_errors[key]
 
     def fit_singles(self, rows: np.ndarray) -> list[Scored]:
         """Every library effect alone, from Gauss-Newton starts out of one Jacobian; best score first."""
@@ -258,7 +258,7 @@ class Diagnoser:
 
         null_z = self.problem.standardize(predicted, everyone)
         null = Scored(
-            Fit((), np.zeros(0), null_z, np.zeros(null_z.shape + (0,)), np.zeros((0, 0)), 0),
+            Fit((), np.zeros(0), null_z, np.zeros(null_z.shape + (0,)), np.zeros((0, 0))),
             null_z,
             _mean_sq(null_z),
             0.0,
@@ -285,19 +285,19 @@ class Diagnoser:
             chosen, unlisted = null, None
 
         after_fit = chosen.fit
-        after = self.problem.predict(after_fit.effects, after_fit.theta, everyone)[0] if after_fit.k else predicted
-        positions_after, wind_factor = None, None
+        after, positions_after, wind_factor = predicted, None, None
         has_wind = any(e.name == "wind" for e in after_fit.effects)
-        if (recordings.trajectories or has_wind) and after_fit.k:
-            positions_after = self.problem.outcomes(
-                after_fit.effects, np.repeat(after_fit.theta[None], len(everyone), 0), everyone, keep_positions=True
-            ).positions
+        if after_fit.k:
+            theta_rows = np.repeat(after_fit.theta[None], len(everyone), 0)
+            keep = bool(recordings.trajectories) or has_wind
+            flown_after = self.problem.outcomes(after_fit.effects, theta_rows, everyone, keep_positions=keep)
+            after, positions_after = flown_after.outcomes() + self.problem.offset, flown_after.positions
             if has_wind:
                 wind_factor = uniform_equivalent_factor(positions_after[..., 2], STATION_HEIGHT_M, FAIRWAY_ROUGHNESS_M)
         heldout_block = self.heldout_summary(null, chosen, grouping, expected)
         context = Context(float(np.median(base.density_kg_m3)), model.temperature_c)
         effects = effect_results(after_fit, context)
-        ambiguities = ambiguity(self.problem, chosen, scored, self.rng) if systematic else []
+        ambiguities = ambiguity(self.problem, chosen, after, scored, self.rng) if systematic else []
         candidates = [
             Candidate(
                 name=s.fit.name,
@@ -354,14 +354,12 @@ class Diagnoser:
         return Diagnosis(
             report,
             recordings,
-            expected.sigma,
             predicted,
             after,
             null.heldout_z * expected.sigma,
             chosen.heldout_z * expected.sigma,
             flown.positions,
             positions_after,
-            model.dt_s,
             chosen if systematic else None,
         )
 

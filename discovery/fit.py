@@ -17,7 +17,7 @@ from scipy.optimize import least_squares
 from discovery.effects import Effect, apply_all
 from discovery.model import FlightModel
 from discovery.recordings import OBSERVABLES, Recordings
-from discovery.simulator import Conditions
+from discovery.simulator import Conditions, Flown
 
 MISSED_LANDING_Z = 10.0
 """Standardized residual given to a shot the model does not land (it cannot be compared)."""
@@ -45,12 +45,18 @@ class Problem:
         return self.recordings.observed
 
     def outcomes(
-        self, effects: tuple[Effect, ...], theta_rows: np.ndarray, rows: np.ndarray, keep_positions: bool = False
-    ):
-        """Fly shots `rows` (may repeat) with per-row parameters theta_rows [M, k]; returns the Flown batch."""
+        self,
+        effects: tuple[Effect, ...],
+        theta_rows: np.ndarray,
+        rows: np.ndarray,
+        keep_positions: bool = False,
+        model: FlightModel | None = None,
+    ) -> Flown:
+        """Fly shots `rows` (may repeat) with per-row parameters theta_rows [M, k] through the diagnosed model (or
+        `model`, e.g. its control); returns the Flown batch."""
         conditions = apply_all(effects, theta_rows, self.base.take(rows))
-        correction = next((e.correction for e in effects if getattr(e, "correction", None) is not None), None)
-        return self.model.fly(conditions, correction, keep_positions)
+        correction = next((e.correction for e in effects if e.correction is not None), None)
+        return (model or self.model).fly(conditions, correction, keep_positions)
 
     def predict(self, effects: tuple[Effect, ...], thetas: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """Outcomes [B, len(rows), 5] of B parameter sets [B, k], all flown in one batch."""
@@ -75,7 +81,6 @@ class Fit:
     z: np.ndarray
     jacobian: np.ndarray
     covariance: np.ndarray
-    evaluations: int
 
     @property
     def name(self) -> str:
@@ -190,21 +195,17 @@ def fit(problem: Problem, effects: tuple[Effect, ...], start: np.ndarray, rows: 
     """Least-squares fit of the effects' parameters on `rows`, then residuals and Jacobian on every shot."""
     low, high, typical, _ = _bounds(effects)
     everyone = np.arange(len(problem.recordings))
-    evaluations = 0
     theta = np.clip(start, low, high)
+    flown: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}  # (z, Jacobian) on `rows` at each theta tried
     if len(theta):
-        cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
         def evaluate(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            nonlocal evaluations
             key = x.tobytes()
-            if key not in cache:
-                z, jac = residuals_and_jacobian(problem, effects, x, rows)
-                used = np.isfinite(z)
-                cache.clear()
-                cache[key] = (z[used], jac[used])
-                evaluations += 1
-            return cache[key]
+            if key not in flown:
+                flown[key] = residuals_and_jacobian(problem, effects, x, rows)
+            z, jac = flown[key]
+            used = np.isfinite(z)
+            return z[used], jac[used]
 
         result = least_squares(
             lambda x: evaluate(x)[0],
@@ -218,8 +219,9 @@ def fit(problem: Problem, effects: tuple[Effect, ...], start: np.ndarray, rows: 
             ftol=1e-4,
         )
         theta = result.x
-    z, jacobian = residuals_and_jacobian(problem, effects, theta, everyone)
-    return Fit(effects, theta, z, jacobian, covariance(z, jacobian, problem.recordings.session), evaluations + 1)
+    every_shot = len(rows) == len(everyone) and theta.tobytes() in flown
+    z, jacobian = flown[theta.tobytes()] if every_shot else residuals_and_jacobian(problem, effects, theta, everyone)
+    return Fit(effects, theta, z, jacobian, covariance(z, jacobian, problem.recordings.session))
 
 
 def folds(groups: np.ndarray, n_folds: int = 5) -> tuple[np.ndarray, str]:

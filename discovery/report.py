@@ -81,12 +81,11 @@ def service_settings(
     return settings
 
 
-def _separation(problem: Problem, a: Fit, b: Fit) -> tuple[str, float, float]:
-    """(observable, RMS difference, the same in expected sigmas) where two fitted explanations differ most."""
+def _separation(problem: Problem, predicted: np.ndarray, b: Fit) -> tuple[str, float, float]:
+    """(observable, RMS difference, the same in expected sigmas) where the explanation that predicts `predicted`
+    [N, 5] and another fitted one differ most."""
     rows = np.arange(len(problem.recordings))
-    pa = problem.predict(a.effects, a.theta, rows)[0]
-    pb = problem.predict(b.effects, b.theta, rows)[0]
-    diff = pa - pb
+    diff = predicted - problem.predict(b.effects, b.theta, rows)[0]
     rms = np.sqrt(np.nanmean(diff**2, axis=0))
     in_sigma = np.sqrt(np.nanmean((diff / problem.sigma) ** 2, axis=0))
     j = int(np.nanargmax(in_sigma))
@@ -94,9 +93,15 @@ def _separation(problem: Problem, a: Fit, b: Fit) -> tuple[str, float, float]:
 
 
 def ambiguity(
-    problem: Problem, chosen: Scored, scored: list[Scored], rng: np.random.Generator, limit: int = 3
+    problem: Problem,
+    chosen: Scored,
+    predicted: np.ndarray,
+    scored: list[Scored],
+    rng: np.random.Generator,
+    limit: int = 3,
 ) -> list[Ambiguity]:
-    """Candidates with no more effects than the chosen one whose held-out error is not clearly worse."""
+    """Candidates with no more effects than the chosen one (whose predictions are `predicted` [N, 5]) whose
+    held-out error is not clearly worse."""
     out = []
     mine = {e.name for e in chosen.fit.effects}
     base, count = per_shot(chosen.heldout_z)
@@ -109,7 +114,7 @@ def ambiguity(
         low, high = (float(q) for q in np.quantile(draws, [0.025, 0.975]))
         if low > 0:
             continue
-        observable, rms, in_sigma = _separation(problem, chosen.fit, other.fit)
+        observable, rms, in_sigma = _separation(problem, predicted, other.fit)
         recorded = observable in problem.recordings.observed_names
         label = LABELS[observable]
         if in_sigma < 0.5:

@@ -15,7 +15,7 @@ import numpy as np
 
 from service.flight import STEPPERS
 from service.physics import CoefficientModel, State, derivatives, initial_state
-from service.wind import Wind, wind_vector
+from service.wind import Wind
 
 CoefficientsFor = Callable[[np.ndarray], CoefficientModel]
 """Builds the model's coefficient function for shots whose air density is `ratio` x the assumed one (per shot)."""
@@ -149,7 +149,7 @@ def _fly(
         density = part.density_kg_m3 * part.density_ratio
         xy = part.wind_xy_mps
         wind = Wind(np.hypot(xy[:, 0], xy[:, 1]), np.degrees(np.arctan2(-xy[:, 0], -xy[:, 1])))
-        air_velocity = wind_vector(wind.speed_mps, wind.from_deg)
+        air_velocity = wind.at_reference
 
         def rhs(s: State) -> State:
             rate = derivatives(s, model, density, wind)

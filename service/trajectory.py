@@ -10,10 +10,6 @@ from __future__ import annotations
 import numpy as np
 
 from service.engine import EulerStates
-from service.limits import TRAJECTORY_RATE_HZ
-
-MAX_RATE_HZ = TRAJECTORY_RATE_HZ.high
-"""Highest resampling rate a request may ask for."""
 
 
 def resample(states: EulerStates, rate_hz: float) -> tuple[np.ndarray, np.ndarray]:

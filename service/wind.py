@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
@@ -61,15 +62,19 @@ class Wind:
     reference_height_m: float = STATION_HEIGHT_M
     roughness_m: float = FAIRWAY_ROUGHNESS_M
 
+    @cached_property
+    def at_reference(self) -> np.ndarray:
+        """Air velocity at the reference height ([..., 3]); worked out once, the integrators ask every step."""
+        return wind_vector(self.speed_mps, self.from_deg)
+
     def velocity(self, height_m: np.ndarray) -> np.ndarray:
         """Air velocity [N, 3] at the balls' heights [N]."""
-        at_reference = wind_vector(self.speed_mps, self.from_deg)
         if self.profile == "uniform":
-            return np.broadcast_to(at_reference, np.shape(height_m) + (3,))
+            return np.broadcast_to(self.at_reference, np.shape(height_m) + (3,))
         factor = log_profile_factor(height_m, self.reference_height_m, self.roughness_m)
-        return at_reference * factor[..., None]
+        return self.at_reference * factor[..., None]
 
-    @property
+    @cached_property
     def is_calm(self) -> bool:
         """True when there is no wind anywhere in the batch."""
         return not np.any(np.asarray(self.speed_mps) != 0.0)
