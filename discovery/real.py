@@ -20,8 +20,10 @@ import numpy as np
 from discovery import svg
 from discovery.diagnose import Diagnosis, diagnose
 from discovery.model import FlightModel, load_model
-from discovery.outputs import write_diagnosis, write_text_atomic
+from discovery.outputs import write_diagnosis
 from discovery.recordings import LABELS, OBSERVABLES, Recordings, from_shot_set
+from shots.files import write_text_atomic
+from shots.markdown import table
 from shots.paths import shared_data_dir
 from shots.records import ShotRecord, ShotSet
 from shots.reference_world import default_tour_averages_path, read_tour_averages
@@ -234,8 +236,8 @@ def main(argv: list[str] | None = None) -> int:
         "excess removed",
         "s",
     ]
-    table = ["| " + " | ".join(header) + " |", "|---" * len(header) + "|"] + ["| " + " | ".join(r) + " |" for r in rows]
-    write_text_atomic(out / "summary.md", f"Model: {model.name}\n\n" + "\n".join(table) + "\n")
+    lines = table(header, rows, align="l" * len(header))
+    write_text_atomic(out / "summary.md", f"Model: {model.name}\n\n" + "\n".join(lines) + "\n")
     write_text_atomic(out / "details.json", json.dumps(details, indent=1) + "\n")
     return 0
 

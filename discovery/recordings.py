@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 
-from service.air import air_density, pressure_at_altitude
 from service.wind import wind_vector
 from shots.records import LAUNCH_COLUMNS, ShotSet, read_shots, read_trajectories, trajectories_path
 
@@ -99,19 +98,7 @@ def _shot_order(session: np.ndarray, timestamp: np.ndarray) -> np.ndarray:
 
 def _conditions(shots: ShotSet) -> tuple[np.ndarray | None, np.ndarray | None]:
     """Per-shot density where any air condition is recorded (blanks: 15 degC, sea level, dry) and recorded wind."""
-    temperature, altitude = shots.column("temperature_c"), shots.column("altitude_m")
-    pressure, humidity = shots.column("pressure_hpa"), shots.column("humidity_pct")
-    density = None
-    if np.isfinite(np.stack([temperature, altitude, pressure, humidity])).any():
-        station = np.where(np.isfinite(pressure), pressure * 100.0, pressure_at_altitude(np.nan_to_num(altitude)))
-        density = np.asarray(
-            air_density(
-                np.where(np.isfinite(temperature), temperature, 15.0),
-                station,
-                np.where(np.isfinite(humidity), humidity, 0.0),
-            ),
-            dtype=float,
-        )
+    density = np.asarray(shots.air().density_kg_m3, dtype=float) if shots.air_recorded() else None
     speed, from_deg = shots.column("wind_speed_mps"), shots.column("wind_from_deg")
     wind = None
     if np.isfinite(speed).any():

@@ -18,12 +18,12 @@ from pathlib import Path
 import numpy as np
 
 from model_export.data import MIN_APEX_M
-from model_export.report import table, write_generated_section
 from service.air import Air
 from service.constants import YARD_M
 from service.flight import Flight, simulate
 from service.onnx_coefficients import OnnxCoefficients
 from service.physics import initial_state
+from shots.markdown import table, write_generated_section
 from shots.paths import shared_data_dir
 from shots.records import ShotSet, write_shots
 from shots.reference_world import CALIBRATION_AIR, TOUR_AVERAGES_FILE, ClubAverage, read_tour_averages

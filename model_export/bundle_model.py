@@ -17,13 +17,13 @@ from onnx import numpy_helper
 from torch import nn
 
 from model_export.export import (
-    COEFFICIENT_COLUMNS,
     PARITY_TOLERANCE,
     onnx_torch_difference,
     probe_inputs,
 )
 from model_export.training import TrainConfig
 from model_export.variants import SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, PhysNN, build_model
+from service.bundle_check import OUTPUT_COLUMNS
 from weights_schema.bundle import load_bundle
 from weights_schema.model_card import ModelCard
 
@@ -32,7 +32,7 @@ def _mlp_state(model: PhysNN, weights: dict[str, torch.Tensor], card: ModelCard)
     """The PhysNN state dict from the graph's layer initializers (undoing the lean layout) and the card's p_M."""
     state = {name: weights[name] for name in model.state_dict() if name.startswith("net.")}
     state["net.0.weight"] = state["net.0.weight"] * torch.tensor([VELOCITY_SCALE_MPS, SPIN_SCALE_RADPS])
-    rows = [COEFFICIENT_COLUMNS.index(head) for head in model.heads]
+    rows = [OUTPUT_COLUMNS.index(head) for head in model.heads]
     last = f"net.{len(model.net) - 1}"
     state[f"{last}.weight"] = state[f"{last}.weight"][rows]
     state[f"{last}.bias"] = state[f"{last}.bias"][rows]

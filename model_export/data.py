@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from service.air import Air, pressure_at_altitude
+from service.air import Air
 from service.constants import YARD_M
 from service.physics import initial_state, reynolds_scale
 from shots.records import ShotSet, read_shots
@@ -71,19 +71,6 @@ class DataSummary:
         return {k: v for k, v in asdict(self).items() if k != "bad_rows"}
 
 
-def shot_air(shots: ShotSet) -> Air:
-    """Air (density, kinematic viscosity) per shot from its recorded conditions. What was not recorded takes the
-    ICAO standard value (15 degC, sea-level pressure, dry), so a shot without conditions flies in standard air."""
-    altitude = np.nan_to_num(shots.column("altitude_m"))
-    pressure_hpa = shots.column("pressure_hpa")
-    temperature = shots.column("temperature_c")
-    return Air.from_conditions(
-        np.where(np.isnan(temperature), 15.0, temperature),
-        humidity_pct=np.nan_to_num(shots.column("humidity_pct")),
-        pressure_pa=np.where(np.isnan(pressure_hpa), pressure_at_altitude(altitude), pressure_hpa * 100.0),
-    )
-
-
 def to_tensors(shots: ShotSet, dtype: torch.dtype = torch.float32) -> ShotTensors:
     """Initial state from `service.physics.initial_state` (one source for eq. 12) and the targets of a set of shots."""
     state = initial_state(**shots.launch())
@@ -95,7 +82,7 @@ def to_tensors(shots: ShotSet, dtype: torch.dtype = torch.float32) -> ShotTensor
     def tensor(array: np.ndarray) -> torch.Tensor:
         return torch.as_tensor(np.nan_to_num(array), dtype=dtype)
 
-    air = shot_air(shots)
+    air = shots.air()
     return ShotTensors(
         tensor(state.position),
         tensor(state.velocity),

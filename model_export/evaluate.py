@@ -18,9 +18,8 @@ import numpy as np
 import torch
 from torch import nn
 
-from model_export.data import shot_air
 from model_export.noise_floor import Floor, noise_floors, nominal_conditions
-from model_export.report import metres_yards, table, write_generated_section
+from model_export.report import metres_yards
 from model_export.torch_physics import euler_rollout, hard_landing, spin_ratio
 from model_export.training import VALIDATION_BATCH, TrainConfig, load_checkpoint, model_from_checkpoint, predict
 from model_export.validation import Errors, Prediction, ValidationSet, errors_of, gap, load_validation
@@ -29,6 +28,7 @@ from service.air import Air
 from service.flight import simulate
 from service.onnx_coefficients import OnnxCoefficients
 from service.physics import initial_state
+from shots.markdown import table, write_generated_section
 from shots.reference_world import CALIBRATED, ReferenceAerodynamics
 
 COMMAND = "evaluate"
@@ -149,7 +149,7 @@ def check_bundle(bundle_dir: str | os.PathLike, val: ValidationSet) -> BundleChe
 
     coefficients = OnnxCoefficients(bundle_dir)
     physics = coefficients.card.physics
-    air = shot_air(val.shots)
+    air = val.shots.air()
     flight = simulate(
         initial_state(**val.shots.launch()),
         coefficients.in_air(air.kinematic_viscosity_m2_s),

@@ -12,6 +12,7 @@ import json
 import os
 import platform
 import warnings
+from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -28,14 +29,14 @@ from model_export.torch_physics import LANDING_SEARCH_START_S, TINY
 from model_export.training import TrainConfig, load_checkpoint, model_from_checkpoint
 from model_export.variants import SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, PhysNN, PhysQ
 from service.air import Air
+from service.bundle_check import OUTPUT_COLUMNS
 from service.coefficients import BASE_DYNAMIC_PRESSURE
 from service.constants import BALL_AREA_M2, BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, TEE_HEIGHT_M
+from shots.files import write_atomic
 from weights_schema.bundle import CARD_FILE, sha256_of
 from weights_schema.model_card import SCHEMA_VERSION, Architecture, ModelCard, TensorSpec
 
 OPSET = 17
-COEFFICIENT_COLUMNS = ("C_L", "C_D", "C_M", "C_Q")
-"""The graph's output columns, in order."""
 ONNX_FILE = "model.onnx"
 VELOCITY_INPUT, SPIN_INPUT, OUTPUT = "v_rel", "omega", "coefficients"
 PARITY_TOLERANCE = 1e-5
@@ -85,22 +86,22 @@ class LeanPhysNN(nn.Module):
         first, last = layers[0], layers[-1]
         with torch.no_grad():
             first.weight.mul_(torch.tensor([1 / VELOCITY_SCALE_MPS, 1 / SPIN_SCALE_RADPS]))
-            padded = nn.Linear(last.in_features, len(COEFFICIENT_COLUMNS))
+            padded = nn.Linear(last.in_features, len(OUTPUT_COLUMNS))
             padded.weight.zero_()
             padded.bias.zero_()
             for row, name in enumerate(model.heads):
-                padded.weight[COEFFICIENT_COLUMNS.index(name)] = last.weight[row]
-                padded.bias[COEFFICIENT_COLUMNS.index(name)] = last.bias[row]
+                padded.weight[OUTPUT_COLUMNS.index(name)] = last.weight[row]
+                padded.bias[OUTPUT_COLUMNS.index(name)] = last.bias[row]
         self.net = nn.Sequential(*layers[:-1], padded)
         self.learned_moment = model.learned_moment
         head_scale = {"C_L": 0.5, "C_D": 0.5, "C_M": 1 / 50, "C_Q": 1.0}
-        self.tail = nn.Linear(len(COEFFICIENT_COLUMNS) + int(self.learned_moment), len(COEFFICIENT_COLUMNS))
+        self.tail = nn.Linear(len(OUTPUT_COLUMNS) + int(self.learned_moment), len(OUTPUT_COLUMNS))
         with torch.no_grad():
             self.tail.weight.zero_()
-            for column, name in enumerate(COEFFICIENT_COLUMNS):
+            for column, name in enumerate(OUTPUT_COLUMNS):
                 self.tail.weight[column, column] = head_scale[name] if name in model.heads else 0.0
             if self.learned_moment:
-                self.tail.weight[COEFFICIENT_COLUMNS.index("C_M"), -1] = BALL_RADIUS_M * float(model.p_m.detach())
+                self.tail.weight[OUTPUT_COLUMNS.index("C_M"), -1] = BALL_RADIUS_M * float(model.p_m.detach())
             self.tail.bias.copy_(torch.tensor([0.0, 0.0, 0.0, 0.0 if model.learned_pressure else BASE_DYNAMIC_PRESSURE]))
 
     def forward(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
@@ -250,7 +251,7 @@ def build_card(
                         description="aerodynamic coefficients per ball",
                     )
                 ],
-                "output_columns": list(COEFFICIENT_COLUMNS),
+                "output_columns": list(OUTPUT_COLUMNS),
                 "contents": "the whole coefficient model: input normalisation, network or polynomial, output "
                 "transforms (sigmoid heads, p_M S, constant C_Q); the equations of motion are not in the graph",
             },
@@ -308,14 +309,9 @@ def build_card(
     )
 
 
-def _replace_atomically(directory: Path, name: str, write) -> None:
-    tmp = directory / f".{name}.{os.getpid()}.tmp"
-    try:
-        write(tmp)
-        os.replace(tmp, directory / name)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
+def _replace_atomically(directory: Path, name: str, write: Callable[[Path], object]) -> None:
+    """One file of the bundle, written whole or not at all (the seam the crash test breaks)."""
+    write_atomic(directory / name, lambda tmp: write(Path(tmp)))
 
 
 def export_bundle(model: nn.Module, payload: dict[str, Any], out_dir: str | os.PathLike) -> ModelCard:

@@ -10,9 +10,7 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 import time
-from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -33,6 +31,7 @@ from model_export.torch_physics import (
 )
 from model_export.variants import build_model
 from service.constants import YARD_M
+from shots.files import write_atomic, write_text_atomic
 
 CHECKPOINT_FORMAT = 1
 VALIDATION_BATCH = 4096
@@ -140,21 +139,9 @@ def validate(model: nn.Module, shots: ShotTensors, config: TrainConfig) -> dict[
     return metrics
 
 
-def _atomic_save(write: Callable[[str], None], path: Path) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def save_checkpoint(path: Path, payload: dict[str, Any]) -> None:
     """torch.save to a temporary file in the same directory, then rename over `path`."""
-    _atomic_save(lambda tmp: torch.save(payload, tmp), path)
+    write_atomic(path, lambda tmp: torch.save(payload, tmp), mode=0o600)
 
 
 def load_checkpoint(path: str | os.PathLike) -> dict[str, Any]:
@@ -179,12 +166,7 @@ def model_from_checkpoint(payload: dict[str, Any]) -> tuple[nn.Module, TrainConf
 
 
 def _write_json(path: Path, data: Any) -> None:
-    def write(tmp: str) -> None:
-        with open(tmp, "w") as handle:
-            json.dump(data, handle, indent=2)
-            handle.write("\n")
-
-    _atomic_save(write, path)
+    write_text_atomic(path, json.dumps(data, indent=2) + "\n")
 
 
 def _check_resume(payload: dict[str, Any], config: TrainConfig, data: DataSummary) -> None:

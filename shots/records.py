@@ -16,7 +16,6 @@ from __future__ import annotations
 import csv
 import math
 import os
-import tempfile
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,8 +25,9 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from service import limits
+from service.air import Air, pressure_at_altitude
 from service.limits import Range
-
+from shots.files import write_atomic
 
 RANGES: dict[str, Range] = {
     "ball_speed_mps": limits.BALL_SPEED_MPS,
@@ -94,6 +94,7 @@ REQUIRED_COLUMNS: tuple[str, ...] = tuple(name for name, f in ShotRecord.model_f
 NUMERIC_COLUMNS: tuple[str, ...] = tuple(RANGES)
 LAUNCH_COLUMNS: tuple[str, ...] = REQUIRED_COLUMNS
 OUTCOME_COLUMNS = ("carry_x_m", "carry_y_m", "apex_m", "flight_time_s", "landing_angle_deg")
+AIR_COLUMNS = ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct")
 TRAJECTORY_COLUMNS = ("shot_id", "t_s", "x_m", "y_m", "z_m")
 
 
@@ -155,6 +156,22 @@ class ShotSet:
     def launch(self) -> dict[str, np.ndarray]:
         """The five launch columns, ready for `service.physics.initial_state(**shots.launch())`."""
         return {name: self.column(name) for name in LAUNCH_COLUMNS}
+
+    def air(self) -> Air:
+        """Air (density, kinematic viscosity) per shot from its recorded conditions. What was not recorded takes the
+        ICAO standard value (15 degC, sea-level pressure, dry), so a shot without conditions flies in standard air."""
+        altitude = np.nan_to_num(self.column("altitude_m"))
+        pressure_hpa = self.column("pressure_hpa")
+        temperature = self.column("temperature_c")
+        return Air.from_conditions(
+            np.where(np.isnan(temperature), 15.0, temperature),
+            humidity_pct=np.nan_to_num(self.column("humidity_pct")),
+            pressure_pa=np.where(np.isnan(pressure_hpa), pressure_at_altitude(altitude), pressure_hpa * 100.0),
+        )
+
+    def air_recorded(self) -> bool:
+        """Whether any shot records any air condition."""
+        return bool(np.isfinite(np.stack([self.column(name) for name in AIR_COLUMNS])).any())
 
     def subset(self, mask: np.ndarray) -> "ShotSet":
         return ShotSet([r for r, keep in zip(self.records, mask) if keep])
@@ -234,20 +251,16 @@ def _format(value: object) -> str:
 
 
 def write_csv_atomic(path: Path, header: Iterable[str], rows: Iterable[Iterable[object]]) -> None:
-    """Write a CSV to a temporary file beside `path`, then rename it: readers never see half a file."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        os.chmod(tmp, 0o644)
-        with os.fdopen(fd, "w", newline="") as handle:
+    """Write a CSV atomically (`shots.files.write_atomic`): readers never see half a file."""
+
+    def write(tmp: str) -> None:
+        with open(tmp, "w", newline="") as handle:
             writer = csv.writer(handle)
             writer.writerow(header)
             for row in rows:
                 writer.writerow([_format(v) for v in row])
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+
+    write_atomic(path, write)
 
 
 def write_shots(path: str | os.PathLike, records: Iterable[ShotRecord]) -> None:

@@ -20,12 +20,12 @@ from model_export.noise_floor import (
     population_air,
     read_session_truth,
 )
-from model_export.report import begin_marker
 from model_export.training import TrainConfig, load_checkpoint, train
 from model_export.validation import load_validation
 from service.air import Air
 from service.physics import initial_state
 from service.wind import Wind
+from shots.markdown import begin_marker
 from shots.records import ShotRecord, read_shots, write_csv_atomic, write_shots
 from shots.reference_world import fly_reference
 from shots.synth import sessions_path

@@ -10,14 +10,16 @@ from shots.calibrate_reference import (
     fit_reference,
     parameters_literal,
     render_markdown,
-    write_generated_section,
 )
+from shots.markdown import write_generated_section
 from shots.reference_world import CALIBRATED, default_tour_averages_path, read_tour_averages
+
+COMMAND = "calibrate-reference"
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
-        "calibrate-reference",
+        COMMAND,
         help="render the reference world's calibration table (or refit it with --fit)",
         description="Fly the PGA 2023 tour-average launches through the reference world and compare with TrackMan. "
         "Without --fit the committed CALIBRATED parameters are used; with --fit they are refitted and the new "
@@ -39,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
         print()
     text = render_markdown(evaluate(clubs, params), params, baseline=evaluate_ferguson(clubs))
     if args.out:
-        write_generated_section(args.out, text)
+        write_generated_section(args.out, text, COMMAND)
         print(f"wrote {args.out}")
     else:
         print(text, end="")

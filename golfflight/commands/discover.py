@@ -9,7 +9,7 @@ from pathlib import Path
 from discovery.diagnose import diagnose
 from discovery.model import REFERENCE, load_model
 from discovery.outputs import write_diagnosis
-from discovery.prove import begin_marker, cases, prove, write_tables
+from discovery.prove import cases, command, prove, write_tables
 from discovery.recordings import read_recordings
 
 
@@ -72,7 +72,7 @@ def run_prove(args: argparse.Namespace) -> int:
     results = prove(model, seeds=args.seeds, n_shots=args.shots, progress=print, only=args.cases)
     if not results:
         raise ValueError(f"--cases {args.cases!r} matches none of: {', '.join(name for name, _ in cases())}")
-    begin = begin_marker(args.model, args.cases, args.seeds if args.cases else None)
-    write_tables(results, Path(args.out), Path(args.json) if args.json else None, args.model, model.name, begin)
+    section = command(args.model, args.cases, args.seeds if args.cases else None)
+    write_tables(results, Path(args.out), Path(args.json) if args.json else None, model.name, section)
     print(f"wrote the tables to {args.out}")
     return 0
