@@ -6,42 +6,18 @@ python benchmarks/bench_http.py [--model DIR] [--rounds 5]
 from __future__ import annotations
 
 import argparse
-import os
-import socket
 import statistics
-import subprocess
-import sys
 import time
 
 import httpx
-from common import PAPER, REPO, SEVEN_IRON, median_of_rounds, mixed_launches, percentiles_ms, print_table, write_results
+from common import PAPER, SEVEN_IRON, median_of_rounds, mixed_launches, percentiles_ms, print_table, write_results
+from server import start
 
 SHOT = {
     "ball_speed_mps": SEVEN_IRON.ball_speed_mps,
     "launch_angle_deg": SEVEN_IRON.launch_angle_deg,
     "spin_rpm": SEVEN_IRON.spin_rpm,
 }
-
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def start_server(model: str | None, port: int) -> subprocess.Popen:
-    command = [sys.executable, "-m", "golfflight", "serve", "--port", str(port)] + (["--model", model] if model else [])
-    server = subprocess.Popen(command, cwd=REPO, env=os.environ.copy(), stdout=subprocess.DEVNULL)
-    deadline = time.monotonic() + 30
-    while time.monotonic() < deadline:
-        try:
-            if httpx.get(f"http://127.0.0.1:{port}/healthz").status_code == 200:
-                return server
-        except httpx.TransportError:
-            pass
-        time.sleep(0.05)
-    server.kill()
-    raise RuntimeError("the server did not become ready in 30 s")
 
 
 def time_requests(client: httpx.Client, path: str, body: dict, n: int) -> list[float]:
@@ -60,18 +36,10 @@ def main() -> None:
     parser.add_argument("--model", help="model bundle (default: the shipped one)")
     parser.add_argument("--rounds", type=int, default=5)
     args = parser.parse_args()
-    port = free_port()
-    server = start_server(args.model, port)
-    batch = {
-        "shots": [
-            dict(
-                zip(("ball_speed_mps", "launch_angle_deg", "launch_direction_deg", "spin_rpm", "spin_axis_deg"), launch)
-            )
-            for launch in mixed_launches(1024)
-        ]
-    }
+    server = start(1, args.model)
+    batch = {"shots": [launch._asdict() for launch in mixed_launches(1024)]}
     try:
-        with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=60) as client:
+        with httpx.Client(base_url=server.base_url, timeout=60) as client:
             time_requests(client, "/v1/shots", SHOT, 300)
             single = median_of_rounds(
                 [percentiles_ms(time_requests(client, "/v1/shots", SHOT, 2000)) for _ in range(args.rounds)]
@@ -80,8 +48,7 @@ def main() -> None:
             batch_rounds = [time_requests(client, "/v1/shots/batch", batch, 5) for _ in range(args.rounds)]
             server_side = client.get("/v1/latency").json()
     finally:
-        server.terminate()
-        server.wait(timeout=10)
+        server.stop()
     batch_ms = statistics.median(statistics.median(r) for r in batch_rounds) * 1e3
     batch_worst = statistics.median(max(r) for r in batch_rounds) * 1e3
     rows = [

@@ -27,9 +27,6 @@ from common import REPO, machine, mixed_launches
 MAX_DURATION_S = 3600
 """Longest measured run the script accepts (a soak); every loop below stops by itself."""
 
-FIELDS = ("ball_speed_mps", "launch_angle_deg", "launch_direction_deg", "spin_rpm", "spin_axis_deg")
-
-
 def request_bytes(path: str, body: dict) -> bytes:
     payload = json.dumps(body).encode()
     head = (
@@ -42,7 +39,7 @@ def request_bytes(path: str, body: dict) -> bytes:
 def request_pool(batch_size: int, seed: int) -> tuple[list[bytes], list[bytes]]:
     """Pre-encoded single-shot and batch requests from launches around every club's tour average."""
     launches = mixed_launches(2000 + 20 * batch_size, seed)
-    shots = [dict(zip(FIELDS, launch)) for launch in launches]
+    shots = [launch._asdict() for launch in launches]
     singles = [request_bytes("/v1/shots", shot) for shot in shots[:2000]]
     batches = [
         request_bytes("/v1/shots/batch", {"shots": shots[2000 + i * batch_size : 2000 + (i + 1) * batch_size]})

@@ -65,7 +65,12 @@ def _norm(x: torch.Tensor) -> torch.Tensor:
 
 def spin_ratio(v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
     """S = R |omega| / |v_rel| [N], guarded like `service.physics.spin_ratio`."""
-    return BALL_RADIUS_M * _norm(omega) / _norm(v_rel).clamp_min(TINY)
+    return spin_ratio_of(_norm(v_rel), _norm(omega))
+
+
+def spin_ratio_of(speed: torch.Tensor, spin_rate: torch.Tensor) -> torch.Tensor:
+    """S = R |omega| / |v_rel| from the two magnitudes, for callers that have them already."""
+    return BALL_RADIUS_M * spin_rate / speed.clamp_min(TINY)
 
 
 def aerodynamics(

@@ -13,7 +13,7 @@ import torch
 from torch import nn
 
 from model_export import DEFAULT_HIDDEN, PHYS_NN_VARIANTS, VARIANTS
-from model_export.torch_physics import spin_ratio
+from model_export.torch_physics import spin_ratio, spin_ratio_of
 from service.coefficients import BASE_DYNAMIC_PRESSURE, FERGUSON_2022
 
 VELOCITY_SCALE_MPS = 89.4
@@ -44,15 +44,13 @@ def normalised_input(velocity: torch.Tensor, spin: torch.Tensor) -> torch.Tensor
     return torch.cat([velocity / VELOCITY_SCALE_MPS, spin / SPIN_SCALE_RADPS], dim=-1)
 
 
-def speed_and_spin_rate(v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
-    """[|v_rel| / 89.4, |omega| / 2094] (2 values): the coefficient MLP's input.
+def speed_and_spin_rate(v_rel: torch.Tensor, omega: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """|v_rel| and |omega| [N, 1]: the coefficient MLP's input, scaled by 89.4 m/s and 2094 rad/s.
 
     A spinning sphere's coefficients depend on the Reynolds number and spin ratio, i.e. on these two magnitudes
     at a given air, not on the direction of flight. The paper feeds the 6 components instead; that lets the
     net tell a slice from a hook (mirrored shots landed up to 14.7 m apart), so we feed the invariants."""
-    speed = torch.linalg.vector_norm(v_rel, dim=-1, keepdim=True)
-    spin_rate = torch.linalg.vector_norm(omega, dim=-1, keepdim=True)
-    return torch.cat([speed / VELOCITY_SCALE_MPS, spin_rate / SPIN_SCALE_RADPS], dim=-1)
+    return torch.linalg.vector_norm(v_rel, dim=-1, keepdim=True), torch.linalg.vector_norm(omega, dim=-1, keepdim=True)
 
 
 class CoefficientModule(nn.Module):
@@ -92,9 +90,13 @@ class PhysNN(CoefficientModule):
         return self.log_p_m.exp()
 
     def coefficients(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
-        out = torch.sigmoid(self.net(speed_and_spin_rate(v_rel, omega)))
+        speed, spin_rate = speed_and_spin_rate(v_rel, omega)  # once: the MLP and S = R |omega| / |v_rel| share them
+        out = torch.sigmoid(self.net(torch.cat([speed / VELOCITY_SCALE_MPS, spin_rate / SPIN_SCALE_RADPS], dim=-1)))
         c_lift, c_drag = out[:, 0] / 2, out[:, 1] / 2
-        c_moment = self.p_m * spin_ratio(v_rel, omega) if self.learned_moment else out[:, 2] / 50
+        if self.learned_moment:
+            c_moment = self.p_m * spin_ratio_of(speed[:, 0], spin_rate[:, 0])
+        else:
+            c_moment = out[:, 2] / 50
         c_q = out[:, 2] if self.learned_pressure else torch.full_like(c_lift, BASE_DYNAMIC_PRESSURE)
         return torch.stack([c_lift, c_drag, c_moment, c_q], dim=-1)
 

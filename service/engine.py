@@ -154,15 +154,9 @@ class FlightEngine:
         return f"the ball was still in the air after {self.max_steps * self.dt:g} s (the simulation cap)"
 
     @staticmethod
-    def _finite(flight: ShotFlight) -> ShotFlight | FlightError:
-        """The flight, or a FlightError if any of its numbers is not finite (never sent to a client)."""
-        numbers = [getattr(flight, name) for name in ShotFlight.__dataclass_fields__ if name != "states"]
-        states = flight.states
-        if all(math.isfinite(v) for v in numbers) and (
-            states is None or all(np.isfinite(a).all() for a in (states.times_s, states.positions, states.velocities))
-        ):
-            return flight
-        return FlightError(NON_FINITE)
+    def _states_finite(states: EulerStates | None) -> bool:
+        """Whether every recorded state is finite (a broken model's NaN never reaches a client)."""
+        return states is None or all(np.isfinite(a).all() for a in (states.times_s, states.positions, states.velocities))
 
     @property
     def variant(self) -> str:
@@ -217,12 +211,10 @@ class FlightEngine:
             times = np.append(np.round(dt * np.arange(len(history) - 1), 9), flight_time)
             states = EulerStates(times, rows[:, :3], rows[:, 3:])
         apex_time = round(apex_step * dt, 9)
-        flight = self._finite(
-            ShotFlight(land[0], land[1], carry, land[0], apex, apex_time, flight_time, angle, speed, spin, states)
-        )
-        if isinstance(flight, FlightError):
-            raise flight
-        return flight
+        numbers = (land[0], land[1], carry, apex, apex_time, flight_time, angle, speed, spin)
+        if not (all(map(math.isfinite, numbers)) and self._states_finite(states)):
+            raise FlightError(NON_FINITE)
+        return ShotFlight(land[0], land[1], carry, land[0], apex, apex_time, flight_time, angle, speed, spin, states)
 
     def fly_batch(
         self,
@@ -298,7 +290,8 @@ class FlightEngine:
                 results.append(ShotFlight(x, y, c, x, h, th, tf, a, s, w))
             else:
                 states = self._batch_states(history, i, last_step[i], landing[:6, i], tf)
-                results.append(self._finite(ShotFlight(x, y, c, x, h, th, tf, a, s, w, states)))
+                flight = ShotFlight(x, y, c, x, h, th, tf, a, s, w, states)
+                results.append(flight if self._states_finite(states) else FlightError(NON_FINITE))
         return results
 
     def _batch_states(self, history: list[np.ndarray], shot: int, last_step: int, landing: np.ndarray, t: float):

@@ -4,15 +4,12 @@ from __future__ import annotations
 
 import csv
 import json
-import socket
 import subprocess
 import sys
-import threading
-import time
 
 import httpx
 import pytest
-import uvicorn
+from servers import running
 
 from service.api.app import create_app
 from service.api.models import MAX_BATCH_SHOTS
@@ -27,25 +24,8 @@ SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100
 
 @pytest.fixture(scope="module")
 def client():
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    server = uvicorn.Server(uvicorn.Config(create_app(), host="127.0.0.1", port=port, log_level="warning"))
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
-    with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=30) as http:
-        deadline = time.monotonic() + 20
-        while True:
-            try:
-                if http.get("/healthz").status_code == 200:
-                    break
-            except httpx.TransportError:
-                pass
-            assert time.monotonic() < deadline, "the service did not become ready"
-            time.sleep(0.05)
+    with running(create_app()) as http:
         yield http
-    server.should_exit = True
-    thread.join(timeout=10)
 
 
 def shot(http: httpx.Client, **body) -> dict:

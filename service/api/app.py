@@ -41,6 +41,7 @@ from service.api.models import (
     BatchResult,
     ShotRequest,
     ShotResult,
+    body_detail,
     describe_errors,
 )
 from service.api.shots import flight_fields, fly_shot
@@ -89,9 +90,7 @@ def _json(model: BaseModel, status_code: int = 200) -> Response:
 
 
 def _flight_error(error: FlightError) -> JSONResponse:
-    message = str(error)
-    detail = {"loc": ["body"], "msg": message, "type": "flight_error", "field": "body", "message": message}
-    return JSONResponse({"detail": [detail]}, 422)
+    return JSONResponse({"detail": [body_detail(str(error), "flight_error")]}, 422)
 
 
 def _origins(text: str | None) -> list[str]:
@@ -164,8 +163,7 @@ def create_app(
         message = "the body is not JSON text in UTF-8"  # FastAPI's 400 for a body it cannot even decode
         if request.url.path == GSPRO_PATH:
             return JSONResponse(GSProReply(Code=500, Message=message).model_dump(exclude_none=True), 422)
-        detail = {"loc": ["body"], "msg": message, "type": "json_invalid", "field": "body", "message": message}
-        return JSONResponse({"detail": [detail]}, 422)
+        return JSONResponse({"detail": [body_detail(message, "json_invalid")]}, 422)
 
     @app.exception_handler(NotReady)
     async def not_ready(request: Request, error: NotReady) -> JSONResponse:

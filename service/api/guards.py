@@ -9,6 +9,8 @@ from __future__ import annotations
 import hmac
 import json
 
+from service.api.models import body_detail
+
 API_KEY_ENV = "GOLFFLIGHT_API_KEY"
 """Environment variable holding the API key; when set (non-empty) every route but /healthz requires it."""
 
@@ -76,8 +78,7 @@ class BodyLimit:
 
     async def _refuse(self, send, size: str) -> None:
         message = f"request body of {size} bytes refused: the limit is {self.limit:,} bytes"
-        detail = {"loc": ["body"], "msg": message, "type": "body_too_large", "field": "body", "message": message}
-        await _send_json(send, 413, {"detail": [detail]})
+        await _send_json(send, 413, {"detail": [body_detail(message, "body_too_large")]})
 
 
 class ApiKey:

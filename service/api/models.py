@@ -300,6 +300,11 @@ def describe_error(error: dict, ranges: dict[str, Range] = RANGES) -> dict:
     return entry
 
 
+def body_detail(message: str, kind: str) -> dict:
+    """A 422/413 detail about the body as a whole (not one field), shaped like `describe_error`'s."""
+    return {"loc": ["body"], "msg": message, "type": kind, "field": "body", "message": message}
+
+
 def describe_errors(errors, ranges: dict[str, Range] = RANGES) -> list[dict]:
     """422 details naming the field, the value and the allowed range (see `describe_error`)."""
     return [describe_error(error, ranges) for error in errors]
