@@ -5,7 +5,8 @@ FROM python:3.11-slim
 ENV PYTHONDONTWRITEBYTECODE=1 PYTHONUNBUFFERED=1
 WORKDIR /app
 COPY pyproject.toml README.md ./
-# every package of the distribution: the command line imports them all (none of them imports torch)
+# every package of the distribution: the command line registers them all; only the training commands import torch,
+# and only when they run
 COPY golfflight ./golfflight
 COPY service ./service
 COPY shots ./shots
