@@ -8,7 +8,6 @@ of the driver shots and measures the second half before and after.
 
 from __future__ import annotations
 
-import csv
 import os
 import tempfile
 from collections.abc import Sequence
@@ -28,7 +27,7 @@ from shots.paths import shared_data_dir
 from shots.records import ShotSet, write_shots
 from shots.reference_world import CALIBRATION_AIR, TOUR_AVERAGES_FILE, ClubAverage, read_tour_averages
 from shots.tourcast import load_tourcast
-from shots.trackman import load_trackman
+from shots.trackman import load_trackman, read_table
 
 COMMAND = "accuracy"
 DRIVER_FILE = Path("real/trackman_driver_sessions/data.csv")
@@ -215,14 +214,13 @@ def measured_driver_shots(path: str | os.PathLike) -> tuple[ShotSet, str]:
 
 
 def ball_types(path: str | os.PathLike) -> dict[str, str]:
-    """The 'Ball' cell of every row of a TrackMan export, keyed like the loader's shot_id (the file line number)."""
-    with open(path, newline="", encoding="utf-8-sig") as handle:
-        rows = list(csv.reader(handle))
-    header = [name.strip() for name in rows[0]]
+    """The 'Ball' cell of every row of a TrackMan export, keyed like the loader's shot_id (the file line number),
+    read by the loader's own table reader (which also skips an optional 'sep=,' first line)."""
+    header, _, rows = read_table(Path(path))
     if "Ball" not in header:
         return {}
     column = header.index("Ball")
-    return {str(line): row[column].strip() for line, row in enumerate(rows, start=1) if len(row) > column}
+    return {str(line): row[column].strip() for line, row in rows if len(row) > column}
 
 
 @dataclass

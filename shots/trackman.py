@@ -124,7 +124,7 @@ class _Malformed(_BadRow):
         self.cell = f"column '{column}': {text!r}"
 
 
-def _read_table(path: Path) -> tuple[list[str], list[str], list[tuple[int, list[str]]]]:
+def read_table(path: Path) -> tuple[list[str], list[str], list[tuple[int, list[str]]]]:
     """Header, units row and (line number, cells) of each data row; an optional 'sep=,' first line is skipped."""
     with reading(path), path.open(newline="", encoding="utf-8-sig") as handle:
         lines = list(enumerate(csv.reader(handle), start=1))
@@ -231,7 +231,7 @@ def load_trackman(path: str | os.PathLike, *, min_tracked_fraction: float | None
     recorded flight: its outcome columns stay blank (and the tracked-fraction filter drops it).
     """
     path = Path(path)
-    header, units, rows = _read_table(path)
+    header, units, rows = read_table(path)
     wanted = {name: accepted for name, (_, accepted) in {**LAUNCH, **OUTCOME}.items()}
     wanted.update({CARRY_LENGTH: LENGTH, CARRY_SIDE: LENGTH, LAST_POINT_TIME: TIME})
     required = set(LAUNCH) | ({LAST_POINT_TIME, CARRY_TIME} if min_tracked_fraction is not None else set())

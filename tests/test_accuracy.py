@@ -18,6 +18,7 @@ from model_export.accuracy import (
     TOURCAST_PBP,
     TOURCAST_TRAJECTORIES,
     ModelFlyer,
+    ball_types,
     compare_clubs,
     outcome_errors,
     path_errors,
@@ -248,3 +249,17 @@ def test_default_model_lands_the_pga_averages():
         pytest.skip("needs the shared PGA 2023 table and the committed models/default bundle")
     mae = compare_clubs(ModelFlyer(model), read_tour_averages(averages)).mean_absolute_error
     assert np.all(mae <= PGA_TARGETS), f"MAE carry {mae[0]:.2f} yd, max height {mae[1]:.2f} yd, land {mae[2]:.2f} deg"
+
+
+@pytest.mark.parametrize("first_line", ["", "sep=,\n"])
+def test_ball_types_are_keyed_like_the_loaders_shot_ids(tmp_path, first_line):
+    """Each shot's ball, by the shot_id the TrackMan loader gives it (its file line), also after Excel's optional
+    'sep=,' line (which once hid the header, so every ball read as blank)."""
+    from shots.trackman import load_trackman
+
+    export = tmp_path / "export.csv"
+    export.write_text(first_line + (Path(__file__).parent / "fixtures" / "trackman_export.csv").read_text())
+    balls = ball_types(export)
+    shot_ids = [record.shot_id for record in load_trackman(export, skip_bad_rows=True).records]
+    assert shot_ids and all(balls[shot_id] for shot_id in shot_ids)
+    assert balls[shot_ids[0]] == "Premium"
