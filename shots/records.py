@@ -1,7 +1,9 @@
 """The canonical shot-record CSV (one row per shot) that training, evaluation and diagnosis all read.
 
 Columns, SI units:
-  identity (optional)  shot_id, session, club, timestamp, split (train/val)
+  identity (optional)  shot_id, session, club, timestamp, split (train/val), source (the data set a merged file
+                       took the row from), group (shots that shared one unrecorded wind and air: a tour hole in one
+                       round, a block of a range session), ball (the ball type as the export names it)
   launch (required)    ball_speed_mps, launch_angle_deg, launch_direction_deg (+ right), spin_rpm,
                        spin_axis_deg (+ tilted right: the ball curves right)
   outcome (optional)   carry_x_m (+ right), carry_y_m (down the line), apex_m, flight_time_s,
@@ -68,6 +70,9 @@ class ShotRecord(BaseModel):
     club: str | None = None
     timestamp: str | None = None
     split: Literal["train", "val"] | None = None
+    source: str | None = None
+    group: str | None = None
+    ball: str | None = None
 
     ball_speed_mps: _bounded(limits.BALL_SPEED_MPS)
     launch_angle_deg: _bounded(limits.LAUNCH_ANGLE_DEG)

@@ -219,13 +219,15 @@ def _when(text: str) -> tuple[str, str]:
 
 def load_trackman(path: str | os.PathLike, *, min_tracked_fraction: float | None = 0.9,
                   balls: Collection[str] | None = None, session: str | None = None,
-                  skip_bad_rows: bool = False) -> Conversion:
+                  lines: tuple[int, int] | None = None, skip_bad_rows: bool = False) -> Conversion:
     """Convert a TrackMan CSV export to canonical records.
 
     min_tracked_fraction: keep a shot only if the radar tracked it for at least this fraction of its flight
     ("Last data Point - Time" >= fraction x "Carry Flat - Time"): the rest were indoor shots whose outcome is
     TrackMan's model. None keeps every flight. balls: keep only these "Ball" types (None keeps all).
     session: the session id when the file has no "Date" column (default: the file name without extension).
+    lines: (first, last) file lines to convert, inclusive and 1-based (the header is line 1); the rest are not read
+    as shots at all (e.g. the held-out half of a file, `shots.heldout`).
     skip_bad_rows: leave malformed rows out (each listed in the report) instead of refusing the file.
     shot_id is the line number of the shot in the export. A shot whose "Carry Flat - Time" is blank or 0 has no
     recorded flight: its outcome columns stay blank (and the tracked-fraction filter drops it).
@@ -244,6 +246,8 @@ def load_trackman(path: str | os.PathLike, *, min_tracked_fraction: float | None
     def cell(cells: list[str], name: str) -> str:
         return cells[text[name]].strip() if name in text and text[name] < len(cells) else ""
 
+    if lines is not None:
+        rows = [(line, cells) for line, cells in rows if lines[0] <= line <= lines[1]]
     report = ConversionReport(str(path), rows_in=len(rows))
     records = []
     for line, cells in rows:
@@ -278,7 +282,7 @@ def load_trackman(path: str | os.PathLike, *, min_tracked_fraction: float | None
             continue
         timestamp, day = _when(cell(cells, "Date")) if cell(cells, "Date") else (None, None)
         records.append(ShotRecord(shot_id=str(line), session=day or session or path.stem, timestamp=timestamp,
-                                  club=cell(cells, "Club") or None, **values))
+                                  club=cell(cells, "Club") or None, ball=ball or None, **values))
     report.refuse_bad_rows(skip_bad_rows)
     report.kept = len(records)
     if keep_balls is None and "Ball" in text:
