@@ -153,7 +153,7 @@ def _require(path: Path, header: list[str] | None, columns: tuple[str, ...]) -> 
         raise RecordError(f"{path}: required columns {missing} are missing (columns: {header})")
 
 
-def _key(path: Path, line: int, row: dict[str, str]) -> tuple[str, str, str, str]:
+def shot_key(path: Path, line: int, row: dict[str, str]) -> tuple[str, str, str, str]:
     """(round, hole, player, shot): the join key shared by trajectory and pbp files."""
     key = []
     for column in ("roundNumber", "holeNumber", "playerId", "shotNumber"):
@@ -167,6 +167,13 @@ def _key(path: Path, line: int, row: dict[str, str]) -> tuple[str, str, str, str
     return tuple(key)
 
 
+def shot_id(tournament: str, key: tuple[str, str, str, str], flight: int | None = None) -> str:
+    """The id of a tour shot, shared by the TOURCAST and pbp loaders; `flight` numbers the flights (from 1) of a key
+    that holds several (a re-teed shot)."""
+    base = f"{tournament}-R{key[0]}-H{key[1]}-P{key[2]}-S{key[3]}"
+    return base if flight is None else f"{base}-f{flight}"
+
+
 def _groups(path: Path) -> tuple[str, list[tuple[int, tuple, list[dict[str, str]]]]]:
     """Tournament number and the file's rows grouped per shot key, in file order: (first line, key, rows)."""
     with reading(path), path.open(newline="", encoding="utf-8-sig") as handle:
@@ -174,7 +181,7 @@ def _groups(path: Path) -> tuple[str, list[tuple[int, tuple, list[dict[str, str]
         _require(path, reader.fieldnames, TRAJECTORY_COLUMNS)
         groups: list[tuple[int, tuple, list[dict[str, str]]]] = []
         for line, row in enumerate(reader, start=2):
-            key = _key(path, line, row)
+            key = shot_key(path, line, row)
             if groups and groups[-1][1] == key and row["row"].strip() != "1":
                 groups[-1][2].append(row)
             else:
@@ -214,7 +221,6 @@ def _flights(line: int, key: tuple, rows: list[dict[str, str]], n: int, tourname
             line,
             f"column 'row': {numbers} with max_row {max_row}",
         )
-    base = f"{tournament}-R{key[0]}-H{key[1]}-P{key[2]}-S{key[3]}"
     count = max_row // n
     flights = []
     for block in range(count):
@@ -224,8 +230,8 @@ def _flights(line: int, key: tuple, rows: list[dict[str, str]], n: int, tourname
             [[_number(r, axis, first + j) for axis in ("zFit", "xFit", "yFit")] for j, r in enumerate(part)]
         )
         scale = max_row / ((block + 1) * n)
-        shot_id = base + (f"-f{block + 1}" if count > 1 else "")
-        flights.append(Flight(shot_id, tournament, f"{tournament}-R{key[0]}", key, line + block * n, coefficients,
+        flights.append(Flight(shot_id(tournament, key, block + 1 if count > 1 else None), tournament,
+                              f"{tournament}-R{key[0]}", key, line + block * n, coefficients,
                               _number(part[-1], "timeInterval", first + n - 1) * scale,
                               _number(part[-1], "measuredTimeInterval", first + n - 1) * scale))
     return flights
@@ -276,7 +282,7 @@ def read_pbp_spin(path: str | os.PathLike, tournament: str) -> dict[tuple[str, s
             if not (spin == 0 or limit.low <= spin <= limit.high):
                 raise RecordError(f"{path} line {line} column 'radarData.launchSpin': {spin:g} outside the allowed "
                                   f"range {limit.describe()} (0 = missing)")
-            spins.setdefault(_key(path, line, row), []).append(spin or None)
+            spins.setdefault(shot_key(path, line, row), []).append(spin or None)
     return spins
 
 

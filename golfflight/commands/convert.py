@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from shots.pbp import load_pbp
 from shots.records import trajectories_path, write_shots, write_trajectories
 from shots.tourcast import load_tourcast
 from shots.trackman import Conversion, load_trackman
@@ -14,7 +15,8 @@ SKIP_HELP = "leave out malformed rows (each listed in the report) instead of ref
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser("convert", help="convert a real export (TrackMan, TOURCAST) to canonical CSV")
+    parser = subparsers.add_parser("convert",
+                                   help="convert a real export (TrackMan, TOURCAST, PGA TOUR pbp) to canonical CSV")
     formats = parser.add_subparsers(dest="format", required=True)
 
     trackman = formats.add_parser("trackman", help="a TrackMan CSV export (header row, then a units row)")
@@ -39,6 +41,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     tourcast.add_argument("--out", required=True, help="canonical CSV to write (the trajectories go beside it)")
     tourcast.add_argument("--skip-bad-rows", action="store_true", help=SKIP_HELP)
     tourcast.set_defaults(run=run_tourcast)
+
+    pbp = formats.add_parser("pbp", help="PGA TOUR play-by-play pbp_*.csv: the radar-measured tee shots' launch")
+    pbp.add_argument("source", help="the pbp_*.csv file")
+    pbp.add_argument("--out", required=True, help="canonical CSV to write")
+    pbp.add_argument("--no-apex", dest="apex", action="store_false",
+                     help="leave apex_m blank instead of reading radarData.apexHeight")
+    pbp.add_argument("--skip-bad-rows", action="store_true", help=SKIP_HELP)
+    pbp.set_defaults(run=run_pbp)
 
 
 def _write(conversion: Conversion, out: str) -> int:
@@ -70,3 +80,7 @@ def run_tourcast(args: argparse.Namespace) -> int:
     conversion = load_tourcast(args.source, args.pbp, estimate_spin=args.estimate_spin,
                                sample_interval_s=args.sample_interval, skip_bad_rows=args.skip_bad_rows)
     return _write(conversion, args.out)
+
+
+def run_pbp(args: argparse.Namespace) -> int:
+    return _write(load_pbp(args.source, apex=args.apex, skip_bad_rows=args.skip_bad_rows), args.out)
