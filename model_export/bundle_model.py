@@ -70,7 +70,8 @@ def model_from_bundle(bundle_dir: str | os.PathLike) -> tuple[nn.Module, ModelCa
 
 
 def config_from_card(card: ModelCard) -> TrainConfig:
-    """The training settings a bundle's card records, as a TrainConfig (the starting point of a fine-tune)."""
+    """The training settings a bundle's card records, as a TrainConfig (the starting point of a fine-tune); a model
+    trained on every observable is fine-tuned with the landing and max-height loss (what a user's file holds)."""
     training = card.training
     return TrainConfig(
         variant=card.variant,
@@ -78,7 +79,7 @@ def config_from_card(card: ModelCard) -> TrainConfig:
         epochs=training.epochs,
         batch_size=training.batch_size,
         lr=training.learning_rate,
-        loss=training.loss,
+        loss="lp+lh" if training.loss == "observables" else training.loss,
         seed=training.seed,
         grad_clip_norm=training.grad_clip_norm,
         soft_argmax_temperature_m=training.soft_argmax_temperature_m,

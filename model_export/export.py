@@ -278,8 +278,11 @@ def build_card(
             },
             "training_data": {
                 **data,
-                "split": "validation = the rows marked 'val' in the file's split column (never a random shuffle); "
-                "training = the rows marked 'train'",
+                "split": payload.get(
+                    "split",
+                    "validation = the rows marked 'val' in the file's split column (never a random shuffle); "
+                    "training = the rows marked 'train'",
+                ),
             },
             "training": {
                 "optimizer": "adam",
@@ -288,9 +291,13 @@ def build_card(
                 "epochs": payload["epoch"],
                 "best_epoch": metrics["epoch"],
                 "loss": config.loss,
-                "loss_description": "L_p = mean |soft-argmax landing (x, y) - target|"
-                + (" + L_h = mean |max r_z - apex|" if config.loss == "lp+lh" else "")
-                + " over the shots that have each target, in metres",
+                "loss_description": payload.get(
+                    "loss_description",
+                    "L_p = mean |soft-argmax landing (x, y) - target|"
+                    + (" + L_h = mean |max r_z - apex|" if config.loss == "lp+lh" else "")
+                    + " over the shots that have each target, in metres",
+                ),
+                "latent_conditions": payload.get("latent_conditions"),
                 "seed": config.seed,
                 "grad_clip_norm": config.grad_clip_norm,
                 "soft_argmax_temperature_m": config.soft_argmax_temperature_m,

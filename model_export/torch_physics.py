@@ -2,7 +2,8 @@
 
 The one place the equations of motion exist in torch. Same axes, signs, constants and guards as the NumPy
 core (errata applied: lift along omega x v, spin only decays, q = C_Q rho |v|^2), batched over shots and
-dtype-agnostic (float64 for the parity tests, float32 for training). No wind: the training data has none.
+dtype-agnostic (float64 for the parity tests, float32 for training). Wind is uniform (one air velocity per shot):
+real-data training fits it as a per-group nuisance, where a uniform wind is the simplest stand-in for the profile.
 """
 
 from __future__ import annotations
@@ -96,11 +97,18 @@ def derivatives(
     coefficients: Coefficients,
     density: torch.Tensor | float,
     reynolds_scale: torch.Tensor | float = 1.0,
+    wind: torch.Tensor | None = None,
+    coefficient_scale: torch.Tensor | None = None,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """d/dt of (position, velocity, spin) in calm air (paper eq. 14 with the errata); the coefficient model is fed
-    (k v, k omega) with k = `reynolds_scale` [N,1] (`service.physics.reynolds_scale`)."""
-    coefficient_values = coefficients(velocity * reynolds_scale, spin * reynolds_scale)
-    acceleration, spin_acceleration = aerodynamics(velocity, spin, coefficient_values, density)
+    """d/dt of (position, velocity, spin) (paper eq. 14 with the errata). The aerodynamics use v_rel = v - `wind`
+    ([N,3] uniform air velocity; None = calm); the coefficient model is fed (k v_rel, k omega) with
+    k = `reynolds_scale` [N,1] (`service.physics.reynolds_scale`), and its output is multiplied by
+    `coefficient_scale` [N,4] where given (a ball type's drag and lift relative to the ball the model learned)."""
+    v_rel = velocity if wind is None else velocity - wind
+    coefficient_values = coefficients(v_rel * reynolds_scale, spin * reynolds_scale)
+    if coefficient_scale is not None:
+        coefficient_values = coefficient_values * coefficient_scale
+    acceleration, spin_acceleration = aerodynamics(v_rel, spin, coefficient_values, density)
     return velocity, acceleration - acceleration.new_tensor([0.0, 0.0, GRAVITY_MPS2]), spin_acceleration
 
 
@@ -113,11 +121,16 @@ def euler_rollout(
     dt: float = DT_S,
     t_sim: float = T_SIM_S,
     reynolds_scale: torch.Tensor | float = 1.0,
+    wind: torch.Tensor | None = None,
+    coefficient_scale: torch.Tensor | None = None,
 ) -> Trajectory:
-    """Forward Euler over the whole t_sim for every shot (no early stop: fixed shapes stay batched, differentiable)."""
+    """Forward Euler over the whole t_sim for every shot (no early stop: fixed shapes stay batched, differentiable);
+    `wind` and `coefficient_scale` as in `derivatives`."""
     positions, velocities, spins = [position], [velocity], [spin]
     for _ in range(int(round(t_sim / dt))):
-        d_position, d_velocity, d_spin = derivatives(position, velocity, spin, coefficients, density, reynolds_scale)
+        d_position, d_velocity, d_spin = derivatives(
+            position, velocity, spin, coefficients, density, reynolds_scale, wind, coefficient_scale
+        )
         position, velocity, spin = position + dt * d_position, velocity + dt * d_velocity, spin + dt * d_spin
         positions.append(position)
         velocities.append(velocity)
@@ -173,3 +186,16 @@ def hard_landing(trajectory: Trajectory, start_s: float = LANDING_SEARCH_START_S
         (before + frac) * trajectory.dt,
         landed,
     )
+
+
+def positions_at(trajectory: Trajectory, times_s: torch.Tensor) -> torch.Tensor:
+    """Positions [N,K,3] at times [N,K] (s), linear between the Euler steps around each time (differentiable in
+    the positions); times beyond t_sim take the last state."""
+    positions = trajectory.positions.transpose(0, 1)  # [N, T+1, 3]
+    last = positions.shape[1] - 1
+    steps = (times_s / trajectory.dt).clamp(0, last)
+    before = steps.floor().long().clamp(max=last - 1)
+    frac = (steps - before).unsqueeze(-1)
+    index = before.unsqueeze(-1).expand(-1, -1, 3)
+    old, new = positions.gather(1, index), positions.gather(1, index + 1)
+    return old + frac * (new - old)

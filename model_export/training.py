@@ -49,7 +49,9 @@ class TrainConfig:
     epochs: int = 50
     batch_size: int = 1024
     lr: float = 1e-3
-    loss: Literal["lp", "lp+lh"] = "lp+lh"
+    loss: Literal["lp", "lp+lh", "observables"] = "lp+lh"
+    """The paper's landing loss, with its max-height loss, or (recorded only: `model_export.joint` trains it) every
+    observable weighted by its noise."""
     seed: int = 0
     grad_clip_norm: float = GRAD_CLIP_NORM
     soft_argmax_temperature_m: float = SOFT_ARGMAX_TEMPERATURE_M
@@ -62,8 +64,8 @@ class TrainConfig:
         self.hidden = tuple(int(h) for h in self.hidden)
         if self.variant not in VARIANTS:
             raise ValueError(f"unknown variant {self.variant!r}; choose from {', '.join(VARIANTS)}")
-        if self.loss not in ("lp", "lp+lh"):
-            raise ValueError(f"loss must be 'lp' or 'lp+lh', not {self.loss!r}")
+        if self.loss not in ("lp", "lp+lh", "observables"):
+            raise ValueError(f"loss must be 'lp', 'lp+lh' or 'observables', not {self.loss!r}")
         if self.variant == "nn" and self.loss != "lp":
             raise ValueError("the NN baseline predicts the landing point only: train it with --loss lp")
 
@@ -247,6 +249,8 @@ def train(
     summary) instead of refusing it.
     Denormal floats are flushed to zero while training (without it the first backward passes through the rollout
     hit denormals and a CPU batch runs 20-100x slower), and the CPU's normal mode is restored afterwards."""
+    if config.loss == "observables":
+        raise ValueError("the 'observables' loss is trained by model_export.joint (golfflight train-real)")
     torch.set_flush_denormal(True)
     try:
         return _train(data_path, out_dir, config, resume, progress, init_state, skip_bad_rows)

@@ -12,9 +12,10 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-SCHEMA_VERSION = "1.1"
-SUPPORTED_SCHEMA_VERSIONS = ("1.1",)
-"""1.1 added physics.kinematic_viscosity_m2_s (the Reynolds scale of the graph's inputs); 1.0 cards lack it."""
+SCHEMA_VERSION = "1.2"
+SUPPORTED_SCHEMA_VERSIONS = ("1.1", "1.2")
+"""1.1 added physics.kinematic_viscosity_m2_s (the Reynolds scale of the graph's inputs); 1.0 cards lack it.
+1.2 added the real-data sections (training_data.sources, training.latent_conditions, held_out), all optional."""
 SCHEMA_PATH = Path(__file__).with_name("model_card.schema.json")
 
 ExportableVariant = Literal["phys-nn", "phys-nn-pm", "phys-nn-pm-cq", "phys-nn+", "phys-q"]
@@ -87,6 +88,29 @@ class Physics(_Strict):
     landing: str
 
 
+class SourceFile(_Strict):
+    """One file a training source was converted from."""
+
+    path: str = Field(description="relative to the shared data folder")
+    sha256: Sha256
+
+
+class TrainingSource(_Strict):
+    """One source of a merged training file, with what it contributed and how much a shot of it weighs."""
+
+    name: str
+    kind: Literal["measured", "modelled", "synthetic"] = Field(
+        description="measured flights; a launch monitor's own model of the flight; our reference world"
+    )
+    files: list[SourceFile]
+    n_rows: int = Field(ge=0)
+    n_train: int = Field(ge=0)
+    n_val: int = Field(ge=0)
+    weight: NonNegative = Field(description="weight of one shot of this source in the loss")
+    observables: list[str] = Field(description="what its shots were trained on")
+    note: str
+
+
 class TrainingData(_Strict):
     """The data the model was trained and validated on."""
 
@@ -103,6 +127,7 @@ class TrainingData(_Strict):
     min_apex_m: NonNegative
     filters: dict[str, int] = Field(description="shots left out, by reason, in the order applied")
     split: str
+    sources: list[TrainingSource] | None = Field(default=None, description="the sources merged into `file`")
 
 
 class TrainingSettings(_Strict):
@@ -113,12 +138,15 @@ class TrainingSettings(_Strict):
     batch_size: int = Field(ge=1)
     epochs: int = Field(ge=1)
     best_epoch: int = Field(ge=1)
-    loss: Literal["lp", "lp+lh"]
+    loss: Literal["lp", "lp+lh", "observables"]
     loss_description: str
     seed: int
     grad_clip_norm: Positive
     soft_argmax_temperature_m: Positive
     limit: int | None
+    latent_conditions: str | None = Field(
+        default=None, description="the unrecorded conditions fitted beside the network, and their priors"
+    )
 
 
 class Validation(_Strict):
@@ -129,6 +157,19 @@ class Validation(_Strict):
     landing_error_yd: NonNegative
     max_height_error_m: NonNegative | None
     max_height_error_yd: NonNegative | None
+
+
+class HeldOutResult(_Strict):
+    """The exported model's error on one held-out set (never trained on, never used to select the model), flown
+    through the runtime path, calm, in the card's air."""
+
+    name: str
+    path: str = Field(description="relative to the shared data folder")
+    sha256: Sha256
+    rows: str = Field(description="which rows of the file: all, or a line range")
+    n_shots: int = Field(ge=1)
+    errors: dict[str, NonNegative] = Field(description="mean absolute error per observable (SI units in the key)")
+    note: str
 
 
 class ExportCheck(_Strict):
@@ -153,7 +194,7 @@ class Producer(_Strict):
 class ModelCard(_Strict):
     """model_card.json of a model bundle."""
 
-    schema_version: Literal["1.1"]
+    schema_version: Literal["1.1", "1.2"]
     variant: ExportableVariant
     architecture: Architecture
     onnx: OnnxGraph
@@ -163,6 +204,7 @@ class ModelCard(_Strict):
     validation: Validation
     export_check: ExportCheck
     producer: Producer
+    held_out: list[HeldOutResult] | None = Field(default=None, description="error on each held-out real set")
 
 
 def schema_text() -> str:

@@ -13,6 +13,7 @@ from golfflight.commands import (
     simulate,
     synth,
     train,
+    train_real,
 )
 
-COMMANDS = [fly, synth, convert, calibrate, train, export, evaluate, finetune, accuracy, serve, simulate, discover]
+COMMANDS = [fly, synth, convert, calibrate, train, train_real, export, evaluate, finetune, accuracy, serve, simulate, discover]

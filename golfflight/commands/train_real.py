@@ -1,0 +1,65 @@
+"""`golfflight train-real`: Phys-NN+ trained on real flights with the unrecorded conditions as latent parameters
+(thin layer over model_export.real_training)."""
+
+from __future__ import annotations
+
+import argparse
+
+from shots.paths import shared_data_dir
+
+
+def _seeds(text: str) -> tuple[int, ...]:
+    try:
+        seeds = tuple(int(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"seeds must be comma-separated integers like 0,1,2, not {text!r}") from None
+    return seeds
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    from model_export.real_data import BUILDERS
+
+    parser = subparsers.add_parser(
+        "train-real",
+        help="train on the real flights of the shared data (held-out sets never read), export the best seed",
+        description="Build WORK/real_flights.csv from every usable real source (docs/training_real.md), fine-tune "
+        "the --init bundle on it jointly with a wind per conditions group, an air factor per air group and a scale "
+        "per ball type, once per seed, and export the seed with the lowest validation loss to --out.",
+    )
+    parser.add_argument("--work", required=True, help="directory for the merged data and each seed's run")
+    parser.add_argument("--out", help="bundle directory to export the chosen seed to")
+    parser.add_argument("--init", default="models/synthetic", help="bundle to start from (default models/synthetic)")
+    parser.add_argument("--data-root", default=None, help="shared data folder (default ../shared/data)")
+    parser.add_argument("--sources", default=",".join(BUILDERS), help=f"comma-separated subset of {list(BUILDERS)}")
+    parser.add_argument("--epochs", type=int, default=30)
+    parser.add_argument("--seeds", type=_seeds, default=(0, 1, 2))
+    parser.add_argument("--lr", type=float, default=1e-3, help="Adam learning rate of the network")
+    parser.add_argument("--threads", type=int, default=2, help="torch CPU threads per seed")
+    parser.add_argument("--jobs", type=int, default=1, help="seeds trained at once, each in its own process")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from model_export.joint import JointConfig
+    from model_export.real_data import BUILDERS
+    from model_export.real_training import train_real
+
+    names = tuple(n.strip() for n in args.sources.split(","))
+    unknown = [n for n in names if n not in BUILDERS]
+    if unknown:
+        raise SystemExit(f"golfflight train-real: --sources: unknown {unknown}; choose from {list(BUILDERS)}")
+    if args.epochs < 1:
+        raise SystemExit(f"golfflight train-real: --epochs must be at least 1, got {args.epochs}")
+    result = train_real(args.data_root or shared_data_dir(), args.work, args.init,
+                        JointConfig(epochs=args.epochs, lr=args.lr), args.seeds, args.out, names,
+                        jobs=args.jobs, threads=args.threads)
+    for data in result.sources:
+        print(f"{data.name}: {len(data.records)} shots ({data.kind})")
+    for seed, run_result in result.runs.items():
+        best = run_result.best
+        print(f"seed {seed}: best epoch {best['epoch']}, validation loss {best['val_loss']:.3f}" if best
+              else f"seed {seed}: no finite validation loss")
+    print(f"chosen seed {result.chosen_seed}; {result.seconds / 60:.1f} min")
+    if result.card is not None:
+        print(f"exported {args.out} (validation landing error {result.card.validation.landing_error_yd:.2f} yd)")
+    return 0

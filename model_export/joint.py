@@ -1,0 +1,334 @@
+"""Joint training on real flights: the coefficient network and, beside it, the conditions nobody recorded.
+
+Every observable a shot has (landing point, apex, flight time, landing angle, path positions) enters the loss in
+units of its measurement noise (`model_export.observations`), through a Huber function (outliers count linearly).
+Each conditions group gets a latent uniform wind, each air group a latent density factor, each non-reference ball
+type a latent lift and drag scale, all with Gaussian priors whose widths are the typical sizes of the matching
+discovery effects (`discovery.effects`: wind, air_density, lift_scale, drag_scale), so the network does not absorb
+a session's weather into the aerodynamics. Validation shots are flown in the air and wind the model assumes (calm,
+recorded or standard air), as the service would fly them; the best epoch is the lowest validation loss at the
+radar noise (the fitted noise scales change what a loss value means, so selection does not use them).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import torch
+from torch import nn
+from tqdm import tqdm
+
+from discovery.effects import EFFECTS, wind_from_components
+from model_export.observations import (
+    OBSERVABLES,
+    PATH_OBSERVATIONS,
+    PATH_SIGMA_M,
+    ObservedData,
+    ObservedShots,
+    load_observed,
+)
+from model_export.torch_physics import DT_S, T_SIM_S, euler_rollout, hard_landing, positions_at
+from model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, save_checkpoint
+from service.constants import YARD_M
+from shots.files import write_text_atomic
+
+HUBER_DELTA = 2.0
+"""Residuals beyond 2 sigma count linearly: mishits and gusts do not dominate the fit."""
+
+SOURCE_WEIGHTS = {
+    "trackman-outdoor": 1.0,
+    "sentry-2022": 1.0,
+    "trackman-model": 0.1,
+    "synthetic": 0.2,
+}
+"""Weight of one shot of each source in the loss: measured flights 1, TrackMan's model 0.1, the reference world 0.2."""
+
+
+def _typical(effect: str) -> float:
+    return EFFECTS[effect].parameters[0].typical
+
+
+@dataclass
+class JointConfig:
+    """Everything that decides a joint run (stored in its checkpoints)."""
+
+    epochs: int = 40
+    batch_size: int = 256
+    lr: float = 3e-4
+    latent_lr: float = 3e-2
+    noise_lr: float = 3e-3
+    """Slow on purpose: early in a run every residual is large, and fast noise scales would mute the data."""
+    seed: int = 0
+    huber_delta: float = HUBER_DELTA
+    weights: dict[str, float] = field(default_factory=lambda: dict(SOURCE_WEIGHTS))
+    wind_prior_mps: float = field(default_factory=lambda: _typical("wind"))
+    density_prior: float = field(default_factory=lambda: _typical("air_density"))
+    ball_prior: float = field(default_factory=lambda: _typical("drag_scale"))
+    mean_wind_prior_mps: float = 0.3
+    mean_density_prior: float = 0.01
+    grad_clip_norm: float = GRAD_CLIP_NORM
+    dt_s: float = DT_S
+    t_sim_s: float = T_SIM_S
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+class LatentConditions(nn.Module):
+    """Per-group winds (x, y in m/s), per-air-group log density factors, per-ball log (lift, drag) scales."""
+
+    def __init__(self, data: ObservedData) -> None:
+        super().__init__()
+        self.wind = nn.Parameter(torch.zeros(len(data.wind_groups), 2))
+        self.log_density = nn.Parameter(torch.zeros(len(data.air_groups)))
+        self.log_ball_scale = nn.Parameter(torch.zeros(len(data.balls), 2))
+
+    @staticmethod
+    def _pick(values: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
+        """values[index] with zeros where index is -1 (no latent for this shot)."""
+        if values.shape[0] == 0:
+            return values.new_zeros((index.shape[0], *values.shape[1:]))
+        picked = values[index.clamp_min(0)]
+        keep = (index >= 0).reshape(-1, *([1] * (picked.dim() - 1)))
+        return torch.where(keep, picked, torch.zeros_like(picked))
+
+    def for_shots(self, shots: ObservedShots) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Wind [n,3], density [n] and coefficient scale [n,4] (C_L, C_D, C_M, C_Q) of these shots."""
+        wind_xy = self._pick(self.wind, shots.wind_group)
+        wind = torch.cat([wind_xy, wind_xy.new_zeros(len(shots), 1)], dim=1)
+        density = shots.density * self._pick(self.log_density, shots.air_group).exp()
+        lift_drag = self._pick(self.log_ball_scale, shots.ball).exp()
+        scale = torch.cat([lift_drag, lift_drag.new_ones(len(shots), 2)], dim=1)
+        return wind, density, scale
+
+    def prior(self, config: JointConfig, wind_source: torch.Tensor, air_source: torch.Tensor) -> torch.Tensor:
+        """Negative log prior (Gaussian, up to a constant): each value about zero, and each source's mean wind and
+        mean log density about zero within `mean_prior_*`. A source's average weather cannot be told apart from the
+        aerodynamics, so the sessions are assumed calm and standard on average; `*_source` [groups] name the
+        source of each wind and air group."""
+        total = (
+            (self.wind / config.wind_prior_mps).pow(2).sum()
+            + (self.log_density / config.density_prior).pow(2).sum()
+            + (self.log_ball_scale / config.ball_prior).pow(2).sum()
+        )
+        for values, source, sd in ((self.wind, wind_source, config.mean_wind_prior_mps),
+                                   (self.log_density, air_source, config.mean_density_prior)):
+            for s in source.unique():
+                total = total + (values[source == s].mean(dim=0) / sd).pow(2).sum()
+        return 0.5 * total
+
+
+class NoiseScales(nn.Module):
+    """How much more each source scatters than the radar, per observable (and for its path): sigma = radar sigma
+    x exp(softplus(s)) (never below the radar's), fitted by maximum likelihood (the loss adds log sigma), so gusts,
+    mishits and TrackMan's extrapolations widen an observable's sigma instead of dominating the fit."""
+
+    def __init__(self, n_sources: int) -> None:
+        super().__init__()
+        self.raw = nn.Parameter(torch.zeros(n_sources, len(OBSERVABLES) + 1))
+
+    def factors(self) -> torch.Tensor:
+        return nn.functional.softplus(self.raw).exp()
+
+
+@dataclass
+class Predicted:
+    """Model observables [n, 5] (order OBSERVABLES), path positions [n, K, 3] and whether each shot landed."""
+
+    observables: torch.Tensor
+    path: torch.Tensor
+    landed: torch.Tensor
+
+
+def fly(model: nn.Module, shots: ObservedShots, config: JointConfig, latent: LatentConditions | None) -> Predicted:
+    """Euler rollout of the shots (with their latent conditions, or as assumed when `latent` is None)."""
+    if latent is None:
+        wind, density, scale = None, shots.density, None
+    else:
+        wind, density, scale = latent.for_shots(shots)
+    trajectory = euler_rollout(shots.position, shots.velocity, shots.spin, model, density, config.dt_s,
+                               config.t_sim_s, shots.reynolds_scale[:, None], wind, scale)
+    landing = hard_landing(trajectory)
+    v = landing.velocity
+    angle = torch.rad2deg(torch.atan2(-v[:, 2], torch.linalg.vector_norm(v[:, :2], dim=-1)))
+    observables = torch.stack([landing.position[:, 0], landing.position[:, 1], trajectory.apex_m,
+                               landing.time_s, angle], dim=1)
+    path = positions_at(trajectory, shots.path_times) - trajectory.positions[0][:, None, :]
+    return Predicted(observables, path, landing.landed)
+
+
+def _huber(x: torch.Tensor, delta: float) -> torch.Tensor:
+    return nn.functional.huber_loss(x, torch.zeros_like(x), reduction="none", delta=delta)
+
+
+def shot_losses(predicted: Predicted, shots: ObservedShots, delta: float, scales: torch.Tensor | None = None
+                ) -> torch.Tensor:
+    """Per-shot loss [n]: Huber of the noise-scaled residual of each recorded observable, plus the path's samples
+    (3-D distance over the path noise) scaled to count as PATH_OBSERVATIONS observations in all. With `scales`
+    (`NoiseScales.factors()`, [sources, 6]) each sigma is widened by its source's factor and log sigma is added
+    (the negative log likelihood, so the factors are fitted too)."""
+    factor = torch.ones(len(shots), len(OBSERVABLES) + 1) if scales is None else scales[shots.source]
+    mask = shots.target_mask & predicted.landed[:, None]
+    sigma = shots.sigma * factor[:, :-1]
+    residual = torch.where(mask, (predicted.observables - shots.targets) / sigma, 0.0)
+    outcome = torch.where(mask, _huber(residual, delta) + sigma.log(), 0.0).sum(dim=1)
+    path_sigma = PATH_SIGMA_M * factor[:, -1:]
+    distance = torch.linalg.vector_norm(predicted.path - shots.path_positions, dim=-1) / path_sigma
+    path_terms = torch.where(shots.path_mask, _huber(distance, delta) + path_sigma.log(), 0.0)
+    n_samples = shots.path_mask.sum(dim=1).clamp_min(1)
+    return outcome + PATH_OBSERVATIONS * path_terms.sum(dim=1) / n_samples
+
+
+def weighted_mean(values: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
+    return (values * weight).sum() / weight.sum().clamp_min(1e-12)
+
+
+@torch.no_grad()
+def evaluate(model: nn.Module, shots: ObservedShots, config: JointConfig, sources: list[str],
+             latent: LatentConditions | None = None, scales: torch.Tensor | None = None) -> dict[str, Any]:
+    """Loss and per-source errors in physical units: landing error (m), mean absolute error of every observable,
+    path error (m), over the shots that have each."""
+    predicted = fly(model, shots, config, latent)
+    losses = shot_losses(predicted, shots, config.huber_delta, scales)
+    metrics: dict[str, Any] = {"loss": float(weighted_mean(losses, shots.weight)), "sources": {}}
+    error = (predicted.observables - shots.targets).abs()
+    ok = shots.target_mask & predicted.landed[:, None]
+    landing_error = torch.linalg.vector_norm(predicted.observables[:, :2] - shots.targets[:, :2], dim=1)
+    path_error = torch.linalg.vector_norm(predicted.path - shots.path_positions, dim=-1)
+    for index, name in enumerate(sources):
+        mine = shots.source == index
+        if not mine.any():
+            continue
+        row: dict[str, float | int] = {"n_shots": int(mine.sum()),
+                                       "loss": float(weighted_mean(losses[mine], torch.ones_like(losses[mine])))}
+        landed = mine & ok[:, 0] & ok[:, 1]
+        if landed.any():
+            row["landing_error_m"] = float(landing_error[landed].mean())
+        for column, observable in enumerate(OBSERVABLES):
+            has = mine & ok[:, column]
+            if has.any():
+                row[f"{observable}_mae"] = float(error[has, column].mean())
+        on_path = shots.path_mask & mine[:, None]
+        if on_path.any():
+            row["path_error_m"] = float(path_error[on_path].mean())
+        metrics["sources"][name] = row
+    return metrics
+
+
+def conditions_report(latent: LatentConditions, data: ObservedData, train: ObservedShots) -> dict[str, Any]:
+    """The fitted latent conditions, readable: winds as speed and from-direction, density ratios, ball scales."""
+    def count(index: torch.Tensor, i: int) -> int:
+        return int((index == i).sum())
+
+    wind = []
+    for i, group in enumerate(data.wind_groups.names):
+        x, y = (float(v) for v in latent.wind[i].detach())
+        speed, from_deg = wind_from_components(x, y)
+        source = data.sources[int(train.source[train.wind_group == i][0])]
+        wind.append({"group": group, "source": source, "n_shots": count(train.wind_group, i), "x_mps": x,
+                     "y_mps": y, "speed_mps": speed, "from_deg": from_deg})
+    air = [{"group": g, "n_shots": count(train.air_group, i), "density_ratio": float(latent.log_density[i].detach().exp())}
+           for i, g in enumerate(data.air_groups.names)]
+    ball = [{"ball": b, "n_shots": count(train.ball, i), "lift_scale": float(latent.log_ball_scale[i, 0].detach().exp()),
+             "drag_scale": float(latent.log_ball_scale[i, 1].detach().exp())} for i, b in enumerate(data.balls.names)]
+    return {"wind": wind, "air": air, "ball": ball}
+
+
+def _group_sources(group: torch.Tensor, source: torch.Tensor, n_groups: int) -> torch.Tensor:
+    """The source index of each latent group [n_groups] (a group never spans two sources)."""
+    out = torch.full((n_groups,), -1, dtype=torch.long)
+    has = group >= 0
+    out[group[has]] = source[has]
+    return out
+
+
+def _noise_report(noise: NoiseScales, data: ObservedData) -> dict[str, dict[str, float]]:
+    factors = noise.factors().detach()
+    names = [*OBSERVABLES, "path"]
+    return {source: {n: float(factors[i, j]) for j, n in enumerate(names)} for i, source in enumerate(data.sources)}
+
+
+@dataclass
+class JointResult:
+    """A finished joint run: its directory, per-epoch history and best epoch."""
+
+    out_dir: Path
+    history: list[dict[str, Any]]
+    best: dict[str, Any] | None
+
+
+def train_joint(data_path: str | os.PathLike, out_dir: str | os.PathLike, config: JointConfig,
+                init: nn.Module, progress: bool = True) -> JointResult:
+    """Train `init` (a coefficient module, changed in place) jointly with the latent conditions on a merged file;
+    writes OUT/best.pt, OUT/last.pt (the `model_export.training` checkpoint format), history.json and
+    conditions.json (the latent conditions of the best epoch)."""
+    torch.set_flush_denormal(True)
+    try:
+        return _train_joint(Path(data_path), Path(out_dir), config, init, progress)
+    finally:
+        torch.set_flush_denormal(False)
+
+
+def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.Module,
+                 progress: bool) -> JointResult:
+    out_dir.mkdir(parents=True, exist_ok=True)
+    data = load_observed(data_path, config.weights)
+    torch.manual_seed(config.seed)
+    latent, noise = LatentConditions(data), NoiseScales(len(data.sources))
+    wind_source = _group_sources(data.train.wind_group, data.train.source, len(data.wind_groups))
+    air_source = _group_sources(data.train.air_group, data.train.source, len(data.air_groups))
+    optimizer = torch.optim.Adam([{"params": model.parameters(), "lr": config.lr},
+                                  {"params": latent.parameters(), "lr": config.latent_lr},
+                                  {"params": noise.parameters(), "lr": config.noise_lr}])
+    train, total_weight = data.train, float(data.train.weight.sum())
+    history: list[dict[str, Any]] = []
+    best: dict[str, Any] | None = None
+    for epoch in range(1, config.epochs + 1):
+        started = time.perf_counter()
+        order = torch.randperm(len(train), generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch))
+        sums, steps = 0.0, 0
+        batches = range(0, len(train), config.batch_size)
+        for start in tqdm(batches, desc=f"epoch {epoch}/{config.epochs}", disable=not progress):
+            batch = train.take(order[start:start + config.batch_size])
+            optimizer.zero_grad(set_to_none=True)
+            losses = shot_losses(fly(model, batch, config, latent), batch, config.huber_delta, noise.factors())
+            loss = (losses * batch.weight).sum() / total_weight * (len(train) / len(batch))
+            loss = loss + latent.prior(config, wind_source, air_source) / len(train)
+            if not torch.isfinite(loss):
+                continue
+            loss.backward()
+            torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip_norm)
+            optimizer.step()
+            sums += float(loss.detach())
+            steps += 1
+        metrics = evaluate(model, data.val, config, data.sources)
+        row = {"epoch": epoch, "train_loss": sums / max(steps, 1), "val_loss": metrics["loss"],
+               "val": metrics["sources"], "seconds": time.perf_counter() - started}
+        history.append(row)
+        if progress:
+            tqdm.write(f"epoch {epoch}: train {row['train_loss']:.3f}, val {row['val_loss']:.3f} " + ", ".join(
+                f"{k} {v.get('landing_error_m', float('nan')):.2f} m" for k, v in metrics["sources"].items()))
+        improved = math.isfinite(metrics["loss"]) and (best is None or metrics["loss"] < best["val_loss"])
+        payload = {"format": CHECKPOINT_FORMAT, "kind": "joint", "epoch": epoch, "config": config.as_dict(),
+                   "model": model.state_dict(), "latent": latent.state_dict(), "noise": noise.state_dict(),
+                   "history": history}
+        save_checkpoint(out_dir / "last.pt", payload)
+        if improved:
+            best = {"epoch": epoch, "val_loss": metrics["loss"], "val": metrics["sources"]}
+            save_checkpoint(out_dir / "best.pt", payload)
+            report = conditions_report(latent, data, train) | {"noise_factors": _noise_report(noise, data)}
+            write_text_atomic(out_dir / "conditions.json", json.dumps(report, indent=2) + "\n")
+        write_text_atomic(out_dir / "history.json",
+                          json.dumps({"config": config.as_dict(), "best": best, "epochs": history}, indent=2) + "\n")
+    return JointResult(out_dir, history, best)
+
+
+def landing_yd(metrics: dict[str, Any], source: str) -> float:
+    """A source's validation landing error in yards (NaN where it has none)."""
+    return metrics.get(source, {}).get("landing_error_m", float("nan")) / YARD_M

@@ -1,0 +1,214 @@
+"""The real-flight training set: every usable source of ../shared/data converted by the loaders, tagged with its
+source, its conditions group and its split, merged into one canonical CSV (+ trajectories) that training reads.
+
+Sources (`SOURCES`), each with a weight per shot in the loss:
+  trackman-outdoor  TrackMan driver shots the radar tracked for >= 90 % of the flight, lines 3-2942 only (the rest
+                    of the file is held out, `shots.heldout`); landing point, apex, flight time, landing angle.
+  sentry-2022       PGA TOUR TrackMan trajectories of the 2022 Sentry joined with the pbp spin: the landing and
+                    apex of the polynomial plus positions along the radar-tracked part of the path.
+  (THE PLAYERS 2020 pbp is not a source: it records launch and spin, and its apex fields are not measured apexes,
+  docs/real_data.md, so it has nothing to train on.)
+  trackman-model    the indoor rows of the driver file (lines 3-2942): TrackMan's own model of the flight, not a
+                    measurement; down-weighted and reported on its own.
+  synthetic         calm reference-world flights of the other clubs and slower players, clean, where real data is
+                    missing; shots inside the measured drivers' launch range are left out, so real data decides there.
+Groups (the `group` column) are the shots that shared one unrecorded wind and air: a tour hole in one round; for the
+driver file, which has no date or session column, a run of consecutive measured rows of one ball type (a new group
+where more than `GAP_LINES` lines separate two measured shots, or after `BLOCK_SHOTS` shots).
+Validation is by group, never a random shuffle: every `VAL_EVERY`-th driver group in file order, the last round of
+each tour event, the synthetic generator's last sessions.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from service.air import Air
+from service.physics import initial_state
+from shots.clubs import CLUBS
+from shots.heldout import check_training_rows
+from shots.records import ShotRecord, trajectories_path, write_shots, write_trajectories
+from shots.reference_world import fly_reference
+from shots.synth import MIN_APEX_M, SynthConfig, draw_launches, draw_sessions
+from shots.tourcast import load_tourcast, read_flights
+from shots.trackman import ConversionReport, load_trackman
+from weights_schema.bundle import sha256_of
+
+DRIVER_FILE = Path("real/trackman_driver_sessions/data.csv")
+DRIVER_TRAIN_LINES = (3, 2942)
+"""Lines of the driver file that may be trained on (NOTES section 9); `shots.heldout` refuses any other."""
+SENTRY_TRAJECTORIES = Path("real/pga_tourcast_trackman/shot_trajectory/shot_trajectory_2021_016_656.csv")
+SENTRY_PBP = Path("real/pga_tourcast_trackman/pbp/pbp_2021_016_656.csv")
+
+GAP_LINES = 3
+BLOCK_SHOTS = 40
+VAL_EVERY = 4
+PATH_INTERVAL_S = 0.5
+"""Spacing of the trajectory samples trained on, up to the radar's last measured time."""
+
+SYNTHETIC_SHOTS = 3000
+SYNTHETIC_SEED = 11
+DRIVER_LIKE = {"max_launch_angle_deg": 20.0, "min_ball_speed_mps": 50.0}
+"""Synthetic shots at least this fast and at most this steep sit where the measured drivers are: left out."""
+
+
+@dataclass
+class SourceData:
+    """One source converted: its records (source, group and split set), sampled paths, files and what was dropped."""
+
+    name: str
+    kind: str
+    records: list[ShotRecord]
+    files: dict[str, str]
+    report: str
+    trajectories: dict[str, np.ndarray] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+
+def _tag(records: list[ShotRecord], source: str, groups: list[str], val: set[str]) -> list[ShotRecord]:
+    return [
+        r.model_copy(update={"source": source, "group": g, "split": "val" if g in val else "train",
+                             "shot_id": f"{source}:{r.shot_id}"})
+        for r, g in zip(records, groups, strict=True)
+    ]
+
+
+def driver_groups(records: list[ShotRecord]) -> list[str]:
+    """A conditions group per record of the driver file (ids = file lines): runs of nearby lines of one ball type."""
+    groups: list[str] = []
+    previous: tuple[int, str | None] | None = None
+    size = 0
+    for record in records:
+        line = int(record.shot_id)
+        same = previous is not None and line - previous[0] <= GAP_LINES and record.ball == previous[1]
+        if not same or size >= BLOCK_SHOTS:
+            groups.append(f"L{line}")
+            size = 0
+        else:
+            groups.append(groups[-1])
+        size += 1
+        previous = (line, record.ball)
+    return groups
+
+
+def _every_nth_val(groups: list[str]) -> set[str]:
+    ordered = list(dict.fromkeys(groups))
+    return {g for i, g in enumerate(ordered) if i % VAL_EVERY == VAL_EVERY - 1}
+
+
+def trackman_outdoor(root: Path) -> SourceData:
+    """Measured driver flights of the training lines."""
+    path = root / DRIVER_FILE
+    conversion = load_trackman(path, lines=DRIVER_TRAIN_LINES, skip_bad_rows=True)
+    check_training_rows(path, (int(r.shot_id) for r in conversion.records))
+    groups = driver_groups(conversion.records)
+    records = _tag(conversion.records, "trackman-outdoor", [f"tm-{g}" for g in groups],
+                   {f"tm-{g}" for g in _every_nth_val(groups)})
+    return SourceData("trackman-outdoor", "measured", records, {str(DRIVER_FILE): sha256_of(path)},
+                      conversion.report.summary())
+
+
+def trackman_model(root: Path) -> SourceData:
+    """The driver file's indoor rows (training lines only): outcomes from TrackMan's model, one air for them all."""
+    path = root / DRIVER_FILE
+    everything = load_trackman(path, lines=DRIVER_TRAIN_LINES, min_tracked_fraction=None, skip_bad_rows=True)
+    measured = {r.shot_id for r in load_trackman(path, lines=DRIVER_TRAIN_LINES, skip_bad_rows=True).records}
+    kept = [r for r in everything.records if r.shot_id not in measured and r.carry_y_m is not None]
+    check_training_rows(path, (int(r.shot_id) for r in kept))
+    groups = [f"tmm-{'val' if i % 10 == 9 else 'train'}" for i in range(len(kept))]
+    records = _tag(kept, "trackman-model", groups, {"tmm-val"})
+    note = (f"{len(kept)} indoor rows (radar tracked < 90 % of the flight): carry, apex, landing angle and flight time "
+            "are TrackMan's model, not a measurement")
+    return SourceData("trackman-model", "modelled", records, {str(DRIVER_FILE): sha256_of(path)}, note)
+
+
+def _tour_group(shot_id: str) -> str:
+    """'016-R2-H15-P29725-S1' -> '016-R2-H15' (tournament, round, hole)."""
+    return "-".join(shot_id.split("-")[:3])
+
+
+def _measured_paths(conversion_paths: dict[str, np.ndarray], measured_s: dict[str, float]) -> dict[str, np.ndarray]:
+    """Samples every PATH_INTERVAL_S from PATH_INTERVAL_S up to the radar's last measured time."""
+    out = {}
+    for shot_id, path in conversion_paths.items():
+        end = min(measured_s[shot_id], path[-1, 0])
+        times = np.arange(PATH_INTERVAL_S, end + 1e-9, PATH_INTERVAL_S)
+        out[shot_id] = np.column_stack([times, *(np.interp(times, path[:, 0], path[:, k]) for k in (1, 2, 3))])
+    return out
+
+
+def sentry(root: Path) -> SourceData:
+    """2022 Sentry trajectories with pbp spin; validation = the last round."""
+    trajectories, pbp = root / SENTRY_TRAJECTORIES, root / SENTRY_PBP
+    conversion = load_tourcast(trajectories, pbp, skip_bad_rows=True)
+    measured = {f.shot_id: f.measured_time_s for f in read_flights(trajectories, ConversionReport(str(trajectories)),
+                                                                   skip_bad_rows=True)}
+    check_training_rows(trajectories, [])
+    check_training_rows(pbp, [])
+    groups = [_tour_group(r.shot_id) for r in conversion.records]
+    last_round = max(g.split("-")[1] for g in groups)
+    val = {g for g in groups if g.split("-")[1] == last_round}
+    records = _tag(conversion.records, "sentry-2022", groups, val)
+    paths = _measured_paths(conversion.trajectories, measured)
+    return SourceData("sentry-2022", "measured", records,
+                      {str(SENTRY_TRAJECTORIES): sha256_of(trajectories), str(SENTRY_PBP): sha256_of(pbp)},
+                      conversion.report.summary(), {f"sentry-2022:{k}": v for k, v in paths.items()})
+
+
+def driver_like(launch: dict[str, np.ndarray]) -> np.ndarray:
+    """Launches where the measured drivers decide (fast and flat)."""
+    return (launch["ball_speed_mps"] >= DRIVER_LIKE["min_ball_speed_mps"]) & (
+        launch["launch_angle_deg"] <= DRIVER_LIKE["max_launch_angle_deg"]
+    )
+
+
+def synthetic(n_shots: int = SYNTHETIC_SHOTS, seed: int = SYNTHETIC_SEED) -> SourceData:
+    """Clean calm flights of the reference world in standard air, launches drawn like the synthetic sessions'
+    (every club, players from 72 % to 103 % of tour speed), less the driver-like ones."""
+    rng = np.random.default_rng(seed)
+    sessions = draw_sessions(rng, n_shots, SynthConfig(n_shots=n_shots, seed=seed, calm=True))
+    table = draw_launches(rng, sessions)
+    launch = table.launch()
+    keep_launch = ~driver_like(launch)
+    flight = fly_reference(initial_state(**launch), Air.standard())
+    keep = keep_launch & flight.landed & (flight.apex_m >= MIN_APEX_M)
+    records, groups = [], []
+    for i in np.flatnonzero(keep):
+        session = sessions[table.session_index[i]].session
+        records.append(ShotRecord(
+            shot_id=f"{session}-{i:05d}", session=session, club=str(table.club[i]),
+            **{k: float(v[i]) for k, v in launch.items()},
+            carry_x_m=float(flight.landing_position[i, 0]), carry_y_m=float(flight.landing_position[i, 1]),
+            apex_m=float(flight.apex_m[i]), flight_time_s=float(flight.flight_time_s[i]),
+            landing_angle_deg=float(flight.landing_angle_deg[i]),
+        ))
+        groups.append(f"syn-{session}")
+    ordered = list(dict.fromkeys(groups))
+    val = set(ordered[-max(1, len(ordered) // 10):])
+    report = (f"synthetic: {len(table.club)} launches drawn, {int((~keep_launch).sum())} driver-like left out, "
+              f"{int((keep_launch & ~keep).sum())} not landed or under 8 yd apex, {len(records)} kept")
+    return SourceData("synthetic", "synthetic", _tag(records, "synthetic", groups, val), {}, report)
+
+
+BUILDERS: dict[str, Callable[[Path], SourceData]] = {
+    "trackman-outdoor": trackman_outdoor,
+    "sentry-2022": sentry,
+    "trackman-model": trackman_model,
+    "synthetic": lambda root: synthetic(),
+}
+"""Every source, by name, in the order the merged file lists them."""
+
+
+def build(root: str | os.PathLike, out: str | os.PathLike, names: tuple[str, ...] = tuple(BUILDERS)) -> list[SourceData]:
+    """Convert the named sources from the shared data folder `root` and write the merged canonical CSV `out` (and
+    its trajectories companion); returns each source's data (files with their SHA-256, report)."""
+    root = Path(root)
+    built = [BUILDERS[name](root) for name in names]
+    write_shots(out, [r for data in built for r in data.records])
+    write_trajectories(trajectories_path(out), {k: v for data in built for k, v in data.trajectories.items()})
+    return built

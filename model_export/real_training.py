@@ -1,0 +1,201 @@
+"""`golfflight train-real` end to end: build the merged real-flight file, train jointly from a starting bundle over
+several seeds, keep the seed with the lowest validation loss, and export it as a bundle whose card names every
+source with its SHA-256 and rows, the latent conditions and (added by `golfflight accuracy`) the held-out errors.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from model_export.export import export_bundle
+from model_export.joint import JointConfig, JointResult, train_joint
+from model_export.observations import NOISE, OBSERVABLES, PATH_OBSERVATIONS, PATH_SIGMA_M
+from model_export.real_data import SourceData, build
+from model_export.training import TrainConfig, load_checkpoint
+from service.constants import YARD_M
+from shots.records import read_shots
+from weights_schema.bundle import sha256_of
+from weights_schema.model_card import ModelCard
+
+DATA_FILE = "real_flights.csv"
+CONDITIONS_FILE = "training_conditions.json"
+"""The fitted latent conditions of the exported run, beside the bundle's card (read by `golfflight accuracy`)."""
+MEASURED_SOURCES = ("trackman-outdoor", "sentry-2022")
+
+
+@dataclass
+class RealRun:
+    """What a `train_real` call leaves: the merged data, each seed's run, the chosen seed and the card."""
+
+    data_file: Path
+    sources: list[SourceData]
+    runs: dict[int, JointResult]
+    chosen_seed: int
+    card: ModelCard | None
+    seconds: float
+
+
+def loss_description(config: JointConfig) -> str:
+    """The card's account of the loss, with the noise figures."""
+    return (
+        f"sum over each recorded observable of Huber_{config.huber_delta:g}(residual / sigma), sigma = the radar "
+        f"noise: landing point {NOISE.carry_m:g} m + {NOISE.carry_fraction:.1%} of the carry per axis, apex "
+        f"{NOISE.apex_m:g} m, flight time {NOISE.flight_time_s:g} s, landing angle {NOISE.landing_angle_deg:g} deg; "
+        f"plus path positions every 0.5 s up to the radar's last point (3-D distance / {PATH_SIGMA_M:g} m, a path "
+        f"counting as {PATH_OBSERVATIONS:g} observations); weighted per source {config.weights}; hard landing "
+        "(Euler states interpolated to r_z = 0), apex = highest Euler state, as the runtime flies them"
+    )
+
+
+def latent_description(config: JointConfig, conditions: dict[str, Any]) -> str:
+    return (
+        f"fitted beside the network with Gaussian priors: a uniform wind per conditions group "
+        f"({len(conditions['wind'])} groups, prior sd {config.wind_prior_mps:g} m/s per component), an air-density "
+        f"factor per air group ({len(conditions['air'])}, prior sd {config.density_prior:g} in log), lift and drag "
+        f"scales per non-Premium ball type ({len(conditions['ball'])}, prior sd {config.ball_prior:g} in log); "
+        f"validation and served shots are flown without them (calm, the air given). Values: {CONDITIONS_FILE}"
+    )
+
+
+def _data_summary(path: Path, sources: list[SourceData]) -> dict[str, Any]:
+    shots = read_shots(path)
+    split = shots.column("split")
+    density = shots.air().density_kg_m3
+    return {
+        "file": path.name,
+        "sha256": sha256_of(path),
+        "n_rows": len(shots),
+        "n_train": int(np.sum(split == "train")),
+        "n_val": int(np.sum(split == "val")),
+        "n_landing_targets": int(np.sum(~np.isnan(shots.column("carry_y_m")))),
+        "n_apex_targets": int(np.sum(~np.isnan(shots.column("apex_m")))),
+        "density_min_kg_m3": float(np.min(density)),
+        "density_max_kg_m3": float(np.max(density)),
+        "n_with_wind": 0,
+        "min_apex_m": 0.0,
+        "filters": {},
+    }
+
+
+def source_cards(sources: list[SourceData], weights: dict[str, float], paths: dict[str, int]) -> list[dict]:
+    """The card's `training_data.sources` entries."""
+    cards = []
+    for data in sources:
+        observed = [o for o in OBSERVABLES if any(getattr(r, o) is not None for r in data.records)]
+        if paths.get(data.name):
+            observed.append("path positions")
+        cards.append({
+            "name": data.name, "kind": data.kind,
+            "files": [{"path": p, "sha256": h} for p, h in data.files.items()],
+            "n_rows": len(data.records),
+            "n_train": sum(r.split == "train" for r in data.records),
+            "n_val": sum(r.split == "val" for r in data.records),
+            "weight": weights[data.name], "observables": observed,
+            "note": data.report.splitlines()[0].split(": ", 1)[-1] if data.report else "",
+        })
+    return cards
+
+
+def _validation_metrics(best: dict[str, Any]) -> dict[str, Any]:
+    """Landing and max-height error over the measured sources' validation shots (shot-weighted)."""
+    rows = [best["val"][s] for s in MEASURED_SOURCES if s in best["val"]]
+    landing = [(r["landing_error_m"], r["n_shots"]) for r in rows if "landing_error_m" in r]
+    apex = [(r["apex_m_mae"], r["n_shots"]) for r in rows if "apex_m_mae" in r]
+
+    def mean(pairs: list[tuple[float, int]]) -> float:
+        return sum(v * n for v, n in pairs) / sum(n for _, n in pairs)
+
+    landing_m, apex_m = mean(landing), mean(apex)
+    return {"epoch": best["epoch"], "landing_error_m": landing_m, "landing_error_yd": landing_m / YARD_M,
+            "max_height_error_m": apex_m, "max_height_error_yd": apex_m / YARD_M,
+            "n_shots": sum(r["n_shots"] for r in rows)}
+
+
+def export_real(run_dir: Path, data_file: Path, sources: list[SourceData], out: Path, variant: str,
+                hidden: tuple[int, ...]) -> ModelCard:
+    """Export a joint run's best epoch with a card that records its sources and latent conditions."""
+    from model_export.variants import build_model
+
+    payload = load_checkpoint(run_dir / "best.pt")
+    config = JointConfig(**payload["config"])
+    model = build_model(variant, hidden)
+    model.load_state_dict(payload["model"])
+    model.eval()
+    history = json.loads((run_dir / "history.json").read_text())
+    metrics = _validation_metrics(history["best"])
+    conditions = json.loads((run_dir / "conditions.json").read_text())
+    data = _data_summary(data_file, sources)
+    data["n_val"] = metrics.pop("n_shots")
+    paths = {s.name: len(s.trajectories) for s in sources}
+    train_config = TrainConfig(variant=variant, hidden=hidden, epochs=payload["epoch"], batch_size=config.batch_size,
+                               lr=config.lr, loss="observables", seed=config.seed,
+                               grad_clip_norm=config.grad_clip_norm, min_apex_m=0.0, dt_s=config.dt_s,
+                               t_sim_s=config.t_sim_s)
+    card = export_bundle(model, {
+        "config": train_config.as_dict(), "epoch": payload["epoch"], "metrics": metrics,
+        "data": {**data, "sources": source_cards(sources, config.weights, paths)},
+        "split": "validation by conditions group, never a random shuffle: every 4th driver-range block in file "
+                 "order, the last round of each tour event, the last synthetic sessions; the validation landing "
+                 "and max-height errors are over the measured sources' validation shots, flown calm",
+        "loss_description": loss_description(config),
+        "latent_conditions": latent_description(config, conditions),
+    }, out)
+    shutil.copyfile(run_dir / "conditions.json", out / CONDITIONS_FILE)
+    return card
+
+
+def train_seed(data_file: Path, run_dir: Path, init: str | os.PathLike, config: JointConfig, threads: int,
+               progress: bool) -> JointResult:
+    """One seed's joint run from the bundle `init` (a process of its own when seeds run in parallel)."""
+    import torch
+
+    from model_export.bundle_model import model_from_bundle
+
+    torch.set_num_threads(threads)
+    model, _ = model_from_bundle(init)
+    model.train()
+    return train_joint(data_file, run_dir, config, model, progress)
+
+
+def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str | os.PathLike,
+               config: JointConfig, seeds: tuple[int, ...], out: str | os.PathLike | None,
+               source_names: tuple[str, ...] | None = None, progress: bool = True, jobs: int = 1,
+               threads: int = 2) -> RealRun:
+    """Build WORK/real_flights.csv from DATA_ROOT, train one joint run per seed from the bundle INIT (WORK/seed-S;
+    `jobs` seeds at a time, each with `threads` torch threads), and export the seed with the lowest validation loss
+    to OUT (if given)."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from weights_schema.bundle import load_bundle
+
+    started = time.perf_counter()
+    work = Path(work)
+    work.mkdir(parents=True, exist_ok=True)
+    data_file = work / DATA_FILE
+    sources = build(data_root, data_file, *(() if source_names is None else (source_names,)))
+    configs = {seed: replace(config, seed=seed) for seed in seeds}
+    if jobs > 1:
+        with ProcessPoolExecutor(jobs) as pool:
+            futures = {s: pool.submit(train_seed, data_file, work / f"seed-{s}", init, c, threads, False)
+                       for s, c in configs.items()}
+            runs = {s: f.result() for s, f in futures.items()}
+    else:
+        runs = {s: train_seed(data_file, work / f"seed-{s}", init, c, threads, progress) for s, c in configs.items()}
+    chosen = min(runs, key=lambda s: runs[s].best["val_loss"] if runs[s].best else float("inf"))
+    exported = None
+    if out is not None:
+        from model_export.held_out import record_held_out
+
+        card, _ = load_bundle(init)
+        export_real(runs[chosen].out_dir, data_file, sources, Path(out), card.variant,
+                    tuple(card.architecture.hidden_units))
+        exported = record_held_out(out, data_root)
+    return RealRun(data_file, sources, runs, chosen, exported, time.perf_counter() - started)

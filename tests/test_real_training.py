@@ -1,0 +1,187 @@
+"""Learning from real flights: the training set never holds held-out rows, latent winds are recovered, the joint
+loss falls, and the shipped model's card names its sources and held-out sets."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from model_export.joint import JointConfig, LatentConditions, train_joint
+from model_export.observations import load_observed
+from model_export.real_data import DRIVER_FILE, build, driver_groups, trackman_outdoor
+from model_export.torch_physics import euler_rollout, hard_landing, positions_at
+from model_export.variants import PhysNN, PhysQ
+from service.physics import initial_state
+from shots.heldout import HELD_OUT, HeldOutError, check_training_rows, held_out_set
+from shots.paths import REPO_ROOT, shared_data_dir
+from shots.records import ShotRecord, read_shots, trajectories_path, write_shots, write_trajectories
+from weights_schema.bundle import load_bundle
+
+torch.set_num_threads(1)
+FIXTURE = Path(__file__).parent / "fixtures" / "trackman_export.csv"
+
+
+def _driver_file(root: Path, measured_lines: list[int], n_lines: int = 2950) -> Path:
+    """A TrackMan export of `n_lines` lines (header and units rows, then shots) laid out like the shared driver
+    file; the shots on `measured_lines` are measured outdoor flights, every other one an indoor row."""
+    with FIXTURE.open(newline="") as handle:
+        header, units, shot = list(csv.reader(handle))[:3]
+    last_point = header.index("Last data Point - Time")
+    indoor = list(shot)
+    indoor[last_point] = "0.3"
+    path = root / DRIVER_FILE
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerows([header, units])
+        writer.writerows(shot if line in measured_lines else indoor for line in range(3, n_lines + 1))
+    return path
+
+
+def test_the_registry_names_the_three_held_out_sets():
+    names = {held.path.name for held in HELD_OUT}
+    assert names == {"data.csv", "pbp_2020_060_688.csv", "trackman_tour_averages_pga_2023.csv"}
+    assert held_out_set("/anywhere/real/trackman_driver_sessions/data.csv").first_line == 2943
+
+
+def test_a_held_out_line_refuses_the_training_set(tmp_path):
+    path = tmp_path / "real" / "trackman_driver_sessions" / "data.csv"
+    check_training_rows(path, [3, 2942])
+    with pytest.raises(HeldOutError, match="lines 2943"):
+        check_training_rows(path, [2941, 2943])
+    with pytest.raises(HeldOutError, match="TOUR Championship"):
+        check_training_rows(tmp_path / "real/pga_tourcast_trackman/pbp/pbp_2020_060_688.csv", [2])
+    check_training_rows(tmp_path / "real/pga_tourcast_trackman/pbp/pbp_2021_016_656.csv", [2])
+
+
+def test_driver_training_shots_stop_at_line_2942(tmp_path):
+    _driver_file(tmp_path, measured_lines=[10, 11, 12, 2941, 2942, 2943, 2944, 2950])
+    data = trackman_outdoor(tmp_path)
+    lines = sorted(int(r.shot_id.split(":")[1]) for r in data.records)
+    assert lines == [10, 11, 12, 2941, 2942]
+    assert {r.source for r in data.records} == {"trackman-outdoor"}
+
+
+def test_driver_groups_are_runs_of_nearby_lines_of_one_ball():
+    def shot(line: int, ball: str) -> ShotRecord:
+        return ShotRecord(shot_id=str(line), ball=ball, ball_speed_mps=60, launch_angle_deg=12,
+                          launch_direction_deg=0, spin_rpm=2500, spin_axis_deg=0)
+
+    records = [shot(3, "Premium"), shot(4, "Premium"), shot(6, "Premium"), shot(20, "Premium"), shot(21, "Soft")]
+    assert driver_groups(records) == ["L3", "L3", "L3", "L20", "L21"]
+
+
+@pytest.mark.skipif(not (shared_data_dir() / DRIVER_FILE).is_file(), reason="shared data not present")
+def test_the_merged_real_training_file_holds_no_held_out_row(tmp_path):
+    built = build(shared_data_dir(), tmp_path / "real.csv", ("trackman-outdoor", "sentry-2022", "trackman-model"))
+    shots = read_shots(tmp_path / "real.csv")
+    driver_lines = [int(s.split(":")[1]) for s, src in zip(shots.column("shot_id"), shots.column("source"))
+                    if src.startswith("trackman")]
+    assert driver_lines and max(driver_lines) <= 2942
+    files = {path for data in built for path in data.files}
+    assert not any(held_out_set(path) is not None and held_out_set(path).first_line == 1 for path in files)
+    splits = {}
+    for group, split in zip(shots.column("group"), shots.column("split")):
+        splits.setdefault(group, set()).add(split)
+    assert all(len(s) == 1 for s in splits.values()), "a conditions group spans train and validation"
+
+
+def test_positions_at_interpolates_between_euler_steps():
+    position = torch.zeros(1, 3)
+    velocity = torch.tensor([[0.0, 10.0, 0.0]])
+    trajectory = euler_rollout(position, velocity, torch.zeros(1, 3), lambda v, w: torch.zeros(1, 4), 1.2, 0.1, 1.0)
+    got = positions_at(trajectory, torch.tensor([[0.25, 0.5]]))
+    np.testing.assert_allclose(got[0, :, 1].numpy(), [2.5, 5.0], atol=1e-5)
+
+
+def _windy_set(path: Path, winds: dict[str, tuple[float, float]], n_per_group: int = 24) -> None:
+    """Shots flown in torch through Ferguson's coefficients, each group (a hole of one round: one air group) in its
+    own uniform wind, with paths."""
+    rng = np.random.default_rng(3)
+    records, paths = [], {}
+    model = PhysQ()
+    for g, (wx, wy) in winds.items():
+        launch = {"ball_speed_mps": rng.uniform(55, 70, n_per_group), "launch_angle_deg": rng.uniform(10, 15, n_per_group),
+                  "launch_direction_deg": np.zeros(n_per_group), "spin_rpm": rng.uniform(2200, 3200, n_per_group),
+                  "spin_axis_deg": np.zeros(n_per_group)}
+        state = initial_state(**launch)
+        tensor = lambda a: torch.as_tensor(a, dtype=torch.float32)  # noqa: E731
+        wind = torch.tensor([[wx, wy, 0.0]]).expand(n_per_group, 3)
+        with torch.no_grad():
+            trajectory = euler_rollout(tensor(state.position), tensor(state.velocity), tensor(state.spin), model,
+                                       1.225, wind=wind)
+            landing = hard_landing(trajectory)
+            times = torch.arange(1, 9, dtype=torch.float32).expand(n_per_group, 8) * 0.5
+            sampled = positions_at(trajectory, times) - trajectory.positions[0][:, None]
+        for i in range(n_per_group):
+            shot_id = f"{g}-{i}"
+            records.append(ShotRecord(
+                shot_id=shot_id, source="sentry-2022", group=g, split="train",
+                **{k: float(v[i]) for k, v in launch.items()},
+                carry_x_m=float(landing.position[i, 0]), carry_y_m=float(landing.position[i, 1]),
+                apex_m=float(trajectory.apex_m[i])))
+            paths[shot_id] = np.column_stack([times[i].numpy(), sampled[i].numpy()])
+    records.append(records[0].model_copy(update={"shot_id": "val-0", "group": "val", "split": "val"}))
+    write_shots(path, records)
+    write_trajectories(trajectories_path(path), paths)
+
+
+def test_a_latent_wind_is_recovered_from_flights_in_a_known_wind(tmp_path):
+    winds = {"016-R1-H1": (0.0, -3.0), "016-R1-H2": (0.0, 3.0), "016-R1-H3": (2.5, 0.0), "016-R1-H4": (-2.5, 0.0)}
+    _windy_set(tmp_path / "windy.csv", winds)
+    model = PhysQ()
+    config = JointConfig(epochs=15, batch_size=32, lr=0.0, latent_lr=0.2, weights={"sentry-2022": 1.0})
+    train_joint(tmp_path / "windy.csv", tmp_path / "run", config, model, progress=False)
+    fitted = torch.load(tmp_path / "run" / "last.pt", weights_only=True)["latent"]["wind"].numpy()
+    for group, truth in zip(load_observed(tmp_path / "windy.csv", config.weights).wind_groups.names, fitted):
+        np.testing.assert_allclose(truth, winds[group], atol=0.35, err_msg=group)
+    assert json.loads((tmp_path / "run" / "conditions.json").read_text())["wind"][0]["group"] == "016-R1-H1"
+
+
+def test_the_latent_prior_pulls_each_sources_mean_wind_to_calm(tmp_path):
+    _windy_set(tmp_path / "windy.csv", {"a": (0.0, 0.0), "b": (0.0, 0.0)}, n_per_group=4)
+    data = load_observed(tmp_path / "windy.csv", {"sentry-2022": 1.0})
+    latent = LatentConditions(data)
+    source = torch.zeros(len(data.wind_groups), dtype=torch.long)
+    air = torch.zeros(len(data.air_groups), dtype=torch.long)
+    with torch.no_grad():
+        latent.wind[:] = torch.tensor([[1.0, 0.0], [-1.0, 0.0]])
+        balanced = latent.prior(JointConfig(), source, air)
+        latent.wind[:] = torch.tensor([[1.0, 0.0], [1.0, 0.0]])
+        shifted = latent.prior(JointConfig(), source, air)
+    assert float(shifted) > float(balanced) + 5
+
+
+def test_a_tiny_joint_run_lowers_its_loss(tmp_path):
+    _windy_set(tmp_path / "windy.csv", {"a": (0.0, 1.0), "b": (1.0, 0.0)}, n_per_group=16)
+    torch.manual_seed(0)
+    model = PhysNN("phys-nn+", (8,))
+    result = train_joint(tmp_path / "windy.csv", tmp_path / "run", JointConfig(epochs=6, batch_size=16, lr=3e-3),
+                         model, progress=False)
+    losses = [row["train_loss"] for row in result.history]
+    assert losses[-1] < 0.8 * losses[0]
+    assert (tmp_path / "run" / "best.pt").is_file()
+
+
+SHIPPED = REPO_ROOT / "models" / "default"
+
+
+def test_the_shipped_card_names_its_sources_with_hashes_and_its_held_out_errors():
+    card, _ = load_bundle(SHIPPED)
+    sources = card.training_data.sources
+    assert sources, "models/default was not trained on real flights"
+    kinds = {s.name: s.kind for s in sources}
+    assert kinds["trackman-outdoor"] == "measured" and kinds["synthetic"] == "synthetic"
+    for source in sources:
+        for f in source.files:
+            held = held_out_set(f.path)
+            assert held is None or held.first_line > 1, f"{f.path} is held out whole"
+    held_out = {h.name: h for h in card.held_out or []}
+    assert {h.name for h in HELD_OUT} <= set(held_out)
+    assert all(h.errors for h in held_out.values())
+    assert (SHIPPED / "training_conditions.json").is_file()
