@@ -6,8 +6,9 @@ Each conditions group gets a latent uniform wind, each air group a latent densit
 type a latent lift and drag scale, all with Gaussian priors whose widths are the typical sizes of the matching
 discovery effects (`discovery.effects`: wind, air_density, lift_scale, drag_scale), so the network does not absorb
 a session's weather into the aerodynamics. Validation shots are flown in the air and wind the model assumes (calm,
-recorded or standard air), as the service would fly them; the best epoch is the lowest validation loss at the
-radar noise (the fitted noise scales change what a loss value means, so selection does not use them).
+recorded or standard air), as the service would fly them; the best epoch is the lowest validation loss of the
+measured sources (`JointConfig.select_on`) at the radar noise (the fitted noise scales change what a loss value
+means, so selection does not use them).
 """
 
 from __future__ import annotations
@@ -70,6 +71,8 @@ class JointConfig:
     wind_prior_mps: float = field(default_factory=lambda: _typical("wind"))
     density_prior: float = field(default_factory=lambda: _typical("air_density"))
     ball_prior: float = field(default_factory=lambda: _typical("drag_scale"))
+    select_on: tuple[str, ...] = ("trackman-outdoor", "sentry-2022")
+    """Sources whose validation loss picks the best epoch: the measured flights decide."""
     mean_wind_prior_mps: float = 0.3
     mean_density_prior: float = 0.01
     grad_clip_norm: float = GRAD_CLIP_NORM
@@ -314,13 +317,16 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
         if progress:
             tqdm.write(f"epoch {epoch}: train {row['train_loss']:.3f}, val {row['val_loss']:.3f} " + ", ".join(
                 f"{k} {v.get('landing_error_m', float('nan')):.2f} m" for k, v in metrics["sources"].items()))
-        improved = math.isfinite(metrics["loss"]) and (best is None or metrics["loss"] < best["val_loss"])
+        selected = [v for k, v in metrics["sources"].items() if k in config.select_on] or list(
+            metrics["sources"].values())
+        row["selection_loss"] = sum(v["loss"] * v["n_shots"] for v in selected) / sum(v["n_shots"] for v in selected)
+        improved = math.isfinite(row["selection_loss"]) and (best is None or row["selection_loss"] < best["val_loss"])
         payload = {"format": CHECKPOINT_FORMAT, "kind": "joint", "epoch": epoch, "config": config.as_dict(),
                    "model": model.state_dict(), "latent": latent.state_dict(), "noise": noise.state_dict(),
                    "history": history}
         save_checkpoint(out_dir / "last.pt", payload)
         if improved:
-            best = {"epoch": epoch, "val_loss": metrics["loss"], "val": metrics["sources"]}
+            best = {"epoch": epoch, "val_loss": row["selection_loss"], "val": metrics["sources"]}
             save_checkpoint(out_dir / "best.pt", payload)
             report = conditions_report(latent, data, train) | {"noise_factors": _noise_report(noise, data)}
             write_text_atomic(out_dir / "conditions.json", json.dumps(report, indent=2) + "\n")

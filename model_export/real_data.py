@@ -9,7 +9,7 @@ Sources (`SOURCES`), each with a weight per shot in the loss:
   (THE PLAYERS 2020 pbp is not a source: it records launch and spin, and its apex fields are not measured apexes,
   docs/real_data.md, so it has nothing to train on.)
   trackman-model    the indoor rows of the driver file (lines 3-2942): TrackMan's own model of the flight, not a
-                    measurement; down-weighted and reported on its own.
+                    measurement; down-weighted and reported on its own; not in DEFAULT_SOURCES (docs/training_real.md).
   synthetic         calm reference-world flights of the other clubs and slower players, clean, where real data is
                     missing; shots inside the measured drivers' launch range are left out, so real data decides there.
 Groups (the `group` column) are the shots that shared one unrecorded wind and air: a tour hole in one round; for the
@@ -202,6 +202,9 @@ BUILDERS: dict[str, Callable[[Path], SourceData]] = {
     "synthetic": lambda root: synthetic(),
 }
 """Every source, by name, in the order the merged file lists them."""
+
+DEFAULT_SOURCES = ("trackman-outdoor", "sentry-2022", "synthetic")
+"""What the shipped model is trained on."""
 
 
 def build(root: str | os.PathLike, out: str | os.PathLike, names: tuple[str, ...] = tuple(BUILDERS)) -> list[SourceData]:

@@ -17,7 +17,7 @@ def _seeds(text: str) -> tuple[int, ...]:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from model_export.real_data import BUILDERS
+    from model_export.real_data import BUILDERS, DEFAULT_SOURCES
 
     parser = subparsers.add_parser(
         "train-real",
@@ -30,8 +30,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", help="bundle directory to export the chosen seed to")
     parser.add_argument("--init", default="models/synthetic", help="bundle to start from (default models/synthetic)")
     parser.add_argument("--data-root", default=None, help="shared data folder (default ../shared/data)")
-    parser.add_argument("--sources", default=",".join(BUILDERS), help=f"comma-separated subset of {list(BUILDERS)}")
-    parser.add_argument("--epochs", type=int, default=30)
+    parser.add_argument("--sources", default=",".join(DEFAULT_SOURCES),
+                        help=f"comma-separated subset of {list(BUILDERS)} (default: {','.join(DEFAULT_SOURCES)})")
+    parser.add_argument("--epochs", type=int, default=20)
     parser.add_argument("--seeds", type=_seeds, default=(0, 1, 2))
     parser.add_argument("--lr", type=float, default=1e-3, help="Adam learning rate of the network")
     parser.add_argument("--threads", type=int, default=2, help="torch CPU threads per seed")
