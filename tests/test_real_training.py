@@ -168,13 +168,13 @@ def test_a_tiny_joint_run_lowers_its_loss(tmp_path):
     assert (tmp_path / "run" / "best.pt").is_file()
 
 
-SHIPPED = REPO_ROOT / "models" / "default"
+REAL = REPO_ROOT / "models" / "real"
 
 
-def test_the_shipped_card_names_its_sources_with_hashes_and_its_held_out_errors():
-    card, _ = load_bundle(SHIPPED)
+def test_the_real_data_card_names_its_sources_with_hashes_and_its_held_out_errors():
+    card, _ = load_bundle(REAL)
     sources = card.training_data.sources
-    assert sources, "models/default was not trained on real flights"
+    assert sources, "models/real was not trained on real flights"
     kinds = {s.name: s.kind for s in sources}
     assert kinds["trackman-outdoor"] == "measured" and kinds["synthetic"] == "synthetic"
     for source in sources:
@@ -184,4 +184,4 @@ def test_the_shipped_card_names_its_sources_with_hashes_and_its_held_out_errors(
     held_out = {h.name: h for h in card.held_out or []}
     assert {h.name for h in HELD_OUT} <= set(held_out)
     assert all(h.errors for h in held_out.values())
-    assert (SHIPPED / "training_conditions.json").is_file()
+    assert (REAL / "training_conditions.json").is_file()
