@@ -1,133 +1,482 @@
-"""Accuracy of a shipped bundle on real data it never saw, through the runtime path (NumPy physics + ONNX Runtime).
+"""`golfflight accuracy`: three models side by side on the real data none of them may be trained on, through the
+runtime path (NumPy physics + each bundle's ONNX graph; Ferguson 2022's quadratics through the same call).
 
-Three real sets, read by path from the shared data folder (never copied): TrackMan's PGA TOUR 2023 averages per
-club, the outdoor TrackMan driver shots, and the PGA TOUR TrackMan trajectories of the 2022 Sentry. None records
-the weather, so every shot is flown calm in one stated air. A fine-tuning study adapts the model to the first half
-of the driver shots and measures the second half before and after.
+The models: the real-data model (`--model`), the synthetic model (`--synthetic`) and Ferguson, McNally & McPhee
+2022. The sets (`model_export.accuracy_sets`): the held-out ones of NOTES section 9 (TrackMan outdoor drivers from
+line 2943, the TOUR Championship 2020, the PGA 2023 averages); then the paper's own figures for context, slow shots
+against published amateur launches (`accuracy_slow`), the Sentry 2022 trajectories (a training set of the real-data
+model) with each shot's latent wind (`accuracy_winds`), and a fine-tuning study on the Sony Open 2022
+(`accuracy_finetune`). None of these sets records its weather: every shot is flown calm, each model in its own air.
 """
 
 from __future__ import annotations
 
+import math
 import os
-import tempfile
-from collections.abc import Sequence
+from collections import Counter
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
-from model_export.data import MIN_APEX_M
-from service.air import Air
+from model_export.accuracy_finetune import MEASURED_ROUNDS, TRAIN_ROUNDS, FinetuneStudy, finetune_study
+from model_export.accuracy_flyers import CoefficientFlyer, Flyer, ModelFlyer, ferguson_flyer
+from model_export.accuracy_sets import (
+    APEX_MAE_YD,
+    APEX_METRICS,
+    DRIVER_FILE,
+    FLIGHT_METRICS,
+    LANDING_ERROR,
+    OUTCOMES,
+    PGA_TARGETS,
+    PREMIUM,
+    SONY_TRAJECTORIES,
+    TOUR_CHAMPIONSHIP_PBP,
+    TOUR_CHAMPIONSHIP_TARGET_FT,
+    TOURCAST_PBP,
+    TOURCAST_TRAJECTORIES,
+    TRACKMAN_TARGETS,
+    ClubComparison,
+    Metric,
+    PathErrors,
+    ball_types,
+    compare_clubs,
+    held_out_driver_shots,
+    outcome_errors,
+    path_errors,
+    tour_championship_shots,
+)
+from model_export.accuracy_slow import OUTCOMES as SLOW_OUTCOMES
+from model_export.accuracy_slow import SLOW_SHOTS, fly_slow
+from model_export.accuracy_winds import (
+    Anova,
+    Consistency,
+    GroupWind,
+    TrainingWindComparison,
+    WindFit,
+    compare_training_winds,
+    consistency,
+    fit_winds,
+    group_winds,
+    measured_paths,
+    training_winds,
+)
 from service.constants import YARD_M
-from service.flight import Flight, simulate
-from service.onnx_coefficients import OnnxCoefficients
-from service.physics import initial_state
 from shots.markdown import table, write_generated_section
 from shots.paths import shared_data_dir
-from shots.records import ShotSet, write_shots
-from shots.reference_world import CALIBRATION_AIR, TOUR_AVERAGES_FILE, ClubAverage, read_tour_averages
-from shots.tourcast import load_tourcast
-from shots.trackman import load_trackman, read_table
+from shots.records import ShotSet
+from shots.reference_world import CALIBRATION_AIR, TOUR_AVERAGES_FILE, read_tour_averages
+from shots.tourcast import load_tourcast, read_flights
+from shots.trackman import ConversionReport
+
+__all__ = [
+    "COMMAND", "DRIVER_FILE", "OUTCOMES", "PATH_FIGURE", "PGA_TARGETS", "TOURCAST_PBP", "TOURCAST_TRAJECTORIES",
+    "AccuracyReport", "CoefficientFlyer", "Flyer", "ModelFlyer", "ball_types", "compare_clubs", "ferguson_flyer",
+    "outcome_errors", "path_errors", "per_model", "run_accuracy",
+]
 
 COMMAND = "accuracy"
-DRIVER_FILE = Path("real/trackman_driver_sessions/data.csv")
-TOURCAST_TRAJECTORIES = Path("real/pga_tourcast_trackman/shot_trajectory/shot_trajectory_2021_016_656.csv")
-TOURCAST_PBP = Path("real/pga_tourcast_trackman/pbp/pbp_2021_016_656.csv")
 PATH_FIGURE = "accuracy_tourcast_path_error.png"
 PATH_TIMES_S = (1.0, 2.0, 3.0, 4.0, 5.0)
-PGA_TARGETS = (3.0, 2.0, 2.0)
-"""Mean absolute error the default model must reach on the PGA table: carry (yd), max height (yd), land angle (deg)."""
+MIN_HOLE_SHOTS = 4
+"""Holes (in a round) listed in the latent-wind table: those with at least this many fitted shots."""
 
+PAPER_TABLE_1 = (("Phys-Q (L_p + L_h)", 6.63, 1.64), ("NN (landing point straight from the launch)", 5.24, None),
+                 ("Phys-NN+ (L_p + L_h)", 4.75, 1.31))
+"""The paper's Table 1 (validation set of its private 90,233 TrackMan shots, yd): landing error L_p, max height L_h."""
 
-class ModelFlyer:
-    """A bundle flown through `service.flight.simulate` with its ONNX coefficient graph, at its card's step and
-    simulated time, calm, in one air (its density and, through the graph's Reynolds scale, its viscosity)."""
-
-    def __init__(self, bundle: str | os.PathLike) -> None:
-        self.bundle = Path(bundle)
-        self.coefficients = OnnxCoefficients(bundle)
-        self.card = self.coefficients.card
-
-    @property
-    def density_kg_m3(self) -> float:
-        """The card's air density: the air the model was trained to treat as nominal."""
-        return self.card.physics.air_density_kg_m3
-
-    def fly(self, launch: dict[str, np.ndarray], air: Air | None = None, keep_states: bool = False) -> Flight:
-        """Fly launches calm in `air` (default: the card's air)."""
-        physics = self.card.physics
-        density = self.density_kg_m3 if air is None else float(air.density_kg_m3)
-        viscosity = physics.kinematic_viscosity_m2_s if air is None else air.kinematic_viscosity_m2_s
-        return simulate(
-            initial_state(**launch),
-            self.coefficients.in_air(viscosity),
-            density,
-            dt=physics.dt_s,
-            t_max=physics.t_sim_s,
-            keep_states=keep_states,
-        )
+T = TypeVar("T")
 
 
 @dataclass
-class ClubComparison:
-    """Model and TrackMan carry (yd), max height (yd) and land angle (deg) per club [n, 3]."""
+class AccuracyReport:
+    """The generated markdown, the figures written, and the numbers behind them, per model label."""
 
-    clubs: list[ClubAverage]
-    model: np.ndarray
-    density_kg_m3: float
-
-    @property
-    def targets(self) -> np.ndarray:
-        return np.array([[c.carry_yd, c.max_height_yd, c.land_angle_deg] for c in self.clubs])
-
-    @property
-    def mean_absolute_error(self) -> np.ndarray:
-        return np.mean(np.abs(self.model - self.targets), axis=0)
-
-    @property
-    def bias(self) -> np.ndarray:
-        return np.mean(self.model - self.targets, axis=0)
+    markdown: str
+    labels: list[str] = field(default_factory=list)
+    figures: list[Path] = field(default_factory=list)
+    driver: dict[str, dict[str, np.ndarray]] | None = None
+    driver_shots: ShotSet | None = None
+    tour_championship: dict[str, dict[str, np.ndarray]] | None = None
+    pga: dict[str, ClubComparison] | None = None
+    slow: dict[str, dict[str, np.ndarray]] | None = None
+    tourcast: dict[str, dict[str, np.ndarray]] | None = None
+    paths: dict[str, PathErrors] | None = None
+    winds: dict[str, WindFit] | None = None
+    training_winds: TrainingWindComparison | None = None
+    study: FinetuneStudy | None = None
 
 
-def compare_clubs(flyer: ModelFlyer, clubs: Sequence[ClubAverage], air: Air | None = None) -> ClubComparison:
-    """Fly each club's average launch (launch direction and spin axis 0) and compare with TrackMan's averages."""
-    n = len(clubs)
-    launch = {
-        "ball_speed_mps": np.array([c.ball_speed_mps for c in clubs]),
-        "launch_angle_deg": np.array([c.launch_angle_deg for c in clubs]),
-        "launch_direction_deg": np.zeros(n),
-        "spin_rpm": np.array([c.spin_rpm for c in clubs]),
-        "spin_axis_deg": np.zeros(n),
-    }
-    density = flyer.density_kg_m3 if air is None else float(air.density_kg_m3)
-    flight = flyer.fly(launch, air)
-    model = np.stack([flight.carry_m / YARD_M, flight.apex_m / YARD_M, flight.landing_angle_deg], axis=1)
-    return ClubComparison(list(clubs), model, density)
+def _key(flyer: Flyer) -> tuple:
+    """What makes two flyers fly alike: the graph and the card's step and air, or the closed-form model."""
+    if isinstance(flyer, ModelFlyer):
+        physics = flyer.card.physics
+        return ("onnx", flyer.card.onnx.sha256, physics.dt_s, physics.t_sim_s, physics.air_density_kg_m3)
+    return ("model", repr(getattr(flyer, "model", flyer)), flyer.dt_s, flyer.t_sim_s, flyer.density_kg_m3)
 
 
-OUTCOMES = {
-    "carry_m": ("carry", "m"),
-    "side_m": ("side", "m"),
-    "landing_m": ("landing point (distance)", "m"),
-    "apex_m": ("max height", "m"),
-    "landing_angle_deg": ("land angle", "deg"),
-    "flight_time_s": ("flight time", "s"),
-}
-"""Outcome errors reported for real shots: key -> (name, unit)."""
+def per_model(flyers: Sequence[Flyer], work: Callable[[Flyer], T]) -> dict[str, T]:
+    """`work` for each model, by label; a model that flies exactly like an earlier one reuses its result."""
+    done: dict[tuple, T] = {}
+    results = {}
+    for flyer in flyers:
+        key = _key(flyer)
+        if key not in done:
+            done[key] = work(flyer)
+        results[flyer.label] = done[key]
+    return results
 
 
-def outcome_errors(flight: Flight, shots: ShotSet) -> dict[str, np.ndarray]:
-    """Per-shot model - recorded errors of every outcome in OUTCOMES (NaN where not recorded or not landed);
-    the landing-point error is the unsigned distance between the two landing points."""
-    x, y = shots.column("carry_x_m"), shots.column("carry_y_m")
-    return {
-        "carry_m": flight.carry_m - np.hypot(x, y),
-        "side_m": flight.lateral_m - x,
-        "landing_m": np.hypot(flight.landing_position[:, 0] - x, flight.landing_position[:, 1] - y),
-        "apex_m": flight.apex_m - shots.column("apex_m"),
-        "landing_angle_deg": flight.landing_angle_deg - shots.column("landing_angle_deg"),
-        "flight_time_s": flight.flight_time_s - shots.column("flight_time_s"),
-    }
+def _missing(path: Path) -> str:
+    return f"_Skipped: `{path}` not found (set `GOLFFLIGHT_SHARED_DATA` or put the shared data beside the repository)._"
+
+
+def _cell(value: float, digits: int = 2, signed: bool = False) -> str:
+    if value is None or not math.isfinite(value):
+        return "–"
+    return f"{value:+.{digits}f}" if signed else f"{value:.{digits}f}"
+
+
+def _metric_rows(metrics: Sequence[Metric], errors: dict[str, dict[str, np.ndarray]], labels: Sequence[str],
+                 mask: np.ndarray | None = None, targets: dict[str, str] | None = None) -> list[tuple[str, ...]]:
+    rows = []
+    for metric in metrics:
+        cells = [_cell(metric.of(errors[label], mask), metric.digits, metric.statistic == "bias") for label in labels]
+        rows.append((metric.name, *cells) + (((targets or {}).get(metric.name, ""),) if targets is not None else ()))
+    return rows
+
+
+def _count(errors: dict[str, np.ndarray], mask: np.ndarray | None = None, key: str = "landing_m") -> int:
+    """Shots with a model and a recorded value of `key` (by default: the landing point)."""
+    values = errors[key] if mask is None else errors[key][mask]
+    return int(np.sum(np.isfinite(values)))
+
+
+def _verdict(name: str, value: float, limit: float, unit: str) -> str:
+    met = math.isfinite(value) and value <= limit
+    return f"{name} {_cell(value)} {unit} (target <= {limit:g}): **{'met' if met else 'not met'}**"
+
+
+def _header(flyers: Sequence[Flyer], rho_note: str) -> list[str]:
+    rows = []
+    for flyer in flyers:
+        if isinstance(flyer, ModelFlyer):
+            card = flyer.card
+            sources = getattr(card.training_data, "sources", None) or []
+            trained = f"`{card.training_data.file}`" + (f" ({', '.join(s.name for s in sources)})" if sources else "")
+            what = (f"`{flyer.bundle}`: {card.variant}, trained on {trained}, ONNX {card.onnx.sha256[:12]}, card air "
+                    f"rho {flyer.density_kg_m3:.3f} kg/m^3")
+        else:
+            what = (f"C_L, C_D quadratic in spin ratio, C_M = 0.011 S (`service.coefficients.FERGUSON_2022`), "
+                    f"rho {flyer.density_kg_m3:.3f} kg/m^3")
+        rows.append((flyer.label, what))
+    models = [f for f in flyers if isinstance(f, ModelFlyer)]
+    same = len({f.card.onnx.sha256 for f in models}) < len(models)
+    lines = [
+        *table(("column", "model"), rows),
+        "",
+        (
+            f"Every model is flown through `service.flight.simulate` (NumPy physics, forward Euler, dt "
+            f"{flyers[0].dt_s:g} s, up to {flyers[0].t_sim_s:g} s), calm, in the air named above: {rho_note}"
+        ),
+    ]
+    if same:
+        lines += ["", "_The real-data and synthetic slots hold the same ONNX graph: their columns are identical._"]
+    return lines
+
+
+def _drivers(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
+    lines = ["### TrackMan outdoor drivers (held out: lines 2943 on)", ""]
+    path = data_dir / DRIVER_FILE
+    if not path.is_file():
+        return lines + [_missing(path)]
+    shots, note = held_out_driver_shots(path)
+    report.driver_shots = shots
+    labels = [f.label for f in flyers]
+    report.driver = per_model(flyers, lambda flyer: outcome_errors(flyer.fly(shots.launch()), shots))
+    balls = ball_types(path)
+    kinds = np.array([r.ball or balls.get(r.shot_id or "", "") for r in shots.records], dtype=object)
+    premium = kinds == PREMIUM
+    targets = {LANDING_ERROR.name: f"<= {TRACKMAN_TARGETS['landing']:g}",
+               APEX_MAE_YD.name: f"<= {TRACKMAN_TARGETS['apex']:g}"}
+    lines += [f"`{DRIVER_FILE}`: {note}.", ""]
+    for title, mask, with_targets in ((f"**{PREMIUM} balls** (the target row)", premium, True),
+                                      ("All balls", None, False)):
+        n = [_count(report.driver[label], mask) for label in labels]
+        rows = _metric_rows(FLIGHT_METRICS, report.driver, labels, mask, targets if with_targets else {})
+        rows.append(("shots", *(str(k) for k in n), ""))
+        lines += [title + ":", "", *table(("", *labels, "target"), rows), ""]
+    counts = Counter(k or "(blank)" for k in kinds).most_common()
+    lines.append(f"Ball types among the kept shots: {', '.join(f'{kind} {n}' for kind, n in counts)}.")
+    lines += ["", "Targets on the Premium row:", ""]
+    for label in labels:
+        errors = report.driver[label]
+        lines.append(
+            f"- {label}: "
+            + "; ".join([
+                _verdict("landing error", LANDING_ERROR.of(errors, premium), TRACKMAN_TARGETS["landing"], "yd"),
+                _verdict("max height MAE", APEX_MAE_YD.of(errors, premium), TRACKMAN_TARGETS["apex"], "yd"),
+            ])
+        )
+    return lines
+
+
+def _tour_championship(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
+    lines = ["### TOUR Championship 2020, East Lake (held out)", ""]
+    path = data_dir / TOUR_CHAMPIONSHIP_PBP
+    if not path.is_file():
+        return lines + [_missing(path)]
+    try:
+        shots, note = tour_championship_shots(path)
+    except ImportError:
+        return lines + ["_Skipped: the pbp loader (`shots.pbp.load_pbp`) is not in this checkout yet._"]
+    labels = [f.label for f in flyers]
+    report.tour_championship = per_model(flyers, lambda flyer: outcome_errors(flyer.fly(shots.launch()), shots))
+    metric = APEX_METRICS[0]
+    rows = _metric_rows(APEX_METRICS, report.tour_championship, labels,
+                        targets={metric.name: f"<= {TOUR_CHAMPIONSHIP_TARGET_FT:g}"})
+    rows.append(("shots", *(str(_count(report.tour_championship[label], key="apex_m")) for label in labels), ""))
+    lines += [f"`{TOUR_CHAMPIONSHIP_PBP.name}`: {note}.", "", *table(("", *labels, "target"), rows), ""]
+    lines += [f"- {label}: " + _verdict("apex MAE", metric.of(report.tour_championship[label]),
+                                        TOUR_CHAMPIONSHIP_TARGET_FT, "ft") for label in labels]
+    return lines
+
+
+def _pga(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport):
+    lines = ["### PGA TOUR 2023 TrackMan averages per club (held out, a check)", ""]
+    path = data_dir / TOUR_AVERAGES_FILE
+    if not path.is_file():
+        return lines + [_missing(path)], None
+    clubs = read_tour_averages(path)
+    labels = [f.label for f in flyers]
+    report.pga = per_model(flyers, lambda flyer: compare_clubs(flyer, clubs))
+    calibration = per_model(flyers, lambda flyer: compare_clubs(flyer, clubs, CALIBRATION_AIR))
+    names = ("carry MAE (bias), yd", "max height MAE (bias), yd", "land angle MAE (bias), deg")
+    rows = [
+        (name, *(f"{report.pga[l].mean_absolute_error[i]:.2f} ({report.pga[l].bias[i]:+.2f})" for l in labels),
+         f"<= {PGA_TARGETS[i]:g}")
+        for i, name in enumerate(names)
+    ]
+    rows.append((f"carry MAE in TrackMan's normalisation air (rho {CALIBRATION_AIR.density_kg_m3:.3f}), yd",
+                 *(f"{calibration[l].mean_absolute_error[0]:.2f} ({calibration[l].bias[0]:+.2f})" for l in labels), ""))
+    rows.append(("targets", *("met" if report.pga[l].met else "not met" for l in labels), ""))
+    lines += [
+        f"Each club's average launch (launch direction and spin axis 0) against TrackMan's average carry, max height "
+        f"and land angle, {len(clubs)} clubs, each model in its own air:",
+        "",
+        *table(("", *labels, "target"), rows),
+        "",
+        f"Per club, {labels[0]} (model / TrackMan / error):",
+        "",
+    ]
+    first = report.pga[labels[0]]
+    club_rows = [(club.club, *(f"{m:.1f} / {t:g} / {m - t:+.1f}" for m, t in zip(model, target)))
+                 for club, model, target in zip(first.clubs, first.model, first.targets)]
+    lines += table(("club", "carry yd", "max height yd", "land angle deg"), club_rows)
+    return lines, clubs
+
+
+def _paper() -> list[str]:
+    rows = [(name, f"{landing:.2f}", "–" if height is None else f"{height:.2f}")
+            for name, landing, height in PAPER_TABLE_1]
+    return [
+        "### The paper's figures (context)",
+        "",
+        "Table 1 of the paper: validation error on its own private set of 90,233 TrackMan shots (the most recent "
+        "10 %), in yards. A different data set from every set above (other players, balls, ranges and weather), so "
+        "these numbers are a scale for ours, not a score to compare with directly.",
+        "",
+        *table(("model (paper)", "landing error, yd", "max height MAE, yd"), rows),
+    ]
+
+
+def _slow(flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
+    labels = [f.label for f in flyers]
+    report.slow = per_model(flyers, fly_slow)
+    rows = []
+    for index, shot in enumerate(SLOW_SHOTS):
+        launch = f"{shot.name}: {shot.launch_angle_deg:g} deg, {shot.spin_rpm:,.0f} rpm"
+        for key, name in SLOW_OUTCOMES:
+            digits = 1
+            rows.append((f"{launch}, {name}" if key == "carry" else f"… {name}",
+                         *(_cell(float(report.slow[l][key][index]), digits) for l in labels), shot.published[key]))
+    lines = [
+        "### Slow shots against published amateur launches",
+        "",
+        "Ball speed as named, launch angle and spin from the sources below (launch direction and spin axis 0), calm, "
+        "each model in its own air. The last column is a published outcome for that launch, where one was found.",
+        "",
+        *table(("shot", *labels, "published"), rows),
+        "",
+        "Sources:",
+        "",
+    ]
+    lines += [f"- {shot.name}: {shot.source}" for shot in SLOW_SHOTS]
+    return lines
+
+
+def _sentry(data_dir: Path, flyers: Sequence[Flyer], out: Path, figures_dir: Path, report: AccuracyReport) -> list[str]:
+    from model_export import figures
+
+    lines = ["### PGA TOUR trajectories, 2022 Sentry at Kapalua (a TRAINING set of the real-data model)", ""]
+    trajectory_file, pbp_file = data_dir / TOURCAST_TRAJECTORIES, data_dir / TOURCAST_PBP
+    if not (trajectory_file.is_file() and pbp_file.is_file()):
+        return lines + [_missing(trajectory_file if not trajectory_file.is_file() else pbp_file)]
+    conversion = load_tourcast(trajectory_file, pbp_file)
+    shots = ShotSet([r for r in conversion.records if r.shot_id in conversion.trajectories])
+    trajectories = [conversion.trajectories[s] for s in shots.column("shot_id")]
+    labels = [f.label for f in flyers]
+
+    def evaluate(flyer: Flyer):
+        flight = flyer.fly(shots.launch(), keep_states=True)
+        return outcome_errors(flight, shots), path_errors(flight, trajectories)
+
+    results = per_model(flyers, evaluate)
+    report.tourcast = {label: results[label][0] for label in labels}
+    report.paths = {label: results[label][1] for label in labels}
+    rows = _metric_rows(FLIGHT_METRICS, report.tourcast, labels)
+    for t in PATH_TIMES_S:
+        rows.append((f"path error at {t:g} s, median m", *(
+            _cell(float(np.median(report.paths[l].at(t)))) if len(report.paths[l].at(t)) else "–" for l in labels)))
+    rows.append(("shots", *(str(_count(report.tourcast[l])) for l in labels)))
+    first = labels[0]
+    figure = figures.path_error(
+        report.paths[first].times_s,
+        report.paths[first].errors_m,
+        Path(figures_dir).resolve() / PATH_FIGURE,
+        f"{first} vs TrackMan trajectories, 2022 Sentry ({len(shots)} tee shots)",
+    )
+    report.figures.append(figure)
+    lines += [
+        (
+            f"Not held out: the real-data model may have been trained on these shots, so its column is a training "
+            f"error, shown for the full-path comparison only. `{TOURCAST_TRAJECTORIES.name}` joined with "
+            f"`{TOURCAST_PBP.name}` for spin: {conversion.report.rows_in} flights, {len(shots)} with a measured spin "
+            "and a complete polynomial (spin axis derived from the initial lift). Path error: 3-D distance between "
+            "the model's position and the polynomial's at the same time since launch."
+        ),
+        "",
+        *table(("", *labels), rows),
+        "",
+        f"![path error, {first}]({os.path.relpath(figure, Path(out).resolve().parent)})",
+        "",
+    ]
+    return lines + _winds(trajectory_file, conversion, shots, flyers, report)
+
+
+def _anova_cells(result: Anova) -> tuple[str, ...]:
+    p = "–" if not math.isfinite(result.p) else (f"{result.p:.2g}" if result.p >= 1e-4 else "<1e-4")
+    return (_cell(result.within_sd), _cell(result.between_sd),
+            "–" if not math.isfinite(result.f) else f"{result.f:.1f} ({p})", _cell(result.between_fraction))
+
+
+def _winds(trajectory_file: Path, conversion, shots: ShotSet, flyers: Sequence[Flyer],
+           report: AccuracyReport) -> list[str]:
+    flights = read_flights(trajectory_file, ConversionReport(str(trajectory_file)))
+    tracked = {f.shot_id: f.measured_time_s for f in flights}
+    ids = list(shots.column("shot_id"))
+    labels = [f.label for f in flyers]
+
+    def fit(flyer: Flyer) -> WindFit:
+        return fit_winds(flyer, measured_paths(ids, shots.launch(), conversion.trajectories, tracked, flyer.dt_s))
+
+    report.winds = per_model(flyers, fit)
+    quality = [
+        (label, str(len(w.shot_ids)), _cell(float(np.median(w.rms_calm_m))), _cell(float(np.median(w.rms_fit_m))),
+         _cell(float(np.median(np.hypot(w.x_mps, w.y_mps)))), str(w.evaluations))
+        for label, w in report.winds.items()
+    ]
+    lines = [
+        "#### Latent winds: does one wind fit the players on the same hole?",
+        "",
+        (
+            "With each model fixed, every shot gets its own uniform wind (x right, y down the target line, m/s): the "
+            "least-squares fit (`scipy.optimize.least_squares`) of the model's positions to the radar's at the "
+            "integrator's step times, up to the radar-tracked time of the shot (beyond it the polynomial is TrackMan's "
+            "extrapolation). The fitted wind also absorbs whatever the model gets wrong for that launch; if it is the "
+            "weather, the shots of one hole in one round agree, and the holes differ."
+        ),
+        "",
+        *table(("model", "shots", "median RMS path error calm, m", "with its fitted wind, m",
+                "median fitted wind, m/s", "flights flown"), quality),
+        "",
+        "Per round: spread of the shots' winds within a hole (pooled SD), spread of the hole means across the round's "
+        "holes (SD), one-way ANOVA F (p) and the share of the variance between holes (SS_between / SS_total), per "
+        "component; the last row of each model pools the whole event (every hole and round a group):",
+        "",
+    ]
+    rows = []
+    results: dict[str, Consistency] = {label: consistency(report.winds[label]) for label in labels}
+    for label in labels:
+        result = results[label]
+        for name, (x, y) in [*result.rounds.items(), ("all rounds", result.event)]:
+            rows.append((label, name, f"{x.n_groups} ({x.n_shots})", *_anova_cells(x), *_anova_cells(y)))
+    lines += table(("model", "round", "holes (shots)", "x: within SD", "x: SD of hole means", "x: F (p)",
+                    "x: between share", "y: within SD", "y: SD of hole means", "y: F (p)", "y: between share"), rows)
+    groups = {label: {g.group: g for g in group_winds(report.winds[label])} for label in labels}
+    listed = [g for g in groups[labels[0]].values() if g.n >= MIN_HOLE_SHOTS]
+
+    def describe(wind: GroupWind | None) -> str:
+        if wind is None:
+            return "–"
+        return (f"{wind.speed_mps:.1f} m/s from {wind.from_deg:.0f} deg (SD {_cell(wind.sd_x_mps, 1)}, "
+                f"{_cell(wind.sd_y_mps, 1)})")
+
+    lines += [
+        "",
+        f"Holes with at least {MIN_HOLE_SHOTS} fitted shots: mean wind (speed and the direction it blows from, "
+        "0 = headwind, 90 = from the right; `discovery.effects.wind_from_components`) and the within-hole SD of x, y:",
+        "",
+        *(table(("round-hole", "shots", *labels),
+                [(g.group, str(g.n), *(describe(groups[l].get(g.group)) for l in labels)) for g in listed])
+          if listed else ["_None._"]),
+        "",
+        _wind_answer(results, labels),
+    ]
+    lines += ["", *_training_wind_lines(flyers[0], groups[labels[0]], report)]
+    return lines
+
+
+def _wind_answer(results: dict[str, Consistency], labels: Sequence[str]) -> str:
+    """The numbers' own answer: in how many rounds with several holes the hole means differ (p < 0.05), and how
+    the within-hole spread compares with the spread of the hole means."""
+    parts = []
+    for label in labels:
+        tested = [(x, y) for x, y in results[label].rounds.values() if x.n_groups >= 2]
+        if not tested:
+            parts.append(f"{label}: no round has two holes with shots, so nothing to compare")
+            continue
+        significant = [sum(1 for pair in tested if pair[axis].p < 0.05) for axis in (0, 1)]
+        within = [float(np.mean([pair[axis].within_sd for pair in tested])) for axis in (0, 1)]
+        between = [float(np.mean([pair[axis].between_sd for pair in tested])) for axis in (0, 1)]
+        parts.append(
+            f"{label}: the hole means differ (p < 0.05) in {significant[0]} of {len(tested)} rounds for x and "
+            f"{significant[1]} of {len(tested)} for y; within a hole the shots scatter by {within[0]:.2f} (x) and "
+            f"{within[1]:.2f} (y) m/s SD against {between[0]:.2f} and {between[1]:.2f} m/s between the hole means"
+        )
+    return "In numbers: " + "; ".join(parts) + "."
+
+
+def _training_wind_lines(flyer: Flyer, fitted: dict[str, GroupWind], report: AccuracyReport) -> list[str]:
+    if not isinstance(flyer, ModelFlyer):
+        return []
+    entries = training_winds(flyer.bundle)
+    if entries is None:
+        return [f"_No `training_conditions.json` beside `{flyer.bundle}`: the comparison with the winds the model was "
+                "trained with is skipped._"]
+    comparison = compare_training_winds(entries, list(fitted.values()))
+    report.training_winds = comparison
+    return [
+        (
+            f"`{flyer.bundle}/training_conditions.json` holds {comparison.n_training_groups} group winds; "
+            f"{comparison.n_groups} of them are Sentry holes fitted here. Correlation of the training winds with the "
+            f"fitted group means: x {_cell(comparison.correlation_x)}, y {_cell(comparison.correlation_y)} (NaN with "
+            f"fewer than 3 groups); mean difference (training - fitted) x "
+            f"{_cell(comparison.mean_difference_x, 2, True)}, y {_cell(comparison.mean_difference_y, 2, True)} m/s."
+        )
+    ]
 
 
 def _summary_rows(errors: dict[str, np.ndarray]) -> list[tuple[str, ...]]:
@@ -138,242 +487,55 @@ def _summary_rows(errors: dict[str, np.ndarray]) -> list[tuple[str, ...]]:
             continue
         bias, mae = float(np.mean(values)), float(np.mean(np.abs(values)))
         if unit == "m":
-            bias_cell = "–" if key == "landing_m" else f"{bias:+.2f} m ({bias / YARD_M:+.2f} yd)"
-            mae_cell = f"{mae:.2f} m ({mae / YARD_M:.2f} yd)"
+            bias_cell = "–" if key == "landing_m" else f"{bias / YARD_M:+.2f} yd"
+            mae_cell = f"{mae / YARD_M:.2f} yd"
         else:
             bias_cell, mae_cell = f"{bias:+.2f} {unit}", f"{mae:.2f} {unit}"
         rows.append((name, str(len(values)), bias_cell, mae_cell))
     return rows
 
 
-def outcome_table(errors: dict[str, np.ndarray]) -> list[str]:
-    """Markdown table of mean bias (model - recorded) and mean absolute error per outcome."""
-    return table(("outcome", "shots", "mean bias", "mean abs error"), _summary_rows(errors))
-
-
-@dataclass
-class PathErrors:
-    """3-D position error (m) between the model's flight and the measured path, for the shots in flight at each time."""
-
-    times_s: np.ndarray
-    errors_m: list[np.ndarray]
-
-    def at(self, time_s: float) -> np.ndarray:
-        return self.errors_m[int(np.argmin(np.abs(self.times_s - time_s)))]
-
-
-def path_errors(flight: Flight, trajectories: Sequence[np.ndarray]) -> PathErrors:
-    """Compare the model's states (every step, relative to its start point) with each measured trajectory [T, 4] of
-    t, x, y, z (relative to the start), interpolated to the step times; a shot counts while both are in the air."""
-    if flight.states is None or flight.times_s is None:
-        raise ValueError("the flight was simulated without keep_states")
-    positions = np.stack([s.position for s in flight.states]) - flight.states[0].position[None]
-    model_end = np.where(flight.landed, flight.flight_time_s, np.inf)
-    errors = []
-    for i, t in enumerate(flight.times_s):
-        in_air = [j for j, path in enumerate(trajectories) if t < min(model_end[j], path[-1, 0])]
-        measured = np.array(
-            [[np.interp(t, trajectories[j][:, 0], trajectories[j][:, k]) for k in (1, 2, 3)] for j in in_air]
-        ).reshape(-1, 3)
-        errors.append(np.linalg.norm(positions[i, in_air] - measured, axis=-1))
-    return PathErrors(np.asarray(flight.times_s), errors)
-
-
-def path_table(paths: PathErrors, times_s: Sequence[float] = PATH_TIMES_S) -> list[str]:
-    """Markdown table of the median and 90th percentile 3-D position error at given times."""
-    rows = []
-    for t in times_s:
-        e = paths.at(t)
-        if len(e):
-            p50, p90 = np.percentile(e, [50, 90])
-            rows.append(
-                (
-                    f"{t:g} s",
-                    str(len(e)),
-                    f"{p50:.2f} m ({p50 / YARD_M:.2f} yd)",
-                    f"{p90:.2f} m ({p90 / YARD_M:.2f} yd)",
-                )
-            )
-    return table(("time", "shots in flight", "median error", "90th percentile"), rows)
-
-
-def measured_driver_shots(path: str | os.PathLike) -> tuple[ShotSet, str]:
-    """The outdoor (radar-tracked) driver shots of a TrackMan export whose apex reaches the training filter's 8 yd
-    (malformed rows are left out, as the loader reports), and a sentence saying what was kept."""
-    conversion = load_trackman(path, skip_bad_rows=True)
+def _study(data_dir: Path, flyer: ModelFlyer, clubs, epochs: int, report: AccuracyReport) -> list[str]:
+    lines = ["### Fine-tuning on a tour event's early rounds (Sony Open 2022)", ""]
+    path = data_dir / SONY_TRAJECTORIES
+    if not path.is_file():
+        return lines + [_missing(path)]
+    if epochs <= 0:
+        return lines + ["_Skipped (no epochs asked for)._"]
+    conversion = load_tourcast(path, None, estimate_spin=True)
     shots = ShotSet(conversion.records)
-    apex = shots.column("apex_m")
-    landed = ~np.isnan(shots.column("carry_x_m")) & ~np.isnan(shots.column("carry_y_m"))
-    keep = landed & (apex >= MIN_APEX_M)
-    note = (
-        f"{conversion.report.rows_in} rows; {conversion.report.kept} measured outdoor flights (radar track >= 90 % "
-        f"of the flight, launch complete and in range); {int(keep.sum())} of them with a carry and a max height of "
-        "at least 8 yd (the training filter)"
-    )
-    return shots.subset(keep), note
-
-
-def ball_types(path: str | os.PathLike) -> dict[str, str]:
-    """The 'Ball' cell of every row of a TrackMan export, keyed like the loader's shot_id (the file line number),
-    read by the loader's own table reader (which also skips an optional 'sep=,' first line)."""
-    header, _, rows = read_table(Path(path))
-    if "Ball" not in header:
-        return {}
-    column = header.index("Ball")
-    return {str(line): row[column].strip() for line, row in rows if len(row) > column}
-
-
-@dataclass
-class FinetuneStudy:
-    """Held-out driver shots before and after fine-tuning on the first half, and what it did to the PGA table."""
-
-    n_train: int
-    n_val: int
-    n_held_out: int
-    epochs: int
-    lr: float
-    batch_size: int
-    best_epoch: int | None
-    improved: bool
-    before: dict[str, np.ndarray]
-    after: dict[str, np.ndarray]
-    pga_after: ClubComparison | None = None
-
-
-def finetune_study(
-    flyer: ModelFlyer,
-    shots: ShotSet,
-    clubs: Sequence[ClubAverage] | None,
-    epochs: int = 30,
-    lr: float = 3e-4,
-    batch_size: int = 64,
-    val_fraction: float = 0.2,
-) -> FinetuneStudy:
-    """Fine-tune on the first half of the shots in file order (its last `val_fraction` picks the best epoch) and
-    compare the second half before and after. Everything is written to a temporary directory, then deleted."""
-    from model_export.finetune import assign_split, finetune
-
-    order = np.argsort([int(s) for s in shots.column("shot_id")], kind="stable")
-    half = len(order) // 2
-    first, second = (ShotSet([shots.records[i] for i in part]) for part in (order[:half], order[half:]))
-    launch = second.launch()
-    before = outcome_errors(flyer.fly(launch), second)
-    with tempfile.TemporaryDirectory(prefix="golfflight-finetune-") as work:
-        train_file = Path(work) / "first_half.csv"
-        split = assign_split(first, val_fraction)
-        write_shots(train_file, split.records)
-        result = finetune(flyer.bundle, train_file, Path(work) / "bundle", epochs, lr, batch_size, progress=False)
-        tuned = ModelFlyer(Path(work) / "bundle") if result.improved else flyer
-        after = outcome_errors(tuned.fly(launch), second)
-        pga_after = compare_clubs(tuned, clubs) if clubs else None
-    return FinetuneStudy(
-        n_train=result.run.data.n_train,
-        n_val=result.run.data.n_val,
-        n_held_out=len(second),
-        epochs=epochs,
-        lr=lr,
-        batch_size=batch_size,
-        best_epoch=None if result.run.best is None else int(result.run.best["epoch"]),
-        improved=result.improved,
-        before=before,
-        after=after,
-        pga_after=pga_after,
-    )
-
-
-@dataclass
-class AccuracyReport:
-    """The generated markdown, the figures written, and the headline numbers."""
-
-    markdown: str
-    figures: list[Path] = field(default_factory=list)
-    pga: ClubComparison | None = None
-    driver: dict[str, np.ndarray] | None = None
-    tourcast: dict[str, np.ndarray] | None = None
-    paths: PathErrors | None = None
-    study: FinetuneStudy | None = None
-
-
-def _missing(path: Path) -> str:
-    return f"_Skipped: `{path}` not found (set `GOLFFLIGHT_SHARED_DATA` or put the shared data beside the repository)._"
-
-
-def _club_lines(comparison: ClubComparison, at_table_air: ClubComparison) -> list[str]:
-    rows = []
-    for club, model, target in zip(comparison.clubs, comparison.model, comparison.targets):
-        rows.append((club.club, *(f"{m:.1f} / {t:g} / {m - t:+.1f}" for m, t in zip(model, target))))
-    mae, bias = comparison.mean_absolute_error, comparison.bias
-    rows.append(("**MAE (bias)**", *(f"**{e:.2f}** ({b:+.2f})" for e, b in zip(mae, bias))))
-    other = at_table_air.mean_absolute_error
-    rows.append(
-        (
-            f"MAE (bias) in TrackMan's normalisation air, rho {at_table_air.density_kg_m3:.3f}",
-            *(f"{e:.2f} ({b:+.2f})" for e, b in zip(other, at_table_air.bias)),
-        )
-    )
-    met = all(e <= t for e, t in zip(mae, PGA_TARGETS))
-    verdict = "met" if met else "NOT met"
-    return [
-        *table(("club", "carry yd (model / TM / err)", "max height yd", "land angle deg"), rows, align="lrrr"),
-        "",
-        (
-            f"Target MAE <= {PGA_TARGETS[0]:g} yd carry, {PGA_TARGETS[1]:g} yd max height, {PGA_TARGETS[2]:g} deg land "
-            f"angle in the card's air (rho {comparison.density_kg_m3:.3f}), what the service flies a shot without "
-            f"conditions in: **{verdict}**."
-        ),
-    ]
-
-
-def _ball_lines(shots: ShotSet, errors: dict[str, np.ndarray], balls: dict[str, str]) -> list[str]:
-    kinds = np.array([balls.get(s, "") for s in shots.column("shot_id")])
-    rows = []
-    for kind in sorted(set(kinds), key=lambda k: -np.sum(kinds == k)):
-        mask = kinds == kind
-        carry = errors["carry_m"][mask]
-        rows.append(
-            (
-                kind or "(blank)",
-                str(int(mask.sum())),
-                f"{np.nanmean(carry) / YARD_M:+.2f}",
-                f"{np.nanmean(np.abs(carry)) / YARD_M:.2f}",
-                f"{np.nanmean(errors['landing_m'][mask]) / YARD_M:.2f}",
-                f"{np.nanmean(errors['apex_m'][mask]) / YARD_M:+.2f}",
-            )
-        )
-    return table(("ball", "shots", "carry bias yd", "carry MAE yd", "landing error yd", "max height bias yd"), rows)
-
-
-def _study_lines(study: FinetuneStudy) -> list[str]:
+    try:
+        study = finetune_study(flyer, shots, clubs, epochs=epochs)
+    except ValueError as error:
+        return lines + [f"_Skipped: {error}._"]
+    report.study = study
     before = {row[0]: row for row in _summary_rows(study.before)}
     after = {row[0]: row for row in _summary_rows(study.after)}
-    rows = [
-        (name, before[name][1], before[name][2], before[name][3], after[name][2], after[name][3])
-        for name in before
-        if name in after
-    ]
-    outcome = (
-        f"best epoch {study.best_epoch}, exported"
-        if study.improved
-        else "no epoch beat the base model on the validation rows: the base model is kept"
-    )
-    lines = [
+    rows = [(name, before[name][1], before[name][2], before[name][3], after[name][2], after[name][3])
+            for name in before if name in after]
+    outcome = (f"best epoch {study.best_epoch}, exported" if study.improved
+               else "no epoch beat the base model on the validation round: the base model is kept")
+    tried = ", ".join(f"lr {lr:g}: {error / YARD_M:.2f} yd (epoch {epoch})" for lr, (error, epoch) in
+                      study.validation.items())
+    lines += [
         (
-            f"Fine-tuned on the first half of the shots in file order ({study.n_train} train + {study.n_val} validation "
-            f"rows, the last {study.n_val} picking the best epoch), {study.epochs} epochs at lr {study.lr:g}, batch "
-            f"{study.batch_size}; {outcome}. Held out: the second half ({study.n_held_out} shots)."
+            f"`{SONY_TRAJECTORIES.name}` ({len(shots)} tee shots; no pbp file with spin exists for this event, so "
+            "every spin is the loader's ESTIMATE from the initial lift, and the spin axis is derived from it). "
+            f"`golfflight finetune` from the {flyer.label} on rounds {'-'.join(map(str, TRAIN_ROUNDS))} "
+            f"({study.n_train} train + {study.n_val} validation shots, split by the command's own rule: the latest "
+            f"session, here a round, picks the best epoch), {study.epochs} epochs, batch {study.batch_size}, at "
+            f"each of {len(study.validation)} learning rates; the rate kept is the one with the lowest validation "
+            f"landing error (base model {study.base_validation_m / YARD_M:.2f} yd; {tried}): lr {study.lr:g}, "
+            f"{outcome}. Measured: rounds {'-'.join(map(str, MEASURED_ROUNDS))} ({study.n_measured} shots), never "
+            "seen by the fine-tuning or any choice in it."
         ),
         "",
-        *table(("outcome (held-out half)", "shots", "bias before", "MAE before", "bias after", "MAE after"), rows),
+        *table(("outcome (rounds 3-4)", "shots", "bias before", "MAE before", "bias after", "MAE after"), rows),
     ]
     if study.pga_after is not None:
         mae = study.pga_after.mean_absolute_error
-        lines += [
-            "",
-            (
-                f"The fine-tuned model on the PGA 2023 table: MAE {mae[0]:.2f} yd carry, {mae[1]:.2f} yd max "
-                f"height, {mae[2]:.2f} deg land angle."
-            ),
-        ]
+        lines += ["", f"The fine-tuned model on the PGA 2023 table: MAE {mae[0]:.2f} yd carry, {mae[1]:.2f} yd max "
+                      f"height, {mae[2]:.2f} deg land angle."]
     return lines
 
 
@@ -383,94 +545,29 @@ def run_accuracy(
     figures_dir: str | os.PathLike,
     data_dir: str | os.PathLike | None = None,
     finetune_epochs: int = 30,
+    synthetic: str | os.PathLike | None = None,
 ) -> AccuracyReport:
-    """Evaluate `bundle` on every real set found under `data_dir` (default: the shared data folder), run the
-    fine-tuning study, write OUT's generated section and the path-error figure; missing sets are announced."""
-    from model_export import figures
-
+    """Compare the real-data model `bundle`, the `synthetic` one (default: the same bundle) and Ferguson 2022 on every
+    real set found under `data_dir` (default: the shared data folder), run the fine-tuning study, and write OUT's
+    generated section and the path-error figure; missing sets are announced."""
     data_dir = Path(data_dir) if data_dir is not None else shared_data_dir()
-    flyer = ModelFlyer(bundle)
-    card = flyer.card
-    report = AccuracyReport("")
-    rho = flyer.density_kg_m3
-    lines = [
-        (
-            f"Model: `{Path(bundle)}` ({card.variant}, trained on `{card.training_data.file}`, checkpoint of epoch "
-            f"{card.training.best_epoch}, validation landing error {card.validation.landing_error_yd:.2f} yd). Runtime "
-            f"path: NumPy physics + ONNX Runtime, Euler dt {card.physics.dt_s:g} s. Every shot is flown calm in the "
-            f"card's air, rho {rho:.3f} kg/m^3 (none of these sets records its weather); the PGA table also in "
-            f"TrackMan's normalisation air (25 C, sea level, rho {CALIBRATION_AIR.density_kg_m3:.3f} kg/m^3), where the "
-            "reference world was calibrated to it."
-        ),
-        "",
-        "### PGA TOUR 2023 TrackMan averages per club",
-        "",
+    real = ModelFlyer(bundle, "real-data model")
+    flyers: list[Flyer] = [
+        real,
+        ModelFlyer(synthetic if synthetic is not None else bundle, "synthetic model"),
+        ferguson_flyer(real.dt_s, real.t_sim_s),
     ]
-    averages = data_dir / TOUR_AVERAGES_FILE
-    clubs = read_tour_averages(averages) if averages.is_file() else None
-    if clubs:
-        report.pga = compare_clubs(flyer, clubs)
-        lines += _club_lines(report.pga, compare_clubs(flyer, clubs, CALIBRATION_AIR))
-    else:
-        lines.append(_missing(averages))
-
-    lines += ["", "### Outdoor TrackMan driver shots", ""]
-    driver_file = data_dir / DRIVER_FILE
-    driver = None
-    if driver_file.is_file():
-        driver, note = measured_driver_shots(driver_file)
-        report.driver = outcome_errors(flyer.fly(driver.launch()), driver)
-        lines += [
-            f"`{DRIVER_FILE}`: {note}.",
-            "",
-            *outcome_table(report.driver),
-            "",
-            "By ball type:",
-            "",
-            *_ball_lines(driver, report.driver, ball_types(driver_file)),
-        ]
-    else:
-        lines.append(_missing(driver_file))
-
-    lines += ["", "### PGA TOUR TrackMan trajectories (2022 Sentry, Kapalua)", ""]
-    trajectory_file, pbp_file = data_dir / TOURCAST_TRAJECTORIES, data_dir / TOURCAST_PBP
-    if trajectory_file.is_file() and pbp_file.is_file():
-        conversion = load_tourcast(trajectory_file, pbp_file)
-        shots = ShotSet([r for r in conversion.records if r.shot_id in conversion.trajectories])
-        flight = flyer.fly(shots.launch(), keep_states=True)
-        report.tourcast = outcome_errors(flight, shots)
-        report.paths = path_errors(flight, [conversion.trajectories[s] for s in shots.column("shot_id")])
-        figure = figures.path_error(
-            report.paths.times_s,
-            report.paths.errors_m,
-            Path(figures_dir).resolve() / PATH_FIGURE,
-            f"{card.variant} vs TrackMan trajectories, 2022 Sentry ({len(shots)} tee shots)",
-        )
-        report.figures.append(figure)
-        lines += [
-            (
-                f"`{TOURCAST_TRAJECTORIES.name}` joined with `{TOURCAST_PBP.name}` for spin: {conversion.report.rows_in} "
-                f"flights, {len(shots)} with a measured spin and a complete polynomial (spin axis derived from the "
-                "initial lift)."
-            ),
-            "",
-            *outcome_table(report.tourcast),
-            "",
-            "Full path: 3-D distance between the model's position and the polynomial's at the same time since launch:",
-            "",
-            *path_table(report.paths),
-            "",
-            f"![path error]({os.path.relpath(figure, Path(out).resolve().parent)})",
-        ]
-    else:
-        lines.append(_missing(trajectory_file if not trajectory_file.is_file() else pbp_file))
-
-    lines += ["", "### Fine-tuning on part of the driver shots", ""]
-    if driver is not None and finetune_epochs > 0:
-        report.study = finetune_study(flyer, driver, clubs, epochs=finetune_epochs)
-        lines += _study_lines(report.study)
-    else:
-        lines.append("_Skipped: needs the driver shots._" if driver is None else "_Skipped (no epochs asked for)._")
+    report = AccuracyReport("", labels=[f.label for f in flyers])
+    lines = _header(flyers, "none of these sets records its weather.")
+    lines += ["", "## Held-out sets (never trained on, never used to choose a model; NOTES section 9)", ""]
+    lines += _drivers(data_dir, flyers, report)
+    lines += ["", *_tour_championship(data_dir, flyers, report)]
+    pga_lines, clubs = _pga(data_dir, flyers, report)
+    lines += ["", *pga_lines]
+    lines += ["", "## Context", "", *_paper(), "", *_slow(flyers, report)]
+    lines += ["", "## Training data and studies", ""]
+    lines += _sentry(data_dir, flyers, Path(out), Path(figures_dir), report)
+    lines += ["", *_study(data_dir, real, clubs, finetune_epochs, report)]
     report.markdown = "\n".join(lines) + "\n"
     write_generated_section(out, report.markdown, COMMAND)
     return report

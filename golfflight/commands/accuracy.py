@@ -1,22 +1,28 @@
-"""`golfflight accuracy`: a model bundle on the real data sets (PGA averages, outdoor driver shots, PGA TOUR
-trajectories) and a fine-tuning study, written into a docs page's generated section."""
+"""`golfflight accuracy`: the real-data model, the synthetic model and Ferguson 2022 side by side on the held-out
+real sets (and the context around them), written into a docs page's generated section."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
+DEFAULT_SYNTHETIC = "models/synthetic"
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "accuracy",
-        help="evaluate a model bundle on the real data sets and write docs/accuracy.md",
-        description="Fly a bundle through the runtime path on the shared real data (read by path, never copied): "
-        "TrackMan's PGA 2023 averages per club, the outdoor TrackMan driver shots and the PGA TOUR trajectories; "
-        "then fine-tune it on the first half of the driver shots and measure the second half. Sets that are not "
-        "found are skipped and said so.",
+        help="compare the real-data model, the synthetic model and Ferguson 2022 on the held-out real data and "
+        "write docs/accuracy.md",
+        description="Fly three models through the runtime path on the shared real data (read by path, never copied): "
+        "the held-out TrackMan drivers (lines 2943 on), the TOUR Championship 2020 and the PGA 2023 averages; the "
+        "paper's figures and slow shots for context; the Sentry 2022 trajectories with each shot's fitted wind; "
+        "and a fine-tuning study on the Sony Open 2022 (rounds 1-2 tuned, 3-4 measured). Sets that are not found are "
+        "skipped and said so.",
     )
-    parser.add_argument("--model", default="models/default", help="model bundle directory (default models/default)")
+    parser.add_argument("--model", default="models/default", help="the real-data model bundle (default models/default)")
+    parser.add_argument("--synthetic", help=f"the synthetic-data model bundle (default {DEFAULT_SYNTHETIC} where it "
+                        "exists, else the --model bundle again)")
     parser.add_argument("--out", default="docs/accuracy.md", help="markdown file whose generated section is replaced")
     parser.add_argument("--figures", help="directory for the path-error PNG (default: figures/ beside --out)")
     parser.add_argument("--data-dir", help="shared data folder (default: $GOLFFLIGHT_SHARED_DATA or ../shared/data)")
@@ -33,8 +39,11 @@ def run(args: argparse.Namespace) -> int:
         import torch
 
         torch.set_num_threads(1)  # batches of 64 shots: a second thread only adds synchronisation
+    synthetic = args.synthetic
+    if synthetic is None:
+        synthetic = DEFAULT_SYNTHETIC if Path(DEFAULT_SYNTHETIC, "model_card.json").is_file() else args.model
     figures = args.figures or Path(args.out).parent / "figures"
-    report = run_accuracy(args.model, args.out, figures, args.data_dir, args.finetune_epochs)
+    report = run_accuracy(args.model, args.out, figures, args.data_dir, args.finetune_epochs, synthetic=synthetic)
     print(report.markdown, end="")
     print(f"wrote {args.out}" + "".join(f", {path}" for path in report.figures))
     return 0

@@ -1,0 +1,113 @@
+"""The fine-tuning study of `golfflight accuracy`: `golfflight finetune` on some rounds of a tour event, measured on
+the event's later rounds before and after. It never touches a held-out set (NOTES section 9): the event is the Sony
+Open 2022 (trajectories only, so its spin is the loader's estimate from the initial lift).
+"""
+
+from __future__ import annotations
+
+import re
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from model_export.accuracy_flyers import ModelFlyer
+from model_export.accuracy_sets import ClubComparison, compare_clubs, outcome_errors
+from shots.records import ShotSet, write_shots
+from shots.reference_world import ClubAverage
+
+TRAIN_ROUNDS = (1, 2)
+MEASURED_ROUNDS = (3, 4)
+ROUND = re.compile(r"-R(\d+)(?:-|$)")
+
+
+def round_number(session: str | None, shot_id: str | None) -> int | None:
+    """The round of a TOURCAST shot: from its session ('006-R2') or its id ('006-R2-H5-P1-S1')."""
+    for text in (session, shot_id):
+        match = ROUND.search(text or "")
+        if match:
+            return int(match.group(1))
+    return None
+
+
+def by_rounds(shots: ShotSet, rounds: Sequence[int]) -> ShotSet:
+    return ShotSet([r for r in shots.records if round_number(r.session, r.shot_id) in rounds])
+
+
+@dataclass
+class FinetuneStudy:
+    """The later rounds before and after fine-tuning on the earlier ones, and what it did to the PGA table.
+    `validation` holds, per learning rate tried, the best epoch's validation landing error (m) and that epoch."""
+
+    n_shots: int
+    n_train: int
+    n_val: int
+    n_measured: int
+    epochs: int
+    lr: float
+    batch_size: int
+    best_epoch: int | None
+    improved: bool
+    before: dict[str, np.ndarray]
+    after: dict[str, np.ndarray]
+    base_validation_m: float
+    validation: dict[float, tuple[float, int | None]]
+    pga_after: ClubComparison | None = None
+
+
+def finetune_study(
+    flyer: ModelFlyer,
+    shots: ShotSet,
+    clubs: Sequence[ClubAverage] | None,
+    epochs: int = 30,
+    lrs: Sequence[float] = (3e-4, 1e-3),
+    batch_size: int = 64,
+    val_fraction: float = 0.2,
+    train_rounds: Sequence[int] = TRAIN_ROUNDS,
+    measured_rounds: Sequence[int] = MEASURED_ROUNDS,
+) -> FinetuneStudy:
+    """Fine-tune on `train_rounds` at each learning rate (written without a split column, so `golfflight finetune`
+    picks its validation shots by its own rule: the latest sessions, i.e. rounds), keep the rate whose best epoch has
+    the lowest validation landing error (the measured rounds play no part in any choice), and compare
+    `measured_rounds` before and after. Everything is written to a temporary directory, then deleted."""
+    from model_export.finetune import finetune
+
+    train, measured = by_rounds(shots, train_rounds), by_rounds(shots, measured_rounds)
+    if not len(train) or not len(measured):
+        raise ValueError(f"needs shots in rounds {list(train_rounds)} and {list(measured_rounds)}; "
+                         f"found {len(train)} and {len(measured)}")
+    launch = measured.launch()
+    before = outcome_errors(flyer.fly(launch), measured)
+    with tempfile.TemporaryDirectory(prefix="golfflight-finetune-") as work:
+        train_file = Path(work) / "train_rounds.csv"
+        write_shots(train_file, [r.model_copy(update={"split": None}) for r in train.records])
+        results = {}
+        for index, lr in enumerate(lrs):
+            results[lr] = (Path(work) / f"bundle-{index}",
+                           finetune(flyer.bundle, train_file, Path(work) / f"bundle-{index}", epochs, lr, batch_size,
+                                    val_fraction=val_fraction, progress=False))
+        validation = {lr: (float(r.run.best["landing_error_m"]) if r.run.best else float("inf"),
+                           None if r.run.best is None else int(r.run.best["epoch"])) for lr, (_, r) in results.items()}
+        lr = min(validation, key=lambda rate: validation[rate][0])
+        out, result = results[lr]
+        tuned = ModelFlyer(out) if result.improved else flyer
+        after = outcome_errors(tuned.fly(launch), measured)
+        pga_after = compare_clubs(tuned, clubs) if clubs and result.improved else None
+    return FinetuneStudy(
+        n_shots=len(shots),
+        n_train=result.run.data.n_train,
+        n_val=result.run.data.n_val,
+        n_measured=len(measured),
+        epochs=epochs,
+        lr=lr,
+        batch_size=batch_size,
+        best_epoch=validation[lr][1],
+        improved=result.improved,
+        before=before,
+        after=after,
+        base_validation_m=float(result.base_metrics["landing_error_m"]),
+        validation=validation,
+        pga_after=pga_after,
+    )
