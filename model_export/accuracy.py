@@ -175,7 +175,7 @@ def _header(flyers: Sequence[Flyer], rho_note: str) -> list[str]:
     models = [f for f in flyers if isinstance(f, ModelFlyer)]
     same = len({f.card.onnx.sha256 for f in models}) < len(models)
     lines = [
-        *table(("column", "model"), rows),
+        *table(("column", "model"), rows, align="ll"),
         "",
         (
             f"Every model is flown through `service.flight.simulate` (NumPy physics, forward Euler, dt "
@@ -351,10 +351,10 @@ def _sentry(data_dir: Path, flyers: Sequence[Flyer], out: Path, figures_dir: Pat
     report.figures.append(figure)
     lines += [
         (
-            f"Not held out: the real-data model may have been trained on these shots, so its column is a training "
-            f"error, shown for the full-path comparison only. `{TOURCAST_TRAJECTORIES.name}` joined with "
-            f"`{TOURCAST_PBP.name}` for spin: {conversion.report.rows_in} flights, {len(shots)} with a measured spin "
-            "and a complete polynomial (spin axis derived from the initial lift). Path error: 3-D distance between "
+            f"Not held out: `golfflight train-real` trains the real-data model on these shots, so its column is a "
+            f"training error, shown for the full-path comparison and the winds. `{TOURCAST_TRAJECTORIES.name}` joined "
+            f"with `{TOURCAST_PBP.name}` for spin: {conversion.report.rows_in} flights, {len(shots)} with a measured "
+            "spin and a complete polynomial (spin axis derived from the initial lift). Path error: 3-D distance between "
             "the model's position and the polynomial's at the same time since launch."
         ),
         "",
