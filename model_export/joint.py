@@ -36,7 +36,6 @@ from model_export.observations import (
 )
 from model_export.torch_physics import DT_S, T_SIM_S, euler_rollout, hard_landing, positions_at
 from model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, save_checkpoint
-from service.constants import YARD_M
 from shots.files import write_text_atomic
 
 HUBER_DELTA = 2.0
@@ -334,7 +333,3 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
                           json.dumps({"config": config.as_dict(), "best": best, "epochs": history}, indent=2) + "\n")
     return JointResult(out_dir, history, best)
 
-
-def landing_yd(metrics: dict[str, Any], source: str) -> float:
-    """A source's validation landing error in yards (NaN where it has none)."""
-    return metrics.get(source, {}).get("landing_error_m", float("nan")) / YARD_M
