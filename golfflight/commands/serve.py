@@ -3,7 +3,8 @@
 Binds 127.0.0.1 unless told otherwise. The API key comes from $GOLFFLIGHT_API_KEY only (never the command line,
 where `ps` would show it); browser origins for CORS from --cors-origin or $GOLFFLIGHT_CORS_ORIGINS. The bundle is
 verified completely before any worker starts; SIGTERM or Ctrl-C lets in-flight requests finish (up to
-GRACEFUL_SHUTDOWN_S) before the workers exit.
+GRACEFUL_SHUTDOWN_S) before the workers exit. --connect-port also takes GSPro Open Connect over TCP in the same
+process (`service.open_connect`), on loopback unless --connect-host says otherwise: the protocol has no key.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from __future__ import annotations
 import argparse
 import ipaddress
 import os
+import socket
 import sys
 
 GRACEFUL_SHUTDOWN_S = 30
@@ -18,7 +20,9 @@ GRACEFUL_SHUTDOWN_S = 30
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser("serve", help="serve flights over HTTP (OpenAPI docs at /docs)")
+    parser = subparsers.add_parser(
+        "serve", help="serve flights over HTTP (OpenAPI docs at /docs) and, with --connect-port, GSPro Open Connect"
+    )
     parser.add_argument("--host", default="127.0.0.1", help="interface to listen on (0.0.0.0 for every one)")
     parser.add_argument("--port", type=int, default=8000)
     parser.add_argument("--workers", type=int, default=1, help="processes, each with its own copy of the model")
@@ -28,6 +32,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         action="append",
         metavar="ORIGIN",
         help="allow browser calls from this origin, e.g. https://sim.example.com (repeatable; default: CORS off)",
+    )
+    parser.add_argument(
+        "--connect-port",
+        type=int,
+        metavar="PORT",
+        help="also take shots from launch-monitor connectors: GSPro Open Connect v1 over TCP on this port (GSPro's "
+        "own is 921; below 1024 needs privileges on Linux)",
+    )
+    parser.add_argument(
+        "--connect-host",
+        default="127.0.0.1",
+        help="interface for --connect-port (Open Connect has no authentication: keep loopback where you can)",
     )
     parser.set_defaults(run=run)
 
@@ -41,30 +57,52 @@ def _loopback(host: str) -> bool:
         return False
 
 
+def _listenable(host: str, port: int) -> None:
+    """Refuse a port that cannot be listened on now with one line saying why, not a traceback at startup."""
+    try:
+        socket.create_server((host, port)).close()
+    except OSError as error:
+        raise ValueError(f"--connect-port: cannot listen on {host}:{port}: {error.strerror or error}") from None
+
+
 def run(args: argparse.Namespace) -> int:
     import uvicorn
 
     from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
     from service.bundle_check import verify_bundle
     from service.model_location import MODEL_ENV, model_dir
+    from service.open_connect.server import CONNECT_HOST_ENV, CONNECT_PORT_ENV
 
     if args.workers < 1:
         raise ValueError(f"--workers must be at least 1, got {args.workers}")
+    if args.connect_port is not None and args.workers != 1:
+        raise ValueError("--connect-port needs --workers 1 (one process holds the connectors' port)")
     bundle = model_dir(args.model).resolve()
     card = verify_bundle(bundle)  # refuse a bad bundle here, before any worker starts
     os.environ[MODEL_ENV] = str(bundle)  # the factory in every worker process reads these
     if args.cors_origin:
         os.environ[CORS_ORIGINS_ENV] = ",".join(args.cors_origin)
+    connect = "off"
+    if args.connect_port is not None:
+        _listenable(args.connect_host, args.connect_port)
+        os.environ[CONNECT_PORT_ENV], os.environ[CONNECT_HOST_ENV] = str(args.connect_port), args.connect_host
+        connect = f"on tcp://{args.connect_host}:{args.connect_port}"
     keyed = bool(os.environ.get(API_KEY_ENV))
     print(
         f"golfflight serve: {card.variant} model from {bundle} on http://{args.host}:{args.port} (docs at /docs), "
         f"{args.workers} worker(s), API key {'required' if keyed else 'off'}, "
-        f"CORS {os.environ.get(CORS_ORIGINS_ENV) or 'off'}"
+        f"CORS {os.environ.get(CORS_ORIGINS_ENV) or 'off'}, GSPro Open Connect {connect}"
     )
     if not keyed and not _loopback(args.host):
         print(
             f"golfflight serve: warning: listening on {args.host} without an API key: anyone who can reach the port "
             f"can use the service (set {API_KEY_ENV})",
+            file=sys.stderr,
+        )
+    if args.connect_port is not None and not _loopback(args.connect_host):
+        print(
+            f"golfflight serve: warning: GSPro Open Connect on {args.connect_host}: anyone who can reach port "
+            f"{args.connect_port} can send shots (the protocol has no key)",
             file=sys.stderr,
         )
     uvicorn.run(

@@ -7,6 +7,7 @@ comes from `golfflight serve --workers N` (one process, one model and one batch 
 The model loads in a background thread at startup; /healthz answers 503 until it is ready. In front of the routes:
 a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and CORS only for configured origins
 ($GOLFFLIGHT_CORS_ORIGINS); every refusal is a 4xx whose body names the field, the value and the allowed range.
+Given a connect address, the lifespan also opens GSPro Open Connect over TCP on the same loop (`service.open_connect`).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from golfflight import __version__
 from service.api.batch_process import BatchProcess
-from service.api.gspro import GSPRO_RANGES, GSProMessage, GSProReply, launch_from_ball_data
+from service.api.gspro import GSProMessage, GSProReply, fly_message, invalid_message
 from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
 from service.api.latency import RequestTimer, Rolling
 from service.api.models import (
@@ -44,12 +45,15 @@ from service.api.models import (
     body_detail,
     describe_errors,
 )
-from service.api.shots import flight_fields, fly_shot
+from service.api.shots import fly_shot
 from service.engine import FlightEngine, FlightError
 from service.model_location import model_dir
+from service.open_connect.server import ConnectAddress, OpenConnectServer
 from weights_schema.model_card import ModelCard
 
 GSPRO_PATH = "/v1/gspro"
+GSPRO_STATUS = {200: 200, 500: 422, 503: 503}
+"""HTTP status of each Open Connect reply code on POST /v1/gspro."""
 BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has been restarted): send the batch again"
 PROBE_SHOT = ShotRequest(ball_speed_mps=55.0, launch_angle_deg=16.0, spin_rpm=7100.0)
 """The shot /v1/latency times on demand: a tour-average 7-iron in standard air."""
@@ -109,19 +113,38 @@ def create_app(
     *,
     api_key: str | None = None,
     cors_origins: list[str] | None = None,
+    connect: ConnectAddress | None = None,
 ) -> FastAPI:
     """The service for a model bundle (default: `service.model_location.model_dir()`).
 
     `api_key` (default $GOLFFLIGHT_API_KEY) makes every route but /healthz require it; `cors_origins` (default the
-    comma-separated $GOLFFLIGHT_CORS_ORIGINS) are the browser origins allowed; none means CORS stays off."""
+    comma-separated $GOLFFLIGHT_CORS_ORIGINS) are the browser origins allowed; none means CORS stays off. `connect`
+    (default from $GOLFFLIGHT_CONNECT_PORT and _HOST) also listens for GSPro Open Connect over TCP there."""
     state = ServiceState(model_dir(model))
     api_key = api_key if api_key is not None else os.environ.get(API_KEY_ENV, "")
     cors_origins = cors_origins if cors_origins is not None else _origins(os.environ.get(CORS_ORIGINS_ENV))
+    connect = connect if connect is not None else ConnectAddress.from_env()
+
+    def gspro_reply(message: GSProMessage) -> GSProReply:
+        """A GSPro shot's reply over HTTP and TCP alike (timed into /v1/latency); Code 503 until the model is ready."""
+        if state.engine is None:
+            return GSProReply(Code=503, Message=state.error or "the model is still loading")
+        started = time.perf_counter()
+        try:
+            return fly_message(state.engine, message)
+        finally:
+            state.simulation.add(time.perf_counter() - started)
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
+        tcp = OpenConnectServer(gspro_reply) if connect else None
+        if tcp:
+            await tcp.start(connect)  # before the model loads: a port that cannot be had stops the startup cleanly
+        app.state.open_connect = tcp
         loading = asyncio.get_running_loop().run_in_executor(None, state.load)
         yield
+        if tcp:
+            await tcp.close()
         await loading
         state.batches.stop()
 
@@ -152,7 +175,7 @@ def create_app(
     @app.exception_handler(RequestValidationError)
     async def invalid_request(request: Request, error: RequestValidationError) -> JSONResponse:
         if request.url.path == GSPRO_PATH:
-            message = "; ".join(d["message"] for d in describe_errors(error.errors(), GSPRO_RANGES))
+            message = invalid_message(error.errors())
             return JSONResponse(GSProReply(Code=500, Message=message).model_dump(exclude_none=True), 422)
         return JSONResponse({"detail": describe_errors(error.errors(), RANGES)}, 422)
 
@@ -167,8 +190,6 @@ def create_app(
 
     @app.exception_handler(NotReady)
     async def not_ready(request: Request, error: NotReady) -> JSONResponse:
-        if request.url.path == GSPRO_PATH:
-            return JSONResponse({"Code": 503, "Message": str(error)}, 503)
         return JSONResponse({"detail": str(error)}, 503)
 
     @app.post(
@@ -222,19 +243,10 @@ def create_app(
         invalid message or a failed flight gets HTTP 422 with Open Connect's error reply (Code 500, a Message)."""
         if message.is_heartbeat:
             return _json(GSProReply(Code=200, Message="heartbeat received"))
-        if message.BallData is None or not message.ShotDataOptions.ContainsBallData:
+        if message.BallData is None:
             return _json(GSProReply(Code=200, Message="no ball data: nothing to fly", ShotNumber=message.ShotNumber))
-        flying = engine()
-        started = time.perf_counter()
-        try:
-            launch = launch_from_ball_data(message.BallData)
-            flight = flying.fly(launch)
-        except (ValueError, FlightError) as error:
-            return _json(GSProReply(Code=500, Message=str(error), ShotNumber=message.ShotNumber), 422)
-        finally:
-            state.simulation.add(time.perf_counter() - started)
-        result = ShotResult.model_construct(**flight_fields(flight, None))
-        return _json(GSProReply(Code=200, Message="shot received", ShotNumber=message.ShotNumber, Flight=result))
+        reply = gspro_reply(message)
+        return _json(reply, GSPRO_STATUS[reply.Code])
 
     @app.get("/healthz")
     async def healthz() -> JSONResponse:

@@ -1,29 +1,53 @@
 """GSPro Open Connect v1 shot messages (NOTES.md section 4), as a launch-monitor connector sends them.
 
-The protocol is not ours, so unknown fields are ignored (connectors add their own); the values we use are
-type- and range-checked like every other launch (GSPRO_RANGES, quoted in the error message).
-Speeds are mph, angles degrees (HLA + = right), spins rpm. BackSpin and
-SideSpin are used only when TotalSpin is absent (or zero while they are not); + SideSpin curves the ball right.
+The protocol is not ours, so unknown fields are ignored (connectors add their own) and known ones are matched in any
+letter case (connectors in the wild send `APIVersion` and `Backspin`); the values we use are type- and range-checked
+like every other launch (GSPRO_RANGES, quoted in the error message). The BallData of a heartbeat or of a message
+that says it carries none is not read (connectors pad it with zeros). Speeds are mph, angles degrees (HLA + =
+right), spins rpm. BackSpin and SideSpin are used only when TotalSpin is absent (or zero while they are not);
++ SideSpin curves the ball right. HTTP (`POST /v1/gspro`) and TCP (`service.open_connect`) answer through
+`fly_message` and `invalid_message`.
 """
 
 from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from service import limits
-from service.api.models import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotResult
-from service.api.shots import spin_from_components
+from service.api.models import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotResult, describe_errors
+from service.api.shots import flight_fields, spin_from_components
 from service.constants import MPH_TO_MPS
-from service.engine import Launch
+from service.engine import FlightEngine, FlightError, Launch
 from service.limits import Range
 
 
+def _spelled_as_fields(data, fields) -> dict:
+    """`data` with each key that matches a field but for letter case renamed to the field (unknown keys kept); a
+    field given twice with different values is refused."""
+    if not isinstance(data, dict):
+        return data
+    names = {name.casefold(): name for name in fields}
+    renamed: dict = {}
+    for key, value in data.items():
+        name = names.get(key.casefold(), key) if isinstance(key, str) else key
+        if name in renamed and renamed[name] != value:
+            raise ValueError(f"{name} is given twice, in two spellings, with different values")
+        renamed[name] = value
+    return renamed
+
+
 class _Lenient(BaseModel):
-    """Ignores unknown fields; refuses non-finite numbers and values of the wrong JSON type."""
+    """Ignores unknown fields and the letter case of known ones; refuses non-finite numbers and values of the wrong
+    JSON type."""
 
     model_config = ConfigDict(extra="ignore", allow_inf_nan=False, strict=True)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _any_case(cls, data):
+        return _spelled_as_fields(data, cls.model_fields)
 
 
 GSPRO_RANGES: dict[str, Range] = {
@@ -75,14 +99,30 @@ class GSProMessage(_Lenient):
     ClubData: dict | None = None
     ShotDataOptions: GSProOptions = Field(default_factory=GSProOptions)
 
+    @model_validator(mode="before")
+    @classmethod
+    def _ball_data_only_for_a_shot(cls, data):
+        """Leave out the BallData of a heartbeat or of a message whose options say it carries none."""
+        data = _spelled_as_fields(data, cls.model_fields)
+        if not isinstance(data, dict):
+            return data
+        options = _spelled_as_fields(data.get("ShotDataOptions"), GSProOptions.model_fields)
+        if not isinstance(options, dict):
+            return data
+        if options.get("IsHeartBeat") is True or options.get("ContainsBallData") is False:
+            data = {key: value for key, value in data.items() if key != "BallData"}
+        return data
+
     @property
     def is_heartbeat(self) -> bool:
         return self.ShotDataOptions.IsHeartBeat
 
 
 class GSProReply(BaseModel):
-    """Open Connect's reply: Code 200 with the flight for a shot, 200 for a heartbeat, 500 with a Message on error
-    (sent with HTTP 422)."""
+    """Open Connect's reply: Code 200 with the flight for a shot; 500 with a Message for an invalid message or a
+    failed flight; 503 while the model loads. Over HTTP a heartbeat gets Code 200 and Code 500 comes with status
+    422; over TCP a heartbeat gets no reply. The flight is the HTTP service's own result, so whatever it gains
+    (the ground phase's total and roll) the reply carries too."""
 
     Code: int
     Message: str
@@ -105,3 +145,19 @@ def launch_from_ball_data(ball: GSProBallData) -> Launch:
     else:
         spin, axis = ball.TotalSpin or 0.0, ball.SpinAxis or 0.0
     return Launch(ball.Speed * MPH_TO_MPS, ball.VLA, ball.HLA or 0.0, spin, axis)
+
+
+def invalid_message(errors: list) -> str:
+    """The Message of Code 500 for a message that failed validation: each problem with its field, value and range."""
+    return "; ".join(detail["message"] for detail in describe_errors(errors, GSPRO_RANGES))
+
+
+def fly_message(engine: FlightEngine, message: GSProMessage) -> GSProReply:
+    """The reply to a message with BallData: Code 200 with its flight (standard air), or Code 500 saying why it
+    could not fly."""
+    try:
+        flight = engine.fly(launch_from_ball_data(message.BallData))
+    except (ValueError, FlightError) as error:
+        return GSProReply(Code=500, Message=str(error), ShotNumber=message.ShotNumber)
+    result = ShotResult.model_construct(**flight_fields(flight, None))
+    return GSProReply(Code=200, Message="shot received", ShotNumber=message.ShotNumber, Flight=result)

@@ -1,0 +1,126 @@
+"""Cut a TCP byte stream into the JSON objects a GSPro connector writes back to back, with no delimiter.
+
+Objects are found by brace depth outside strings (escapes honoured) and parsed only once complete. Parsing the
+growing buffer with `json.JSONDecoder.raw_decode` instead cannot tell an object cut mid-token (`{"IsHeartBeat": tr`)
+from a broken one, nor where a broken object ends; counting braces answers both, so one bad object is refused and
+the next one read. Bytes are scanned as they come: `{`, `}`, `"` and `\\` never occur inside a UTF-8 multi-byte
+character, so no decoding is needed to find the ends.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+MAX_MESSAGE_BYTES = 64 * 1024
+"""Largest object accepted; an Open Connect message is about 600 bytes."""
+
+_IN_OBJECT = re.compile(rb'[{}"]')
+_IN_STRING = re.compile(rb'["\\]')
+_NOT_SPACE = re.compile(rb"[^ \t\r\n]")
+_QUOTED = 40
+"""Characters of refused input quoted in its refusal."""
+
+
+def _quote(data: bytes) -> str:
+    text = data.decode("utf-8", "replace")
+    return repr(text if len(text) <= _QUOTED else text[:_QUOTED] + "...")
+
+
+@dataclass(frozen=True)
+class Refused:
+    """Input that is not a JSON object (stray bytes, an object over the size limit, one given up half-sent)."""
+
+    message: str
+
+
+class ObjectFramer:
+    """Feed it the bytes of one connection as they arrive; it hands back each complete top-level object (bytes, not
+    yet parsed) and a `Refused` for whatever is not one, in stream order. Memory stays under `limit` bytes: an
+    object that outgrows it is refused at once and the rest of it skipped."""
+
+    def __init__(self, limit: int = MAX_MESSAGE_BYTES):
+        self.limit = limit
+        self._reset()
+
+    def _reset(self) -> None:
+        self._object = bytearray()
+        self._depth = 0
+        self._in_string = False
+        self._escaped = False
+        self._oversized = False
+
+    @property
+    def partial(self) -> bool:
+        """Whether an object has begun and not yet ended."""
+        return self._depth > 0
+
+    def give_up(self) -> Refused | None:
+        """Drop the object begun and not finished (its sender went quiet), so the next object starts clean; the
+        refusal, or None for an object already refused for its size."""
+        refusal = Refused(f"incomplete JSON object {_quote(self._object)}: nothing more came")
+        oversized = self._oversized
+        self._reset()
+        return None if oversized else refusal
+
+    def feed(self, data: bytes) -> list[bytes | Refused]:
+        """Complete objects and refusals found in `data` (plus what earlier calls left unfinished)."""
+        found: list[bytes | Refused] = []
+        position = 0
+        while position < len(data):
+            if self._depth == 0:
+                position = self._top_level(data, position, found)
+            else:
+                position = self._inside(data, position, found)
+        return found
+
+    def _top_level(self, data: bytes, position: int, found: list[bytes | Refused]) -> int:
+        """Skip whitespace; open the next object, or refuse the stray bytes up to it."""
+        start = _NOT_SPACE.search(data, position)
+        if start is None:
+            return len(data)
+        if data[start.start()] == ord("{"):
+            self._depth, self._object = 1, bytearray(b"{")
+            return start.start() + 1
+        end = data.find(b"{", start.start())
+        end = len(data) if end < 0 else end
+        stray = _quote(data[start.start() : end].rstrip())
+        found.append(Refused(f"expected a JSON object starting with '{{', got {stray}"))
+        return end
+
+    def _inside(self, data: bytes, position: int, found: list[bytes | Refused]) -> int:
+        """Advance through an open object to its end or the end of `data`."""
+        if self._escaped:  # the byte after a backslash that ended the previous chunk
+            self._escaped = False
+            self._keep(data, position, position + 1, found)
+            return position + 1
+        pattern = _IN_STRING if self._in_string else _IN_OBJECT
+        hit = pattern.search(data, position)
+        if hit is None:
+            self._keep(data, position, len(data), found)
+            return len(data)
+        end, byte = hit.end(), data[hit.start()]
+        if byte == ord("\\"):
+            if end == len(data):
+                self._escaped = True
+            else:
+                end += 1
+        elif byte == ord('"'):
+            self._in_string = not self._in_string
+        else:
+            self._depth += 1 if byte == ord("{") else -1
+        self._keep(data, position, end, found)
+        if self._depth == 0:
+            if not self._oversized:
+                found.append(bytes(self._object))
+            self._object, self._oversized = bytearray(), False
+        return end
+
+    def _keep(self, data: bytes, start: int, end: int, found: list[bytes | Refused]) -> None:
+        """Add data[start:end] to the open object unless it is being skipped for its size."""
+        if self._oversized:
+            return
+        self._object += data[start:end]
+        if len(self._object) > self.limit:
+            found.append(Refused(f"message over {self.limit:,} bytes: skipped to its end"))
+            self._object, self._oversized = bytearray(), True

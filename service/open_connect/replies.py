@@ -1,0 +1,38 @@
+"""What golfflight sends back for each object a connector writes over TCP: a shot's reply, an error, or nothing.
+
+Heartbeats and messages without ball data get no reply (GSPro sends none: a connector that waits for one would
+resend). Everything that is not a valid message gets Code 500 with a Message saying what is wrong, as the HTTP
+route's does (`service.api.gspro.invalid_message`).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+
+from pydantic import ValidationError
+
+from service.api.gspro import GSProMessage, GSProReply, invalid_message
+from service.open_connect.framing import Refused
+
+Answer = Callable[[GSProMessage], GSProReply]
+"""Flies a message that carries BallData: the service's shared GSPro answer (timing, the engine, its readiness)."""
+
+
+def reply_to(item: bytes | Refused, answer: Answer) -> GSProReply | None:
+    """The reply to one framed object (or refusal); None for a heartbeat or a message without ball data."""
+    if isinstance(item, Refused):
+        return GSProReply(Code=500, Message=item.message)
+    try:
+        data = json.loads(item)
+    except ValueError as error:  # JSONDecodeError, or UnicodeDecodeError for bytes that are not UTF-8
+        return GSProReply(Code=500, Message=f"not valid JSON: {error}")
+    except RecursionError:
+        return GSProReply(Code=500, Message="not valid JSON: nested too deeply")
+    try:
+        message = GSProMessage.model_validate(data)
+    except ValidationError as error:
+        return GSProReply(Code=500, Message=invalid_message(error.errors()))
+    if message.BallData is None:
+        return None
+    return answer(message)

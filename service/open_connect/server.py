@@ -1,0 +1,110 @@
+"""The TCP listener: one task per connector connection, objects framed as they arrive, one reply per shot.
+
+It runs on the HTTP service's event loop, opened and closed by the app's lifespan, not in a process of its own: the
+model is loaded once, TCP shots count in /v1/latency with HTTP's, and whatever the app does with its shots sees
+these too. Shots fly inline on the loop (no thread): one takes about half a millisecond, less than a hop to a
+thread costs, and the replies measured with several connectors sending at once stay in milliseconds
+(docs/service.md), against the 5 s after which a connector sends a shot again.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import os
+from dataclasses import dataclass
+
+from service.api.gspro import GSProReply
+from service.open_connect.framing import ObjectFramer, Refused
+from service.open_connect.replies import Answer, reply_to
+
+CONNECT_HOST_ENV = "GOLFFLIGHT_CONNECT_HOST"
+CONNECT_PORT_ENV = "GOLFFLIGHT_CONNECT_PORT"
+GIVE_UP_S = 2.0
+"""How long a half-received object waits for the rest: a connector writes a message in one go, so its pieces arrive
+within milliseconds; after this the piece is refused and the next object starts clean, before a connector's
+5 s resend arrives."""
+READ_BYTES = 64 * 1024
+INTERNAL_ERROR = "internal error while answering this message (the server log has the details)"
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class ConnectAddress:
+    """Where to listen for connectors: loopback unless told otherwise (the protocol has no authentication)."""
+
+    port: int
+    host: str = "127.0.0.1"
+
+    @classmethod
+    def from_env(cls) -> ConnectAddress | None:
+        """The address `golfflight serve --connect-port` passes its workers, or None when TCP is off."""
+        port = os.environ.get(CONNECT_PORT_ENV)
+        if not port:
+            return None
+        return cls(int(port), os.environ.get(CONNECT_HOST_ENV) or cls.host)
+
+
+class OpenConnectServer:
+    """GSPro Open Connect v1 on a TCP port; `answer` flies each message that carries a shot."""
+
+    def __init__(self, answer: Answer):
+        self.answer = answer
+        self._server: asyncio.Server | None = None
+        self._connections: set[asyncio.Task] = set()
+
+    async def start(self, address: ConnectAddress) -> None:
+        """Listen (OSError when the port cannot be had)."""
+        self._server = await asyncio.start_server(self._serve, address.host, address.port)
+
+    @property
+    def port(self) -> int:
+        """The port listened on."""
+        return self._server.sockets[0].getsockname()[1]
+
+    async def close(self) -> None:
+        """Stop listening and close every connection (replies already written still go out)."""
+        self._server.close()
+        connections = list(self._connections)
+        for connection in connections:
+            connection.cancel()
+        await asyncio.gather(*connections, return_exceptions=True)
+        await self._server.wait_closed()
+
+    async def _serve(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        task = asyncio.current_task()
+        self._connections.add(task)
+        framer = ObjectFramer()
+        try:
+            while True:
+                try:
+                    async with asyncio.timeout(GIVE_UP_S if framer.partial else None):
+                        data = await reader.read(READ_BYTES)
+                except TimeoutError:
+                    refusal = framer.give_up()
+                    items = [refusal] if refusal else []
+                else:
+                    if not data:
+                        break
+                    items = framer.feed(data)
+                for item in items:
+                    reply = self._reply(item)
+                    if reply is not None:
+                        writer.write(reply.model_dump_json(exclude_none=True).encode())
+                await writer.drain()
+        except ConnectionError:
+            pass  # the connector went away; it reconnects on its own
+        except asyncio.CancelledError:
+            pass  # close(): ends here, not as an error of the stream's callback
+        finally:
+            self._connections.discard(task)
+            writer.close()
+
+    def _reply(self, item: bytes | Refused) -> GSProReply | None:
+        """`reply_to`, with any unexpected failure answered (and logged) instead of ending the connection."""
+        try:
+            return reply_to(item, self.answer)
+        except Exception:
+            log.exception("GSPro Open Connect: answering a message failed")
+            return GSProReply(Code=500, Message=INTERNAL_ERROR)

@@ -1,0 +1,320 @@
+"""GSPro Open Connect v1 over TCP: a real server (the app with its shipped model, uvicorn, a loopback port) and a
+client that behaves like a connector (one socket, heartbeats, objects with no delimiter, resend after 5 s of
+silence)."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import socket
+import threading
+import time
+
+import pytest
+
+from golfflight.cli import main
+from service.api.app import create_app
+from service.api.gspro import GSProReply
+from service.open_connect.framing import MAX_MESSAGE_BYTES
+from service.open_connect.server import GIVE_UP_S, INTERNAL_ERROR, ConnectAddress, OpenConnectServer
+from tests.servers import free_port, running
+
+RESEND_S = 5.0
+"""A popular connector's wait for a reply before it sends the shot again."""
+
+SHOT = {
+    "DeviceID": "Connector test",
+    "Units": "Yards",
+    "ShotNumber": 1,
+    "APIversion": "1",
+    "BallData": {
+        "Speed": 167.0,
+        "SpinAxis": -3.0,
+        "TotalSpin": 2650.0,
+        "BackSpin": 2646.0,
+        "SideSpin": -139.0,
+        "HLA": 1.2,
+        "VLA": 11.0,
+        "CarryDistance": 270.0,
+    },
+    "ClubData": {"Speed": 112.0, "AngleOfAttack": 1.0, "FaceToTarget": 0.5, "Path": 1.0},
+    "ShotDataOptions": {
+        "ContainsBallData": True,
+        "ContainsClubData": True,
+        "LaunchMonitorIsReady": True,
+        "LaunchMonitorBallDetected": True,
+        "IsHeartBeat": False,
+    },
+}
+HEARTBEAT = {
+    "DeviceID": "Connector test",
+    "Units": "Yards",
+    "ShotNumber": 0,
+    "APIversion": "1",
+    "BallData": {"Speed": 0.0, "SpinAxis": 0.0, "TotalSpin": 0.0, "HLA": 0.0, "VLA": 0.0},
+    "ShotDataOptions": {"ContainsBallData": False, "LaunchMonitorIsReady": True, "IsHeartBeat": True},
+}
+
+
+def shot(number: int, **ball) -> dict:
+    return {**SHOT, "ShotNumber": number, "BallData": {**SHOT["BallData"], **ball}}
+
+
+def encoded(message: dict) -> bytes:
+    return json.dumps(message).encode()
+
+
+def _no_constant(name: str):
+    raise AssertionError(f"a reply carried {name}")
+
+
+class Connector:
+    """A launch-monitor connector's side of the socket: it writes JSON objects and reads the replies."""
+
+    def __init__(self, port: int):
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=RESEND_S)
+        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.buffer = b""
+
+    def close(self) -> None:
+        self.sock.close()
+
+    def send(self, data: bytes) -> None:
+        self.sock.sendall(data)
+
+    def reply(self, timeout_s: float = RESEND_S) -> dict | None:
+        """The next reply, or None after `timeout_s` of silence (NaN or infinity in it fails the test)."""
+        deadline = time.monotonic() + timeout_s
+        while True:
+            text = self.buffer.decode().lstrip()
+            if text:
+                try:
+                    reply, end = json.JSONDecoder(parse_constant=_no_constant).raw_decode(text)
+                except json.JSONDecodeError:
+                    pass
+                else:
+                    self.buffer = text[end:].encode()
+                    return reply
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return None
+            self.sock.settimeout(left)
+            try:
+                data = self.sock.recv(8096)
+            except TimeoutError:
+                return None
+            assert data, "the server closed the connection"
+            self.buffer += data
+
+    def fly(self, message: dict, attempts: int = 3) -> tuple[dict, float, int]:
+        """Send a shot as connectors do, again after RESEND_S of silence: (reply, seconds to it, sends)."""
+        for sends in range(1, attempts + 1):
+            started = time.perf_counter()
+            self.send(encoded(message))
+            reply = self.reply()
+            if reply is not None:
+                return reply, time.perf_counter() - started, sends
+        raise AssertionError(f"no reply after {attempts} sends")
+
+    def still_open(self) -> bool:
+        """Whether the server keeps the connection (a shot still gets its reply)."""
+        reply, _, _ = self.fly(shot(99))
+        return reply["Code"] == 200
+
+
+@pytest.fixture(scope="module")
+def service():
+    """(HTTP client, TCP port) of one app serving both."""
+    port = free_port()
+    with running(create_app(connect=ConnectAddress(port))) as http:
+        yield http, port
+
+
+@pytest.fixture()
+def connector(service):
+    client = Connector(service[1])
+    yield client
+    client.close()
+
+
+def test_a_connector_session_heartbeat_then_a_shot_answered_at_once(service, connector):
+    http, _ = service
+    connector.send(encoded(HEARTBEAT))
+    assert connector.reply(timeout_s=0.5) is None  # heartbeats get no reply
+    reply, seconds, sends = connector.fly(SHOT)
+    assert reply["Code"] == 200 and reply["ShotNumber"] == 1 and sends == 1
+    assert seconds < 0.5, f"{seconds:.3f} s to the reply"  # connectors resend after 5 s
+    over_http = http.post("/v1/gspro", json=SHOT).json()
+    assert reply["Flight"] == over_http["Flight"]  # one mapping, one engine
+    flight = reply["Flight"]
+    assert 230 < flight["carry_yd"] < 300 and flight["apex_yd"] > 20 and flight["landing_angle_deg"] > 20
+    connector.send(encoded(HEARTBEAT))
+    assert connector.reply(timeout_s=0.5) is None and connector.still_open()
+
+
+def test_objects_back_to_back_in_one_send_each_get_their_reply_in_order(connector):
+    connector.send(b"".join(encoded(m) for m in (shot(11), HEARTBEAT, shot(12, Speed=90.0, VLA=24.0), shot(13))))
+    replies = [connector.reply() for _ in range(3)]
+    assert [r["ShotNumber"] for r in replies] == [11, 12, 13] and {r["Code"] for r in replies} == {200}
+    assert replies[1]["Flight"]["carry_yd"] < replies[0]["Flight"]["carry_yd"]
+    assert connector.reply(timeout_s=0.3) is None
+
+
+def test_an_object_split_byte_by_byte(connector):
+    message = {**shot(21), "DeviceID": 'R10 "{bay 2}" \\ ünïcode'}  # braces, quotes and escapes inside a string
+    data = encoded(message) + encoded(HEARTBEAT)
+    for i in range(len(data)):
+        connector.send(data[i : i + 1])
+        time.sleep(0.0005)
+    reply = connector.reply()
+    assert reply["Code"] == 200 and reply["ShotNumber"] == 21
+    assert connector.reply(timeout_s=0.3) is None  # the heartbeat that followed
+
+
+def test_both_key_spellings_seen_in_the_wild(connector):
+    spelled = encoded(shot(31, TotalSpin=None))  # no TotalSpin: the flight needs BackSpin, however it is spelled
+    respelled = spelled.replace(b'"APIversion"', b'"APIVersion"').replace(b'"BackSpin"', b'"Backspin"')
+    assert b'"Backspin"' in respelled and b'"APIVersion"' in respelled
+    replies = []
+    for data in (spelled, respelled):
+        connector.send(data)
+        replies.append(connector.reply())
+    assert replies[0]["Code"] == 200 and replies[0] == replies[1]
+
+
+def test_malformed_input_gets_a_5xx_with_a_message_and_the_connection_goes_on(connector):
+    for bad, says in (
+        (b'{"BallData": {"Speed": 150,, "VLA": 12}}', "not valid JSON"),
+        (b'hello{"ShotNumber": 3, "BallData": {"Speed": 150.0, "VLA": 12.0, "TotalSpin": 3000.0}}', "expected a JSON"),
+        (b'{"DeviceID": "\xff\xfe", "BallData": {}}', "not valid JSON"),
+        (b'{"ShotNumber": "seven"}', "ShotNumber"),
+        (b'{"a": ' + b"[" * 30_000 + b"]" * 30_000 + b"}", "nested too deeply"),
+    ):
+        connector.send(bad)
+        reply = connector.reply()
+        assert 500 <= reply["Code"] < 600 and says in reply["Message"], reply
+        if bad.startswith(b"hello"):  # the object after the stray bytes is read as usual
+            assert connector.reply()["Code"] == 200
+    assert connector.reply(timeout_s=0.3) is None and connector.still_open()
+
+
+def test_out_of_range_values_name_the_field_and_its_range(connector):
+    for ball, says in (
+        ({"Speed": 400.0}, "(got 400.0); allowed 1.11847 to 223.694 mph"),
+        ({"VLA": -45.0}, "BallData.VLA"),
+        ({"TotalSpin": 20000.0}, "BallData.TotalSpin"),
+        ({"TotalSpin": None, "BackSpin": 14000.0, "SideSpin": 9000.0}, "BackSpin and SideSpin make 16643 rpm"),
+        ({"VLA": None}, "BallData is missing VLA"),
+    ):
+        reply, _, _ = connector.fly(shot(41, **ball))
+        assert reply["Code"] == 500 and says in reply["Message"], reply
+    connector.send(encoded(shot(42)).replace(b'"Speed": 167.0', b'"Speed": NaN'))
+    reply = connector.reply()
+    assert reply["Code"] == 500 and "BallData.Speed: Input should be a finite number" in reply["Message"]
+    assert connector.still_open()
+
+
+def test_an_object_over_the_size_limit_is_refused_and_skipped(connector):
+    padding = "x" * MAX_MESSAGE_BYTES
+    connector.send(encoded({**shot(51), "DeviceID": padding}) + encoded(shot(52)))
+    refused, following = connector.reply(), connector.reply()
+    assert refused["Code"] == 500 and f"message over {MAX_MESSAGE_BYTES:,} bytes" in refused["Message"]
+    assert following["Code"] == 200 and following["ShotNumber"] == 52
+
+
+def test_a_half_sent_object_is_given_up_after_a_pause(connector):
+    connector.send(encoded(shot(61))[:40])
+    started = time.perf_counter()
+    reply = connector.reply()
+    waited = time.perf_counter() - started
+    assert reply["Code"] == 500 and "incomplete JSON object" in reply["Message"]
+    assert GIVE_UP_S - 0.1 < waited < GIVE_UP_S + 1.0 < RESEND_S
+    assert connector.fly(shot(62))[0]["ShotNumber"] == 62
+
+
+def test_a_resent_shot_is_answered_again(connector):
+    first, _, _ = connector.fly(shot(71))
+    again, _, _ = connector.fly(shot(71))
+    assert first == again
+
+
+def test_several_connectors_at_once_each_answered_in_milliseconds(service):
+    _, port = service
+    stalled = Connector(port)
+    stalled.send(encoded(shot(80))[:50])  # half a message on one connection holds up no other
+    seconds: list[float] = []
+    failures: list[BaseException] = []
+
+    def bay(number: int) -> None:
+        client = Connector(port)
+        try:
+            client.send(encoded(HEARTBEAT))
+            for i in range(25):
+                reply, took, sends = client.fly(shot(1000 * number + i, Speed=100.0 + 3 * i))
+                assert reply["Code"] == 200 and reply["ShotNumber"] == 1000 * number + i and sends == 1
+                seconds.append(took)
+        except BaseException as error:  # noqa: BLE001 - reported by the main thread
+            failures.append(error)
+        finally:
+            client.close()
+
+    bays = [threading.Thread(target=bay, args=(n,)) for n in range(1, 5)]
+    for thread in bays:
+        thread.start()
+    for thread in bays:
+        thread.join(timeout=60)
+    stalled.close()
+    assert not failures, failures
+    assert len(seconds) == 100
+    p50, worst = sorted(seconds)[50], max(seconds)
+    print(f"4 connectors, 100 shots: reply p50 {p50 * 1e3:.2f} ms, max {worst * 1e3:.2f} ms")
+    assert worst < 1.0 < RESEND_S
+
+
+def test_shutdown_closes_every_connection_and_the_port(tmp_path):
+    port = free_port()
+    with running(create_app(connect=ConnectAddress(port))):
+        client = Connector(port)
+        reply, _, _ = client.fly(shot(91))
+        assert reply["Code"] == 200
+    client.sock.settimeout(5)
+    assert client.sock.recv(100) == b""  # the server closed it
+    client.close()
+    with pytest.raises(ConnectionRefusedError):
+        socket.create_connection(("127.0.0.1", port), timeout=2).close()
+
+
+def test_a_failure_inside_an_answer_is_answered_and_the_connection_kept():
+    calls = []
+
+    def answer(message):
+        calls.append(message.ShotNumber)
+        if len(calls) == 1:
+            raise RuntimeError("a bug")
+        return GSProReply(Code=200, Message="shot received", ShotNumber=message.ShotNumber)
+
+    async def session() -> list[dict]:
+        server = OpenConnectServer(answer)
+        await server.start(ConnectAddress(0))
+        reader, writer = await asyncio.open_connection("127.0.0.1", server.port)
+        writer.write(encoded(shot(1)) + encoded(shot(2)))
+        replies = [json.loads(await reader.readuntil(b"}")) for _ in range(2)]
+        await server.close()
+        assert await reader.read() == b""
+        writer.close()
+        return replies
+
+    replies = asyncio.run(session())
+    assert replies == [
+        {"Code": 500, "Message": INTERNAL_ERROR},
+        {"Code": 200, "Message": "shot received", "ShotNumber": 2},
+    ]
+
+
+def test_serve_refuses_tcp_with_several_workers_and_a_busy_port(capsys):
+    assert main(["serve", "--connect-port", str(free_port()), "--workers", "2"]) == 2
+    assert "--connect-port" in capsys.readouterr().err
+    with socket.create_server(("127.0.0.1", 0)) as busy:
+        taken = busy.getsockname()[1]
+        assert main(["serve", "--port", str(free_port()), "--connect-port", str(taken)]) == 2
+    assert f"127.0.0.1:{taken}" in capsys.readouterr().err
