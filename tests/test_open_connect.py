@@ -11,11 +11,14 @@ import threading
 import time
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from golfflight.cli import main
 from service.api.app import create_app
 from service.api.gspro import GSProReply
-from service.open_connect.framing import MAX_MESSAGE_BYTES
+from service.open_connect.framing import MAX_MESSAGE_BYTES, ObjectFramer, Refused
+from service.open_connect.replies import reply_to
 from service.open_connect.server import GIVE_UP_S, INTERNAL_ERROR, ConnectAddress, OpenConnectServer
 from tests.servers import free_port, running
 
@@ -120,6 +123,38 @@ class Connector:
         """Whether the server keeps the connection (a shot still gets its reply)."""
         reply, _, _ = self.fly(shot(99))
         return reply["Code"] == 200
+
+
+TRICKY_TEXT = st.text(alphabet=st.sampled_from('ab{}[]"\\ é\n'), max_size=8)
+"""Strings full of what a framer could mistake for structure."""
+JSON_VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers() | TRICKY_TEXT,
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(TRICKY_TEXT, inner, max_size=3),
+    max_leaves=8,
+)
+
+
+@settings(deadline=None)
+@given(st.lists(st.dictionaries(TRICKY_TEXT, JSON_VALUES, max_size=4), min_size=1, max_size=4), st.data())
+def test_any_split_of_a_stream_of_objects_gives_them_back(objects, data):
+    stream = b"".join(json.dumps(o, ensure_ascii=False).encode() for o in objects)
+    cuts = sorted(data.draw(st.sets(st.integers(1, len(stream)), max_size=12)))
+    framer, found = ObjectFramer(), []
+    for start, end in zip([0, *cuts], [*cuts, len(stream)], strict=True):
+        found += framer.feed(stream[start:end])
+    assert [json.loads(item) for item in found] == objects and not framer.partial
+
+
+@settings(deadline=None)
+@given(st.binary(max_size=200) | st.builds(lambda b: b"{" + b, st.binary(max_size=200)))
+def test_any_bytes_are_answered_or_passed_over_never_raised(data):
+    framer = ObjectFramer(limit=100)
+    items = framer.feed(data) + ([framer.give_up()] if framer.partial else [])
+    for item in items:
+        assert isinstance(item, bytes | Refused | None)
+        if item is not None:
+            reply = reply_to(item, lambda message: GSProReply(Code=200, Message="flown"))
+            assert reply is None or reply.Code in (200, 500)
 
 
 @pytest.fixture(scope="module")
