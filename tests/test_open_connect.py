@@ -349,6 +349,8 @@ def test_a_failure_inside_an_answer_is_answered_and_the_connection_kept():
 def test_serve_refuses_tcp_with_several_workers_and_a_busy_port(capsys):
     assert main(["serve", "--connect-port", str(free_port()), "--workers", "2"]) == 2
     assert "--connect-port" in capsys.readouterr().err
+    assert main(["serve", "--connect-port", "70000"]) == 2
+    assert "--connect-port must be 1 to 65535" in capsys.readouterr().err
     with socket.create_server(("127.0.0.1", 0)) as busy:
         taken = busy.getsockname()[1]
         assert main(["serve", "--port", str(free_port()), "--connect-port", str(taken)]) == 2

@@ -59,6 +59,8 @@ def _loopback(host: str) -> bool:
 
 def _listenable(host: str, port: int) -> None:
     """Refuse a port that cannot be listened on now with one line saying why, not a traceback at startup."""
+    if not 0 < port < 65536:
+        raise ValueError(f"--connect-port must be 1 to 65535, got {port}")
     try:
         socket.create_server((host, port)).close()
     except OSError as error:
