@@ -8,6 +8,7 @@ COPY pyproject.toml README.md ./
 # every package of the distribution: the command line registers them all; only the training commands import torch,
 # and only when they run
 COPY golfflight ./golfflight
+COPY flight ./flight
 COPY service ./service
 COPY shots ./shots
 COPY weights_schema ./weights_schema

@@ -22,10 +22,10 @@ import onnxruntime as ort
 from common import SEVEN_IRON, write_results
 from onnx import TensorProto, helper
 
-from service.bundle_check import session_options
+from flight.bundle_check import session_options
+from flight.physics import euler_step
 from service.engine import FlightEngine
 from service.model_location import model_dir
-from service.physics import euler_step
 from weights_schema.bundle import load_bundle
 
 
@@ -95,7 +95,7 @@ def main() -> None:
         rows.append({"name": f"one-row ORT call, {name}", "unit": "us", "p50": one_row_call_us(model),
                      "nodes": len(model.graph.node), "nodes_after_ort": optimised_node_count(model)})
     state = (0.0, 30.0, 20.0, 5.0, 50.0, 10.0, 600.0, 0.0, -30.0)
-    rows.append({"name": "plain-float Euler step (service.physics.euler_step)", "unit": "us",
+    rows.append({"name": "plain-float Euler step (flight.physics.euler_step)", "unit": "us",
                  "p50": median_us(lambda: euler_step(*state, (0.2, 0.25, 0.001, 0.5), 1.225, 0.0, 0.0, 0.1))})
     engine = FlightEngine(bundle)
     steps = engine.fly(SEVEN_IRON).flight_time_s / card.physics.dt_s

@@ -16,12 +16,13 @@ from pydantic import ValidationError
 
 from discovery.effects import Context, equivalent_altitude_m
 from discovery.noise import RADAR_NOISE
-from service.air import Air
-from service.flight import Flight
-from service.physics import initial_state
-from service.wind import Wind, uniform_equivalent_factor
+from flight.air import Air
+from flight.outcomes import Flight
+from flight.physics import initial_state
+from flight.reference_aero import CALIBRATED
+from flight.wind import Wind, uniform_equivalent_factor
 from shots.records import ShotRecord, ShotSet
-from shots.reference_world import CALIBRATED, fly_reference
+from shots.reference_world import fly_reference
 from shots.synth import MIN_APEX_M, LaunchTable, MeasurementNoise, SynthConfig, draw_launches, draw_sessions, measure
 
 NOMINAL_AIR = Air.standard()

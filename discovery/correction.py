@@ -17,7 +17,7 @@ import numpy as np
 from discovery.effects import Context, Effect, Parameter, Reported
 from discovery.fit import Fit, Problem, fit, residuals_and_jacobian
 from discovery.schema import Unlisted
-from discovery.simulator import Conditions
+from discovery.simulator import Setup
 
 NAME = "unlisted"
 MIN_T = 4.0
@@ -79,7 +79,7 @@ def correction_effect(kept: tuple[int, ...]) -> Effect:
     def accelerate(v: np.ndarray, w: np.ndarray, weights: np.ndarray) -> np.ndarray:
         return np.einsum("nk,nkc->nc", weights, features(v, w)[:, kept])
 
-    def apply(theta: np.ndarray, conditions: Conditions) -> Conditions:
+    def apply(theta: np.ndarray, conditions: Setup) -> Setup:
         out = conditions.copy()
         out.correction_weights = theta
         return out

@@ -45,7 +45,7 @@ from discovery.noise import (
 from discovery.recordings import LABELS, OBSERVABLES, Recordings
 from discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
 from discovery.schema import Candidate, Heldout, ModelInfo, Report, ScatterStat
-from service.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
+from flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
 from shots.synth import MeasurementNoise
 
 OUTLIER_MAD = 8.0
@@ -232,12 +232,12 @@ class Diagnoser:
         recordings, model = self.recordings, self.model
         base = base_conditions(recordings, model)
         everyone = np.arange(len(recordings))
-        flown = model.fly(base, keep_positions=bool(recordings.trajectories))
+        flown = model.simulate(base, keep_positions=bool(recordings.trajectories))
         predicted = flown.outcomes()
         expected: ExpectedError = expected_error(model, recordings, base, predicted, self.noise)
         offset = np.zeros_like(predicted)
         if model.control is not None:  # the model's known error on these launches, taken out of every prediction
-            offset = np.nan_to_num(model.control.fly(base).outcomes() - predicted)
+            offset = np.nan_to_num(model.control.simulate(base).outcomes() - predicted)
             predicted = predicted + offset
         residual = recordings.observed - predicted
         wild = outlier_mask(residual)

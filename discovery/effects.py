@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from discovery.simulator import Conditions, Correction
-from service.air import DRY_AIR_GAS_CONSTANT, ZERO_CELSIUS_K, altitude_for_pressure
+from discovery.simulator import Setup, Correction
+from flight.air import DRY_AIR_GAS_CONSTANT, ZERO_CELSIUS_K, altitude_for_pressure
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,7 @@ class Effect:
 
     name: str
     parameters: tuple[Parameter, ...]
-    apply: Callable[[np.ndarray, Conditions], Conditions]
+    apply: Callable[[np.ndarray, Setup], Setup]
     describe: Callable[[np.ndarray, np.ndarray, Context], Reported]
     summary: str
     correction: Correction | None = None
@@ -66,8 +66,8 @@ class Context:
     temperature_c: float
 
 
-def _launch(name: str, offset: bool) -> Callable[[np.ndarray, Conditions], Conditions]:
-    def apply(theta: np.ndarray, conditions: Conditions) -> Conditions:
+def _launch(name: str, offset: bool) -> Callable[[np.ndarray, Setup], Setup]:
+    def apply(theta: np.ndarray, conditions: Setup) -> Setup:
         out = conditions.copy()
         out.launch[name] = out.launch[name] + theta[:, 0] if offset else out.launch[name] * theta[:, 0]
         return out
@@ -75,8 +75,8 @@ def _launch(name: str, offset: bool) -> Callable[[np.ndarray, Conditions], Condi
     return apply
 
 
-def _coefficient(column: int) -> Callable[[np.ndarray, Conditions], Conditions]:
-    def apply(theta: np.ndarray, conditions: Conditions) -> Conditions:
+def _coefficient(column: int) -> Callable[[np.ndarray, Setup], Setup]:
+    def apply(theta: np.ndarray, conditions: Setup) -> Setup:
         out = conditions.copy()
         out.coefficient_scale = out.coefficient_scale.copy()
         out.coefficient_scale[:, column] *= theta[:, 0]
@@ -85,19 +85,19 @@ def _coefficient(column: int) -> Callable[[np.ndarray, Conditions], Conditions]:
     return apply
 
 
-def _wind(theta: np.ndarray, conditions: Conditions) -> Conditions:
+def _wind(theta: np.ndarray, conditions: Setup) -> Setup:
     out = conditions.copy()
     out.wind_xy_mps = out.wind_xy_mps + theta[:, :2]
     return out
 
 
-def _density(theta: np.ndarray, conditions: Conditions) -> Conditions:
+def _density(theta: np.ndarray, conditions: Setup) -> Setup:
     out = conditions.copy()
     out.density_ratio = out.density_ratio * theta[:, 0]
     return out
 
 
-def _ground(theta: np.ndarray, conditions: Conditions) -> Conditions:
+def _ground(theta: np.ndarray, conditions: Setup) -> Setup:
     out = conditions.copy()
     out.ground_height_m = out.ground_height_m + theta[:, 0]
     return out
@@ -230,7 +230,7 @@ LIBRARY: tuple[Effect, ...] = (
 EFFECTS: dict[str, Effect] = {effect.name: effect for effect in LIBRARY}
 
 
-def apply_all(effects: tuple[Effect, ...], theta: np.ndarray, conditions: Conditions) -> Conditions:
+def apply_all(effects: tuple[Effect, ...], theta: np.ndarray, conditions: Setup) -> Setup:
     """Apply several effects; theta [N, sum of their sizes] holds their parameters side by side."""
     start = 0
     for effect in effects:

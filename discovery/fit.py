@@ -17,7 +17,7 @@ from scipy.optimize import least_squares
 from discovery.effects import Effect, apply_all
 from discovery.model import FlightModel
 from discovery.recordings import OBSERVABLES, Recordings
-from discovery.simulator import Conditions, Flown
+from discovery.simulator import Flown, Setup
 
 MISSED_LANDING_Z = 10.0
 """Standardized residual given to a shot the model does not land (it cannot be compared)."""
@@ -35,7 +35,7 @@ class Problem:
 
     model: FlightModel
     recordings: Recordings
-    base: Conditions
+    base: Setup
     sigma: np.ndarray
     use: np.ndarray
     offset: np.ndarray
@@ -56,7 +56,7 @@ class Problem:
         `model`, e.g. its control); returns the Flown batch."""
         conditions = apply_all(effects, theta_rows, self.base.take(rows))
         correction = next((e.correction for e in effects if e.correction is not None), None)
-        return (model or self.model).fly(conditions, correction, keep_positions)
+        return (model or self.model).simulate(conditions, correction, keep_positions)
 
     def predict(self, effects: tuple[Effect, ...], thetas: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """Outcomes [B, len(rows), 5] of B parameter sets [B, k], all flown in one batch."""

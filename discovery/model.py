@@ -18,10 +18,10 @@ from typing import Literal
 import numpy as np
 
 from discovery.recordings import OBSERVABLES
-from discovery.simulator import CoefficientsFor, Conditions, Correction, Flown, fly
-from service.air import Air
-from service.onnx_coefficients import OnnxCoefficients
-from shots.reference_world import CALIBRATED, ReferenceAerodynamics, ReferenceParameters
+from discovery.simulator import CoefficientsFor, Correction, Flown, Setup, simulate_setup
+from flight.air import Air
+from flight.onnx_coefficients import OnnxCoefficients
+from flight.reference_aero import CALIBRATED, ReferenceAerodynamics, ReferenceParameters
 
 DEFAULT_BUNDLE = Path(__file__).resolve().parents[1] / "models" / "default"
 REFERENCE = "reference"
@@ -55,8 +55,10 @@ class FlightModel:
     too and adds the difference to every prediction: the model's own known error on these launches is taken out
     before anything is fitted, so it is not mistaken for left-out physics."""
 
-    def fly(self, conditions: Conditions, correction: Correction | None = None, keep_positions: bool = False) -> Flown:
-        return fly(conditions, self.coefficients_for, self.dt_s, self.t_max_s, self.method, correction, keep_positions)
+    def simulate(self, setup: Setup, correction: Correction | None = None, keep_positions: bool = False) -> Flown:
+        """Fly a setup's shots through this model (`discovery.simulator.simulate_setup`)."""
+        settings = (self.dt_s, self.t_max_s, self.method, correction, keep_positions)
+        return simulate_setup(setup, self.coefficients_for, *settings)
 
 
 def from_bundle(directory: str | os.PathLike, controlled: bool = True) -> FlightModel:

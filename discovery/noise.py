@@ -15,7 +15,7 @@ import numpy as np
 from discovery.fit import cluster_bootstrap
 from discovery.model import FlightModel, reference
 from discovery.recordings import OBSERVABLES, Recordings
-from discovery.simulator import Conditions, concatenate
+from discovery.simulator import Setup, concatenate
 from shots.records import LAUNCH_COLUMNS
 from shots.synth import MeasurementNoise
 
@@ -37,12 +37,12 @@ class ExpectedError:
     launch_noise: dict[str, float]
 
 
-def base_conditions(recordings: Recordings, model: FlightModel) -> Conditions:
+def base_conditions(recordings: Recordings, model: FlightModel) -> Setup:
     """The conditions the model assumes for the recordings: recorded air and wind where present, else its own air."""
     n = len(recordings)
     density = recordings.density_kg_m3 if recordings.density_kg_m3 is not None else np.full(n, model.density_kg_m3)
     wind = recordings.wind_xy_mps if recordings.wind_xy_mps is not None else np.zeros((n, 2))
-    return Conditions(
+    return Setup(
         {k: v.copy() for k, v in recordings.launch.items()},
         np.ones(n),
         np.asarray(density, dtype=float),
@@ -71,7 +71,7 @@ def _rms(values: np.ndarray) -> dict[str, float]:
 def expected_error(
     model: FlightModel,
     recordings: Recordings,
-    base: Conditions,
+    base: Setup,
     predicted: np.ndarray,
     noise: MeasurementNoise = RADAR_NOISE,
 ) -> ExpectedError:
@@ -83,7 +83,7 @@ def expected_error(
         shifted = base.copy()
         shifted.launch[name] = shifted.launch[name] + step
         parts.append(shifted)
-    moved = model.fly(concatenate(parts)).outcomes().reshape(len(steps), n, len(OBSERVABLES))
+    moved = model.simulate(concatenate(parts)).outcomes().reshape(len(steps), n, len(OBSERVABLES))
     launch_var = np.nansum((moved - predicted[None]) ** 2, axis=0)
 
     carry = np.hypot(predicted[:, 0], predicted[:, 1])
@@ -103,7 +103,7 @@ def expected_error(
     source = dict(model.error_source)
     missing = [name for name in OBSERVABLES if name not in model_sigma]
     if missing:
-        truth = reference().fly(base).outcomes()
+        truth = reference().simulate(base).outcomes()
         for j, name in enumerate(OBSERVABLES):
             if name in missing:
                 model_sigma[name] = float(np.sqrt(np.nanmean((predicted[:, j] - truth[:, j]) ** 2)))

@@ -22,10 +22,10 @@ from discovery.diagnose import diagnose
 from discovery.effects import EFFECTS, LIBRARY
 from discovery.model import FlightModel
 from discovery.recordings import from_shot_set
-from service.wind import wind_vector
+from flight.reference_aero import CALIBRATED
+from flight.wind import wind_vector
 from shots.files import write_text_atomic
 from shots.markdown import write_generated_section
-from shots.reference_world import CALIBRATED
 
 COMBINATION = ("wind", "ball_speed_bias")
 """The two-effect case: a carry-alike pair that only the other observables can separate."""

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from service.wind import wind_vector
+from flight.wind import wind_vector
 from shots.records import LAUNCH_COLUMNS, ShotSet, read_shots, read_trajectories, trajectories_path
 
 OBSERVABLES: tuple[str, ...] = ("carry_y_m", "carry_x_m", "apex_m", "flight_time_s", "landing_angle_deg")

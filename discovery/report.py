@@ -17,9 +17,9 @@ from discovery.schema import (
     Located,
     ServiceSettings,
     Unlisted,
-    Wind,
+    WindSetting,
 )
-from service.wind import STATION_HEIGHT_M
+from flight.wind import STATION_HEIGHT_M
 
 MATERIAL = 0.05
 """Share above the expected error that counts as a material excess (as in `discovery.diagnose`)."""
@@ -58,9 +58,9 @@ def service_settings(
     for effect in effects:
         p = effect.parameters
         if effect.name == "wind":
-            settings.wind = Wind(speed_mps=p["speed_mps"], from_deg=p["from_deg"])
+            settings.wind = WindSetting(speed_mps=p["speed_mps"], from_deg=p["from_deg"])
             if wind_factor:
-                settings.wind_at_station = Wind(
+                settings.wind_at_station = WindSetting(
                     speed_mps=p["speed_mps"] / wind_factor,
                     from_deg=p["from_deg"],
                     profile="log",

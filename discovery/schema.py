@@ -141,7 +141,7 @@ class Unlisted(_Strict):
     library_heldout_error: float = Field(description="held-out error of the best library explanation alone")
 
 
-class Wind(_Strict):
+class WindSetting(_Strict):
     speed_mps: float
     from_deg: float
     profile: Literal["uniform", "log"] = "uniform"
@@ -160,8 +160,8 @@ class AirAltitude(_Strict):
 class ServiceSettings(_Strict):
     """The correction in the service's request options where it has one; launch-monitor corrections otherwise."""
 
-    wind: Wind | None = None
-    wind_at_station: Wind | None = Field(
+    wind: WindSetting | None = None
+    wind_at_station: WindSetting | None = Field(
         default=None,
         description="the same wind as a weather station's 10 m reading with the log profile (the uniform speed over "
         "the profile's mean speed factor along the corrected flights of these shots)",

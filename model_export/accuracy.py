@@ -21,6 +21,7 @@ from typing import TypeVar
 
 import numpy as np
 
+from flight.constants import YARD_M
 from model_export.accuracy_finetune import MEASURED_ROUNDS, TRAIN_ROUNDS, FinetuneStudy, finetune_study
 from model_export.accuracy_flyers import CoefficientFlyer, Flyer, ModelFlyer, ferguson_flyer
 from model_export.accuracy_sets import (
@@ -63,7 +64,6 @@ from model_export.accuracy_winds import (
     measured_paths,
     training_winds,
 )
-from service.constants import YARD_M
 from shots.markdown import table, write_generated_section
 from shots.paths import shared_data_dir
 from shots.records import ShotSet
@@ -169,7 +169,7 @@ def _header(flyers: Sequence[Flyer], rho_note: str) -> list[str]:
             what = (f"`{flyer.bundle}`: {card.variant}, trained on {trained}, ONNX {card.onnx.sha256[:12]}, card air "
                     f"rho {flyer.density_kg_m3:.3f} kg/m^3")
         else:
-            what = (f"C_L, C_D quadratic in spin ratio, C_M = 0.011 S (`service.coefficients.FERGUSON_2022`), "
+            what = (f"C_L, C_D quadratic in spin ratio, C_M = 0.011 S (`flight.coefficients.FERGUSON_2022`), "
                     f"rho {flyer.density_kg_m3:.3f} kg/m^3")
         rows.append((flyer.label, what))
     models = [f for f in flyers if isinstance(f, ModelFlyer)]
@@ -178,7 +178,7 @@ def _header(flyers: Sequence[Flyer], rho_note: str) -> list[str]:
         *table(("column", "model"), rows, align="ll"),
         "",
         (
-            f"Every model is flown through `service.flight.simulate` (NumPy physics, forward Euler, dt "
+            f"Every model is flown through `flight.integrator.simulate` (NumPy physics, forward Euler, dt "
             f"{flyers[0].dt_s:g} s, up to {flyers[0].t_sim_s:g} s), calm, in the air named above: {rho_note}"
         ),
     ]
@@ -195,7 +195,7 @@ def _drivers(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport) ->
     shots, note = held_out_driver_shots(path)
     report.driver_shots = shots
     labels = [f.label for f in flyers]
-    report.driver = per_model(flyers, lambda flyer: outcome_errors(flyer.fly(shots.launch()), shots))
+    report.driver = per_model(flyers, lambda flyer: outcome_errors(flyer.simulate(shots.launch()), shots))
     balls = ball_types(path)
     kinds = np.array([r.ball or balls.get(r.shot_id or "", "") for r in shots.records], dtype=object)
     premium = kinds == PREMIUM
@@ -233,7 +233,7 @@ def _tour_championship(data_dir: Path, flyers: Sequence[Flyer], report: Accuracy
     except ImportError:
         return lines + ["_Skipped: the pbp loader (`shots.pbp.load_pbp`) is not in this checkout yet._"]
     labels = [f.label for f in flyers]
-    report.tour_championship = per_model(flyers, lambda flyer: outcome_errors(flyer.fly(shots.launch()), shots))
+    report.tour_championship = per_model(flyers, lambda flyer: outcome_errors(flyer.simulate(shots.launch()), shots))
     metric = APEX_METRICS[0]
     rows = _metric_rows(APEX_METRICS, report.tour_championship, labels,
                         targets={metric.name: f"<= {TOUR_CHAMPIONSHIP_TARGET_FT:g}"})
@@ -330,7 +330,7 @@ def _sentry(data_dir: Path, flyers: Sequence[Flyer], out: Path, figures_dir: Pat
     labels = [f.label for f in flyers]
 
     def evaluate(flyer: Flyer):
-        flight = flyer.fly(shots.launch(), keep_states=True)
+        flight = flyer.simulate(shots.launch(), keep_states=True)
         return outcome_errors(flight, shots), path_errors(flight, trajectories)
 
     results = per_model(flyers, evaluate)

@@ -79,7 +79,7 @@ def finetune_study(
         raise ValueError(f"needs shots in rounds {list(train_rounds)} and {list(measured_rounds)}; "
                          f"found {len(train)} and {len(measured)}")
     launch = measured.launch()
-    before = outcome_errors(flyer.fly(launch), measured)
+    before = outcome_errors(flyer.simulate(launch), measured)
     with tempfile.TemporaryDirectory(prefix="golfflight-finetune-") as work:
         train_file = Path(work) / "train_rounds.csv"
         write_shots(train_file, [r.model_copy(update={"split": None}) for r in train.records])
@@ -93,7 +93,7 @@ def finetune_study(
         lr = min(validation, key=lambda rate: validation[rate][0])
         out, result = results[lr]
         tuned = ModelFlyer(out) if result.improved else flyer
-        after = outcome_errors(tuned.fly(launch), measured)
+        after = outcome_errors(tuned.simulate(launch), measured)
         pga_after = compare_clubs(tuned, clubs) if clubs and result.improved else None
     return FinetuneStudy(
         n_shots=len(shots),

@@ -1,4 +1,4 @@
-"""The models `golfflight accuracy` compares, each flown through the same runtime call (`service.flight.simulate`,
+"""The models `golfflight accuracy` compares, each flown through the same runtime call (`flight.integrator.simulate`,
 NumPy physics, forward Euler at the card's step): a bundle's ONNX graph, or a closed-form coefficient model such as
 Ferguson, McNally & McPhee 2022's quadratics in spin ratio.
 """
@@ -10,19 +10,21 @@ from pathlib import Path
 
 import numpy as np
 
-from service.air import Air
-from service.coefficients import FERGUSON_2022, QuadraticSpinRatio
-from service.flight import Flight, simulate
-from service.onnx_coefficients import OnnxCoefficients
-from service.physics import CoefficientModel, initial_state
-from service.wind import CALM, Wind
+from flight.air import Air
+from flight.coefficients import FERGUSON_2022, QuadraticSpinRatio
+from flight.integrator import simulate
+from flight.onnx_coefficients import OnnxCoefficients
+from flight.outcomes import Flight
+from flight.physics import CoefficientModel, initial_state
+from flight.wind import CALM, Wind
 
 STANDARD_DENSITY_KG_M3 = 1.225
 """ICAO standard air: the air a closed-form model is flown in (it has no Reynolds-number input)."""
 
 
 class Flyer:
-    """A coefficient model and the air and step it is flown at; `fly` is the one simulate call every model shares.
+    """A coefficient model and the air and step it is flown at; `simulate` is the one flight-core call every model
+    shares.
 
     `ground_height_m` lets a caller fly past the ground (a large negative height: the wind fit compares positions at
     fixed times, so no ball may stop early); `t_max_s` overrides the simulated time."""
@@ -40,7 +42,7 @@ class Flyer:
     def coefficients_in(self, air: Air | None) -> CoefficientModel:
         raise NotImplementedError
 
-    def fly(
+    def simulate(
         self,
         launch: dict[str, np.ndarray],
         air: Air | None = None,

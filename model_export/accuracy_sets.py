@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
+from flight.air import Air
+from flight.constants import FOOT_M, YARD_M
+from flight.outcomes import Flight
 from model_export.accuracy_flyers import Flyer
 from model_export.data import MIN_APEX_M
-from service.air import Air
-from service.constants import FOOT_M, YARD_M
-from service.flight import Flight
 from shots.heldout import HELD_OUT
 from shots.records import ShotSet
 from shots.reference_world import ClubAverage
@@ -75,7 +75,7 @@ def compare_clubs(flyer: Flyer, clubs: Sequence[ClubAverage], air: Air | None = 
         "spin_axis_deg": np.zeros(n),
     }
     density = flyer.density_kg_m3 if air is None else float(air.density_kg_m3)
-    flight = flyer.fly(launch, air)
+    flight = flyer.simulate(launch, air)
     model = np.stack([flight.carry_m / YARD_M, flight.apex_m / YARD_M, flight.landing_angle_deg], axis=1)
     return ClubComparison(list(clubs), model, density)
 

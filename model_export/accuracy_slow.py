@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flight.constants import MPH_TO_MPS, YARD_M
 from model_export.accuracy_flyers import Flyer
-from service.constants import MPH_TO_MPS, YARD_M
 
 
 @dataclass(frozen=True)
@@ -97,5 +97,5 @@ def launch_of(shots: Sequence[SlowShot]) -> dict[str, np.ndarray]:
 
 def fly_slow(flyer: Flyer, shots: Sequence[SlowShot] = SLOW_SHOTS) -> dict[str, np.ndarray]:
     """Carry (yd), max height (yd) and land angle (deg) of each slow shot, calm, in the flyer's own air."""
-    flight = flyer.fly(launch_of(shots))
+    flight = flyer.simulate(launch_of(shots))
     return {"carry": flight.carry_m / YARD_M, "apex": flight.apex_m / YARD_M, "land": flight.landing_angle_deg}

@@ -21,8 +21,8 @@ from scipy.optimize import least_squares
 from scipy.stats import f as f_distribution
 
 from discovery.effects import wind_from_components
+from flight.wind import Wind
 from model_export.accuracy_flyers import Flyer
-from service.wind import Wind
 
 TRAINING_CONDITIONS_FILE = "training_conditions.json"
 """Written beside a bundle by the real-data training pipeline: the per-group winds (and air, ball) it learned."""
@@ -44,12 +44,6 @@ def group_of(shot_id: str) -> str | None:
 
 def round_of(group: str) -> str:
     return group.rsplit("-H", 1)[0]
-
-
-def wind_of_components(x_mps: np.ndarray, y_mps: np.ndarray) -> Wind:
-    """A uniform wind per shot from its air velocity components (the inverse of `service.wind.wind_vector`)."""
-    x, y = np.asarray(x_mps, dtype=float), np.asarray(y_mps, dtype=float)
-    return Wind(np.hypot(x, y), np.degrees(np.arctan2(-x, -y)) % 360.0)
 
 
 @dataclass
@@ -94,7 +88,7 @@ def measured_paths(
 
 def _model_positions(flyer: Flyer, paths: MeasuredPaths, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     steps = paths.positions.shape[0]
-    flight = flyer.fly(paths.launch, keep_states=True, wind=wind_of_components(x, y),
+    flight = flyer.simulate(paths.launch, keep_states=True, wind=Wind.from_components(x, y),
                        t_max_s=steps * paths.dt_s, ground_height_m=NEVER_LANDS_M)
     start = flight.states[0].position
     return np.stack([s.position for s in flight.states[1 : steps + 1]]) - start[None]

@@ -16,6 +16,7 @@ import torch
 from onnx import numpy_helper
 from torch import nn
 
+from flight.bundle_check import OUTPUT_COLUMNS
 from model_export.export import (
     PARITY_TOLERANCE,
     onnx_torch_difference,
@@ -23,7 +24,6 @@ from model_export.export import (
 )
 from model_export.training import TrainConfig
 from model_export.variants import SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, PhysNN, build_model
-from service.bundle_check import OUTPUT_COLUMNS
 from weights_schema.bundle import load_bundle
 from weights_schema.model_card import ModelCard
 

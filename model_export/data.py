@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from service.air import Air
-from service.constants import YARD_M
-from service.physics import initial_state, reynolds_scale
+from flight.air import Air
+from flight.constants import YARD_M
+from flight.physics import initial_state, reynolds_scale
 from shots.records import ShotSet, read_shots
 from weights_schema.bundle import sha256_of
 
@@ -26,7 +26,7 @@ MIN_APEX_M = 8 * YARD_M
 @dataclass
 class ShotTensors:
     """One split as tensors [N,...]: initial state, targets (NaN-free, with masks), air density and the Reynolds
-    scale of the network's inputs (`service.physics.reynolds_scale`; 1 in standard air)."""
+    scale of the network's inputs (`flight.physics.reynolds_scale`; 1 in standard air)."""
 
     position: torch.Tensor
     velocity: torch.Tensor
@@ -72,7 +72,7 @@ class DataSummary:
 
 
 def to_tensors(shots: ShotSet, dtype: torch.dtype = torch.float32) -> ShotTensors:
-    """Initial state from `service.physics.initial_state` (one source for eq. 12) and the targets of a set of shots."""
+    """Initial state from `flight.physics.initial_state` (one source for eq. 12) and the targets of a set of shots."""
     state = initial_state(**shots.launch())
     landing = np.stack([shots.column("carry_x_m"), shots.column("carry_y_m")], -1)
     apex = shots.column("apex_m")

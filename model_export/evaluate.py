@@ -18,18 +18,18 @@ import numpy as np
 import torch
 from torch import nn
 
+from flight.air import Air
+from flight.integrator import simulate
+from flight.onnx_coefficients import OnnxCoefficients
+from flight.physics import initial_state
+from flight.reference_aero import CALIBRATED, ReferenceAerodynamics
 from model_export.noise_floor import Floor, noise_floors, nominal_conditions
 from model_export.report import metres_yards
 from model_export.torch_physics import euler_rollout, hard_landing, spin_ratio
 from model_export.training import VALIDATION_BATCH, TrainConfig, load_checkpoint, model_from_checkpoint, predict
 from model_export.validation import Errors, Prediction, ValidationSet, errors_of, gap, load_validation
 from model_export.variants import PhysNN, PhysQ
-from service.air import Air
-from service.flight import simulate
-from service.onnx_coefficients import OnnxCoefficients
-from service.physics import initial_state
 from shots.markdown import table, write_generated_section
-from shots.reference_world import CALIBRATED, ReferenceAerodynamics
 
 COMMAND = "evaluate"
 FIGURES = ("fig6_errors.png", "fig7_coefficients.png")
@@ -143,7 +143,7 @@ class BundleCheck:
 
 
 def check_bundle(bundle_dir: str | os.PathLike, val: ValidationSet) -> BundleCheck:
-    """Validation errors of a bundle through `service.flight.simulate` + `OnnxCoefficients` (the runtime path) and
+    """Validation errors of a bundle through `flight.integrator.simulate` + `OnnxCoefficients` (the runtime path) and
     the largest per-shot difference from the torch float64 evaluation of the same weights."""
     from model_export.bundle_model import config_from_card, model_from_bundle
 
@@ -229,7 +229,7 @@ def write_figures(
     with Phys-Q's curves), for the variants among `runs`. Figure 7's effective coefficients are C x 2 C_Q x
     rho_trained / rho_air: the force the model applies, expressed in the reference world's (nominal) air."""
     from model_export import figures
-    from service.coefficients import FERGUSON_2022
+    from flight.coefficients import FERGUSON_2022
 
     directory = Path(directory)
     by_variant = {run.variant: run for run in runs}
@@ -351,7 +351,7 @@ def render(runs: list[RunEvaluation], floors: list[Floor], val: ValidationSet, b
                 ("path", "L_p m", "L_p yd", "L_h m", "L_h yd"),
                 (
                     (
-                        "NumPy + ONNX Runtime (`service.flight.simulate`)",
+                        "NumPy + ONNX Runtime (`flight.integrator.simulate`)",
                         *metres_yards(bundle.numpy_errors.mean_landing_m),
                         *metres_yards(bundle.numpy_errors.mean_abs_apex_m),
                     ),

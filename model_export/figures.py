@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from PIL import Image
 
-from service.constants import YARD_M
+from flight.constants import YARD_M
 
 DPI = 110
 MAX_SCATTER_POINTS = 50_000

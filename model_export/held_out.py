@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from flight.constants import YARD_M
 from model_export.accuracy_flyers import ModelFlyer
 from model_export.accuracy_sets import (
     PGA_AVERAGES_HELD_OUT,
@@ -19,7 +20,6 @@ from model_export.accuracy_sets import (
     outcome_errors,
     tour_championship_shots,
 )
-from service.constants import YARD_M
 from shots.files import write_text_atomic
 from shots.heldout import HeldOutSet
 from shots.reference_world import read_tour_averages
@@ -52,12 +52,12 @@ def held_out_results(bundle: str | os.PathLike, data_dir: str | os.PathLike) -> 
     driver = data_dir / TRACKMAN_HELD_OUT.path
     if driver.is_file():
         shots, note = held_out_driver_shots(driver)
-        errors = _mae(outcome_errors(flyer.fly(shots.launch()), shots), FLIGHT_ERRORS)
+        errors = _mae(outcome_errors(flyer.simulate(shots.launch()), shots), FLIGHT_ERRORS)
         results.append(_result(TRACKMAN_HELD_OUT, driver, len(shots), errors, f"all ball types; {note}"))
     tour = data_dir / TOUR_CHAMPIONSHIP_HELD_OUT.path
     if tour.is_file():
         shots, note = tour_championship_shots(tour)
-        errors = _mae(outcome_errors(flyer.fly(shots.launch()), shots), {"apex_m": "apex_m"})
+        errors = _mae(outcome_errors(flyer.simulate(shots.launch()), shots), {"apex_m": "apex_m"})
         results.append(_result(TOUR_CHAMPIONSHIP_HELD_OUT, tour, len(shots), errors, note))
     averages = data_dir / PGA_AVERAGES_HELD_OUT.path
     if averages.is_file():

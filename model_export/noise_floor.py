@@ -14,10 +14,10 @@ from typing import NamedTuple
 
 import numpy as np
 
+from flight.air import Air
+from flight.physics import initial_state
+from flight.wind import CALM, Wind
 from model_export.validation import Errors, Prediction, ValidationSet, errors_of
-from service.air import Air
-from service.physics import initial_state
-from service.wind import CALM, Wind
 from shots.records import ShotSet
 from shots.reference_world import fly_reference
 from shots.synth import MeasurementNoise, sessions_path

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from service.air import Air
-from service.physics import initial_state, reynolds_scale
+from flight.air import Air
+from flight.physics import initial_state, reynolds_scale
 from shots.records import ShotSet, read_shots, read_trajectories, trajectories_path
 from shots.synth import MeasurementNoise
 

@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from service.air import Air
-from service.physics import initial_state
+from flight.air import Air
+from flight.physics import initial_state
 from shots.clubs import CLUBS
 from shots.heldout import check_training_rows
 from shots.records import ShotRecord, trajectories_path, write_shots, write_trajectories

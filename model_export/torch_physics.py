@@ -1,4 +1,4 @@
-"""Differentiable PyTorch twin of `service.physics` + forward Euler (paper sections 2.1, 2.3).
+"""Differentiable PyTorch twin of `flight.physics` + forward Euler (paper sections 2.1, 2.3).
 
 The one place the equations of motion exist in torch. Same axes, signs, constants and guards as the NumPy
 core (errata applied: lift along omega x v, spin only decays, q = C_Q rho |v|^2), batched over shots and
@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import torch
 
-from service.constants import BALL_AREA_M2, BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2
-from service.physics import TINY
+from flight.constants import BALL_AREA_M2, BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2
+from flight.physics import TINY
 
 DT_S = 0.1
 """Euler step of the paper (section 2.3.2): the step the models are trained and served with."""
@@ -31,7 +31,7 @@ crossing much like a linear interpolation (so the landing time gets a gradient):
 soft landing was on average 0.16 m from the interpolated one, against 0.27 m at 0.25 m and 0.20 m at 1 m."""
 
 Coefficients = Callable[[torch.Tensor, torch.Tensor], torch.Tensor]
-"""(v_rel [N,3], omega [N,3]) -> [N,4] = C_L, C_D, C_M, C_Q, as in `service.physics.CoefficientModel`."""
+"""(v_rel [N,3], omega [N,3]) -> [N,4] = C_L, C_D, C_M, C_Q, as in `flight.physics.CoefficientModel`."""
 
 
 @dataclass
@@ -65,7 +65,7 @@ def _norm(x: torch.Tensor) -> torch.Tensor:
 
 
 def spin_ratio(v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
-    """S = R |omega| / |v_rel| [N], guarded like `service.physics.spin_ratio`."""
+    """S = R |omega| / |v_rel| [N], guarded like `flight.physics.spin_ratio`."""
     return spin_ratio_of(_norm(v_rel), _norm(omega))
 
 
@@ -77,7 +77,7 @@ def spin_ratio_of(speed: torch.Tensor, spin_rate: torch.Tensor) -> torch.Tensor:
 def aerodynamics(
     v_rel: torch.Tensor, omega: torch.Tensor, coefficients: torch.Tensor, density: torch.Tensor | float
 ) -> tuple[torch.Tensor, torch.Tensor]:
-    """Aerodynamic acceleration [N,3] (drag + Magnus lift) and spin acceleration [N,3], as in `service.physics`."""
+    """Aerodynamic acceleration [N,3] (drag + Magnus lift) and spin acceleration [N,3], as in `flight.physics`."""
     c_lift, c_drag, c_moment, c_q = coefficients.unbind(dim=-1)
     speed = _norm(v_rel)
     q_area = c_q * density * speed**2 * BALL_AREA_M2
@@ -102,7 +102,7 @@ def derivatives(
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """d/dt of (position, velocity, spin) (paper eq. 14 with the errata). The aerodynamics use v_rel = v - `wind`
     ([N,3] uniform air velocity; None = calm); the coefficient model is fed (k v_rel, k omega) with
-    k = `reynolds_scale` [N,1] (`service.physics.reynolds_scale`), and its output is multiplied by
+    k = `reynolds_scale` [N,1] (`flight.physics.reynolds_scale`), and its output is multiplied by
     `coefficient_scale` [N,4] where given (a ball type's drag and lift relative to the ball the model learned)."""
     v_rel = velocity if wind is None else velocity - wind
     coefficient_values = coefficients(v_rel * reynolds_scale, spin * reynolds_scale)
@@ -159,7 +159,7 @@ def soft_landing(
 
 def hard_landing(trajectory: Trajectory, start_s: float = LANDING_SEARCH_START_S) -> Landing:
     """Landing used at validation and inference: hard argmax of -|r_z| from i_s on, then the state interpolated
-    linearly to r_z = 0 between the two steps that bracket the crossing (as `service.flight.simulate` does).
+    linearly to r_z = 0 between the two steps that bracket the crossing (as `flight.integrator.simulate` does).
     Where that step has no downward crossing beside it (no landing within t_sim), the state of the step itself."""
     positions = trajectory.positions
     last = positions.shape[0] - 1

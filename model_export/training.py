@@ -19,6 +19,7 @@ import torch
 from torch import nn
 from tqdm import tqdm
 
+from flight.constants import YARD_M
 from model_export import DEFAULT_HIDDEN, VARIANTS
 from model_export.data import MIN_APEX_M, DataSummary, ShotTensors, load_training_data
 from model_export.torch_physics import (
@@ -30,7 +31,6 @@ from model_export.torch_physics import (
     soft_landing,
 )
 from model_export.variants import build_model
-from service.constants import YARD_M
 from shots.files import write_atomic, write_text_atomic
 
 CHECKPOINT_FORMAT = 1

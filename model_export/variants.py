@@ -1,7 +1,7 @@
 """The model variants of Table 1: Phys-NN family (MLP coefficients), Phys-Q (quadratic in S) and NN (launch -> landing).
 
 Every physics variant is a torch module with `coefficients(v_rel, omega) -> [N,4]` = C_L, C_D, C_M, C_Q, the same
-contract as `service.physics.CoefficientModel` and as the exported ONNX graph.
+contract as `flight.physics.CoefficientModel` and as the exported ONNX graph.
 """
 
 from __future__ import annotations
@@ -12,9 +12,9 @@ from collections.abc import Sequence
 import torch
 from torch import nn
 
+from flight.coefficients import BASE_DYNAMIC_PRESSURE, FERGUSON_2022
 from model_export import DEFAULT_HIDDEN, PHYS_NN_VARIANTS, VARIANTS
 from model_export.torch_physics import spin_ratio, spin_ratio_of
-from service.coefficients import BASE_DYNAMIC_PRESSURE, FERGUSON_2022
 
 VELOCITY_SCALE_MPS = 89.4
 """MLP input normalisation (paper section 2.2): 200 mph."""
@@ -103,7 +103,7 @@ class PhysNN(CoefficientModule):
 
 class PhysQ(CoefficientModule):
     """Phys-Q baseline: C_L = max(0, p0 + p1 S + p2 S^2), C_D = p3 + p4 S + p5 S^2, C_M = p6 S, started from
-    Ferguson et al. 2022; the same formulas as `service.coefficients.QuadraticSpinRatio`."""
+    Ferguson et al. 2022; the same formulas as `flight.coefficients.QuadraticSpinRatio`."""
 
     variant = "phys-q"
 

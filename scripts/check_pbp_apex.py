@@ -18,16 +18,18 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from service.air import Air  # noqa: E402
-from service.coefficients import FERGUSON_2022, QuadraticSpinRatio  # noqa: E402
-from service.constants import FOOT_M  # noqa: E402
-from service.flight import Flight, simulate  # noqa: E402
-from service.physics import initial_state  # noqa: E402
+from flight.air import Air  # noqa: E402
+from flight.coefficients import FERGUSON_2022, QuadraticSpinRatio  # noqa: E402
+from flight.constants import FOOT_M  # noqa: E402
+from flight.integrator import simulate  # noqa: E402
+from flight.outcomes import Flight  # noqa: E402
+from flight.physics import initial_state  # noqa: E402
+from flight.reference_aero import REFERENCE_DT_S, REFERENCE_T_MAX_S  # noqa: E402
 from shots.markdown import table  # noqa: E402
 from shots.paths import shared_data_dir  # noqa: E402
 from shots.pbp import load_pbp, recorded_apex  # noqa: E402
 from shots.records import ShotSet  # noqa: E402
-from shots.reference_world import REFERENCE_DT_S, REFERENCE_T_MAX_S, fly_reference  # noqa: E402
+from shots.reference_world import fly_reference  # noqa: E402
 from shots.tourcast import load_tourcast  # noqa: E402
 
 TOURCAST = Path("real/pga_tourcast_trackman")

@@ -1,1 +1,2 @@
-"""The runtime: NumPy physics, air and wind, integrators, the ONNX flight engine and the HTTP service (`service.api`)."""
+"""Serving: the runtime flight engine, model location, trajectory resampling, the HTTP app (`service.api`) and GSPro
+Open Connect over TCP (`service.open_connect`). The physics it serves is the `flight` package's."""

@@ -1,7 +1,7 @@
-"""The runtime simulator: a model bundle's ONNX coefficients inside the equations of `service.physics`.
+"""The runtime simulator: a model bundle's ONNX coefficients inside the equations of `flight.physics`.
 
 Forward Euler at the card's step, one ONNX Runtime call per step for everything still in the air, fed v_rel and
-omega times the air's Reynolds scale (`service.physics.reynolds_scale`, 1 in the card's air). One shot runs
+omega times the air's Reynolds scale (`flight.physics.reynolds_scale`, 1 in the card's air). One shot runs
 on plain Python floats with the network's inputs and output bound once to preallocated float32 buffers
 (IOBinding, one thread): per-call overheads, not arithmetic, decide single-shot latency (NOTES.md section 6).
 A batch runs on NumPy [N] arrays and drops each shot from the batch as it lands. Either way a shot stops at its
@@ -24,12 +24,16 @@ from typing import NamedTuple
 
 import numpy as np
 
-from service.bundle_check import open_session, open_verified, session_options
-from service.conditions import STANDARD, Conditions
-from service.constants import RPM_TO_RADPS
-from service.limits import FLIGHT_TIME_S
-from service.physics import euler_step, initial_state, reynolds_scale
-from service.wind import log_profile_factor
+from flight.bundle_check import open_session, session_options
+from flight.conditions import STANDARD, Conditions
+from flight.constants import RPM_TO_RADPS
+from flight.field import BallInAir
+from flight.integrator import GroundPlane, integrate
+from flight.limits import FLIGHT_TIME_S
+from flight.onnx_coefficients import OnnxCoefficients
+from flight.outcomes import Flight, landing_angle_deg, parabola_apex
+from flight.physics import euler_step, initial_state, reynolds_scale
+from flight.wind import Wind, log_profile_factor
 from weights_schema.model_card import ModelCard
 
 MAX_FLIGHT_TIME_S = FLIGHT_TIME_S.high
@@ -90,7 +94,7 @@ def _summary(x, y, vx, vy, vz, wx, wy, wz):
     """(carry, landing angle, landing speed, landing spin) from a landing state (floats or arrays)."""
     return (
         np.hypot(x, y),
-        np.degrees(np.arctan2(-vz, np.hypot(vx, vy))),
+        landing_angle_deg(vx, vy, vz),
         (vx * vx + vy * vy + vz * vz) ** 0.5,
         (wx * wx + wy * wy + wz * wz) ** 0.5 / RPM_TO_RADPS,
     )
@@ -114,6 +118,19 @@ def _physics_inputs(conditions: Conditions) -> tuple[float, float, float, bool, 
     )
 
 
+def _batch_field(model: OnnxCoefficients, per_shot: list[Conditions]) -> BallInAir:
+    """The equations of motion for a batch, each shot in its own air and wind."""
+    density, _, _, _, reference_height, roughness, viscosity = np.array([_physics_inputs(c) for c in per_shot]).T
+    wind = Wind(
+        np.array([c.wind.speed_mps for c in per_shot], dtype=float),
+        np.array([c.wind.from_deg for c in per_shot], dtype=float),
+        np.array([c.wind.profile for c in per_shot]),
+        reference_height,
+        roughness,
+    )
+    return BallInAir(model.in_air(viscosity), density, wind)
+
+
 class FlightEngine:
     """A loaded model bundle and the two ways to fly shots through it: `fly` (one) and `fly_batch` (many)."""
 
@@ -122,24 +139,23 @@ class FlightEngine:
         otherwise), then warm both paths up."""
         started = time.perf_counter()
         self.bundle_dir = Path(bundle_dir)
-        self.card: ModelCard
-        self.card, onnx_path, self._batch_session = open_verified(self.bundle_dir, batch_threads)
+        self._batch_model = OnnxCoefficients(self.bundle_dir, batch_threads)
+        self.card: ModelCard = self._batch_model.card
         self.dt = self.card.physics.dt_s
         self.t_sim = self.card.physics.t_sim_s
         self.nominal_viscosity = self.card.physics.kinematic_viscosity_m2_s
         self.max_steps = math.ceil(max(MAX_FLIGHT_TIME_S, self.t_sim) / self.dt - 1e-9)
-        self._velocity_name, self._spin_name = (spec.name for spec in self.card.onnx.inputs)
-        self._output_name = self.card.onnx.outputs[0].name
-        self._single_session = open_session(onnx_path, session_options(1))
+        velocity_name, spin_name = (spec.name for spec in self.card.onnx.inputs)
+        self._single_session = open_session(self._batch_model.onnx_path, session_options(1))
         self._single_lock = threading.Lock()
         self._velocity_in = np.zeros((1, 3), np.float32)
         self._spin_in = np.zeros((1, 3), np.float32)
         self._coefficients_out = np.zeros((1, 4), np.float32)
         self._binding = self._single_session.io_binding()
-        for name, buffer in ((self._velocity_name, self._velocity_in), (self._spin_name, self._spin_in)):
+        for name, buffer in ((velocity_name, self._velocity_in), (spin_name, self._spin_in)):
             self._binding.bind_input(name, "cpu", 0, np.float32, list(buffer.shape), buffer.ctypes.data)
         self._binding.bind_output(
-            self._output_name,
+            self.card.onnx.outputs[0].name,
             "cpu",
             0,
             np.float32,
@@ -178,7 +194,7 @@ class FlightEngine:
         k = reynolds_scale(viscosity, self.nominal_viscosity)
         air_x, air_y = wind_x, wind_y
         dt = self.dt
-        apex, apex_step = z, 0
+        apex, apex_step, before_apex, after_apex = z, 0, math.nan, math.nan
         history = [(x, y, z, vx, vy, vz)] if keep_states else None
         velocity_in, spin_in, out = self._velocity_in[0], self._spin_in[0], self._coefficients_out[0]
         with self._single_lock:
@@ -193,7 +209,9 @@ class FlightEngine:
                 old = (x, y, z, vx, vy, vz, wx, wy, wz)
                 x, y, z, vx, vy, vz, wx, wy, wz = euler_step(*old, out.tolist(), density, air_x, air_y, dt)
                 if z > apex:
-                    apex, apex_step = z, step
+                    apex, apex_step, before_apex, after_apex = z, step, old[2], math.nan
+                elif apex_step == step - 1:
+                    after_apex = z
                 if z <= 0.0 < old[2]:
                     break
                 if history is not None:
@@ -210,7 +228,7 @@ class FlightEngine:
             rows = np.array(history)
             times = np.append(np.round(dt * np.arange(len(history) - 1), 9), flight_time)
             states = EulerStates(times, rows[:, :3], rows[:, 3:])
-        apex_time = round(apex_step * dt, 9)
+        apex, apex_time = parabola_apex(before_apex, apex, after_apex, apex_step * dt, dt)
         numbers = (land[0], land[1], carry, apex, apex_time, flight_time, angle, speed, spin)
         if not (all(map(math.isfinite, numbers)) and self._states_finite(states)):
             raise FlightError(NON_FINITE)
@@ -222,7 +240,8 @@ class FlightEngine:
         conditions: Sequence[Conditions] | Conditions = STANDARD,
         keep_states: bool = False,
     ) -> list[ShotFlight | FlightError]:
-        """Fly many shots on NumPy arrays, one ONNX Runtime call per step over the shots still in the air.
+        """Fly many shots through the flight core (`flight.integrator`): forward Euler, one ONNX Runtime call per
+        step over the shots still in the air.
 
         Results are in the order of `launches`; a shot that has not landed by MAX_FLIGHT_TIME_S (or whose flight is
         not finite) gets a FlightError.
@@ -233,68 +252,35 @@ class FlightEngine:
         per_shot = [conditions] * n if isinstance(conditions, Conditions) else list(conditions)
         if len(per_shot) != n:
             raise ValueError(f"{len(per_shot)} conditions for {n} launches")
-        launch = np.array(launches, dtype=float).reshape(n, 5)
-        start = initial_state(*launch.T)
-        state = np.concatenate([start.position.T, start.velocity.T, start.spin.T])  # [9, n]
-        # per-shot constants, sliced along with the state as shots land: density, wind x/y, log profile, h_ref, z0,
-        # and (replacing the kinematic viscosity) the Reynolds scale of the network's inputs
-        params = np.array([_physics_inputs(c) for c in per_shot]).T
-        params[6] = reynolds_scale(params[6], self.nominal_viscosity)
-        alive = np.arange(n)
-        landing = np.full((9, n), np.nan)
-        flight_time = np.full(n, np.nan)
-        apex, apex_step = state[2].copy(), np.zeros(n, dtype=int)
-        last_step = np.zeros(n, dtype=int)
-        history = [state[:6].copy()] if keep_states else None
-        dt, session = self.dt, self._batch_session
-        outputs, names = [self._output_name], (self._velocity_name, self._spin_name)
-        for step in range(1, self.max_steps + 1):
-            density, air_x, air_y = params[0], params[1], params[2]
-            if params[3].any():
-                factor = np.where(params[3] > 0, log_profile_factor(state[2], params[4], params[5]), 1.0)
-                air_x, air_y = air_x * factor, air_y * factor
-            k = params[6]
-            velocity = np.stack([(state[3] - air_x) * k, (state[4] - air_y) * k, state[5] * k], axis=1)
-            spin = (state[6:9] * k).T
-            feeds = {names[0]: velocity.astype(np.float32), names[1]: spin.astype(np.float32)}
-            coefficients = session.run(outputs, feeds)[0]
-            new = np.array(euler_step(*state, coefficients.T, density, air_x, air_y, dt))
-            higher = new[2] > apex[alive]
-            apex[alive[higher]], apex_step[alive[higher]] = new[2, higher], step
-            if history is not None:
-                snapshot = np.full((6, n), np.nan)
-                snapshot[:, alive] = new[:6]
-                history.append(snapshot)
-            crossing = (state[2] > 0.0) & (new[2] <= 0.0)
-            if crossing.any():
-                frac = state[2, crossing] / (state[2, crossing] - new[2, crossing])
-                ids = alive[crossing]
-                landing[:, ids] = state[:, crossing] + frac * (new[:, crossing] - state[:, crossing])
-                flight_time[ids] = (step - 1 + frac) * dt
-                last_step[ids] = step - 1
-                keep = ~crossing
-                new, params, alive = new[:, keep], params[:, keep], alive[keep]
-            state = new
-            if alive.size == 0:
-                break
-        carry, angle, speed, spin = _summary(landing[0], landing[1], *landing[3:])
-        numbers = (landing[0], landing[1], carry, apex, np.round(dt * apex_step, 9), flight_time, angle, speed, spin)
+        start = initial_state(*np.array(launches, dtype=float).reshape(n, 5).T)
+        field = _batch_field(self._batch_model, per_shot)
+        record = "states" if keep_states else "summary"
+        flight = integrate(start, field, self.dt, self.max_steps, "euler", GroundPlane(), record)
+        x, y, _ = flight.landing_position.T
+        carry, angle, speed, spin = _summary(x, y, *flight.landing_velocity.T, *flight.landing_spin.T)
+        numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
         finite = np.isfinite(np.stack(numbers)).all(axis=0)
+        history = None
+        if flight.states is not None:
+            history = (np.stack([s.position for s in flight.states]), np.stack([s.velocity for s in flight.states]))
         results: list[ShotFlight | FlightError] = []
-        for i, (x, y, c, h, th, tf, a, s, w) in enumerate(zip(*(a.tolist() for a in numbers))):
-            if math.isnan(tf):
+        for i, (xi, yi, c, h, th, tf, a, v, w) in enumerate(zip(*(a.tolist() for a in numbers))):
+            if not flight.landed[i]:
                 results.append(FlightError(self._cap_message()))
             elif not finite[i]:
                 results.append(FlightError(NON_FINITE))
             elif history is None:
-                results.append(ShotFlight(x, y, c, x, h, th, tf, a, s, w))
+                results.append(ShotFlight(xi, yi, c, xi, h, th, tf, a, v, w))
             else:
-                states = self._batch_states(history, i, last_step[i], landing[:6, i], tf)
-                flight = ShotFlight(x, y, c, x, h, th, tf, a, s, w, states)
-                results.append(flight if self._states_finite(states) else FlightError(NON_FINITE))
+                states = self._shot_states(history, flight, i)
+                flown = ShotFlight(xi, yi, c, xi, h, th, tf, a, v, w, states)
+                results.append(flown if self._states_finite(states) else FlightError(NON_FINITE))
         return results
 
-    def _batch_states(self, history: list[np.ndarray], shot: int, last_step: int, landing: np.ndarray, t: float):
-        rows = np.array([history[k][:, shot] for k in range(last_step + 1)] + [landing])
-        times = np.append(np.round(self.dt * np.arange(last_step + 1), 9), t)
-        return EulerStates(times, rows[:, :3], rows[:, 3:])
+    def _shot_states(self, history: tuple[np.ndarray, np.ndarray], flight: Flight, shot: int) -> EulerStates:
+        """One shot's states up to its landing, the interpolated landing last."""
+        last = int(flight.last_step[shot])
+        positions = np.vstack([history[0][: last + 1, shot], flight.landing_position[shot]])
+        velocities = np.vstack([history[1][: last + 1, shot], flight.landing_velocity[shot]])
+        times = np.append(np.round(self.dt * np.arange(last + 1), 9), flight.flight_time_s[shot])
+        return EulerStates(times, positions, velocities)

@@ -12,21 +12,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from service.air import Air
-from service.coefficients import QuadraticSpinRatio
-from service.constants import YARD_M
-from service.flight import Flight, simulate
-from service.physics import State, initial_state
-from shots.reference_world import (
-    CALIBRATED,
-    CALIBRATION_AIR,
-    FREE_PARAMETERS,
-    REFERENCE_DT_S,
-    REFERENCE_T_MAX_S,
-    ClubAverage,
-    ReferenceParameters,
-    fly_reference,
-)
+from flight.air import Air
+from flight.coefficients import QuadraticSpinRatio
+from flight.constants import YARD_M
+from flight.integrator import simulate
+from flight.outcomes import Flight
+from flight.physics import State, initial_state
+from flight.reference_aero import CALIBRATED, FREE_PARAMETERS, REFERENCE_DT_S, REFERENCE_T_MAX_S, ReferenceParameters
+from shots.reference_world import CALIBRATION_AIR, ClubAverage, fly_reference
 
 DECAY_TIMES_S = (1.0, 3.0, 5.0)
 TRACKMAN_SPIN_LOSS_PCT = {"Driver": (3.1, 8.8, 12.8), "5-iron": (3.4, 9.7, 15.5), "8-iron": (3.6, 9.0, 13.3)}

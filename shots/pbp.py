@@ -19,7 +19,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from service.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from shots.heldout import held_out_set
 from shots.records import RANGES, RecordError, ShotRecord, reading
 from shots.tourcast import shot_id, shot_key

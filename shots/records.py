@@ -26,9 +26,9 @@ from typing import Annotated, Iterable, Iterator, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from service import limits
-from service.air import Air, pressure_at_altitude
-from service.limits import Range
+from flight import limits
+from flight.air import Air, pressure_at_altitude
+from flight.limits import Range
 from shots.files import write_atomic
 
 RANGES: dict[str, Range] = {
@@ -159,7 +159,7 @@ class ShotSet:
         return np.array(values, dtype=object)
 
     def launch(self) -> dict[str, np.ndarray]:
-        """The five launch columns, ready for `service.physics.initial_state(**shots.launch())`."""
+        """The five launch columns, ready for `flight.physics.initial_state(**shots.launch())`."""
         return {name: self.column(name) for name in LAUNCH_COLUMNS}
 
     def air(self) -> Air:

@@ -15,14 +15,15 @@ from pathlib import Path
 
 import numpy as np
 
-from service.air import Air
-from service.constants import YARD_M
-from service.flight import Flight
-from service.physics import initial_state
-from service.wind import Wind
+from flight.air import Air
+from flight.constants import YARD_M
+from flight.outcomes import Flight
+from flight.physics import initial_state
+from flight.reference_aero import CALIBRATED, ReferenceParameters
+from flight.wind import Wind
 from shots.clubs import CLUBS, club_weights
 from shots.records import LAUNCH_COLUMNS, RANGES, ShotRecord, write_csv_atomic, write_shots
-from shots.reference_world import CALIBRATED, ReferenceParameters, fly_reference
+from shots.reference_world import fly_reference
 
 MIN_APEX_M = 8 * YARD_M
 """The paper drops shots that peak under 8 yd (tops and duffs)."""

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.polynomial import Polynomial
 from pydantic import ValidationError
 
-from service.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
+from flight.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
 from shots.records import RANGES, RecordError, ShotRecord, reading
 from shots.trackman import Conversion, ConversionReport
 
@@ -52,7 +52,7 @@ NO_SPIN_HINT = "spin is required; --estimate-spin estimates it from the lift"
 
 
 @dataclass(frozen=True)
-class Flight:
+class TrackedFlight:
     """One trajectory polynomial: coefficients [n, 3] in our axes (X right, Y down the line, Z up), ascending powers."""
 
     shot_id: str
@@ -211,7 +211,7 @@ def _number(row: dict[str, str], column: str, line: int) -> float:
     return value
 
 
-def _flights(line: int, key: tuple, rows: list[dict[str, str]], n: int, tournament: str) -> list[Flight]:
+def _flights(line: int, key: tuple, rows: list[dict[str, str]], n: int, tournament: str) -> list[TrackedFlight]:
     """Split one key's rows (consecutive lines from `line`) into flights of n coefficients each."""
     max_row = int(_number(rows[0], "max_row", line))
     numbers = [int(_number(r, "row", line + i)) for i, r in enumerate(rows)]
@@ -230,14 +230,14 @@ def _flights(line: int, key: tuple, rows: list[dict[str, str]], n: int, tourname
             [[_number(r, axis, first + j) for axis in ("zFit", "xFit", "yFit")] for j, r in enumerate(part)]
         )
         scale = max_row / ((block + 1) * n)
-        flights.append(Flight(shot_id(tournament, key, block + 1 if count > 1 else None), tournament,
+        flights.append(TrackedFlight(shot_id(tournament, key, block + 1 if count > 1 else None), tournament,
                               f"{tournament}-R{key[0]}", key, line + block * n, coefficients,
                               _number(part[-1], "timeInterval", first + n - 1) * scale,
                               _number(part[-1], "measuredTimeInterval", first + n - 1) * scale))
     return flights
 
 
-def read_flights(path: str | os.PathLike, report: ConversionReport, skip_bad_rows: bool = False) -> list[Flight]:
+def read_flights(path: str | os.PathLike, report: ConversionReport, skip_bad_rows: bool = False) -> list[TrackedFlight]:
     """Every flight of a trajectory file. A malformed shot refuses the file (RecordError naming line and column), or
     with `skip_bad_rows` is counted in `report` as one row in, dropped and listed."""
     path = Path(path)
@@ -286,9 +286,9 @@ def read_pbp_spin(path: str | os.PathLike, tournament: str) -> dict[tuple[str, s
     return spins
 
 
-def _spin_sources(flights: list[Flight], spins: dict | None) -> dict[str, float | str]:
+def _spin_sources(flights: list[TrackedFlight], spins: dict | None) -> dict[str, float | str]:
     """Per shot id the pbp spin (rpm) or, where there is none, the reason why."""
-    by_key: dict[tuple, list[Flight]] = {}
+    by_key: dict[tuple, list[TrackedFlight]] = {}
     for flight in flights:
         by_key.setdefault(flight.key, []).append(flight)
     found: dict[str, float | str] = {}
@@ -308,7 +308,7 @@ def _spin_sources(flights: list[Flight], spins: dict | None) -> dict[str, float 
     return found
 
 
-def _record(flight: Flight, spin: float) -> ShotRecord:
+def _record(flight: TrackedFlight, spin: float) -> ShotRecord:
     coefficients = flight.coefficients
     speed, angle, direction = launch(coefficients)
     axis = spin_axis_deg(coefficients)
@@ -368,7 +368,7 @@ def load_tourcast(trajectory_path: str | os.PathLike, pbp_path: str | os.PathLik
     return Conversion(records, report, trajectories)
 
 
-def _notes(report: ConversionReport, flights: list[Flight], records: list[ShotRecord], estimated: int) -> None:
+def _notes(report: ConversionReport, flights: list[TrackedFlight], records: list[ShotRecord], estimated: int) -> None:
     split = sorted({f.shot_id.rsplit("-f", 1)[0] for f in flights if "-f" in f.shot_id})
     if split:
         report.notes.append(f"{len(split)} shot keys hold several flights (re-teed shots): ids end -f1, -f2, ... "

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from service.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from shots.records import RANGES, RecordError, ShotRecord, reading
 
 SPEED = {"mph": MPH_TO_MPS, "m/s": 1.0, "km/h": 1.0 / 3.6}

@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.coefficients import QuadraticSpinRatio
-from service.flight import simulate
-from service.physics import initial_state
+from flight.coefficients import QuadraticSpinRatio
+from flight.integrator import simulate
+from flight.physics import initial_state
 from shots.records import ShotRecord, write_shots
 
 

@@ -14,6 +14,13 @@ import pytest
 import torch
 from scipy.stats import f_oneway
 
+from flight.air import Air
+from flight.coefficients import FERGUSON_2022, QuadraticSpinRatio
+from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from flight.integrator import simulate
+from flight.outcomes import Flight
+from flight.physics import State, initial_state
+from flight.wind import Wind, wind_vector
 from golfflight.cli import main
 from model_export.accuracy import (
     DRIVER_FILE,
@@ -42,16 +49,9 @@ from model_export.accuracy_winds import (
     group_winds,
     measured_paths,
     training_winds,
-    wind_of_components,
 )
 from model_export.export import export_checkpoint
 from model_export.training import TrainConfig, train
-from service.air import Air
-from service.coefficients import FERGUSON_2022, QuadraticSpinRatio
-from service.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from service.flight import Flight, simulate
-from service.physics import State, initial_state
-from service.wind import wind_vector
 from shots.heldout import HELD_OUT
 from shots.paths import shared_data_dir
 from shots.records import ShotRecord, ShotSet
@@ -200,7 +200,7 @@ def test_the_ferguson_flyer_is_quadratic_spin_ratio_through_the_same_simulate_ca
     launch = _launches(5)
     flyer = ferguson_flyer(dt_s=0.1, t_sim_s=10.0)
     direct = simulate(initial_state(**launch), QuadraticSpinRatio(FERGUSON_2022), density=1.225, dt=0.1, t_max=10.0)
-    flown = flyer.fly(launch)
+    flown = flyer.simulate(launch)
     assert flyer.density_kg_m3 == 1.225 and flyer.label == "Ferguson 2022"
     assert flown.carry_m == pytest.approx(direct.carry_m, rel=1e-12)
     assert flown.apex_m == pytest.approx(direct.apex_m, rel=1e-12)
@@ -208,7 +208,7 @@ def test_the_ferguson_flyer_is_quadratic_spin_ratio_through_the_same_simulate_ca
     assert np.all((direct.carry_m > 150) & (direct.carry_m < 300)), "plausible drives"
     thin = Air.from_conditions(25.0, 2000.0)
     in_thin = simulate(initial_state(**launch), QuadraticSpinRatio(), density=thin.density_kg_m3, dt=0.1, t_max=10.0)
-    assert flyer.fly(launch, thin).carry_m == pytest.approx(in_thin.carry_m, rel=1e-12)
+    assert flyer.simulate(launch, thin).carry_m == pytest.approx(in_thin.carry_m, rel=1e-12)
 
 
 def test_models_that_fly_alike_are_flown_once(bundle):
@@ -291,7 +291,7 @@ def test_the_held_out_range_of_the_shared_driver_file():
 def _fly_with_wind(flyer, launch: dict[str, np.ndarray], x: np.ndarray, y: np.ndarray):
     """Trajectories [T, 4] (t, x, y, z relative to the start) of launches flown in a known uniform wind per shot,
     and a radar-tracked time of 90 % of each flight."""
-    flight = flyer.fly(launch, keep_states=True, wind=wind_of_components(x, y))
+    flight = flyer.simulate(launch, keep_states=True, wind=Wind.from_components(x, y))
     start = flight.states[0].position
     positions = np.stack([s.position for s in flight.states]) - start[None]
     ids = [f"901-R1-H{1 + i % 2}-P{i}-S1" for i in range(len(x))]
@@ -323,7 +323,7 @@ def test_wind_components_round_trip_through_the_wind_object():
     from discovery.effects import wind_from_components
 
     x, y = np.array([2.0, -1.0, 0.0]), np.array([-3.0, 0.0, 4.0])
-    wind = wind_of_components(x, y)
+    wind = Wind.from_components(x, y)
     assert wind_vector(wind.speed_mps, wind.from_deg)[:, :2] == pytest.approx(np.column_stack([x, y]))
     assert wind.from_deg[1] == pytest.approx(90.0), "air moving left blows from the right"
     assert (wind.speed_mps[0], wind.from_deg[0]) == pytest.approx(wind_from_components(2.0, -3.0))

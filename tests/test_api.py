@@ -11,9 +11,9 @@ import httpx
 import pytest
 from servers import running
 
+from flight.constants import MPH_TO_MPS, YARD_M
 from service.api.app import create_app
 from service.api.models import MAX_BATCH_SHOTS
-from service.constants import MPH_TO_MPS, YARD_M
 from service.model_location import model_dir
 from shots.paths import shared_data_dir
 from weights_schema.bundle import load_bundle

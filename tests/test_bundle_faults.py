@@ -14,11 +14,11 @@ import pytest
 from onnx import numpy_helper
 from servers import running
 
+from flight.onnx_coefficients import OnnxCoefficients
 from golfflight.cli import main
 from service.api.app import create_app
 from service.engine import FlightEngine
 from service.model_location import model_dir
-from service.onnx_coefficients import OnnxCoefficients
 from weights_schema.bundle import BundleError, sha256_of
 
 REPO = Path(__file__).resolve().parents[1]

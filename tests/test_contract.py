@@ -12,7 +12,7 @@ import psutil
 import pytest
 from servers import running
 
-from service import limits
+from flight import limits
 from service.api.app import create_app
 from service.api.guards import MAX_BODY_BYTES
 from service.api.models import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, RANGES, ShotRequest

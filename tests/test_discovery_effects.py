@@ -1,4 +1,4 @@
-"""Discovery: the simulator matches service.flight.simulate, and each library effect moves a flight the right way."""
+"""Discovery: the simulator matches flight.integrator.simulate, and each library effect moves a flight the right way."""
 
 from __future__ import annotations
 
@@ -7,13 +7,13 @@ import pytest
 
 from discovery.effects import EFFECTS, LIBRARY, apply_all, wind_from_components
 from discovery.model import reference
-from discovery.simulator import Conditions, fly
-from service.air import Air
-from service.flight import simulate
-from service.physics import initial_state
-from service.wind import Wind, wind_vector
+from discovery.simulator import Setup, simulate_setup
+from flight.air import Air
+from flight.integrator import simulate
+from flight.physics import initial_state
+from flight.reference_aero import CALIBRATED, ReferenceAerodynamics
+from flight.wind import Wind, wind_vector
 from shots.clubs import CLUBS
-from shots.reference_world import CALIBRATED, ReferenceAerodynamics
 
 CARRY_Y, CARRY_X, APEX, TIME, ANGLE = range(5)
 MODEL = reference()
@@ -32,10 +32,10 @@ def launches() -> dict[str, np.ndarray]:
     }
 
 
-def base() -> Conditions:
+def base() -> Setup:
     launch = launches()
     n = len(launch["spin_rpm"])
-    return Conditions(
+    return Setup(
         launch, np.ones(n), np.full(n, MODEL.density_kg_m3), np.zeros((n, 2)), np.zeros(n), np.ones((n, 3))
     )
 
@@ -49,7 +49,7 @@ def outcomes(name: str, **parameters: float) -> tuple[np.ndarray, np.ndarray]:
         theta = np.array([parameters[p.name] for p in effect.parameters])
     conditions = base()
     changed = apply_all((effect,), np.repeat(theta[None], len(conditions), 0), conditions)
-    return MODEL.fly(conditions).outcomes(), MODEL.fly(changed).outcomes()
+    return MODEL.simulate(conditions).outcomes(), MODEL.simulate(changed).outcomes()
 
 
 @pytest.mark.parametrize("method", ["euler", "rk4"])
@@ -78,8 +78,8 @@ def test_simulator_matches_service_simulate(method):
         method=method,
         ground_height_m=ground,
     )
-    conditions = Conditions(launch, np.ones(n), np.full(n, float(air.density_kg_m3)), wind, ground, np.ones((n, 3)))
-    got = fly(
+    conditions = Setup(launch, np.ones(n), np.full(n, float(air.density_kg_m3)), wind, ground, np.ones((n, 3)))
+    got = simulate_setup(
         conditions,
         lambda ratio: ReferenceAerodynamics(CALIBRATED, air.kinematic_viscosity_m2_s / ratio),
         0.1,
@@ -95,9 +95,10 @@ def test_simulator_matches_service_simulate(method):
 
 def test_null_parameters_change_nothing():
     conditions = base()
-    before = MODEL.fly(conditions).outcomes()
+    before = MODEL.simulate(conditions).outcomes()
     for effect in LIBRARY:
-        after = MODEL.fly(apply_all((effect,), np.repeat(effect.null[None], len(conditions), 0), conditions)).outcomes()
+        nulls = np.repeat(effect.null[None], len(conditions), 0)
+        after = MODEL.simulate(apply_all((effect,), nulls, conditions)).outcomes()
         np.testing.assert_array_equal(after, before, err_msg=effect.name)
 
 

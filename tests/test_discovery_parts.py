@@ -10,7 +10,7 @@ from discovery.effects import EFFECTS, Context, equivalent_altitude_m
 from discovery.prove import Run, cases, draw_effect, expected_label, relative_error, tables
 from discovery.report import plus_minus, service_settings
 from discovery.schema import EffectResult
-from service.air import pressure_at_altitude
+from flight.air import pressure_at_altitude
 from shots.markdown import replace_section
 
 ICAO = Context(1.225, 15.0)

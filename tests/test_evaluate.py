@@ -9,6 +9,9 @@ import numpy as np
 import pytest
 import torch
 
+from flight.air import Air
+from flight.physics import initial_state
+from flight.wind import Wind
 from golfflight.cli import main
 from model_export.data import load_training_data
 from model_export.evaluate import COMMAND, FIGURES, run_evaluation
@@ -22,9 +25,6 @@ from model_export.noise_floor import (
 )
 from model_export.training import TrainConfig, load_checkpoint, train
 from model_export.validation import load_validation
-from service.air import Air
-from service.physics import initial_state
-from service.wind import Wind
 from shots.markdown import begin_marker
 from shots.records import ShotRecord, read_shots, write_csv_atomic, write_shots
 from shots.reference_world import fly_reference

@@ -13,14 +13,14 @@ import pytest
 import torch
 from conftest import random_launches
 
+from flight import constants
+from flight.integrator import simulate
+from flight.onnx_coefficients import OnnxCoefficients
+from flight.physics import initial_state
 from golfflight.cli import main
 from model_export.export import OPSET, export_bundle, export_checkpoint, probe_inputs
 from model_export.torch_physics import euler_rollout, hard_landing
 from model_export.training import TrainConfig, load_checkpoint, model_from_checkpoint, train
-from service import constants
-from service.flight import simulate
-from service.onnx_coefficients import OnnxCoefficients
-from service.physics import initial_state
 from weights_schema import BundleError, load_bundle
 from weights_schema.model_card import SCHEMA_PATH, schema_text
 
@@ -174,7 +174,7 @@ def test_command_line_train_and_export(tiny_shots, tmp_path, capsys):
 
 def test_runtime_path_imports_no_torch():
     code = (
-        "import sys, service.onnx_coefficients, service.flight, weights_schema, golfflight.cli\n"
+        "import sys, flight.onnx_coefficients, flight.integrator, weights_schema, golfflight.cli\n"
         "golfflight.cli.build_parser()\n"
         "assert 'torch' not in sys.modules, 'torch imported on the serving path'"
     )

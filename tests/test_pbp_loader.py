@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.commands import convert
-from service.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from shots.paths import shared_data_dir
 from shots.pbp import distance_m, load_pbp, recorded_apex, rest_positions
 from shots.records import RecordError, read_shots

@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from service.air import Air
-from service.coefficients import ConstantCoefficients, QuadraticSpinRatio
-from service.constants import BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, TEE_HEIGHT_M
-from service.flight import simulate
-from service.physics import State, derivatives, initial_state, mechanical_energy
-from service.wind import Wind
+from flight.air import Air
+from flight.coefficients import ConstantCoefficients, QuadraticSpinRatio
+from flight.constants import BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, TEE_HEIGHT_M
+from flight.integrator import simulate
+from flight.physics import State, derivatives, initial_state, mechanical_energy
+from flight.wind import Wind
 
 RHO = Air.standard().density_kg_m3
 

@@ -12,11 +12,11 @@ import torch
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from service import limits
-from service.conditions import AirConditions, Conditions
+from flight import limits
+from flight.conditions import AirConditions, Conditions
+from flight.wind import CALM, Wind
 from service.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
 from service.model_location import model_dir
-from service.wind import CALM, Wind
 
 torch.set_num_threads(1)
 

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 import torch
 
+from flight.physics import initial_state
 from model_export.joint import JointConfig, LatentConditions, train_joint
 from model_export.observations import load_observed
 from model_export.real_data import DRIVER_FILE, build, driver_groups, trackman_outdoor
 from model_export.torch_physics import euler_rollout, hard_landing, positions_at
 from model_export.variants import PhysNN, PhysQ
-from service.physics import initial_state
 from shots.heldout import HELD_OUT, HeldOutError, check_training_rows, held_out_set
 from shots.paths import REPO_ROOT, shared_data_dir
 from shots.records import ShotRecord, read_shots, trajectories_path, write_shots, write_trajectories

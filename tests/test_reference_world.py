@@ -7,19 +7,16 @@ import dataclasses
 import numpy as np
 import pytest
 
-from service.air import Air
-from service.constants import BALL_RADIUS_M, MPH_TO_MPS, YARD_M
-from service.flight import simulate
-from service.physics import initial_state
+from flight.air import Air
+from flight.constants import BALL_RADIUS_M, MPH_TO_MPS, YARD_M
+from flight.integrator import simulate
+from flight.physics import initial_state
+from flight.reference_aero import CALIBRATED, REFERENCE_DT_S, REFERENCE_T_MAX_S, ReferenceAerodynamics
 from shots.calibrate_reference import TRACKMAN_SPIN_LOSS_PCT, evaluate, render_markdown
 from shots.paths import shared_data_dir
 from shots.reference_world import (
-    CALIBRATED,
     CALIBRATION_AIR,
-    REFERENCE_DT_S,
-    REFERENCE_T_MAX_S,
     ClubAverage,
-    ReferenceAerodynamics,
     default_tour_averages_path,
     fly_reference,
     read_tour_averages,

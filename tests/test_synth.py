@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
+from flight.air import Air
 from golfflight.cli import main
-from service.air import Air
 from shots.records import read_shots
 from shots.synth import MIN_APEX_M, SynthConfig, draw_sessions, generate, sessions_path, validation_sessions
 

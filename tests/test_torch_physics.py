@@ -7,13 +7,13 @@ import pytest
 import torch
 from conftest import random_launches
 
+from flight.air import Air
+from flight.coefficients import ConstantCoefficients, QuadraticSpinRatio
+from flight.integrator import simulate
+from flight.physics import State, initial_state
+from flight.physics import derivatives as np_derivatives
 from model_export.torch_physics import Trajectory, derivatives, euler_rollout, hard_landing, soft_landing
 from model_export.variants import PhysQ
-from service.air import Air
-from service.coefficients import ConstantCoefficients, QuadraticSpinRatio
-from service.flight import simulate
-from service.physics import State, initial_state
-from service.physics import derivatives as np_derivatives
 
 torch.set_num_threads(1)  # tiny models: one thread is as fast, and immune to other jobs on the 2 cores
 
@@ -68,7 +68,10 @@ def test_euler_flights_and_landing_match_numpy(launch_state, name, numpy_model, 
     np.testing.assert_allclose(landing.velocity.numpy(), flight.landing_velocity, rtol=0, atol=1e-6)
     np.testing.assert_allclose(landing.spin.numpy(), flight.landing_spin, rtol=0, atol=1e-6)
     np.testing.assert_allclose(landing.time_s.numpy(), flight.flight_time_s, rtol=0, atol=1e-9)
-    np.testing.assert_allclose(trajectory.apex_m.numpy(), flight.apex_m, rtol=0, atol=1e-6)
+    highest_step = np.stack([s.position[:, 2] for s in flight.states]).max(axis=0)
+    np.testing.assert_allclose(trajectory.apex_m.numpy(), highest_step, rtol=0, atol=1e-6)
+    # the core's apex lies between the steps: on the parabola through the highest one and its neighbours
+    assert (highest_step <= flight.apex_m).all() and (flight.apex_m <= highest_step + 0.02).all()
 
 
 @torch.no_grad()

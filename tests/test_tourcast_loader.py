@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from flight.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M, FOOT_M, GRAVITY_MPS2, MPH_TO_MPS, RPM_TO_RADPS
 from golfflight.commands import convert
-from service.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M, FOOT_M, GRAVITY_MPS2, MPH_TO_MPS, RPM_TO_RADPS
 from shots.paths import shared_data_dir
 from shots.records import RecordError, read_shots, read_trajectories, trajectories_path
 from shots.tourcast import load_tourcast, spin_axis_deg

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.commands import convert
-from service.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from shots.paths import shared_data_dir
 from shots.records import RecordError, read_shots
 from shots.trackman import load_trackman

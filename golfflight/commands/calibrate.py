@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from flight.reference_aero import CALIBRATED
 from shots.calibrate_reference import (
     evaluate,
     evaluate_ferguson,
@@ -12,7 +13,7 @@ from shots.calibrate_reference import (
     render_markdown,
 )
 from shots.markdown import write_generated_section
-from shots.reference_world import CALIBRATED, default_tour_averages_path, read_tour_averages
+from shots.reference_world import default_tour_averages_path, read_tour_averages
 
 COMMAND = "calibrate-reference"
 

@@ -7,10 +7,10 @@ import json
 
 import numpy as np
 
-from service.air import Air
-from service.constants import YARD_M
-from service.physics import initial_state
-from service.wind import Wind
+from flight.air import Air
+from flight.constants import YARD_M
+from flight.physics import initial_state
+from flight.wind import Wind
 from shots.clubs import CLUBS
 from shots.reference_world import fly_reference
 

@@ -71,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     import uvicorn
 
     from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
-    from service.bundle_check import verify_bundle
+    from flight.bundle_check import verify_bundle
     from service.model_location import MODEL_ENV, model_dir
     from service.open_connect.server import CONNECT_HOST_ENV, CONNECT_PORT_ENV
 

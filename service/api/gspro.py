@@ -15,12 +15,12 @@ from typing import Annotated
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from service import limits
+from flight import limits
+from flight.constants import MPH_TO_MPS
+from flight.limits import Range
 from service.api.models import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotResult, describe_errors
 from service.api.shots import flight_fields, spin_from_components
-from service.constants import MPH_TO_MPS
 from service.engine import FlightEngine, FlightError, Launch
-from service.limits import Range
 
 
 def _spelled_as_fields(data, fields) -> dict:

@@ -1,6 +1,6 @@
 """The HTTP contract: pydantic request and response models (SI inside, imperial only in fields named for it).
 
-Every number is range-checked against `service.limits` (NaN and infinity refused), types are strict (no "55" for
+Every number is range-checked against `flight.limits` (NaN and infinity refused), types are strict (no "55" for
 55), unknown fields are refused, and each launch quantity comes in exactly one form: ball_speed_mps or
 ball_speed_mph; spin_rpm (+ spin_axis_deg) or back_spin_rpm (+ side_spin_rpm). The one-form rules are also written
 into the OpenAPI schema (oneOf / not), so a schema-driven client or fuzzer builds the requests the service takes.
@@ -13,10 +13,10 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from service import limits
-from service.conditions import NORMALIZED_REFERENCE
-from service.constants import MPH_TO_MPS
-from service.limits import Range
+from flight import limits
+from flight.conditions import NORMALIZED_REFERENCE
+from flight.constants import MPH_TO_MPS
+from flight.limits import Range
 
 MAX_BATCH_SHOTS = 10_000
 """Most shots one POST /v1/shots/batch may carry."""

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import math
 
+from flight.conditions import STANDARD, AirConditions, Conditions
+from flight.constants import MPH_TO_MPS, YARD_M
+from flight.wind import CALM, Wind
 from service.api.models import (
     AirRequest,
     Landing,
@@ -16,11 +19,8 @@ from service.api.models import (
     TrajectoryRequest,
     WindRequest,
 )
-from service.conditions import STANDARD, AirConditions, Conditions
-from service.constants import MPH_TO_MPS, YARD_M
 from service.engine import FlightEngine, FlightError, Launch, ShotFlight
 from service.trajectory import resample
-from service.wind import CALM, Wind
 
 
 def spin_from_components(back_spin_rpm: float, side_spin_rpm: float) -> tuple[float, float]:

@@ -2,7 +2,7 @@
 
 Requests describe air the way people know it (temperature, altitude or station pressure, humidity) or give a
 density outright; `AirConditions` turns that into the two numbers the equations use: the density (dynamic
-pressure) and the kinematic viscosity (Reynolds number, `service.physics.reynolds_scale`). Anything
+pressure) and the kinematic viscosity (Reynolds number, `flight.physics.reynolds_scale`). Anything
 left out takes the ICAO standard value (15 degC, sea level, dry: 1.225 kg/m^3), the air the models were trained
 in, so a request without conditions reproduces the training simulator.
 """
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from service.air import air_density, dynamic_viscosity, pressure_at_altitude
-from service.wind import CALM, Wind, wind_vector
+from flight.air import air_density, dynamic_viscosity, pressure_at_altitude
+from flight.wind import CALM, Wind, wind_vector
 
 STANDARD_TEMPERATURE_C = 15.0
 STANDARD_HUMIDITY_PCT = 0.0

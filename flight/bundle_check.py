@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import onnxruntime as ort
 
-from service import limits
-from service.constants import RPM_TO_RADPS
+from flight import limits
+from flight.constants import RPM_TO_RADPS
 from weights_schema.bundle import CARD_FILE, BundleError, load_bundle
 from weights_schema.model_card import ModelCard
 

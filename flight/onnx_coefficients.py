@@ -1,7 +1,7 @@
 """Coefficient model backed by an exported bundle's ONNX graph (ONNX Runtime, no torch).
 
 model = OnnxCoefficients(path); card = model.card
-simulate(state, model, density=card.physics.air_density_kg_m3, dt=card.physics.dt_s, t_max=card.physics.t_sim_s)
+flight.integrator.simulate(state, model, card.physics.air_density_kg_m3, card.physics.dt_s, card.physics.t_sim_s)
 In other air: `model.in_air(air.kinematic_viscosity_m2_s)` (the same graph, inputs at that air's Reynolds scale) and
 that air's density.
 """
@@ -13,13 +13,13 @@ import os
 
 import numpy as np
 
-from service.bundle_check import open_verified
-from service.physics import reynolds_scale
+from flight.bundle_check import open_verified
+from flight.physics import reynolds_scale
 
 
 class OnnxCoefficients:
-    """`service.physics.CoefficientModel` running a bundle's graph: float32 in, float64 [N,4] C_L, C_D, C_M, C_Q out.
-    The bundle is verified like the engine's (`service.bundle_check`): a bad one raises BundleError."""
+    """`flight.physics.CoefficientModel` running a bundle's graph: float32 in, float64 [N,4] C_L, C_D, C_M, C_Q out.
+    The bundle is verified like the engine's (`flight.bundle_check`): a bad one raises BundleError."""
 
     def __init__(self, bundle_dir: str | os.PathLike, intra_op_threads: int = 1):
         self.card, self.onnx_path, self.session = open_verified(bundle_dir, intra_op_threads)
@@ -34,6 +34,14 @@ class OnnxCoefficients:
         scale = reynolds_scale(np.asarray(kinematic_viscosity_m2_s, dtype=float), nominal)
         other = copy.copy(self)
         other.input_scale = float(scale) if scale.ndim == 0 else scale[:, None]
+        return other
+
+    def take(self, index: np.ndarray) -> OnnxCoefficients:
+        """This model for some of the balls (their own air's input scale)."""
+        if isinstance(self.input_scale, float):
+            return self
+        other = copy.copy(self)
+        other.input_scale = self.input_scale[index]
         return other
 
     def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:

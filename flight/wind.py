@@ -54,30 +54,51 @@ def uniform_equivalent_factor(heights_m: np.ndarray, reference_height_m: float, 
 
 @dataclass(frozen=True)
 class Wind:
-    """A steady wind; speed and direction may be arrays (one per shot of a batch)."""
+    """A steady wind. Every field may instead be an array with one value per shot of a batch (`profile` an array
+    of "uniform"/"log"), so each shot of one batch can have its own wind."""
 
     speed_mps: float | np.ndarray = 0.0
     from_deg: float | np.ndarray = 0.0
-    profile: Literal["uniform", "log"] = "uniform"
-    reference_height_m: float = STATION_HEIGHT_M
-    roughness_m: float = FAIRWAY_ROUGHNESS_M
+    profile: Literal["uniform", "log"] | np.ndarray = "uniform"
+    reference_height_m: float | np.ndarray = STATION_HEIGHT_M
+    roughness_m: float | np.ndarray = FAIRWAY_ROUGHNESS_M
+
+    @classmethod
+    def from_components(cls, x_mps: ArrayLike, y_mps: ArrayLike, **profile) -> Wind:
+        """The wind whose air moves at (x, y) m/s at the reference height (x right, y to the target)."""
+        x, y = np.asarray(x_mps, dtype=float), np.asarray(y_mps, dtype=float)
+        return cls(np.hypot(x, y), np.degrees(np.arctan2(-x, -y)) % 360.0, **profile)
 
     @cached_property
     def at_reference(self) -> np.ndarray:
         """Air velocity at the reference height ([..., 3]); worked out once, the integrators ask every step."""
         return wind_vector(self.speed_mps, self.from_deg)
 
+    @cached_property
+    def is_log(self) -> np.ndarray:
+        """Which shots' wind follows the log profile (a boolean, or one per shot)."""
+        return np.asarray(self.profile) == "log"
+
     def velocity(self, height_m: np.ndarray) -> np.ndarray:
         """Air velocity [N, 3] at the balls' heights [N]."""
-        if self.profile == "uniform":
+        if not self.is_log.any():
             return np.broadcast_to(self.at_reference, np.shape(height_m) + (3,))
         factor = log_profile_factor(height_m, self.reference_height_m, self.roughness_m)
+        if not self.is_log.all():
+            factor = np.where(self.is_log, factor, 1.0)
         return self.at_reference * factor[..., None]
 
     @cached_property
     def is_calm(self) -> bool:
         """True when there is no wind anywhere in the batch."""
         return not np.any(np.asarray(self.speed_mps) != 0.0)
+
+    def take(self, index: np.ndarray) -> Wind:
+        """The wind of some of the shots (itself when it is the same for every shot)."""
+        fields = (self.speed_mps, self.from_deg, self.profile, self.reference_height_m, self.roughness_m)
+        if all(np.ndim(f) == 0 for f in fields):
+            return self
+        return Wind(*(f if np.ndim(f) == 0 else np.asarray(f)[index] for f in fields))
 
 
 CALM = Wind()

@@ -21,7 +21,7 @@ from typing import Protocol
 
 import numpy as np
 
-from service.constants import (
+from flight.constants import (
     BALL_AREA_M2,
     BALL_INERTIA_KG_M2,
     BALL_MASS_KG,
@@ -30,14 +30,23 @@ from service.constants import (
     RPM_TO_RADPS,
     TEE_HEIGHT_M,
 )
-from service.wind import CALM, Wind
+from flight.wind import CALM, Wind
 
 TINY = 1e-12
 """Guards the unit vectors of a ball at rest or with no spin."""
 
 
 class CoefficientModel(Protocol):
-    """Aerodynamic coefficients [N,4] = (C_L, C_D, C_M, C_Q) of balls with air-relative velocity and spin [N,3]."""
+    """Aerodynamic coefficients [N,4] = (C_L, C_D, C_M, C_Q) of balls with air-relative velocity and spin [N,3].
+
+    A model holding per-ball values (air, scales) also has `take(index)`, the same model for those balls only, so
+    the integrator can drop landed balls from the batch; one without per-ball values needs none."""
+
+    def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray: ...
+
+
+class ExtraAcceleration(Protocol):
+    """An acceleration [N,3] added to the equations from (air-relative velocity, spin) [N,3]; `take` as above."""
 
     def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray: ...
 
@@ -49,6 +58,10 @@ class State:
     position: np.ndarray
     velocity: np.ndarray
     spin: np.ndarray
+
+    def take(self, index: np.ndarray) -> State:
+        """The state of some of the balls."""
+        return State(self.position[index], self.velocity[index], self.spin[index])
 
 
 def initial_state(
@@ -132,13 +145,20 @@ def aerodynamics(v_rel: np.ndarray, omega: np.ndarray, coefficients: np.ndarray,
 
 
 def derivatives(
-    state: State, coefficient_model: CoefficientModel, density: np.ndarray | float, wind: Wind = CALM
+    state: State,
+    coefficient_model: CoefficientModel,
+    density: np.ndarray | float,
+    wind: Wind = CALM,
+    extra: ExtraAcceleration | None = None,
 ) -> State:
-    """d/dt of (position, velocity, spin): the right-hand side of the equations of motion (paper eq. 14)."""
+    """d/dt of (position, velocity, spin): the right-hand side of the equations of motion (paper eq. 14), plus an
+    optional extra acceleration of the air-relative velocity and spin (discovery's learned correction)."""
     v_rel = state.velocity if wind.is_calm else state.velocity - wind.velocity(state.position[:, 2])
     coefficients = coefficient_model(v_rel, state.spin)
     acceleration, spin_acceleration = aerodynamics(v_rel, state.spin, coefficients, density)
     acceleration[:, 2] -= GRAVITY_MPS2
+    if extra is not None:
+        acceleration += extra(v_rel, state.spin)
     return State(state.velocity, acceleration, spin_acceleration)
 
 
