@@ -1,3 +1,6 @@
 """golfflight: a physics + neural-network golf ball flight engine (Phys-NN+)."""
 
-__version__ = "0.1.0"
+from importlib.metadata import version
+
+__version__ = version("golfflight")
+"""The installed distribution's version (pyproject.toml is its one source)."""

@@ -74,7 +74,7 @@ class BatchProcess:
         """Start the child and wait until it has loaded the model; returns the model's ONNX hash."""
         return self._pool.submit(_ready).result()
 
-    async def fly(self, body: bytes) -> tuple[bytes, float]:
+    async def submit(self, body: bytes) -> tuple[bytes, float]:
         """The encoded BatchResult of a validated BatchRequest body, and the simulation seconds. A child found dead
         (killed, out of memory) is replaced before the batch is sent; one that dies under this batch is replaced
         for the next and this one raises BrokenProcessPool."""

@@ -1,0 +1,47 @@
+"""How refusals read: every 4xx body names the field, the value and the allowed range, and POST /v1/gspro answers
+in Open Connect's own form (Code 500, a Message); a route called before the model is ready gets 503."""
+
+from __future__ import annotations
+
+from fastapi import FastAPI, Request
+from fastapi.exception_handlers import http_exception_handler
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse, Response
+from starlette.exceptions import HTTPException as StarletteHTTPException
+
+from service.api.gspro import GSProReply, invalid_message
+from service.api.models import RANGES, body_detail, describe_errors
+from service.api.routes.gspro import GSPRO_PATH
+from service.api.state import NotReady
+
+NOT_JSON = "the body is not JSON text in UTF-8"
+"""FastAPI's 400 for a body it cannot even decode, said as a 422 like every other refusal of a body."""
+
+
+def _gspro_error(message: str) -> JSONResponse:
+    return JSONResponse(GSProReply(Code=500, Message=message).model_dump(exclude_none=True), 422)
+
+
+async def invalid_request(request: Request, error: RequestValidationError) -> JSONResponse:
+    if request.url.path == GSPRO_PATH:
+        return _gspro_error(invalid_message(error.errors()))
+    return JSONResponse({"detail": describe_errors(error.errors(), RANGES)}, 422)
+
+
+async def http_error(request: Request, error: StarletteHTTPException) -> Response:
+    if error.status_code != 400:
+        return await http_exception_handler(request, error)
+    if request.url.path == GSPRO_PATH:
+        return _gspro_error(NOT_JSON)
+    return JSONResponse({"detail": [body_detail(NOT_JSON, "json_invalid")]}, 422)
+
+
+async def not_ready(request: Request, error: NotReady) -> JSONResponse:
+    return JSONResponse({"detail": str(error)}, 503)
+
+
+def install(app: FastAPI) -> None:
+    """Register the handlers on an app."""
+    app.add_exception_handler(RequestValidationError, invalid_request)
+    app.add_exception_handler(StarletteHTTPException, http_error)
+    app.add_exception_handler(NotReady, not_ready)

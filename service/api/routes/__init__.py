@@ -1,0 +1,1 @@
+"""The HTTP routes, one router per concern, each a thin layer over the plain functions of `service.api`."""

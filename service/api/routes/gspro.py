@@ -1,0 +1,37 @@
+"""POST /v1/gspro: a GSPro Open Connect v1 message over HTTP, answered as over TCP (`ServiceState.gspro_reply`)."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, Depends
+from fastapi.responses import Response
+
+from service.api.gspro import GSProMessage, GSProReply
+from service.api.routes.responses import ERROR_RESPONSES, json_response
+from service.api.state import ServiceState, service_state
+
+GSPRO_PATH = "/v1/gspro"
+GSPRO_STATUS = {200: 200, 500: 422, 503: 503}
+"""HTTP status of each Open Connect reply code on POST /v1/gspro."""
+
+router = APIRouter()
+
+
+@router.post(
+    GSPRO_PATH,
+    response_model=GSProReply,
+    response_model_exclude_none=True,
+    responses={
+        422: {"model": GSProReply, "description": "an invalid message or a failed flight: Open Connect's Code 500"},
+        **ERROR_RESPONSES,
+    },
+)
+async def gspro(message: GSProMessage, state: ServiceState = Depends(service_state)) -> Response:
+    """A GSPro Open Connect v1 message: a shot gets its flight with Code 200, a heartbeat just Code 200; an
+    invalid message or a failed flight gets HTTP 422 with Open Connect's error reply (Code 500, a Message)."""
+    if message.is_heartbeat:
+        return json_response(GSProReply(Code=200, Message="heartbeat received"))
+    if message.BallData is None:
+        nothing = GSProReply(Code=200, Message="no ball data: nothing to fly", ShotNumber=message.ShotNumber)
+        return json_response(nothing)
+    reply = state.gspro_reply(message)
+    return json_response(reply, GSPRO_STATUS[reply.Code])

@@ -1,0 +1,70 @@
+"""POST /v1/shots (inline: one shot takes well under a millisecond, less than a hop to a thread would cost) and
+POST /v1/shots/batch (in the batch process, at a lower CPU priority: `service.api.batch_process`)."""
+
+from __future__ import annotations
+
+import time
+from concurrent.futures.process import BrokenProcessPool
+
+from fastapi import APIRouter, Depends, Request
+from fastapi.responses import JSONResponse, Response
+
+from service.api.models import (
+    MAX_BATCH_SHOTS,
+    MAX_BATCH_TRAJECTORIES,
+    BatchRequest,
+    BatchResult,
+    ShotRequest,
+    ShotResult,
+    body_detail,
+)
+from service.api.routes.responses import ERROR_RESPONSES, json_response
+from service.api.shots import fly_shot
+from service.api.state import ServiceState, ready_engine, service_state
+from service.engine import FlightEngine, FlightError
+
+BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has been restarted): send the batch again"
+
+router = APIRouter(prefix="/v1/shots")
+
+
+@router.post(
+    "",
+    response_model=ShotResult,
+    response_model_exclude_none=True,
+    responses={422: {"description": "invalid launch or conditions, or a shot that cannot land"}, **ERROR_RESPONSES},
+)
+async def shot(
+    request: ShotRequest,
+    engine: FlightEngine = Depends(ready_engine),
+    state: ServiceState = Depends(service_state),
+) -> Response:
+    """Fly one shot: launch in SI or launch-monitor units, optional wind, air, normalized and trajectory."""
+    started = time.perf_counter()
+    try:
+        result = fly_shot(engine, request)
+    except FlightError as error:
+        return JSONResponse({"detail": [body_detail(str(error), "flight_error")]}, 422)
+    finally:
+        state.simulation.add(time.perf_counter() - started)
+    return json_response(result)
+
+
+@router.post(
+    "/batch",
+    response_model=BatchResult,
+    response_model_exclude_none=True,
+    responses=ERROR_RESPONSES,
+    description=f"Fly up to {MAX_BATCH_SHOTS:,} shots together in one engine batch (at most "
+    f"{MAX_BATCH_TRAJECTORIES} of them with a trajectory); results come back in order and a shot that cannot "
+    "land gets an error entry of its own.",
+    dependencies=[Depends(ready_engine)],
+)
+async def batch(request: BatchRequest, http: Request, state: ServiceState = Depends(service_state)) -> Response:
+    """FastAPI has validated `request` (a 422 otherwise); the batch process flies its raw body."""
+    try:
+        body, seconds = await state.batches.submit(await http.body())
+    except BrokenProcessPool:
+        return JSONResponse({"detail": BATCH_PROCESS_DIED}, 503)
+    state.simulation.add(seconds)
+    return Response(body, media_type="application/json")

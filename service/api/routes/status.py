@@ -1,0 +1,60 @@
+"""GET /healthz (readiness, no key needed), /v1/model (the card) and /v1/latency (rolling figures and a probe)."""
+
+from __future__ import annotations
+
+import time
+from importlib.metadata import version
+
+from fastapi import APIRouter, Depends
+from fastapi.responses import JSONResponse, Response
+
+from service.api.models import ShotRequest
+from service.api.routes.responses import ERROR_RESPONSES
+from service.api.shots import fly_shot
+from service.api.state import ServiceState, ready_engine, service_state
+from service.engine import FlightEngine
+from weights_schema.model_card import ModelCard
+
+PROBE_SHOT = ShotRequest(ball_speed_mps=55.0, launch_angle_deg=16.0, spin_rpm=7100.0)
+"""The shot /v1/latency times on demand: a tour-average 7-iron in standard air."""
+
+router = APIRouter()
+
+
+@router.get("/healthz")
+async def healthz(state: ServiceState = Depends(service_state)) -> JSONResponse:
+    """Ready (200) once the model is loaded, with its variant and hash; 503 while loading or if it failed."""
+    if state.engine is None:
+        status = "failed" if state.error else "loading"
+        return JSONResponse({"status": status, "error": state.error, "model_dir": str(state.bundle_dir)}, 503)
+    engine = state.engine
+    model = {
+        "variant": engine.variant,
+        "sha256": engine.sha256,
+        "dir": str(state.bundle_dir),
+        "load_seconds": engine.load_seconds,
+    }
+    return JSONResponse({"status": "ready", "model": model, "version": version("golfflight")})
+
+
+@router.get("/v1/model", response_model=ModelCard, responses=ERROR_RESPONSES)
+async def model_card(engine: FlightEngine = Depends(ready_engine)) -> Response:
+    """The loaded bundle's model card (every field, nulls included, as the card's schema requires)."""
+    return Response(engine.card.model_dump_json(), media_type="application/json")
+
+
+@router.get("/v1/latency", responses=ERROR_RESPONSES)
+async def latency(
+    engine: FlightEngine = Depends(ready_engine), state: ServiceState = Depends(service_state)
+) -> JSONResponse:
+    """Rolling p50/p95/p99 of simulation time and whole requests, and a probe shot timed now."""
+    started = time.perf_counter()
+    fly_shot(engine, PROBE_SHOT)
+    probe_ms = (time.perf_counter() - started) * 1e3
+    return JSONResponse(
+        {
+            "simulation": state.simulation.summary(),
+            "request": state.requests.summary(),
+            "probe": {"shot": PROBE_SHOT.model_dump(exclude_none=True), "simulation_ms": probe_ms},
+        }
+    )

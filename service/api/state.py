@@ -1,0 +1,68 @@
+"""What the routes share, and the dependencies that hand it to them: the service state on `app.state` and its
+engine once loaded (`NotReady`, a 503, before that)."""
+
+from __future__ import annotations
+
+import gc
+import threading
+import time
+from pathlib import Path
+
+from fastapi import Depends, Request
+
+from service.api.batch_process import BatchProcess
+from service.api.gspro import GSProMessage, GSProReply, fly_message
+from service.api.latency import Rolling
+from service.engine import FlightEngine
+
+
+class NotReady(Exception):
+    """A simulation route was called before the model was loaded."""
+
+
+class ServiceState:
+    """The engine once loaded (or why it failed), the batch process and the rolling latency figures."""
+
+    def __init__(self, bundle_dir: Path):
+        self.bundle_dir = bundle_dir
+        self.engine: FlightEngine | None = None
+        self.error: str | None = None
+        self.simulation = Rolling()
+        self.requests = Rolling()
+        self.loaded = threading.Event()
+        self.batches = BatchProcess(bundle_dir)
+
+    def load(self) -> None:
+        """Load the model here and in the batch process; either failing leaves the service up to say why."""
+        try:
+            engine = FlightEngine(self.bundle_dir)
+            if self.batches.start() != engine.sha256:
+                raise RuntimeError("the batch process loaded a different model (the bundle changed during startup)")
+            self.engine = engine
+            gc.freeze()  # the app and the model are here for good: keep them out of every later collection's scan
+        except Exception as error:  # noqa: BLE001 - reported by /healthz, the service stays up to say so
+            self.error = f"{type(error).__name__}: {error}"
+        finally:
+            self.loaded.set()
+
+    def gspro_reply(self, message: GSProMessage) -> GSProReply:
+        """A GSPro shot's reply over HTTP and TCP alike (timed into /v1/latency); Code 503 until the model is ready."""
+        if self.engine is None:
+            return GSProReply(Code=503, Message=self.error or "the model is still loading")
+        started = time.perf_counter()
+        try:
+            return fly_message(self.engine, message)
+        finally:
+            self.simulation.add(time.perf_counter() - started)
+
+
+def service_state(request: Request) -> ServiceState:
+    """The app's `ServiceState` (set by `create_app`)."""
+    return request.app.state.service
+
+
+def ready_engine(state: ServiceState = Depends(service_state)) -> FlightEngine:
+    """The loaded engine; NotReady (503) while the model loads or after it failed to."""
+    if state.engine is None:
+        raise NotReady(state.error or "the model is still loading")
+    return state.engine
