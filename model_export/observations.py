@@ -25,6 +25,8 @@ NOISE = MeasurementNoise()
 PATH_SIGMA_M = 0.3
 PATH_OBSERVATIONS = 3.0
 OBSERVABLES = ("carry_x_m", "carry_y_m", "apex_m", "flight_time_s", "landing_angle_deg")
+TOUR_SOURCES = ("sentry-2022", "players-2020")
+"""Sources grouped by tour hole and round ('016-R2-H15'): one wind per hole and round, one air per round."""
 REFERENCE_BALLS = (None, "Premium")
 """Ball types the network itself learns (tour balls are unnamed); every other type gets a latent drag/lift scale."""
 
@@ -137,7 +139,7 @@ def _air_key(source: str | None, group: str | None) -> str | None:
         return None
     if source == "trackman-model":
         return source
-    if source == "sentry-2022":
+    if source in TOUR_SOURCES:
         return "-".join(group.split("-")[:2])
     return group
 

@@ -6,8 +6,9 @@ Sources (`SOURCES`), each with a weight per shot in the loss:
                     of the file is held out, `shots.heldout`); landing point, apex, flight time, landing angle.
   sentry-2022       PGA TOUR TrackMan trajectories of the 2022 Sentry joined with the pbp spin: the landing and
                     apex of the polynomial plus positions along the radar-tracked part of the path.
-  (THE PLAYERS 2020 pbp is not a source: it records launch and spin, and its apex fields are not measured apexes,
-  docs/real_data.md, so it has nothing to train on.)
+  players-2020      THE PLAYERS 2020 (round 1) pbp radar tee shots: launch and spin, and the carry, which this event
+                    records in its apexRange field (its apexHeight is not an apex and is left out, docs/real_data.md);
+                    no spin axis is recorded, so the side is not trained on.
   trackman-model    the indoor rows of the driver file (lines 3-2942): TrackMan's own model of the flight, not a
                     measurement; down-weighted and reported on its own; not in DEFAULT_SOURCES (docs/training_real.md).
   synthetic         calm reference-world flights of the other clubs and slower players, clean, where real data is
@@ -16,11 +17,12 @@ Groups (the `group` column) are the shots that shared one unrecorded wind and ai
 driver file, which has no date or session column, a run of consecutive measured rows of one ball type (a new group
 where more than `GAP_LINES` lines separate two measured shots, or after `BLOCK_SHOTS` shots).
 Validation is by group, never a random shuffle: every `VAL_EVERY`-th driver group in file order, the last round of
-each tour event, the synthetic generator's last sessions.
+the Sentry, every `VAL_EVERY`-th hole of THE PLAYERS (one round was played), the synthetic generator's last sessions.
 """
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -32,6 +34,7 @@ from flight.air import Air
 from flight.physics import initial_state
 from shots.clubs import CLUBS
 from shots.heldout import check_training_rows
+from shots.pbp import load_pbp, recorded_apex
 from shots.records import ShotRecord, trajectories_path, write_shots, write_trajectories
 from shots.reference_world import fly_reference
 from shots.synth import MIN_APEX_M, SynthConfig, draw_launches, draw_sessions
@@ -44,6 +47,7 @@ DRIVER_TRAIN_LINES = (3, 2942)
 """Lines of the driver file that may be trained on (NOTES section 9); `shots.heldout` refuses any other."""
 SENTRY_TRAJECTORIES = Path("real/pga_tourcast_trackman/shot_trajectory/shot_trajectory_2021_016_656.csv")
 SENTRY_PBP = Path("real/pga_tourcast_trackman/pbp/pbp_2021_016_656.csv")
+PLAYERS_PBP = Path("real/pga_tourcast_trackman/pbp/pbp_2020_011_011.csv")
 
 GAP_LINES = 3
 BLOCK_SHOTS = 40
@@ -160,6 +164,31 @@ def sentry(root: Path) -> SourceData:
                       conversion.report.summary(), {f"sentry-2022:{k}": v for k, v in paths.items()})
 
 
+def players(root: Path) -> SourceData:
+    """THE PLAYERS 2020 radar tee shots: recorded launch and spin (spin axis 0) and the forward carry from the
+    apexRange and apexSide fields, which this event fills with the landing point (docs/real_data.md). The side
+    is left out of the loss (no spin axis is recorded, so no model can predict it). Validation: every
+    `VAL_EVERY`-th hole."""
+    path = root / PLAYERS_PBP
+    check_training_rows(path, [])
+    conversion = load_pbp(path, skip_bad_rows=True)
+    fields = recorded_apex(path)
+    records, no_carry = [], 0
+    for record in conversion.records:
+        recorded = fields[record.shot_id]
+        if recorded.range_m is None:
+            no_carry += 1
+            continue
+        side = recorded.side_m or 0.0
+        records.append(record.model_copy(update={"carry_y_m": math.sqrt(max(recorded.range_m**2 - side**2, 0.0))}))
+    groups = [r.group for r in records]
+    val = {g for g in groups if int(g.rsplit("-H", 1)[1]) % VAL_EVERY == 0}
+    report = (f"{conversion.report.summary()}\n  carry = sqrt(apexRange^2 - apexSide^2) of {len(records)} shots"
+              f"{f'; {no_carry} without apexRange left out' if no_carry else ''}")
+    return SourceData("players-2020", "measured", _tag(records, "players-2020", groups, val),
+                      {str(PLAYERS_PBP): sha256_of(path)}, report)
+
+
 def driver_like(launch: dict[str, np.ndarray]) -> np.ndarray:
     """Launches where the measured drivers decide (fast and flat)."""
     return (launch["ball_speed_mps"] >= DRIVER_LIKE["min_ball_speed_mps"]) & (
@@ -198,12 +227,13 @@ def synthetic(n_shots: int = SYNTHETIC_SHOTS, seed: int = SYNTHETIC_SEED) -> Sou
 BUILDERS: dict[str, Callable[[Path], SourceData]] = {
     "trackman-outdoor": trackman_outdoor,
     "sentry-2022": sentry,
+    "players-2020": players,
     "trackman-model": trackman_model,
     "synthetic": lambda root: synthetic(),
 }
 """Every source, by name, in the order the merged file lists them."""
 
-DEFAULT_SOURCES = ("trackman-outdoor", "sentry-2022", "synthetic")
+DEFAULT_SOURCES = ("trackman-outdoor", "sentry-2022", "players-2020", "synthetic")
 """What the shipped model is trained on."""
 
 

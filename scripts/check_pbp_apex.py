@@ -1,8 +1,9 @@
 """Are the pbp apex fields TrackMan's apex? Per event, the recorded apexHeight against the apex physics predicts
 for the same launch (ball speed, launch angle, spin; calm, rho = 1.225 kg/m^3) with Ferguson et al. 2022's
 coefficients and with the reference world; apexRange against the predicted apex range and carry; how strongly the
-recorded and predicted apex grow with spin; and, for the 2022 Sentry, pbp apexHeight against the apex of the
-event's TOURCAST polynomials. Prints markdown tables (docs/real_data.md quotes them); writes nothing.
+recorded and predicted apex grow with spin; apexRange against ShotLink's tee-to-rest distance (a carry stops
+short of the rest point by the roll); and, for the 2022 Sentry, pbp apexHeight against the apex of the event's
+TOURCAST polynomials. Prints markdown tables (docs/real_data.md quotes them); writes nothing.
 
     python3 scripts/check_pbp_apex.py [--data DIR]
 """
@@ -27,7 +28,7 @@ from flight.physics import initial_state  # noqa: E402
 from flight.reference_aero import REFERENCE_DT_S, REFERENCE_T_MAX_S  # noqa: E402
 from shots.markdown import table  # noqa: E402
 from shots.paths import shared_data_dir  # noqa: E402
-from shots.pbp import load_pbp, recorded_apex  # noqa: E402
+from shots.pbp import load_pbp, recorded_apex, rest_positions  # noqa: E402
 from shots.records import ShotSet  # noqa: E402
 from shots.reference_world import fly_reference  # noqa: E402
 from shots.tourcast import load_tourcast  # noqa: E402
@@ -102,6 +103,22 @@ def event_data(path: Path) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarra
     return ShotSet(records).launch(), height, span
 
 
+def against_rest(root: Path) -> list[str]:
+    """Per event, apexRange against ShotLink's horizontal tee-to-rest distance of the same shots: a carry is a
+    little shorter than the rest distance (by the roll), a range at the apex about two thirds of it."""
+    rows = []
+    for event, path in EVENTS.items():
+        fields, rest = recorded_apex(root / path), rest_positions(root / path)
+        pairs = np.array([(fields[k].range_m, rest[k].distance_m) for k in fields
+                          if fields[k].range_m and rest.get(k) and rest[k].distance_m])
+        span, distance = pairs[:, 0], pairs[:, 1]
+        q1, median, q3 = np.percentile(distance - span, [25, 50, 75]) / 0.9144
+        rows.append([event, len(pairs), f"{np.median(span / distance):.3f}", f"{np.mean(span <= distance):.0%}",
+                     f"{median:.1f} ({q1:.1f} to {q3:.1f})"])
+    return table(["event", "shots", "median apexRange / rest distance", "apexRange <= rest distance",
+                  "rest distance - apexRange, yd: median (IQR)"], rows)
+
+
 def sentry_polynomials(root: Path) -> list[str]:
     """pbp apexHeight against the apex of the same shots' TOURCAST polynomials (shots with a measured spin)."""
     fields = recorded_apex(root / EVENTS["Sentry 2022"])
@@ -142,6 +159,8 @@ def main() -> int:
                "/ carry: median", "IQR", "correlation"], ranges),
         ["How the apex grows with spin: log apex fitted on log ball speed, log sin(launch angle), log spin"],
         table(["event", "apex", "spin exponent", "residual sd of log apex"], exponents),
+        ["apexRange against ShotLink's horizontal tee-to-rest distance"],
+        against_rest(root),
         ["The 2022 Sentry's pbp apexHeight against its TOURCAST trajectory polynomials"],
         sentry_polynomials(root),
     ]

@@ -14,7 +14,7 @@ import torch
 from flight.physics import initial_state
 from model_export.joint import JointConfig, LatentConditions, train_joint
 from model_export.observations import load_observed
-from model_export.real_data import DRIVER_FILE, build, driver_groups, trackman_outdoor
+from model_export.real_data import DRIVER_FILE, PLAYERS_PBP, build, driver_groups, players, trackman_outdoor
 from model_export.torch_physics import euler_rollout, hard_landing, positions_at
 from model_export.variants import PhysNN, PhysQ
 from shots.heldout import HELD_OUT, HeldOutError, check_training_rows, held_out_set
@@ -76,9 +76,31 @@ def test_driver_groups_are_runs_of_nearby_lines_of_one_ball():
     assert driver_groups(records) == ["L3", "L3", "L3", "L20", "L21"]
 
 
+def test_players_shots_train_on_the_carry_their_apex_range_records(tmp_path):
+    fixture = Path(__file__).parent / "fixtures" / "pbp.csv"
+    with fixture.open(newline="") as handle:
+        rows = [{**r, "seasonYear": "2020", "tournamentNumber": "011", "radarData.horizontalLaunchAngle": "1.0"}
+                for r in csv.DictReader(handle) if r["radarData.verticalLaunchAngle"] != "high"]
+    path = tmp_path / PLAYERS_PBP
+    path.parent.mkdir(parents=True)
+    with path.open("w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    data = players(tmp_path)
+    first = next(r for r in data.records if r.shot_id == "players-2020:011-R1-H1-P11111-S1")
+    range_m, side_m = 520.5 * 0.3048, -12.5 * 0.3048
+    assert first.carry_y_m == pytest.approx(np.sqrt(range_m**2 - side_m**2))
+    assert first.carry_x_m is None and first.apex_m is None and first.flight_time_s is None
+    assert {r.source for r in data.records} == {"players-2020"}
+    assert {r.split for r in data.records if r.group.endswith("-H4")} == {"val"}
+    assert {r.split for r in data.records if not r.group.endswith("-H4")} == {"train"}
+
+
 @pytest.mark.skipif(not (shared_data_dir() / DRIVER_FILE).is_file(), reason="shared data not present")
 def test_the_merged_real_training_file_holds_no_held_out_row(tmp_path):
-    built = build(shared_data_dir(), tmp_path / "real.csv", ("trackman-outdoor", "sentry-2022", "trackman-model"))
+    built = build(shared_data_dir(), tmp_path / "real.csv",
+                  ("trackman-outdoor", "sentry-2022", "players-2020", "trackman-model"))
     shots = read_shots(tmp_path / "real.csv")
     driver_lines = [int(s.split(":")[1]) for s, src in zip(shots.column("shot_id"), shots.column("source"))
                     if src.startswith("trackman")]
