@@ -1,12 +1,13 @@
 """Properties of the flight engine over the whole valid input range (hypothesis): every flight is finite and
-lands, single and batch agree, carry grows with ball speed for a fixed launch in calm air, and the simulation is
-mirror-symmetric (exactly: the shipped network sees the speed and spin magnitudes only)."""
+lands, single and batch agree, carry grows with ball speed for a fixed launch in calm air, the simulation is
+mirror-symmetric (exactly: the shipped network sees the speed and spin magnitudes only), and spin only decays."""
 
 from __future__ import annotations
 
 import dataclasses
 import math
 
+import numpy as np
 import pytest
 import torch
 from hypothesis import HealthCheck, given, settings
@@ -15,6 +16,7 @@ from hypothesis import strategies as st
 from flight import limits
 from flight.conditions import AirConditions, Conditions
 from flight.wind import CALM, Wind
+from flight.onnx_coefficients import OnnxCoefficients
 from service.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
 from service.model_location import model_dir
 
@@ -128,3 +130,19 @@ def test_mirrored_launch_and_wind_land_mirrored(engine, launch, where):
     assert mirror.landing_x_m == pytest.approx(-flight.landing_x_m, abs=1e-6)
     for name in ("landing_y_m", "carry_m", "apex_m", "flight_time_s", "landing_angle_deg", "landing_spin_rpm"):
         assert getattr(mirror, name) == pytest.approx(getattr(flight, name), abs=1e-6), name
+
+
+def test_the_shipped_network_only_slows_the_spin_and_always_drags():
+    """C_M >= 0 (dω/dt = −C_M q d A ω̂ / I: spin never grows) and C_D > 0 over every air speed and spin a flight
+    meets, from a rolling ball to the fastest launch plus the strongest wind, at Reynolds scales 0.8-1.25 (thin
+    hot air to cold dense air)."""
+    speeds = np.linspace(1.0, limits.BALL_SPEED_MPS.high + limits.WIND_SPEED_MPS.high, 60)
+    spins = np.linspace(0.0, limits.SPIN_RPM.high, 60) * 2 * math.pi / 60
+    v, w = (grid.ravel() for grid in np.meshgrid(speeds, spins))
+    v_rel = np.column_stack([np.zeros_like(v), v, np.zeros_like(v)])
+    omega = np.column_stack([w, np.zeros_like(w), np.zeros_like(w)])
+    model = OnnxCoefficients(model_dir())
+    for scale in (0.8, 1.0, 1.25):
+        coefficients = model.in_air(model.card.physics.kinematic_viscosity_m2_s / scale)(v_rel, omega)
+        assert coefficients[:, 2].min() >= 0.0, "C_M < 0: the spin would grow"
+        assert coefficients[:, 1].min() > 0.0, "C_D <= 0: the air would push the ball"
