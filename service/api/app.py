@@ -57,7 +57,6 @@ def create_app(
         tcp = OpenConnectServer(state.gspro_reply) if connect else None
         if tcp:
             await tcp.start(connect)  # before the model loads: a port that cannot be had stops the startup cleanly
-        app.state.open_connect = tcp
         loading = asyncio.get_running_loop().run_in_executor(None, state.load)
         yield
         if tcp:
