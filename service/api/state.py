@@ -56,12 +56,13 @@ class ServiceState:
             self.simulation.add(time.perf_counter() - started)
 
 
-def service_state(request: Request) -> ServiceState:
-    """The app's `ServiceState` (set by `create_app`)."""
+async def service_state(request: Request) -> ServiceState:
+    """The app's `ServiceState` (set by `create_app`). `async def`, as every dependency here: FastAPI would run a
+    plain `def` in its thread pool, a hop that costs more than a single shot's simulation."""
     return request.app.state.service
 
 
-def ready_engine(state: ServiceState = Depends(service_state)) -> FlightEngine:
+async def ready_engine(state: ServiceState = Depends(service_state)) -> FlightEngine:
     """The loaded engine; NotReady (503) while the model loads or after it failed to."""
     if state.engine is None:
         raise NotReady(state.error or "the model is still loading")
