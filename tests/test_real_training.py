@@ -12,7 +12,7 @@ import pytest
 import torch
 
 from flight.physics import initial_state
-from model_export.joint import JointConfig, LatentConditions, train_joint
+from model_export.joint import JointConfig, LatentConditions, cosine_factor, train_joint
 from model_export.observations import load_observed
 from model_export.real_data import DRIVER_FILE, PLAYERS_PBP, build, driver_groups, players, trackman_outdoor
 from model_export.torch_physics import euler_rollout, hard_landing, positions_at
@@ -207,3 +207,9 @@ def test_the_real_data_card_names_its_sources_with_hashes_and_its_held_out_error
     assert {h.name for h in HELD_OUT} <= set(held_out)
     assert all(h.errors for h in held_out.values())
     assert (REAL / "training_conditions.json").is_file()
+
+
+def test_the_learning_rate_decays_along_half_a_cosine():
+    assert cosine_factor(0, 101, 0.1) == 1.0
+    assert cosine_factor(50, 101, 0.1) == pytest.approx(0.1 + 0.9 * 0.5)
+    assert cosine_factor(100, 101, 0.1) == pytest.approx(0.1)
