@@ -1,0 +1,17 @@
+"""The ground phase: a landed ball bounces (Penner's impact model) and rolls to rest on a plane through its landing
+point, level or sloped. Pure NumPy, batch-first; `ground_phase` is the entry point, `SURFACES` the one table of
+surface parameters."""
+
+from flight.ground.phase import GroundPhase, GroundPath, ground_phase
+from flight.ground.surfaces import SURFACES, Surface, green_rolling_resistance, holding_slope_deg, surface
+
+__all__ = [
+    "SURFACES",
+    "GroundPath",
+    "GroundPhase",
+    "Surface",
+    "green_rolling_resistance",
+    "ground_phase",
+    "holding_slope_deg",
+    "surface",
+]

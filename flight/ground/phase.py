@@ -1,0 +1,245 @@
+"""Bounce and roll to rest: the ground phase of a batch of landed balls, on a plane through each landing point.
+
+Bounces: an impact (`flight.ground.impact`), then a hop under gravity alone, solved exactly (a parabola back to the
+plane): hops are short and slow (a driver's first is about 0.5 s at 15 m/s), drag would take a few per cent of a
+hop's length, and a closed form needs no steps and no coefficient model. A ball whose rebound leaves the plane at
+less than MIN_HOP_SPEED_MPS stays down and rolls.
+
+Roll: the ball first rolls without slipping (the slip left by the last impact taken out with the angular momentum
+about the contact point kept: v = 5/7 v_t - 2/7 R n x omega), then decelerates by the surface's rolling resistance
+c_r g cos(phi) and grass drag k v against its motion, plus 5/7 of gravity along a slope. Level ground is solved in
+closed form; a slope is stepped (ROLL_STEP_S, constant acceleration within a step) until the ball stops, which it
+does on any slope the surface holds (`holding_slope_deg`; steeper slopes are refused).
+
+Every state of the phase can be kept (`keep_path`): after each impact, each touchdown, each roll step and the rest,
+with velocities, and a level roll's states every ROLL_STEP_S, so a renderer's cubic Hermite resampling follows the
+hops exactly (parabolas) and the roll closely.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
+from flight.ground.impact import _dot, impact
+from flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, holding_slope_deg
+
+MIN_HOP_SPEED_MPS = 1.0
+"""Rebounds slower than this off the plane (a hop under 5 cm high: a skip the turf soaks up) end the bounces: the
+ball rolls."""
+
+MAX_BOUNCES = 40
+"""A ball still bouncing after this many hops rolls (a safety net: real bounces die out in a handful)."""
+
+ROLL_STEP_S = 0.1
+"""Step of a roll on a slope (on level ground the roll is solved exactly)."""
+
+MAX_ROLL_TIME_S = 120.0
+"""Longest roll stepped on a slope (a safety net: on a slope the surface holds, every ball stops well before)."""
+
+GRAVITY = np.array([0.0, 0.0, -GRAVITY_MPS2])
+
+
+@dataclass(frozen=True)
+class GroundPath:
+    """One ball's states on the ground: times from touchdown [K], positions and velocities [K,3]. An impact appears
+    twice, the incoming and the outgoing velocity at one time; the last row is the rest (velocity zero)."""
+
+    times_s: np.ndarray
+    positions: np.ndarray
+    velocities: np.ndarray
+
+
+@dataclass(frozen=True)
+class GroundPhase:
+    """Where a batch of balls came to rest after landing: rest and roll-start points [N,3], hops [N], time on the
+    ground [N] and, when kept, each ball's path."""
+
+    rest_position: np.ndarray
+    roll_start: np.ndarray
+    bounces: np.ndarray
+    time_s: np.ndarray
+    paths: list[GroundPath] | None = None
+
+
+def plane_normals(slope_deg: np.ndarray | float, slope_dir_deg: np.ndarray | float, n: int) -> np.ndarray:
+    """Unit normals [n,3] of planes falling at `slope_deg` towards `slope_dir_deg` (clockwise from the target line
+    seen from behind the golfer: 0 = falls away towards the target, 90 = falls to the right, 180 = rises towards
+    the target)."""
+    phi = np.broadcast_to(np.radians(slope_deg), (n,))
+    beta = np.broadcast_to(np.radians(slope_dir_deg), (n,))
+    return np.stack([np.sin(phi) * np.sin(beta), np.sin(phi) * np.cos(beta), np.cos(phi)], -1)
+
+
+class _Recorder:
+    """Per-ball lists of (t, position, velocity), or nothing when paths are not kept."""
+
+    def __init__(self, n: int, keep: bool) -> None:
+        self.rows: list[list[tuple]] | None = [[] for _ in range(n)] if keep else None
+
+    def add(self, ids: np.ndarray, t: np.ndarray, position: np.ndarray, velocity: np.ndarray) -> None:
+        if self.rows is None:
+            return
+        for k, i in enumerate(ids.tolist()):
+            self.rows[i].append((float(t[k]), position[k].copy(), velocity[k].copy()))
+
+    def paths(self) -> list[GroundPath] | None:
+        if self.rows is None:
+            return None
+        return [
+            GroundPath(np.array([r[0] for r in rows]), np.array([r[1] for r in rows]), np.array([r[2] for r in rows]))
+            for rows in self.rows
+        ]
+
+
+def _bounce(position, velocity, spin, normal, surface: Surface, record: _Recorder):
+    """Impacts and hops until every ball rolls: (roll-start position, rolling velocity, time, hops)."""
+    n = len(position)
+    time, hops = np.zeros(n), np.zeros(n, dtype=int)
+    position, velocity, spin = position.copy(), velocity.copy(), spin.copy()
+    bouncing = np.arange(n)
+    record.add(bouncing, time, position, velocity)
+    while bouncing.size:
+        ids = bouncing
+        v_out, w_out = impact(velocity[ids], spin[ids], normal[ids], surface.take(ids))
+        rebound = _dot(v_out, normal[ids])
+        hop = (rebound > MIN_HOP_SPEED_MPS) & (hops[ids] < MAX_BOUNCES)
+        velocity[ids], spin[ids] = v_out, w_out
+        flying = ids[hop]
+        if flying.size:
+            record.add(flying, time[flying], position[flying], velocity[flying])
+            duration = 2.0 * rebound[hop] / (GRAVITY_MPS2 * normal[flying, 2])
+            position[flying] += velocity[flying] * duration[:, None] + 0.5 * GRAVITY * duration[:, None] ** 2
+            velocity[flying] += GRAVITY * duration[:, None]
+            time[flying] += duration
+            hops[flying] += 1
+            record.add(flying, time[flying], position[flying], velocity[flying])
+        bouncing = flying
+    on_plane = velocity - _dot(velocity, normal)[:, None] * normal
+    rolling = 5.0 / 7.0 * on_plane - 2.0 / 7.0 * BALL_RADIUS_M * np.cross(normal, spin)
+    rolling -= _dot(rolling, normal)[:, None] * normal
+    return position, rolling, time, hops
+
+
+def _ratios(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """log(1 + x) / x and (x - log(1 + x)) / x^2 for x >= 0, without cancellation near 0 (limits 1 and 1/2)."""
+    small = x < 1e-4
+    safe = np.where(small, 1.0, x)
+    log = np.log1p(safe)
+    return np.where(small, 1.0 - x / 2.0, log / safe), np.where(small, 0.5 - x / 3.0, (safe - log) / safe**2)
+
+
+def _roll_level(position, velocity, resistance, drag):
+    """Rest point and roll time on level ground under a constant deceleration a = c_r g plus k v: the ball stops
+    after T = ln(1 + k v0 / a) / k, having run v0 / k - a T / k (v0^2 / 2a without grass drag)."""
+    deceleration = resistance * GRAVITY_MPS2
+    speed = np.linalg.norm(velocity, axis=-1)
+    time_ratio, distance_ratio = _ratios(drag * speed / deceleration)
+    distance = speed * speed / deceleration * distance_ratio
+    direction = velocity / np.maximum(speed, 1e-12)[:, None]
+    return position + direction * distance[:, None], speed / deceleration * time_ratio
+
+
+def _level_states(speed, deceleration, drag, t):
+    """Distance run and speed [K] of a level roll at times t [K] from its start (closed form)."""
+    kt = drag * t
+    small = kt < 1e-6
+    safe_k = np.where(small, 1.0, drag)
+    fade = -np.expm1(-kt)
+    distance = np.where(
+        small,
+        speed * t - 0.5 * deceleration * t * t,
+        speed * fade / safe_k + deceleration * (fade - kt) / safe_k**2,
+    )
+    fast = (speed + deceleration / safe_k) * (1.0 - fade) - deceleration / safe_k
+    velocity = np.where(small, speed - deceleration * t, fast)
+    return distance, velocity
+
+
+def _record_level(record: _Recorder, ids, start_time, position, velocity, resistance, drag, roll_time) -> None:
+    """The states of level rolls every ROLL_STEP_S (the rest is recorded by the caller)."""
+    if record.rows is None:
+        return
+    deceleration = resistance * GRAVITY_MPS2
+    for k, i in enumerate(ids.tolist()):
+        speed = float(np.linalg.norm(velocity[k]))
+        times = np.arange(ROLL_STEP_S, roll_time[k] - 1e-9, ROLL_STEP_S)
+        run, now = _level_states(speed, deceleration[k], drag[k], times)
+        direction = velocity[k] / max(speed, 1e-12)
+        record.add(np.full(len(times), i), start_time[k] + times, position[k] + run[:, None] * direction,
+                   now[:, None] * direction)
+
+
+def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder, ids, start):
+    """Rest point and roll time on slopes, stepped: each step at the acceleration of its start, a step in which the
+    ball would stop ending at the stop."""
+    downhill = ROLLING_GRAVITY_FRACTION * (GRAVITY - GRAVITY[2] * normal[:, 2:3] * normal)
+    brake = resistance * GRAVITY_MPS2 * normal[:, 2]
+    position, velocity = position.copy(), velocity.copy()
+    rest, time = position.copy(), np.zeros(len(position))
+    moving = np.arange(len(position))
+    for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
+        if not moving.size:
+            break
+        v = velocity[moving]
+        speed = np.linalg.norm(v, axis=-1)
+        direction = v / np.maximum(speed, 1e-12)[:, None]
+        acceleration = downhill[moving] - (brake[moving] + drag[moving] * speed)[:, None] * direction
+        braking = np.maximum(-_dot(acceleration, direction), 1e-12)
+        stops = speed <= braking * ROLL_STEP_S
+        stop_time = np.where(stops, speed / braking, ROLL_STEP_S)
+        stopped, going = moving[stops], moving[~stops]
+        rest[stopped] = position[stopped] + direction[stops] * (speed[stops] ** 2 / (2.0 * braking[stops]))[:, None]
+        time[moving] += stop_time
+        dt = ROLL_STEP_S
+        position[going] += v[~stops] * dt + 0.5 * acceleration[~stops] * dt * dt
+        velocity[going] = v[~stops] + acceleration[~stops] * dt
+        record.add(ids[going], start[going] + time[going], position[going], velocity[going])
+        moving = going
+    rest[moving] = position[moving]
+    return rest, time
+
+
+def ground_phase(
+    position: np.ndarray,
+    velocity: np.ndarray,
+    spin: np.ndarray,
+    surface: Surface,
+    slope_deg: np.ndarray | float = 0.0,
+    slope_dir_deg: np.ndarray | float = 0.0,
+    keep_path: bool = False,
+) -> GroundPhase:
+    """Bounce and roll a batch of balls to rest from their landing states [N,3] (position on the ground, velocity,
+    spin in rad/s) on planes through the landing points, sloped by `slope_deg` towards `slope_dir_deg`
+    (`plane_normals`); `surface` holds floats or [N] arrays. ValueError if a slope is steeper than its surface
+    holds a ball on."""
+    n = len(position)
+    resistance = np.broadcast_to(np.asarray(surface.rolling_resistance, dtype=float), (n,))
+    drag = np.broadcast_to(np.asarray(surface.grass_drag_per_s, dtype=float), (n,))
+    slope = np.broadcast_to(np.asarray(slope_deg, dtype=float), (n,))
+    steep = slope >= holding_slope_deg(resistance)
+    if steep.any():
+        i = int(np.flatnonzero(steep)[0])
+        raise ValueError(
+            f"slope_deg {slope[i]:g} is steeper than the surface holds a ball on "
+            f"({float(holding_slope_deg(resistance[i])):.2f} deg): it would never come to rest"
+        )
+    normal = plane_normals(slope, slope_dir_deg, n)
+    record = _Recorder(n, keep_path)
+    start, rolling, time, hops = _bounce(position, velocity, spin, normal, surface, record)
+    record.add(np.flatnonzero(np.linalg.norm(rolling, axis=-1) > 0.0), time, start, rolling)
+    level, sloped = np.flatnonzero(slope == 0.0), np.flatnonzero(slope != 0.0)
+    rest, roll_time = np.empty_like(start), np.empty(n)
+    rest[level], roll_time[level] = _roll_level(start[level], rolling[level], resistance[level], drag[level])
+    _record_level(record, level, time[level], start[level], rolling[level], resistance[level], drag[level],
+                  roll_time[level])
+    if sloped.size:
+        rest[sloped], roll_time[sloped] = _roll_slope(
+            start[sloped], rolling[sloped], normal[sloped], resistance[sloped], drag[sloped], record, sloped,
+            time[sloped],
+        )
+    total = time + roll_time
+    record.add(np.arange(n), total, rest, np.zeros_like(rest))
+    return GroundPhase(rest, start, hops, total, record.paths())
