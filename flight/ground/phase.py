@@ -8,8 +8,8 @@ less than MIN_HOP_SPEED_MPS stays down and rolls.
 Roll: the ball first rolls without slipping (the slip left by the last impact taken out with the angular momentum
 about the contact point kept: v = 5/7 v_t - 2/7 R n x omega), then decelerates by the surface's rolling resistance
 c_r g cos(phi) and grass drag k v against its motion, plus 5/7 of gravity along a slope. Level ground is solved in
-closed form; a slope is stepped (ROLL_STEP_S, constant acceleration within a step) until the ball stops, which it
-does on any slope the surface holds (`holding_slope_deg`; steeper slopes are refused).
+closed form; a slope is stepped (ROLL_STEP_S, gravity and resistance held within a step) until the ball stops,
+which it does on any slope the surface holds (`holding_slope_deg`; steeper slopes are refused).
 
 Every state of the phase can be kept (`keep_path`): after each impact, each touchdown, each roll step and the rest,
 with velocities, and a level roll's states every ROLL_STEP_S, so a renderer's cubic Hermite resampling follows the
@@ -26,8 +26,8 @@ from flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
 from flight.ground.impact import _dot, impact
 from flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, holding_slope_deg
 
-MIN_HOP_SPEED_MPS = 1.0
-"""Rebounds slower than this off the plane (a hop under 5 cm high: a skip the turf soaks up) end the bounces: the
+MIN_HOP_SPEED_MPS = 0.5
+"""Rebounds slower than this off the plane (a hop under 13 mm high: a skip the turf soaks up) end the bounces: the
 ball rolls."""
 
 MAX_BOUNCES = 40
@@ -142,20 +142,21 @@ def _roll_level(position, velocity, resistance, drag):
     return position + direction * distance[:, None], speed / deceleration * time_ratio
 
 
-def _level_states(speed, deceleration, drag, t):
-    """Distance run and speed [K] of a level roll at times t [K] from its start (closed form)."""
+def _decay(drag, t):
+    """E1 = (1 - exp(-k t)) / k and E2 = (t - E1) / k, without cancellation for small k t (limits t and t^2 / 2):
+    under a constant acceleration A and drag k v, v(t) = v0 (1 - k E1) + A E1 and x(t) = x0 + v0 E1 + A E2."""
     kt = drag * t
     small = kt < 1e-6
     safe_k = np.where(small, 1.0, drag)
-    fade = -np.expm1(-kt)
-    distance = np.where(
-        small,
-        speed * t - 0.5 * deceleration * t * t,
-        speed * fade / safe_k + deceleration * (fade - kt) / safe_k**2,
-    )
-    fast = (speed + deceleration / safe_k) * (1.0 - fade) - deceleration / safe_k
-    velocity = np.where(small, speed - deceleration * t, fast)
-    return distance, velocity
+    e1 = np.where(small, t - 0.5 * kt * t, -np.expm1(-kt) / safe_k)
+    e2 = np.where(small, 0.5 * t * t - kt * t * t / 6.0, (t - e1) / safe_k)
+    return e1, e2
+
+
+def _level_states(speed, deceleration, drag, t):
+    """Distance run and speed [K] of a level roll at times t [K] from its start (closed form)."""
+    e1, e2 = _decay(drag, t)
+    return speed * e1 - deceleration * e2, speed * (1.0 - drag * e1) - deceleration * e1
 
 
 def _record_level(record: _Recorder, ids, start_time, position, velocity, resistance, drag, roll_time) -> None:
@@ -173,8 +174,9 @@ def _record_level(record: _Recorder, ids, start_time, position, velocity, resist
 
 
 def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder, ids, start):
-    """Rest point and roll time on slopes, stepped: each step at the acceleration of its start, a step in which the
-    ball would stop ending at the stop."""
+    """Rest point and roll time on slopes, stepped: in each step gravity and rolling resistance act as at its start
+    and grass drag exactly (`_decay`); a step in which the ball would stop ends at the stop, found as on level
+    ground, so the stepped roll meets the closed form as the slope vanishes."""
     downhill = ROLLING_GRAVITY_FRACTION * (GRAVITY - GRAVITY[2] * normal[:, 2:3] * normal)
     brake = resistance * GRAVITY_MPS2 * normal[:, 2]
     position, velocity = position.copy(), velocity.copy()
@@ -183,19 +185,21 @@ def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder,
     for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
         if not moving.size:
             break
-        v = velocity[moving]
+        v, k = velocity[moving], drag[moving]
         speed = np.linalg.norm(v, axis=-1)
         direction = v / np.maximum(speed, 1e-12)[:, None]
-        acceleration = downhill[moving] - (brake[moving] + drag[moving] * speed)[:, None] * direction
+        acceleration = downhill[moving] - brake[moving, None] * direction
         braking = np.maximum(-_dot(acceleration, direction), 1e-12)
-        stops = speed <= braking * ROLL_STEP_S
-        stop_time = np.where(stops, speed / braking, ROLL_STEP_S)
+        time_ratio, distance_ratio = _ratios(k * speed / braking)
+        stop_time = speed / braking * time_ratio
+        stops = stop_time <= ROLL_STEP_S
         stopped, going = moving[stops], moving[~stops]
-        rest[stopped] = position[stopped] + direction[stops] * (speed[stops] ** 2 / (2.0 * braking[stops]))[:, None]
-        time[moving] += stop_time
-        dt = ROLL_STEP_S
-        position[going] += v[~stops] * dt + 0.5 * acceleration[~stops] * dt * dt
-        velocity[going] = v[~stops] + acceleration[~stops] * dt
+        run = speed[stops] ** 2 / braking[stops] * distance_ratio[stops]
+        rest[stopped] = position[stopped] + direction[stops] * run[:, None]
+        time[moving] += np.where(stops, stop_time, ROLL_STEP_S)
+        e1, e2 = _decay(k[~stops], ROLL_STEP_S)
+        position[going] += v[~stops] * e1[:, None] + acceleration[~stops] * e2[:, None]
+        velocity[going] = v[~stops] * (1.0 - k[~stops] * e1)[:, None] + acceleration[~stops] * e1[:, None]
         record.add(ids[going], start[going] + time[going], position[going], velocity[going])
         moving = going
     rest[moving] = position[moving]
