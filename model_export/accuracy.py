@@ -1,5 +1,6 @@
 """`golfflight accuracy`: three models side by side on the real data none of them may be trained on, through the
-runtime path (NumPy physics + each bundle's ONNX graph; Ferguson 2022's quadratics through the same call).
+flight core the engine's batch path runs (`flight.integrator`: NumPy physics + each bundle's ONNX graph; Ferguson
+2022's quadratics through the same call).
 
 The models: the real-data model (`--model`), the synthetic model (`--synthetic`) and Ferguson, McNally & McPhee
 2022. The sets (`model_export.accuracy_sets`): the held-out ones of NOTES section 9 (TrackMan outdoor drivers from

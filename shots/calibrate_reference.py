@@ -18,7 +18,13 @@ from flight.constants import YARD_M
 from flight.integrator import simulate
 from flight.outcomes import Flight
 from flight.physics import State, initial_state
-from flight.reference_aero import CALIBRATED, FREE_PARAMETERS, REFERENCE_DT_S, REFERENCE_T_MAX_S, ReferenceParameters
+from flight.reference_aero import (
+    CALIBRATED,
+    FREE_PARAMETERS,
+    REFERENCE_DT_S,
+    REFERENCE_T_MAX_S,
+    ReferenceParameters,
+)
 from shots.reference_world import CALIBRATION_AIR, ClubAverage, fly_reference
 
 DECAY_TIMES_S = (1.0, 3.0, 5.0)
@@ -145,7 +151,8 @@ def fit_reference(
 
 
 def parameters_literal(params: ReferenceParameters) -> str:
-    """Source of `CALIBRATED = ReferenceParameters(...)` with the fitted values, to paste into reference_world.py."""
+    """Source of `CALIBRATED = ReferenceParameters(...)` with the fitted values, to paste into
+    flight/reference_aero.py."""
     lines = [f"    {name}={_round(getattr(params, name))!r}," for name in FREE_PARAMETERS]
     return "CALIBRATED = ReferenceParameters(\n" + "\n".join(lines) + "\n)"
 

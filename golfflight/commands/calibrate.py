@@ -24,7 +24,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="render the reference world's calibration table (or refit it with --fit)",
         description="Fly the PGA 2023 tour-average launches through the reference world and compare with TrackMan. "
         "Without --fit the committed CALIBRATED parameters are used; with --fit they are refitted and the new "
-        "literal is printed for pasting into shots/reference_world.py.",
+        "literal is printed for pasting into flight/reference_aero.py.",
     )
     parser.add_argument("--fit", action="store_true", help="run the least-squares fit first (about a minute)")
     parser.add_argument("--data", default=None, help="tour-averages CSV (default: the shared data's PGA 2023 table)")
@@ -37,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
     params = CALIBRATED
     if args.fit:
         params = fit_reference(clubs)
-        print("# Paste into shots/reference_world.py:")
+        print("# Paste into flight/reference_aero.py:")
         print(parameters_literal(params))
         print()
     text = render_markdown(evaluate(clubs, params), params, baseline=evaluate_ferguson(clubs))
