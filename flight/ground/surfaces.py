@@ -7,8 +7,9 @@ a normal speed of 13 m/s (in proportion to it otherwise, `flight.ground.impact`)
 deceleration on level ground in units of g, and `grass_drag_per_s` a further deceleration in proportion to the
 rolling speed (grass the ball brushes through: a fast roll slows sooner). The fairway row is fitted on THE PLAYERS
 2020 rest positions (`golfflight ground-fit`, docs/ground.md); the other rows are anchors from NOTES.md section 7
-(Penner 2002, libgolf, openfairway), not measurements. A green's rolling resistance comes from its
-stimpmeter reading.
+(Penner 2002, libgolf, openfairway), not measurements, but for the firm fairway: the fitted fairway with Penner's
+restitution, the fit's least rolling resistance and half its grass drag, set by that rule and not tuned. A green's
+rolling resistance comes from its stimpmeter reading.
 """
 
 from __future__ import annotations
@@ -57,8 +58,8 @@ class Surface:
 
 
 SURFACES: dict[str, Surface] = {
-    "fairway": Surface(1.0, 15.0, 0.5, 0.12, 1.0),
-    "firm_fairway": Surface(1.15, 10.0, 0.4, 0.07, 0.3),
+    "fairway": Surface(0.6693, 0.0, 0.5, 0.121, 1.579),
+    "firm_fairway": Surface(1.0, 0.0, 0.4, 0.08, 0.8),
     "rough": Surface(0.55, 20.0, 0.62, 0.35, 1.5),
     "green": Surface(0.75, 20.6, 0.58, float(green_rolling_resistance(DEFAULT_STIMP_FT)), 0.0),
     "bunker": Surface(0.2, 30.0, 0.8, 1.0, 3.0),

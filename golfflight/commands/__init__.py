@@ -9,6 +9,7 @@ from golfflight.commands import (
     export,
     finetune,
     fly,
+    ground_fit,
     serve,
     simulate,
     synth,
@@ -16,4 +17,7 @@ from golfflight.commands import (
     train_real,
 )
 
-COMMANDS = [fly, synth, convert, calibrate, train, train_real, export, evaluate, finetune, accuracy, serve, simulate, discover]
+COMMANDS = [
+    fly, synth, convert, calibrate, train, train_real, export, evaluate, finetune, accuracy, ground_fit, serve,
+    simulate, discover,
+]

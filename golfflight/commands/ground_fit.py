@@ -1,0 +1,41 @@
+"""`golfflight ground-fit`: fit the fairway's ground parameters on THE PLAYERS 2020 rest positions, check them on the
+TOUR Championship 2020 against a constant roll, print the table and write docs/ground.md's generated section and a
+results file."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "ground-fit",
+        help="fit the fairway's bounce and roll on PGA TOUR rest positions and write docs/ground.md",
+        description="Fly every radar tee shot that came to rest on the fairway (THE PLAYERS 2020, TOUR Championship "
+        "2020 pbp files of the shared data, read in place) through the model to its rest elevation, bounce and roll "
+        "it on the fairway; fit the fairway on THE PLAYERS, check on the TOUR Championship against carry plus a "
+        "constant roll.",
+    )
+    parser.add_argument("--model", default="models/default", help="model bundle (default models/default)")
+    parser.add_argument("--data-dir", help="shared data folder (default: $GOLFFLIGHT_SHARED_DATA or ../shared/data)")
+    parser.add_argument("--out", default="docs/ground.md", help="markdown file whose generated section is replaced")
+    parser.add_argument("--results", default="docs/ground_fit.json", help="JSON results file")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from shots.files import write_text_atomic
+    from shots.ground_fit import markdown, run_fit
+    from shots.markdown import write_generated_section
+    from shots.paths import shared_data_dir
+
+    data_dir = Path(args.data_dir) if args.data_dir else shared_data_dir()
+    fit = run_fit(args.model, data_dir)
+    section = markdown(fit, args.model)
+    print(section, end="")
+    write_generated_section(args.out, section, "ground-fit")
+    write_text_atomic(args.results, json.dumps({"model": args.model, **fit.as_dict()}, indent=2) + "\n")
+    print(f"wrote {args.out}, {args.results}")
+    return 0
