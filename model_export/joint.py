@@ -6,9 +6,10 @@ Each conditions group gets a latent uniform wind, each air group a latent densit
 type a latent lift and drag scale, all with Gaussian priors whose widths are the typical sizes of the matching
 discovery effects (`discovery.effects`: wind, air_density, lift_scale, drag_scale), so the network does not absorb
 a session's weather into the aerodynamics. Validation shots are flown in the air and wind the model assumes (calm,
-recorded or standard air), as the service would fly them; the best epoch is the lowest mean validation loss of the
-measured sources (`JointConfig.select_on`, each source counting equally) at the radar noise (the fitted noise scales
-change what a loss value means, so selection does not use them).
+recorded or standard air), as the service would fly them. A run ends on its last epoch, where the cosine-decayed
+learning rates have settled it (picking the lowest of noisy per-epoch validation losses picked early, barely moved
+epochs); its validation loss, the mean over the measured sources (`JointConfig.select_on`, each counting equally)
+at the radar noise, compares seeds (the fitted noise scales change what a loss value means, so it does not use them).
 """
 
 from __future__ import annotations
@@ -78,7 +79,7 @@ class JointConfig:
     density_prior: float = field(default_factory=lambda: _typical("air_density"))
     ball_prior: float = field(default_factory=lambda: _typical("drag_scale"))
     select_on: tuple[str, ...] = ("trackman-outdoor", "sentry-2022", "players-2020")
-    """Sources whose validation loss picks the best epoch, each counting equally: the measured flights decide."""
+    """Sources whose validation loss compares runs, each counting equally: the measured flights decide."""
     mean_wind_prior_mps: float = 0.3
     mean_density_prior: float = 0.01
     grad_clip_norm: float = GRAD_CLIP_NORM
@@ -271,18 +272,18 @@ def _noise_report(noise: NoiseScales, data: ObservedData) -> dict[str, dict[str,
 
 @dataclass
 class JointResult:
-    """A finished joint run: its directory, per-epoch history and best epoch."""
+    """A finished joint run: its directory, per-epoch history and its final epoch (epoch, val_loss, val)."""
 
     out_dir: Path
     history: list[dict[str, Any]]
-    best: dict[str, Any] | None
+    final: dict[str, Any] | None
 
 
 def train_joint(data_path: str | os.PathLike, out_dir: str | os.PathLike, config: JointConfig,
                 init: nn.Module, progress: bool = True) -> JointResult:
     """Train `init` (a coefficient module, changed in place) jointly with the latent conditions on a merged file;
-    writes OUT/best.pt, OUT/last.pt (the `model_export.training` checkpoint format), history.json and
-    conditions.json (the latent conditions of the best epoch)."""
+    writes OUT/last.pt (the `model_export.training` checkpoint format), history.json and conditions.json (the
+    latent conditions and noise factors), all of the last epoch finished."""
     torch.set_flush_denormal(True)
     try:
         return _train_joint(Path(data_path), Path(out_dir), config, init, progress)
@@ -306,7 +307,7 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
     schedule = torch.optim.lr_scheduler.LambdaLR(
         optimizer, lambda step: cosine_factor(step, total_steps, config.final_lr_fraction))
     history: list[dict[str, Any]] = []
-    best: dict[str, Any] | None = None
+    final: dict[str, Any] | None = None
     for epoch in range(1, config.epochs + 1):
         started = time.perf_counter()
         order = torch.randperm(len(train), generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch))
@@ -336,17 +337,14 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
         selected = [v for k, v in metrics["sources"].items() if k in config.select_on] or list(
             metrics["sources"].values())
         row["selection_loss"] = sum(v["loss"] for v in selected) / len(selected)
-        improved = math.isfinite(row["selection_loss"]) and (best is None or row["selection_loss"] < best["val_loss"])
         payload = {"format": CHECKPOINT_FORMAT, "kind": "joint", "epoch": epoch, "config": config.as_dict(),
                    "model": model.state_dict(), "latent": latent.state_dict(), "noise": noise.state_dict(),
                    "history": history}
         save_checkpoint(out_dir / "last.pt", payload)
-        if improved:
-            best = {"epoch": epoch, "val_loss": row["selection_loss"], "val": metrics["sources"]}
-            save_checkpoint(out_dir / "best.pt", payload)
-            report = conditions_report(latent, data, train) | {"noise_factors": _noise_report(noise, data)}
-            write_text_atomic(out_dir / "conditions.json", json.dumps(report, indent=2) + "\n")
+        final = {"epoch": epoch, "val_loss": row["selection_loss"], "val": metrics["sources"]}
+        report = conditions_report(latent, data, train) | {"noise_factors": _noise_report(noise, data)}
+        write_text_atomic(out_dir / "conditions.json", json.dumps(report, indent=2) + "\n")
         write_text_atomic(out_dir / "history.json",
-                          json.dumps({"config": config.as_dict(), "best": best, "epochs": history}, indent=2) + "\n")
-    return JointResult(out_dir, history, best)
+                          json.dumps({"config": config.as_dict(), "final": final, "epochs": history}, indent=2) + "\n")
+    return JointResult(out_dir, history, final)
 

@@ -104,9 +104,9 @@ def source_cards(sources: list[SourceData], weights: dict[str, float], paths: di
     return cards
 
 
-def _validation_metrics(best: dict[str, Any]) -> dict[str, Any]:
+def _validation_metrics(final: dict[str, Any]) -> dict[str, Any]:
     """Landing and max-height error over the measured sources' validation shots (shot-weighted)."""
-    rows = [best["val"][s] for s in MEASURED_SOURCES if s in best["val"]]
+    rows = [final["val"][s] for s in MEASURED_SOURCES if s in final["val"]]
     landing = [(r["landing_error_m"], r["n_shots"]) for r in rows if "landing_error_m" in r]
     apex = [(r["apex_m_mae"], r["n_shots"]) for r in rows if "apex_m_mae" in r]
 
@@ -114,23 +114,23 @@ def _validation_metrics(best: dict[str, Any]) -> dict[str, Any]:
         return sum(v * n for v, n in pairs) / sum(n for _, n in pairs)
 
     landing_m, apex_m = mean(landing), mean(apex)
-    return {"epoch": best["epoch"], "landing_error_m": landing_m, "landing_error_yd": landing_m / YARD_M,
+    return {"epoch": final["epoch"], "landing_error_m": landing_m, "landing_error_yd": landing_m / YARD_M,
             "max_height_error_m": apex_m, "max_height_error_yd": apex_m / YARD_M,
             "n_shots": sum(r["n_shots"] for r in rows)}
 
 
 def export_real(run_dir: Path, data_file: Path, sources: list[SourceData], out: Path, variant: str,
                 hidden: tuple[int, ...]) -> ModelCard:
-    """Export a joint run's best epoch with a card that records its sources and latent conditions."""
+    """Export a joint run's final epoch with a card that records its sources and latent conditions."""
     from model_export.variants import build_model
 
-    payload = load_checkpoint(run_dir / "best.pt")
+    payload = load_checkpoint(run_dir / "last.pt")
     config = JointConfig(**payload["config"])
     model = build_model(variant, hidden)
     model.load_state_dict(payload["model"])
     model.eval()
     history = json.loads((run_dir / "history.json").read_text())
-    metrics = _validation_metrics(history["best"])
+    metrics = _validation_metrics(history["final"])
     conditions = json.loads((run_dir / "conditions.json").read_text())
     data = _data_summary(data_file, sources)
     data["n_val"] = metrics.pop("n_shots")
@@ -189,7 +189,7 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
             runs = {s: f.result() for s, f in futures.items()}
     else:
         runs = {s: train_seed(data_file, work / f"seed-{s}", init, c, threads, progress) for s, c in configs.items()}
-    chosen = min(runs, key=lambda s: runs[s].best["val_loss"] if runs[s].best else float("inf"))
+    chosen = min(runs, key=lambda s: runs[s].final["val_loss"] if runs[s].final else float("inf"))
     exported = None
     if out is not None:
         from model_export.held_out import record_held_out

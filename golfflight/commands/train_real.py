@@ -21,7 +21,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     parser = subparsers.add_parser(
         "train-real",
-        help="train on the real flights of the shared data (held-out sets never read), export the best seed",
+        help="train on the real flights of the shared data (held-out sets never read), export the seed with the lowest validation loss",
         description="Build WORK/real_flights.csv from every usable real source (docs/training_real.md), fine-tune "
         "the --init bundle on it jointly with a wind per conditions group, an air factor per air group and a scale "
         "per ball type, once per seed, and export the seed with the lowest validation loss to --out.",
@@ -57,9 +57,9 @@ def run(args: argparse.Namespace) -> int:
     for data in result.sources:
         print(f"{data.name}: {len(data.records)} shots ({data.kind})")
     for seed, run_result in result.runs.items():
-        best = run_result.best
-        print(f"seed {seed}: best epoch {best['epoch']}, validation loss {best['val_loss']:.3f}" if best
-              else f"seed {seed}: no finite validation loss")
+        final = run_result.final
+        print(f"seed {seed}: epoch {final['epoch']}, validation loss {final['val_loss']:.3f}" if final
+              else f"seed {seed}: no epoch finished")
     print(f"chosen seed {result.chosen_seed}; {result.seconds / 60:.1f} min")
     if result.card is not None:
         print(f"exported {args.out} (validation landing error {result.card.validation.landing_error_yd:.2f} yd)")
