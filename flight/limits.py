@@ -38,3 +38,8 @@ WIND_FROM_DEG = Range(0.0, 360.0, "deg")
 AIR_DENSITY_KG_M3 = Range(0.5, 1.6, "kg/m^3")
 WIND_REFERENCE_HEIGHT_M = Range(0.5, 100.0, "m")
 TRAJECTORY_RATE_HZ = Range(1.0, 1000.0, "Hz")
+
+GROUND_ELEVATION_M = Range(-100.0, 100.0, "m")
+SLOPE_DEG = Range(0.0, 20.0, "deg")
+SLOPE_DIR_DEG = Range(0.0, 360.0, "deg")
+STIMP_FT = Range(4.0, 16.0, "ft")

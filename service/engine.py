@@ -5,9 +5,10 @@ omega times the air's Reynolds scale (`flight.physics.reynolds_scale`, 1 in the 
 on plain Python floats with the network's inputs and output bound once to preallocated float32 buffers
 (IOBinding, one thread): per-call overheads, not arithmetic, decide single-shot latency (NOTES.md section 6).
 A batch runs on NumPy [N] arrays and drops each shot from the batch as it lands. Either way a shot stops at its
-landing (first downward crossing of z = 0, the state interpolated linearly to it, exact for Euler's straight
-segments), flies on past the card's t_sim if it is still in the air, and fails alone if it has not landed
-by MAX_FLIGHT_TIME_S.
+landing (first downward crossing of its ground's plane, z = elevation, the state interpolated linearly to it, exact
+for Euler's straight segments), flies on past the card's t_sim if it is still in the air, and fails alone if it has
+not landed by MAX_FLIGHT_TIME_S. Then, unless asked for the flight alone (ground None), it bounces and rolls to rest
+on that ground (`flight.ground`).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from flight.bundle_check import open_session, session_options
 from flight.conditions import STANDARD, Conditions
 from flight.constants import RPM_TO_RADPS
 from flight.field import BallInAir
+from flight.ground import GroundPhase, GroundSpec, Surface, ground_phase
 from flight.integrator import GroundPlane, integrate
 from flight.limits import FLIGHT_TIME_S
 from flight.onnx_coefficients import OnnxCoefficients
@@ -65,8 +67,8 @@ class FlightError(Exception):
 
 @dataclass(frozen=True)
 class EulerStates:
-    """The integrator's states of one shot up to its landing: times [K], positions and velocities [K,3]; the
-    last row is the interpolated landing."""
+    """States of one shot: times [K], positions and velocities [K,3]: the integrator's steps to the interpolated
+    landing and, when the shot was rolled, the ground phase's states to the rest (an impact twice: in and out)."""
 
     times_s: np.ndarray
     positions: np.ndarray
@@ -74,8 +76,23 @@ class EulerStates:
 
 
 @dataclass(frozen=True)
+class Rest:
+    """Where a shot came to rest after bouncing and rolling, SI: the point, its horizontal distance from the tee, the
+    distance gained after the landing (total - carry: negative for a ball that spun back), hops, time on the
+    ground."""
+
+    x_m: float
+    y_m: float
+    total_m: float
+    roll_m: float
+    bounces: int
+    ground_time_s: float
+
+
+@dataclass(frozen=True)
 class ShotFlight:
-    """The outcome of one shot at the launch elevation, SI."""
+    """The outcome of one shot down to its ground's elevation and, unless the flight alone was asked for, to rest,
+    SI; `states`, when kept, run through the bounces and the roll to the rest."""
 
     landing_x_m: float
     landing_y_m: float
@@ -88,6 +105,7 @@ class ShotFlight:
     landing_speed_mps: float
     landing_spin_rpm: float
     states: EulerStates | None = None
+    rest: Rest | None = None
 
 
 def _summary(x, y, vx, vy, vz, wx, wy, wz):
@@ -115,6 +133,23 @@ def _physics_inputs(conditions: Conditions) -> tuple[float, float, float, bool, 
         wind.reference_height_m,
         wind.roughness_m,
         air.kinematic_viscosity_m2_s,
+    )
+
+
+def _rest(phase: GroundPhase, i: int, carry: float) -> Rest:
+    """Shot i's rest from a ground phase of the tee at the origin."""
+    x, y, _ = phase.rest_position[i].tolist()
+    total = math.hypot(x, y)
+    return Rest(x, y, total, total - carry, int(phase.bounces[i]), float(phase.time_s[i]))
+
+
+def _through_rest(states: EulerStates, phase: GroundPhase, i: int, flight_time: float) -> EulerStates:
+    """A flight's states continued through shot i's ground path (its first row, the landing, is the flight's last)."""
+    path = phase.paths[i]
+    return EulerStates(
+        np.append(states.times_s, flight_time + path.times_s[1:]),
+        np.vstack([states.positions, path.positions[1:]]),
+        np.vstack([states.velocities, path.velocities[1:]]),
     )
 
 
@@ -166,7 +201,11 @@ class FlightEngine:
         self.fly_batch([Launch(60.0, 12.0, 0.0, 3000.0, 0.0)] * 8)
         self.load_seconds = time.perf_counter() - started
 
-    def _cap_message(self) -> str:
+    def _unlanded_message(self, apex_m: float, height_m: float) -> str:
+        """Why a shot never came down through its ground's plane: it never rose above it, or it was still in the air
+        at the cap."""
+        if apex_m <= height_m:
+            return f"the ball never rose to its landing ground: apex {apex_m:.1f} m, ground.elevation_m {height_m:g} m"
         return f"the ball was still in the air after {self.max_steps * self.dt:g} s (the simulation cap)"
 
     @staticmethod
@@ -183,9 +222,16 @@ class FlightEngine:
         """SHA-256 of the ONNX graph (checked against the card at load)."""
         return self.card.onnx.sha256
 
-    def fly(self, launch: Launch, conditions: Conditions = STANDARD, keep_states: bool = False) -> ShotFlight:
-        """Fly one shot on Python floats; raises FlightError if it has not landed by MAX_FLIGHT_TIME_S (or, from a
-        broken model, if any number of its flight is not finite)."""
+    def fly(
+        self,
+        launch: Launch,
+        conditions: Conditions = STANDARD,
+        keep_states: bool = False,
+        ground: GroundSpec | None = None,
+    ) -> ShotFlight:
+        """Fly one shot on Python floats down to its ground and roll it to rest there (ground None: the flight alone,
+        down to z = 0); raises FlightError if it has not landed by MAX_FLIGHT_TIME_S (or, from a broken model, if
+        any number of its flight is not finite)."""
         start = initial_state(*(np.array([value], dtype=float) for value in launch))
         x, y, z = start.position[0].tolist()
         vx, vy, vz = start.velocity[0].tolist()
@@ -194,6 +240,7 @@ class FlightEngine:
         k = reynolds_scale(viscosity, self.nominal_viscosity)
         air_x, air_y = wind_x, wind_y
         dt = self.dt
+        height = 0.0 if ground is None else ground.elevation_m
         apex, apex_step, before_apex, after_apex = z, 0, math.nan, math.nan
         history = [(x, y, z, vx, vy, vz)] if keep_states else None
         velocity_in, spin_in, out = self._velocity_in[0], self._spin_in[0], self._coefficients_out[0]
@@ -212,13 +259,13 @@ class FlightEngine:
                     apex, apex_step, before_apex, after_apex = z, step, old[2], math.nan
                 elif apex_step == step - 1:
                     after_apex = z
-                if z <= 0.0 < old[2]:
+                if z <= height < old[2]:
                     break
                 if history is not None:
                     history.append((x, y, z, vx, vy, vz))
             else:
-                raise FlightError(self._cap_message())
-        frac = old[2] / (old[2] - z)
+                raise FlightError(self._unlanded_message(apex, height))
+        frac = (old[2] - height) / (old[2] - z)
         land = [a + frac * (b - a) for a, b in zip(old, (x, y, z, vx, vy, vz, wx, wy, wz))]
         flight_time = (step - 1 + frac) * dt
         carry, angle, speed, spin = (float(v) for v in _summary(land[0], land[1], *land[3:]))
@@ -232,16 +279,26 @@ class FlightEngine:
         numbers = (land[0], land[1], carry, apex, apex_time, flight_time, angle, speed, spin)
         if not (all(map(math.isfinite, numbers)) and self._states_finite(states)):
             raise FlightError(NON_FINITE)
-        return ShotFlight(land[0], land[1], carry, land[0], apex, apex_time, flight_time, angle, speed, spin, states)
+        rest = None
+        if ground is not None:
+            landing = np.array([land[0:3]]), np.array([land[3:6]]), np.array([land[6:9]])
+            phase = ground_phase(*landing, ground.surface, ground.slope_deg, ground.slope_dir_deg, keep_states)
+            rest = _rest(phase, 0, carry)
+            states = None if states is None else _through_rest(states, phase, 0, flight_time)
+        return ShotFlight(
+            land[0], land[1], carry, land[0], apex, apex_time, flight_time, angle, speed, spin, states, rest
+        )
 
     def fly_batch(
         self,
         launches: Sequence[Launch],
         conditions: Sequence[Conditions] | Conditions = STANDARD,
         keep_states: bool = False,
+        grounds: Sequence[GroundSpec] | GroundSpec | None = None,
     ) -> list[ShotFlight | FlightError]:
         """Fly many shots through the flight core (`flight.integrator`): forward Euler, one ONNX Runtime call per
-        step over the shots still in the air.
+        step over the shots still in the air, each down to its ground; then bounce and roll them to rest together
+        (grounds None: the flights alone, down to z = 0).
 
         Results are in the order of `launches`; a shot that has not landed by MAX_FLIGHT_TIME_S (or whose flight is
         not finite) gets a FlightError.
@@ -250,12 +307,14 @@ class FlightEngine:
         if n == 0:
             return []
         per_shot = [conditions] * n if isinstance(conditions, Conditions) else list(conditions)
-        if len(per_shot) != n:
-            raise ValueError(f"{len(per_shot)} conditions for {n} launches")
+        shot_grounds = [grounds] * n if grounds is None or isinstance(grounds, GroundSpec) else list(grounds)
+        if len(per_shot) != n or len(shot_grounds) != n:
+            raise ValueError(f"{len(per_shot)} conditions and {len(shot_grounds)} grounds for {n} launches")
+        heights = np.array([0.0 if g is None else g.elevation_m for g in shot_grounds])
         start = initial_state(*np.array(launches, dtype=float).reshape(n, 5).T)
         field = _batch_field(self._batch_model, per_shot)
         record = "states" if keep_states else "summary"
-        flight = integrate(start, field, self.dt, self.max_steps, "euler", GroundPlane(), record)
+        flight = integrate(start, field, self.dt, self.max_steps, "euler", GroundPlane(heights), record)
         x, y, _ = flight.landing_position.T
         carry, angle, speed, spin = _summary(x, y, *flight.landing_velocity.T, *flight.landing_spin.T)
         numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
@@ -263,19 +322,44 @@ class FlightEngine:
         history = None
         if flight.states is not None:
             history = (np.stack([s.position for s in flight.states]), np.stack([s.velocity for s in flight.states]))
+        rolled = np.flatnonzero(flight.landed & finite & np.array([g is not None for g in shot_grounds]))
+        phase = self._ground_phase(flight, rolled, [shot_grounds[i] for i in rolled], keep_states)
+        row = {shot: k for k, shot in enumerate(rolled.tolist())}
         results: list[ShotFlight | FlightError] = []
         for i, (xi, yi, c, h, th, tf, a, v, w) in enumerate(zip(*(a.tolist() for a in numbers))):
             if not flight.landed[i]:
-                results.append(FlightError(self._cap_message()))
-            elif not finite[i]:
+                results.append(FlightError(self._unlanded_message(h, float(heights[i]))))
+                continue
+            if not finite[i]:
                 results.append(FlightError(NON_FINITE))
-            elif history is None:
-                results.append(ShotFlight(xi, yi, c, xi, h, th, tf, a, v, w))
-            else:
-                states = self._shot_states(history, flight, i)
-                flown = ShotFlight(xi, yi, c, xi, h, th, tf, a, v, w, states)
-                results.append(flown if self._states_finite(states) else FlightError(NON_FINITE))
+                continue
+            states = None if history is None else self._shot_states(history, flight, i)
+            rest = None
+            if i in row:
+                rest = _rest(phase, row[i], c)
+                states = None if states is None else _through_rest(states, phase, row[i], tf)
+            flown = ShotFlight(xi, yi, c, xi, h, th, tf, a, v, w, states, rest)
+            results.append(flown if self._states_finite(states) else FlightError(NON_FINITE))
         return results
+
+    @staticmethod
+    def _ground_phase(
+        flight: Flight, shots: np.ndarray, grounds: list[GroundSpec], keep_states: bool
+    ) -> GroundPhase | None:
+        """The ground phase of the landed `shots` of a batch flight, each on its ground, in one batch."""
+        if not shots.size:
+            return None
+        distinct = {id(g.surface): g.surface for g in grounds}
+        surface = next(iter(distinct.values())) if len(distinct) == 1 else Surface.stack([g.surface for g in grounds])
+        return ground_phase(
+            flight.landing_position[shots],
+            flight.landing_velocity[shots],
+            flight.landing_spin[shots],
+            surface,
+            np.array([g.slope_deg for g in grounds]),
+            np.array([g.slope_dir_deg for g in grounds]),
+            keep_states,
+        )
 
     def _shot_states(self, history: tuple[np.ndarray, np.ndarray], flight: Flight, shot: int) -> EulerStates:
         """One shot's states up to its landing, the interpolated landing last."""

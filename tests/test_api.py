@@ -61,6 +61,11 @@ def test_single_shot_in_both_unit_forms(client):
         "landing_angle_deg",
         "landing_speed_mps",
         "landing_spin_rpm",
+        "total_m",
+        "total_yd",
+        "roll_m",
+        "rest",
+        "bounces",
     }
     assert set(monitor) == expected
     faded = shot(client, **SEVEN_IRON | {"spin_rpm": None}, back_spin_rpm=7000.0, side_spin_rpm=800.0)
@@ -144,10 +149,14 @@ def test_trajectory_as_euler_states_or_resampled(client):
     states = shot(client, **SEVEN_IRON, trajectory={})
     points = states["trajectory"]
     assert points[0] == {"t_s": 0.0, "x_m": 0.0, "y_m": 0.0, "z_m": 0.01}
-    assert points[1]["t_s"] == pytest.approx(0.1) and points[-1]["t_s"] == states["flight_time_s"]
-    assert points[-1]["z_m"] == pytest.approx(0.0, abs=1e-9)
+    assert points[1]["t_s"] == pytest.approx(0.1)
+    landing = next(p for p in points if p["t_s"] == states["flight_time_s"])
+    assert landing["z_m"] == pytest.approx(0.0, abs=1e-9) and landing["y_m"] == states["landing"]["y_m"]
+    rest = points[-1]
+    assert (rest["x_m"], rest["y_m"]) == pytest.approx((states["rest"]["x_m"], states["rest"]["y_m"]))
+    assert rest["z_m"] == pytest.approx(0.0, abs=1e-9) and rest["t_s"] > states["flight_time_s"]
     resampled = shot(client, **SEVEN_IRON, trajectory={"rate_hz": 60})["trajectory"]
-    assert len(resampled) == int(states["flight_time_s"] * 60) + 2
+    assert len(resampled) == int(rest["t_s"] * 60) + 2 and resampled[-1] == pytest.approx(rest)
     assert resampled[6]["t_s"] == pytest.approx(0.1) and resampled[6]["y_m"] == pytest.approx(points[1]["y_m"])
     assert max(p["z_m"] for p in resampled) == pytest.approx(states["apex_m"], abs=0.2)
 

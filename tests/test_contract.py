@@ -39,8 +39,16 @@ FIELDS = {
     "from_deg": (("wind",), SEVEN_IRON),
     "reference_height_m": (("wind",), SEVEN_IRON),
     "rate_hz": (("trajectory",), SEVEN_IRON),
+    "stimp_ft": (("ground",), SEVEN_IRON),
+    "elevation_m": (("ground",), SEVEN_IRON),
+    "slope_deg": (("ground",), SEVEN_IRON),
+    "slope_dir_deg": (("ground",), SEVEN_IRON),
 }
 """Every numeric request field: where it sits in the body and a valid shot to put it in."""
+
+SECTION_BASE = {"wind": {"speed_mps": 3.0}, "stimp_ft": {"surface": "green"}, "slope_deg": {"surface": "rough"}}
+"""What a field's section needs besides it to be valid (by section or field name): a stimp reading is a green's,
+and slopes up to 20 degrees are held by the rough only."""
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +66,7 @@ def body_with(name: str, value) -> dict:
     path, base = FIELDS[name]
     body = json.loads(json.dumps(base))
     if path:
-        body[path[0]] = {"speed_mps": 3.0} if path == ("wind",) else {}
+        body[path[0]] = dict(SECTION_BASE.get(name, SECTION_BASE.get(path[0], {})))
         body[path[0]][name] = value
     else:
         body[name] = value

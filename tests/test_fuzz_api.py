@@ -19,8 +19,9 @@ CASES_PER_ROUTE = 25
 """Hypothesis examples per operation and mode (valid, invalid): about 300 requests in all, a few seconds."""
 
 NOT_EXPRESSIBLE = [positive_data_acceptance]
-"""Left out: two cross-field rules cannot be written in JSON Schema (back and side spin together within 15,000 rpm;
-a GSPro shot needs Speed, VLA and a spin), so a few schema-valid requests are rightly refused."""
+"""Left out: some cross-field rules cannot be written in JSON Schema (back and side spin together within 15,000 rpm;
+a GSPro shot needs Speed, VLA and a spin; a ground's slope no steeper than its surface holds a ball on, a stimp
+reading for a green only), so a few schema-valid requests are rightly refused."""
 
 
 @pytest.fixture(autouse=True)

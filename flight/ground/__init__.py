@@ -2,13 +2,16 @@
 point, level or sloped. Pure NumPy, batch-first; `ground_phase` is the entry point, `SURFACES` the one table of
 surface parameters."""
 
-from flight.ground.phase import GroundPhase, GroundPath, ground_phase
+from flight.ground.phase import GroundPath, GroundPhase, ground_phase
+from flight.ground.spec import LEVEL_FAIRWAY, GroundSpec
 from flight.ground.surfaces import SURFACES, Surface, green_rolling_resistance, holding_slope_deg, surface
 
 __all__ = [
+    "LEVEL_FAIRWAY",
     "SURFACES",
     "GroundPath",
     "GroundPhase",
+    "GroundSpec",
     "Surface",
     "green_rolling_resistance",
     "ground_phase",

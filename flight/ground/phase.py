@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
-from flight.ground.impact import _dot, impact
+from flight.ground.impact import _cross, _dot, impact
 from flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, holding_slope_deg
 
 MIN_HOP_SPEED_MPS = 0.5
@@ -118,7 +118,7 @@ def _bounce(position, velocity, spin, normal, surface: Surface, record: _Recorde
             record.add(flying, time[flying], position[flying], velocity[flying])
         bouncing = flying
     on_plane = velocity - _dot(velocity, normal)[:, None] * normal
-    rolling = 5.0 / 7.0 * on_plane - 2.0 / 7.0 * BALL_RADIUS_M * np.cross(normal, spin)
+    rolling = 5.0 / 7.0 * on_plane - 2.0 / 7.0 * BALL_RADIUS_M * _cross(normal, spin)
     rolling -= _dot(rolling, normal)[:, None] * normal
     return position, rolling, time, hops
 

@@ -83,9 +83,3 @@ def holding_slope_deg(rolling_resistance: float | np.ndarray) -> float | np.ndar
     """The steepest slope a surface holds a ball still on: (5/7) g sin(phi) < c_r g cos(phi). Steeper, a ball never
     comes to rest on an endless plane."""
     return np.degrees(np.arctan(np.asarray(rolling_resistance, dtype=float) / ROLLING_GRAVITY_FRACTION))
-
-
-def max_slope_deg(name: str, stimp_ft: float | None = None) -> float:
-    """The steepest slope a preset accepts (its holding slope), for messages and validation."""
-    return float(holding_slope_deg(surface(name, stimp_ft).rolling_resistance))
-

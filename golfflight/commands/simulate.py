@@ -3,7 +3,8 @@
 Input: JSON (one shot, a list of shots, or {"shots": [...]}, in the HTTP request format) or a CSV of launches
 (one row per shot, the request's launch fields as columns plus optional flat conditions: temperature_c,
 altitude_m, pressure_hpa, humidity_pct, density_kg_m3, wind_speed_mps, wind_from_deg, wind_profile,
-wind_reference_height_m, normalized). A canonical shot file works as is: its identity and outcome columns are
+wind_reference_height_m, normalized, and the ground: ground_surface, stimp_ft, ground_elevation_m, slope_deg,
+slope_dir_deg). A canonical shot file works as is: its identity and outcome columns are
 passed over, its shot_id echoed. Output: {"results": [...]} as JSON, or a flat CSV when --out ends in .csv.
 
 A bad shot (a value out of range or not a number, an extra cell, a shot_id seen before) refuses the file with its
@@ -26,6 +27,13 @@ WIND_COLUMNS = {
     "wind_from_deg": "from_deg",
     "wind_profile": "profile",
     "wind_reference_height_m": "reference_height_m",
+}
+GROUND_COLUMNS = {
+    "ground_surface": "surface",
+    "stimp_ft": "stimp_ft",
+    "ground_elevation_m": "elevation_m",
+    "slope_deg": "slope_deg",
+    "slope_dir_deg": "slope_dir_deg",
 }
 LAUNCH_COLUMNS = (
     "ball_speed_mps",
@@ -72,6 +80,7 @@ def _number_or_text(text: str):
 REQUEST_TO_COLUMN = {
     **{f"air.{field}": column for column, field in AIR_COLUMNS.items()},
     **{f"wind.{field}": column for column, field in WIND_COLUMNS.items()},
+    **{f"ground.{field}": column for column, field in GROUND_COLUMNS.items()},
 }
 """Request field -> CSV column, to name the column of a refused value."""
 
@@ -81,7 +90,7 @@ def shots_from_csv(path: Path) -> tuple[list[dict], list[str | None], list[str],
     found while reading (extra cells, repeated shot ids) of a launches CSV."""
     with reading(path), open(path, newline="") as handle:
         reader = csv.DictReader(handle)
-        known = {"shot_id", "normalized", *LAUNCH_COLUMNS, *AIR_COLUMNS, *WIND_COLUMNS, *PASSED_OVER}
+        known = {"shot_id", "normalized", *LAUNCH_COLUMNS, *AIR_COLUMNS, *WIND_COLUMNS, *GROUND_COLUMNS, *PASSED_OVER}
         unknown = [c for c in reader.fieldnames or [] if c not in known]
         if not reader.fieldnames:
             raise ValueError(f"{path} line 1: no header row; launch columns are {', '.join(LAUNCH_COLUMNS)}")
@@ -103,10 +112,10 @@ def shots_from_csv(path: Path) -> tuple[list[dict], list[str | None], list[str],
             shot = {k: cells[k] for k in LAUNCH_COLUMNS if k in cells}
             air = {AIR_COLUMNS[k]: cells[k] for k in AIR_COLUMNS if k in cells}
             wind = {WIND_COLUMNS[k]: cells[k] for k in WIND_COLUMNS if k in cells}
-            if air:
-                shot["air"] = air
-            if wind:
-                shot["wind"] = wind
+            ground = {GROUND_COLUMNS[k]: cells[k] for k in GROUND_COLUMNS if k in cells}
+            for name, part in (("air", air), ("wind", wind), ("ground", ground)):
+                if part:
+                    shot[name] = part
             if "normalized" in cells:
                 shot["normalized"] = str(cells["normalized"]).lower() in ("1", "1.0", "true", "yes")
             shots.append(shot)
@@ -151,8 +160,8 @@ def flat_row(result: dict) -> dict:
         if not flight:
             continue
         for key, value in flight.items():
-            if key == "landing":
-                row[f"{prefix}landing_x_m"], row[f"{prefix}landing_y_m"] = value["x_m"], value["y_m"]
+            if key in ("landing", "rest"):
+                row[f"{prefix}{key}_x_m"], row[f"{prefix}{key}_y_m"] = value["x_m"], value["y_m"]
             elif key not in ("trajectory", "normalized", "conditions"):
                 row[prefix + key] = value
     return row

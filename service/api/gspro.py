@@ -17,6 +17,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from flight import limits
 from flight.constants import MPH_TO_MPS
+from flight.ground import LEVEL_FAIRWAY
 from flight.limits import Range
 from service.api.models import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotResult, describe_errors
 from service.api.shots import flight_fields, spin_from_components
@@ -153,10 +154,10 @@ def invalid_message(errors: list) -> str:
 
 
 def fly_message(engine: FlightEngine, message: GSProMessage) -> GSProReply:
-    """The reply to a message with BallData: Code 200 with its flight (standard air), or Code 500 saying why it
-    could not fly."""
+    """The reply to a message with BallData: Code 200 with its flight (standard air) rolled to rest on a level
+    fairway, or Code 500 saying why it could not fly."""
     try:
-        flight = engine.fly(launch_from_ball_data(message.BallData))
+        flight = engine.fly(launch_from_ball_data(message.BallData), ground=LEVEL_FAIRWAY)
     except (ValueError, FlightError) as error:
         return GSProReply(Code=500, Message=str(error), ShotNumber=message.ShotNumber)
     result = ShotResult.model_construct(**flight_fields(flight, None))

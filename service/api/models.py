@@ -16,6 +16,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from flight import limits
 from flight.conditions import NORMALIZED_REFERENCE
 from flight.constants import MPH_TO_MPS
+from flight.ground import SURFACES, holding_slope_deg, surface
 from flight.limits import Range
 
 MAX_BATCH_SHOTS = 10_000
@@ -45,6 +46,10 @@ RANGES: dict[str, Range] = {
     "from_deg": limits.WIND_FROM_DEG,
     "reference_height_m": limits.WIND_REFERENCE_HEIGHT_M,
     "rate_hz": limits.TRAJECTORY_RATE_HZ,
+    "stimp_ft": limits.STIMP_FT,
+    "elevation_m": limits.GROUND_ELEVATION_M,
+    "slope_deg": limits.SLOPE_DEG,
+    "slope_dir_deg": limits.SLOPE_DIR_DEG,
 }
 """Allowed range of every numeric request field, by name (also quoted in 422 answers)."""
 
@@ -151,6 +156,34 @@ class TrajectoryRequest(Strict):
     rate_hz: _in("rate_hz", "resampling rate, positions from t = 0 to the landing", True) = None
 
 
+SurfaceName = Literal[tuple(SURFACES)]
+
+
+class GroundRequest(Strict):
+    """The ground the ball comes down on, bounces and rolls to rest on (flight.ground, docs/ground.md); omitted =
+    level fairway at the tee's elevation. A slope may be no steeper than the surface holds a ball still on."""
+
+    surface: SurfaceName = Field("fairway", description=f"one of {', '.join(SURFACES)}")
+    stimp_ft: _in("stimp_ft", "green speed, the stimpmeter reading; green only (default 10)", True) = None
+    elevation_m: _in("elevation_m", "landing ground above (+) or below (-) the tee's ground; the carry is there") = 0.0
+    slope_deg: _in("slope_deg", "slope of the ground around the landing point") = 0.0
+    slope_dir_deg: _in(
+        "slope_dir_deg", "direction it falls towards, clockwise from the target line: 0 = away, 90 = to the right"
+    ) = 0.0
+
+    @model_validator(mode="after")
+    def _holds_a_ball(self) -> GroundRequest:
+        if self.stimp_ft is not None and self.surface != "green":
+            raise ValueError(f"stimp_ft: a green's reading; surface {self.surface!r} takes none")
+        limit = float(holding_slope_deg(surface(self.surface, self.stimp_ft).rolling_resistance))
+        if self.slope_deg >= limit:
+            raise ValueError(
+                f"slope_deg: {self.slope_deg:g} is steeper than {self.surface} holds a ball still on; allowed 0 to "
+                f"{limit - 0.005:.2f} deg on this surface"
+            )
+        return self
+
+
 class ShotRequest(Strict):
     """One launch, its conditions, and what to return besides the flight. Back and side spin together may not
     exceed the total spin range."""
@@ -181,6 +214,7 @@ class ShotRequest(Strict):
         False, description="true (or reference air): also return the flight in calm reference air (TrackMan's)"
     )
     trajectory: TrajectoryRequest | None = None
+    ground: GroundRequest | None = None
 
     @model_validator(mode="after")
     def _one_form_each(self) -> ShotRequest:
@@ -217,7 +251,14 @@ class BatchRequest(Strict):
 
 
 class Landing(BaseModel):
-    """Where the ball comes down, at the launch elevation."""
+    """Where the ball comes down, on its ground's plane (the tee's elevation unless ground.elevation_m)."""
+
+    x_m: float = Field(description="right (+) of the target line")
+    y_m: float = Field(description="down the target line")
+
+
+class RestPoint(BaseModel):
+    """Where the ball comes to rest after bouncing and rolling."""
 
     x_m: float = Field(description="right (+) of the target line")
     y_m: float = Field(description="down the target line")
@@ -231,7 +272,8 @@ class TrajectoryPoint(BaseModel):
 
 
 class FlightResult(BaseModel):
-    """One flight to its landing at the launch elevation ("flat"), metres with yards alongside."""
+    """One flight to its landing on its ground (at the tee's elevation, "flat", unless ground.elevation_m), then
+    bounced and rolled to rest; metres with yards alongside."""
 
     landing: Landing
     carry_m: float = Field(description="horizontal distance from the tee to the landing point")
@@ -244,7 +286,14 @@ class FlightResult(BaseModel):
     landing_angle_deg: float = Field(description="descent angle below the horizontal")
     landing_speed_mps: float
     landing_spin_rpm: float
-    trajectory: list[TrajectoryPoint] | None = Field(None, description="only when asked for")
+    total_m: float = Field(description="horizontal distance from the tee to the rest point (carry and roll)")
+    total_yd: float
+    roll_m: float = Field(description="total minus carry: the run after landing (negative: the ball came back)")
+    rest: RestPoint
+    bounces: int = Field(description="hops after the landing before the ball rolls")
+    trajectory: list[TrajectoryPoint] | None = Field(
+        None, description="only when asked for: the flight, the bounces (an impact twice: in and out) and the roll"
+    )
 
 
 class NormalizedFlight(FlightResult):

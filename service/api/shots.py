@@ -6,12 +6,15 @@ import math
 
 from flight.conditions import STANDARD, AirConditions, Conditions
 from flight.constants import MPH_TO_MPS, YARD_M
+from flight.ground import LEVEL_FAIRWAY, GroundSpec, surface
 from flight.wind import CALM, Wind
 from service.api.models import (
     AirRequest,
+    GroundRequest,
     Landing,
     NormalizedFlight,
     ReferenceAir,
+    RestPoint,
     ShotFailure,
     ShotRequest,
     ShotResult,
@@ -60,6 +63,15 @@ def conditions_of(shot: ShotRequest) -> Conditions:
     return Conditions(air_of(shot.air), wind_of(shot.wind))
 
 
+def ground_of(ground: GroundRequest | None) -> GroundSpec:
+    """The engine's ground from a request's; omitted = level fairway at the tee's elevation."""
+    if ground is None:
+        return LEVEL_FAIRWAY
+    return GroundSpec(
+        surface(ground.surface, ground.stimp_ft), ground.elevation_m, ground.slope_deg, ground.slope_dir_deg
+    )
+
+
 def reference_of(shot: ShotRequest) -> ReferenceAir | None:
     """The reference air of the normalized flight, or None when none was asked for."""
     if shot.normalized is False:
@@ -79,7 +91,8 @@ def _trajectory(flight: ShotFlight, request: TrajectoryRequest) -> list[Trajecto
 
 
 def flight_fields(flight: ShotFlight, trajectory: TrajectoryRequest | None) -> dict:
-    """The FlightResult fields of an engine flight (yards alongside metres)."""
+    """The FlightResult fields of an engine flight rolled to rest (yards alongside metres)."""
+    rest = flight.rest
     return {
         "landing": Landing.model_construct(x_m=flight.landing_x_m, y_m=flight.landing_y_m),
         "carry_m": flight.carry_m,
@@ -92,6 +105,11 @@ def flight_fields(flight: ShotFlight, trajectory: TrajectoryRequest | None) -> d
         "landing_angle_deg": flight.landing_angle_deg,
         "landing_speed_mps": flight.landing_speed_mps,
         "landing_spin_rpm": flight.landing_spin_rpm,
+        "total_m": rest.total_m,
+        "total_yd": rest.total_m / YARD_M,
+        "roll_m": rest.roll_m,
+        "rest": RestPoint.model_construct(x_m=rest.x_m, y_m=rest.y_m),
+        "bounces": rest.bounces,
         "trajectory": None if trajectory is None else _trajectory(flight, trajectory),
     }
 
@@ -108,12 +126,12 @@ def result_of(shot: ShotRequest, flight: ShotFlight, normalized: ShotFlight | No
 
 def fly_shot(engine: FlightEngine, shot: ShotRequest) -> ShotResult:
     """One shot (and its normalized replay) on the engine's single-shot path; FlightError if it cannot land."""
-    launch, keep = launch_of(shot), shot.trajectory is not None
-    flight = engine.fly(launch, conditions_of(shot), keep)
+    launch, keep, ground = launch_of(shot), shot.trajectory is not None, ground_of(shot.ground)
+    flight = engine.fly(launch, conditions_of(shot), keep, ground)
     reference = reference_of(shot)
     normalized = None
     if reference is not None:
-        normalized = engine.fly(launch, Conditions(air_of(reference), CALM), keep)
+        normalized = engine.fly(launch, Conditions(air_of(reference), CALM), keep, ground)
     return result_of(shot, flight, normalized)
 
 
@@ -121,10 +139,12 @@ def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> li
     """One engine batch for `shots` and their normalized replays; results in order."""
     launches = [launch_of(shot) for shot in shots]
     conditions = [conditions_of(shot) for shot in shots]
+    grounds = [ground_of(shot.ground) for shot in shots]
     replays = [i for i, shot in enumerate(shots) if reference_of(shot) is not None]
     launches += [launches[i] for i in replays]
     conditions += [Conditions(air_of(reference_of(shots[i])), CALM) for i in replays]
-    flights = engine.fly_batch(launches, conditions, keep)
+    grounds += [grounds[i] for i in replays]
+    flights = engine.fly_batch(launches, conditions, keep, grounds)
     replayed = dict(zip(replays, flights[len(shots) :], strict=True))
     results: list[ShotResult | ShotFailure] = []
     for i, shot in enumerate(shots):

@@ -1,0 +1,29 @@
+"""Where a flight comes down and what it then bounces and rolls on: one shot's ground, as the engine takes it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from flight.ground.surfaces import SURFACES, Surface, holding_slope_deg
+
+
+@dataclass(frozen=True)
+class GroundSpec:
+    """A plane `elevation_m` above the tee's ground (z = 0; the flight lands where it comes down through it), sloped
+    by `slope_deg` towards `slope_dir_deg` around the landing point (`flight.ground.phase.plane_normals`), of
+    `surface`. ValueError for a slope steeper than the surface holds a ball still on."""
+
+    surface: Surface = field(default_factory=lambda: SURFACES["fairway"])
+    elevation_m: float = 0.0
+    slope_deg: float = 0.0
+    slope_dir_deg: float = 0.0
+
+    def __post_init__(self) -> None:
+        limit = float(holding_slope_deg(self.surface.rolling_resistance))
+        if not 0.0 <= self.slope_deg < limit:
+            raise ValueError(f"slope_deg {self.slope_deg:g} is outside 0 to {limit:.2f} deg, the slopes this surface "
+                             "holds a ball still on")
+
+
+LEVEL_FAIRWAY = GroundSpec()
+"""The ground when none is given: the fitted fairway, level, at the tee's elevation."""

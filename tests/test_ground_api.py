@@ -1,0 +1,131 @@
+"""The ground phase through the service's contract: `ground` in single, batch and normalized shots, its 422s, the
+trajectory to rest, GSPro replies (HTTP and the TCP server's `fly_message`) and `golfflight simulate`."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+from servers import running
+
+from flight.constants import YARD_M
+from golfflight.cli import main
+from service.api.app import create_app
+from service.api.gspro import GSProMessage, fly_message
+from service.engine import FlightEngine
+from service.model_location import model_dir
+
+DRIVER = {"ball_speed_mph": 171.0, "launch_angle_deg": 10.4, "back_spin_rpm": 2545.0}
+WEDGE = {"ball_speed_mps": 40.0, "launch_angle_deg": 30.0, "spin_rpm": 10000.0}
+
+
+@pytest.fixture(scope="module")
+def client():
+    with running(create_app()) as http:
+        yield http
+
+
+def shot(http, **body) -> dict:
+    response = http.post("/v1/shots", json=body)
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+def test_every_shot_rolls_to_rest_on_a_level_fairway_unless_told(client):
+    driver = shot(client, **DRIVER)
+    assert driver["total_m"] > driver["carry_m"] and driver["total_yd"] == pytest.approx(driver["total_m"] / YARD_M)
+    assert driver["roll_m"] == pytest.approx(driver["total_m"] - driver["carry_m"])
+    assert driver["rest"]["y_m"] == pytest.approx(driver["total_m"]) and driver["bounces"] >= 0
+    assert shot(client, **DRIVER, ground={}) == driver
+
+
+def test_the_carry_is_at_the_ground_elevation(client):
+    flat = shot(client, **DRIVER)
+    below = shot(client, **DRIVER, ground={"elevation_m": -10.0})
+    above = shot(client, **DRIVER, ground={"elevation_m": 10.0})
+    assert above["carry_m"] < flat["carry_m"] < below["carry_m"]
+    assert above["flight_time_s"] < flat["flight_time_s"] < below["flight_time_s"]
+    too_high = client.post("/v1/shots", json={**DRIVER, "ground": {"elevation_m": 90.0}})
+    assert too_high.status_code == 422 and "never rose to its landing ground" in too_high.json()["detail"][0]["message"]
+
+
+def test_a_fast_green_and_heavy_spin_bring_a_wedge_back(client):
+    wedge = shot(client, **WEDGE, ground={"surface": "green", "stimp_ft": 13.0})
+    assert wedge["roll_m"] < 0.0 and wedge["total_m"] < wedge["carry_m"]
+    soft = shot(client, **WEDGE, ground={"surface": "rough"})
+    assert abs(soft["roll_m"]) < abs(wedge["roll_m"])
+
+
+def test_slopes_move_the_rest(client):
+    level = shot(client, **DRIVER)
+    uphill = shot(client, **DRIVER, ground={"slope_deg": 3.0, "slope_dir_deg": 180.0})
+    downhill = shot(client, **DRIVER, ground={"slope_deg": 3.0, "slope_dir_deg": 0.0})
+    right = shot(client, **DRIVER, ground={"slope_deg": 3.0, "slope_dir_deg": 90.0})
+    assert uphill["total_m"] < level["total_m"] < downhill["total_m"] and right["rest"]["x_m"] > 0.1
+
+
+@pytest.mark.parametrize(
+    ("ground", "words"),
+    [
+        ({"surface": "green", "slope_deg": 8.0}, ["slope_deg", "allowed 0 to 4.47 deg"]),
+        ({"surface": "fairway", "stimp_ft": 10.0}, ["stimp_ft", "a green's reading"]),
+        ({"surface": "carpet"}, ["ground.surface", "fairway"]),
+        ({"stimp_ft": 30.0, "surface": "green"}, ["ground.stimp_ft", "4 to 16 ft"]),
+        ({"slope_dir_deg": -1.0}, ["ground.slope_dir_deg", "0 to 360 deg"]),
+    ],
+)
+def test_a_bad_ground_is_a_422_naming_the_field(client, ground, words):
+    response = client.post("/v1/shots", json={**DRIVER, "ground": ground})
+    assert response.status_code == 422, response.text
+    message = response.json()["detail"][0]["message"]
+    assert all(word in message for word in words), message
+
+
+def test_the_trajectory_runs_on_through_the_bounces_to_rest(client):
+    result = shot(client, **WEDGE, ground={"surface": "green"}, trajectory={"rate_hz": 30})
+    points = result["trajectory"]
+    assert points[-1]["y_m"] == pytest.approx(result["rest"]["y_m"]) and points[-1]["z_m"] == pytest.approx(0.0)
+    after = [p for p in points if p["t_s"] > result["flight_time_s"]]
+    assert after and all(p["z_m"] >= -1e-9 for p in after)
+    assert result["bounces"] >= 1 and max(p["z_m"] for p in after) > 0.01
+
+
+def test_batch_and_normalized_carry_the_ground_phase(client):
+    shots = [
+        {**DRIVER, "normalized": True},
+        {**WEDGE, "ground": {"surface": "green", "stimp_ft": 12.0}},
+        {**DRIVER, "ground": {"elevation_m": -5.0, "slope_deg": 2.0, "slope_dir_deg": 45.0}},
+    ]
+    results = client.post("/v1/shots/batch", json={"shots": shots}).json()["results"]
+    for body, result in zip(shots, results, strict=True):
+        single = shot(client, **body)
+        assert result["total_m"] == pytest.approx(single["total_m"], abs=1e-6)
+        assert result["bounces"] == single["bounces"]
+    assert results[0]["normalized"]["total_m"] > results[0]["normalized"]["carry_m"]
+
+
+def test_gspro_replies_carry_the_total(client):
+    message = {"ShotNumber": 3, "APIversion": "1", "BallData": {"Speed": 167.0, "VLA": 11.0, "TotalSpin": 2650.0}}
+    reply = client.post("/v1/gspro", json=message).json()
+    assert reply["Code"] == 200 and reply["Flight"]["total_yd"] > reply["Flight"]["carry_yd"]
+    tcp = fly_message(FlightEngine(model_dir()), GSProMessage.model_validate(message))
+    assert tcp.Flight.total_m == pytest.approx(reply["Flight"]["total_m"])
+
+
+def test_simulate_takes_ground_columns_and_writes_the_rest(tmp_path):
+    source, out = tmp_path / "launches.csv", tmp_path / "results.csv"
+    with open(source, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, ["ball_speed_mps", "launch_angle_deg", "spin_rpm", "ground_surface", "stimp_ft"])
+        writer.writeheader()
+        writer.writerow({"ball_speed_mps": 40, "launch_angle_deg": 30, "spin_rpm": 10000, "ground_surface": "green",
+                         "stimp_ft": 12})
+        writer.writerow({"ball_speed_mps": 40, "launch_angle_deg": 30, "spin_rpm": 10000, "ground_surface": "rough"})
+    assert main(["simulate", str(source), "--out", str(out)]) == 0
+    with open(out) as handle:
+        rows = list(csv.DictReader(handle))
+    assert {"total_m", "roll_m", "rest_x_m", "rest_y_m", "bounces"} <= set(rows[0])
+    assert float(rows[0]["roll_m"]) < float(rows[1]["roll_m"])
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps([{**WEDGE, "ground": {"surface": "green", "slope_deg": 9.0}}]))
+    assert main(["simulate", str(bad)]) == 2
