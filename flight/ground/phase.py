@@ -8,8 +8,8 @@ less than MIN_HOP_SPEED_MPS stays down and rolls.
 Roll: the ball first rolls without slipping (the slip left by the last impact taken out with the angular momentum
 about the contact point kept: v = 5/7 v_t - 2/7 R n x omega), then decelerates by the surface's rolling resistance
 c_r g cos(phi) and grass drag k v against its motion, plus 5/7 of gravity along a slope. Level ground is solved in
-closed form; a slope is stepped (ROLL_STEP_S, gravity and resistance held within a step) until the ball stops,
-which it does on any slope the surface holds (`holding_slope_deg`; steeper slopes are refused).
+closed form; a slope is stepped (ROLL_STEP_S, midpoint steps) until the ball stops, which it does on any slope the
+surface holds (`holding_slope_deg`; steeper slopes are refused).
 
 Every state of the phase can be kept (`keep_path`): after each impact, each touchdown, each roll step and the rest,
 with velocities, and a level roll's states every ROLL_STEP_S, so a renderer's cubic Hermite resampling follows the
@@ -33,8 +33,9 @@ ball rolls."""
 MAX_BOUNCES = 40
 """A ball still bouncing after this many hops rolls (a safety net: real bounces die out in a handful)."""
 
-ROLL_STEP_S = 0.1
-"""Step of a roll on a slope (on level ground the roll is solved exactly)."""
+ROLL_STEP_S = 0.25
+"""Step of a roll on a slope (on level ground the roll is solved exactly): rests within 2 cm of those of 100 times
+finer steps on 3-6 degree slopes."""
 
 MAX_ROLL_TIME_S = 120.0
 """Longest roll stepped on a slope (a safety net: on a slope the surface holds, every ball stops well before)."""
@@ -174,9 +175,10 @@ def _record_level(record: _Recorder, ids, start_time, position, velocity, resist
 
 
 def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder, ids, start):
-    """Rest point and roll time on slopes, stepped: in each step gravity and rolling resistance act as at its start
-    and grass drag exactly (`_decay`); a step in which the ball would stop ends at the stop, found as on level
-    ground, so the stepped roll meets the closed form as the slope vanishes."""
+    """Rest point and roll time on slopes, stepped: in each step gravity and the rolling resistance along the
+    direction of motion at the step's middle (a midpoint step: errors fall as the step squared), grass drag exactly
+    (`_decay`); a step in which the ball would stop ends at the stop, found as on level ground, so the stepped roll
+    meets the closed form as the slope vanishes."""
     downhill = ROLLING_GRAVITY_FRACTION * (GRAVITY - GRAVITY[2] * normal[:, 2:3] * normal)
     brake = resistance * GRAVITY_MPS2 * normal[:, 2]
     position, velocity = position.copy(), velocity.copy()
@@ -197,9 +199,14 @@ def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder,
         run = speed[stops] ** 2 / braking[stops] * distance_ratio[stops]
         rest[stopped] = position[stopped] + direction[stops] * run[:, None]
         time[moving] += np.where(stops, stop_time, ROLL_STEP_S)
-        e1, e2 = _decay(k[~stops], ROLL_STEP_S)
-        position[going] += v[~stops] * e1[:, None] + acceleration[~stops] * e2[:, None]
-        velocity[going] = v[~stops] * (1.0 - k[~stops] * e1)[:, None] + acceleration[~stops] * e1[:, None]
+        v, k = v[~stops], k[~stops]
+        half_e1, _ = _decay(k, 0.5 * ROLL_STEP_S)
+        half = v * (1.0 - k * half_e1)[:, None] + acceleration[~stops] * half_e1[:, None]
+        turned = half / np.maximum(np.linalg.norm(half, axis=-1), 1e-12)[:, None]
+        midpoint = downhill[going] - brake[going, None] * turned
+        e1, e2 = _decay(k, ROLL_STEP_S)
+        position[going] += v * e1[:, None] + midpoint * e2[:, None]
+        velocity[going] = v * (1.0 - k * e1)[:, None] + midpoint * e1[:, None]
         record.add(ids[going], start[going] + time[going], position[going], velocity[going])
         moving = going
     rest[moving] = position[moving]
