@@ -213,6 +213,17 @@ def run_fit(model_dir: str | os.PathLike, data_dir: str | os.PathLike) -> Ground
                      sweep)
 
 
+def verdict(fit: GroundFit, event: str) -> str:
+    """One line: the fitted ground phase against the constant roll on `event`."""
+    constant, ground = (next(s for s in fit.scores if s.event == event and s.method.startswith(start))
+                        for start in ("carry + constant", "ground phase, fitted"))
+    difference = ground.mae_m - constant.mae_m
+    word = "better" if difference < 0 else "worse"
+    return (f"- {event}: the ground phase's MAE {ground.mae_m:.2f} m against the constant roll's "
+            f"{constant.mae_m:.2f} m ({word} by {abs(difference):.2f} m); recorded median roll "
+            f"{constant.recorded_roll_m:.1f} m.")
+
+
 def markdown(fit: GroundFit, model_dir: str) -> str:
     """The generated section of docs/ground.md."""
     yd = YARD_M
@@ -227,6 +238,7 @@ def markdown(fit: GroundFit, model_dir: str) -> str:
              f"{s.rmse_m:.2f}", f"{s.median_roll_m:.1f}", f"{s.recorded_roll_m:.1f}") for s in fit.scores]
     lines += table(["event", "method", "shots", "bias m", "MAE m", "MAE yd", "RMSE m", "median roll m",
                     "recorded roll m"], rows, "llrrrrrrr")
+    lines += [""] + [verdict(fit, event) for event in dict.fromkeys(score.event for score in fit.scores)]
     check = fit.carry_check
     lines += ["", f"The flight part alone: the model's carry minus apexRange (THE PLAYERS 2020 records the carry "
               f"there, docs/real_data.md), {check['shots']} shots: median {check['median_m']:+.2f} m, IQR "
