@@ -46,6 +46,9 @@ def test_the_carry_is_at_the_ground_elevation(client):
     above = shot(client, **DRIVER, ground={"elevation_m": 10.0})
     assert above["carry_m"] < flat["carry_m"] < below["carry_m"]
     assert above["flight_time_s"] < flat["flight_time_s"] < below["flight_time_s"]
+    assert "flat" not in flat and below["flat"]["carry_m"] == pytest.approx(flat["carry_m"])
+    assert above["flat"]["flight_time_s"] == pytest.approx(flat["flight_time_s"])
+    assert above["flat"]["carry_yd"] == pytest.approx(flat["carry_yd"])
     too_high = client.post("/v1/shots", json={**DRIVER, "ground": {"elevation_m": 90.0}})
     assert too_high.status_code == 422 and "never rose to its landing ground" in too_high.json()["detail"][0]["message"]
 
@@ -95,13 +98,15 @@ def test_batch_and_normalized_carry_the_ground_phase(client):
     shots = [
         {**DRIVER, "normalized": True},
         {**WEDGE, "ground": {"surface": "green", "stimp_ft": 12.0}},
-        {**DRIVER, "ground": {"elevation_m": -5.0, "slope_deg": 2.0, "slope_dir_deg": 45.0}},
+        {**DRIVER, "ground": {"elevation_m": -5.0, "slope_deg": 2.0, "slope_dir_deg": 45.0}, "normalized": True},
     ]
     results = client.post("/v1/shots/batch", json={"shots": shots}).json()["results"]
     for body, result in zip(shots, results, strict=True):
         single = shot(client, **body)
         assert result["total_m"] == pytest.approx(single["total_m"], abs=1e-6)
         assert result["bounces"] == single["bounces"]
+        assert result.get("flat", {}).get("carry_m") == pytest.approx(single.get("flat", {}).get("carry_m"))
+        assert result.get("normalized", {}).get("total_m") == pytest.approx(single.get("normalized", {}).get("total_m"))
     assert results[0]["normalized"]["total_m"] > results[0]["normalized"]["carry_m"]
 
 
@@ -116,16 +121,19 @@ def test_gspro_replies_carry_the_total(client):
 def test_simulate_takes_ground_columns_and_writes_the_rest(tmp_path):
     source, out = tmp_path / "launches.csv", tmp_path / "results.csv"
     with open(source, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, ["ball_speed_mps", "launch_angle_deg", "spin_rpm", "ground_surface", "stimp_ft"])
+        columns = ["ball_speed_mps", "launch_angle_deg", "spin_rpm", "ground_surface", "stimp_ft", "ground_elevation_m"]
+        writer = csv.DictWriter(handle, columns)
         writer.writeheader()
         writer.writerow({"ball_speed_mps": 40, "launch_angle_deg": 30, "spin_rpm": 10000, "ground_surface": "green",
                          "stimp_ft": 12})
-        writer.writerow({"ball_speed_mps": 40, "launch_angle_deg": 30, "spin_rpm": 10000, "ground_surface": "rough"})
+        writer.writerow({"ball_speed_mps": 40, "launch_angle_deg": 30, "spin_rpm": 10000, "ground_surface": "rough",
+                         "ground_elevation_m": -3})
     assert main(["simulate", str(source), "--out", str(out)]) == 0
     with open(out) as handle:
         rows = list(csv.DictReader(handle))
-    assert {"total_m", "roll_m", "rest_x_m", "rest_y_m", "bounces"} <= set(rows[0])
-    assert float(rows[0]["roll_m"]) < float(rows[1]["roll_m"])
+    assert {"total_m", "roll_m", "rest_x_m", "rest_y_m", "bounces", "flat_carry_m"} <= set(rows[0])
+    assert float(rows[0]["roll_m"]) < float(rows[1]["roll_m"]) and rows[0]["flat_carry_m"] == ""
+    assert float(rows[1]["flat_carry_m"]) < float(rows[1]["carry_m"])
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps([{**WEDGE, "ground": {"surface": "green", "slope_deg": 9.0}}]))
     assert main(["simulate", str(bad)]) == 2

@@ -154,15 +154,15 @@ def shots_from_json(text: str, source: str) -> list[dict]:
 
 
 def flat_row(result: dict) -> dict:
-    """One CSV row of a result: the flight's numbers, then normalized_* ones, or the error."""
+    """One CSV row of a result: the flight's numbers, then normalized_* and flat_* ones, or the error."""
     row = {}
-    for prefix, flight in (("", result), ("normalized_", result.get("normalized"))):
+    for prefix, flight in (("", result), ("normalized_", result.get("normalized")), ("flat_", result.get("flat"))):
         if not flight:
             continue
         for key, value in flight.items():
             if key in ("landing", "rest"):
                 row[f"{prefix}{key}_x_m"], row[f"{prefix}{key}_y_m"] = value["x_m"], value["y_m"]
-            elif key not in ("trajectory", "normalized", "conditions"):
+            elif key not in ("trajectory", "normalized", "flat", "conditions"):
                 row[prefix + key] = value
     return row
 

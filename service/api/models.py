@@ -302,10 +302,23 @@ class NormalizedFlight(FlightResult):
     conditions: ReferenceAir
 
 
+class FlatFlight(BaseModel):
+    """The same flight down to the tee's elevation ("flat", TrackMan's figures), beside one that lands higher or
+    lower."""
+
+    landing: Landing
+    carry_m: float
+    carry_yd: float
+    lateral_m: float
+    flight_time_s: float
+    landing_angle_deg: float
+
+
 class ShotResult(FlightResult):
     """The flight in the conditions given, and in reference conditions when asked for."""
 
     normalized: NormalizedFlight | None = None
+    flat: FlatFlight | None = Field(None, description="only when ground.elevation_m is not 0: the flight to z = 0")
 
 
 class ShotFailure(BaseModel):

@@ -10,6 +10,7 @@ from flight.ground import LEVEL_FAIRWAY, GroundSpec, surface
 from flight.wind import CALM, Wind
 from service.api.models import (
     AirRequest,
+    FlatFlight,
     GroundRequest,
     Landing,
     NormalizedFlight,
@@ -114,14 +115,34 @@ def flight_fields(flight: ShotFlight, trajectory: TrajectoryRequest | None) -> d
     }
 
 
-def result_of(shot: ShotRequest, flight: ShotFlight, normalized: ShotFlight | None = None) -> ShotResult:
-    """The response for one shot from its flight and, if asked for, its normalized flight (built without
-    re-validation: every value comes from the engine)."""
+def lands_off_the_flat(shot: ShotRequest) -> bool:
+    """Whether the shot's ground lies above or below the tee's, so that its flat flight is returned beside it."""
+    return shot.ground is not None and shot.ground.elevation_m != 0.0
+
+
+def flat_fields(flight: ShotFlight) -> FlatFlight:
+    """The flat figures of a flight flown down to z = 0."""
+    return FlatFlight.model_construct(
+        landing=Landing.model_construct(x_m=flight.landing_x_m, y_m=flight.landing_y_m),
+        carry_m=flight.carry_m,
+        carry_yd=flight.carry_m / YARD_M,
+        lateral_m=flight.lateral_m,
+        flight_time_s=flight.flight_time_s,
+        landing_angle_deg=flight.landing_angle_deg,
+    )
+
+
+def result_of(
+    shot: ShotRequest, flight: ShotFlight, normalized: ShotFlight | None = None, flat: ShotFlight | None = None
+) -> ShotResult:
+    """The response for one shot from its flight and, if asked for, its normalized flight, and its flat flight when
+    its ground is off the tee's elevation (built without re-validation: every value comes from the engine)."""
     extra = None
     if normalized is not None:
         fields = flight_fields(normalized, shot.trajectory)
         extra = NormalizedFlight.model_construct(**fields, conditions=reference_of(shot))
-    return ShotResult.model_construct(**flight_fields(flight, shot.trajectory), normalized=extra)
+    flat_result = None if flat is None else flat_fields(flat)
+    return ShotResult.model_construct(**flight_fields(flight, shot.trajectory), normalized=extra, flat=flat_result)
 
 
 def fly_shot(engine: FlightEngine, shot: ShotRequest) -> ShotResult:
@@ -132,25 +153,28 @@ def fly_shot(engine: FlightEngine, shot: ShotRequest) -> ShotResult:
     normalized = None
     if reference is not None:
         normalized = engine.fly(launch, Conditions(air_of(reference), CALM), keep, ground)
-    return result_of(shot, flight, normalized)
+    flat = engine.fly(launch, conditions_of(shot)) if lands_off_the_flat(shot) else None
+    return result_of(shot, flight, normalized, flat)
 
 
 def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> list[ShotResult | ShotFailure]:
-    """One engine batch for `shots` and their normalized replays; results in order."""
+    """One engine batch for `shots`, their normalized replays and their flat flights; results in order."""
     launches = [launch_of(shot) for shot in shots]
     conditions = [conditions_of(shot) for shot in shots]
-    grounds = [ground_of(shot.ground) for shot in shots]
+    grounds: list[GroundSpec | None] = [ground_of(shot.ground) for shot in shots]
     replays = [i for i, shot in enumerate(shots) if reference_of(shot) is not None]
-    launches += [launches[i] for i in replays]
-    conditions += [Conditions(air_of(reference_of(shots[i])), CALM) for i in replays]
-    grounds += [grounds[i] for i in replays]
+    flats = [i for i, shot in enumerate(shots) if lands_off_the_flat(shot)]
+    launches += [launches[i] for i in replays + flats]
+    conditions += [Conditions(air_of(reference_of(shots[i])), CALM) for i in replays] + [conditions[i] for i in flats]
+    grounds += [grounds[i] for i in replays] + [None] * len(flats)
     flights = engine.fly_batch(launches, conditions, keep, grounds)
-    replayed = dict(zip(replays, flights[len(shots) :], strict=True))
+    replayed = dict(zip(replays, flights[len(shots) : len(shots) + len(replays)], strict=True))
+    flat = dict(zip(flats, flights[len(shots) + len(replays) :], strict=True))
     results: list[ShotResult | ShotFailure] = []
     for i, shot in enumerate(shots):
-        flight, normalized = flights[i], replayed.get(i)
-        failure = next((f for f in (flight, normalized) if isinstance(f, FlightError)), None)
-        results.append(ShotFailure(error=str(failure)) if failure else result_of(shot, flight, normalized))
+        own = (flights[i], replayed.get(i), flat.get(i))
+        failure = next((f for f in own if isinstance(f, FlightError)), None)
+        results.append(ShotFailure(error=str(failure)) if failure else result_of(shot, *own))
     return results
 
 
