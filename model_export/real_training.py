@@ -143,8 +143,9 @@ def export_real(run_dir: Path, data_file: Path, sources: list[SourceData], out: 
         "config": train_config.as_dict(), "epoch": payload["epoch"], "metrics": metrics,
         "data": {**data, "sources": source_cards(sources, config.weights, paths)},
         "split": "validation by conditions group, never a random shuffle: every 4th driver-range block in file "
-                 "order, the last round of each tour event, the last synthetic sessions; the validation landing "
-                 "and max-height errors are over the measured sources' validation shots, flown calm",
+                 "order, the Sentry's last round, every 4th hole of THE PLAYERS (one round), the last synthetic "
+                 "sessions; the validation landing and max-height errors are over the measured sources' validation "
+                 "shots, flown calm (the last epoch of the chosen seed)",
         "loss_description": loss_description(config),
         "latent_conditions": latent_description(config, conditions),
     }, out)
