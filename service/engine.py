@@ -29,7 +29,7 @@ from flight.bundle_check import open_session, session_options
 from flight.conditions import STANDARD, Conditions
 from flight.constants import RPM_TO_RADPS
 from flight.field import BallInAir
-from flight.ground import GroundPhase, GroundSpec, Surface, ground_phase
+from flight.ground import GroundPhase, GroundSpec, Surface, ground_phase, ground_phase_one
 from flight.integrator import GroundPlane, integrate
 from flight.limits import FLIGHT_TIME_S
 from flight.onnx_coefficients import OnnxCoefficients
@@ -229,9 +229,10 @@ class FlightEngine:
         keep_states: bool = False,
         ground: GroundSpec | None = None,
     ) -> ShotFlight:
-        """Fly one shot on Python floats down to its ground and roll it to rest there (ground None: the flight alone,
-        down to z = 0); raises FlightError if it has not landed by MAX_FLIGHT_TIME_S (or, from a broken model, if
-        any number of its flight is not finite)."""
+        """Fly one shot on Python floats down to its ground and roll it to rest there on floats too
+        (`flight.ground.ground_phase_one`; with states kept, the batch ground phase, which records the path); ground
+        None: the flight alone, down to z = 0. Raises FlightError if it has not landed by MAX_FLIGHT_TIME_S (or, from
+        a broken model, if any number of its flight is not finite)."""
         start = initial_state(*(np.array([value], dtype=float) for value in launch))
         x, y, z = start.position[0].tolist()
         vx, vy, vz = start.velocity[0].tolist()
@@ -280,11 +281,19 @@ class FlightEngine:
         if not (all(map(math.isfinite, numbers)) and self._states_finite(states)):
             raise FlightError(NON_FINITE)
         rest = None
-        if ground is not None:
+        if ground is not None and states is None:
+            one = ground_phase_one(
+                tuple(land[0:3]), tuple(land[3:6]), tuple(land[6:9]), ground.surface, ground.slope_deg,
+                ground.slope_dir_deg,
+            )
+            x, y, _ = one.position
+            total = math.hypot(x, y)
+            rest = Rest(x, y, total, total - carry, one.bounces, one.time_s)
+        elif ground is not None:
             landing = np.array([land[0:3]]), np.array([land[3:6]]), np.array([land[6:9]])
-            phase = ground_phase(*landing, ground.surface, ground.slope_deg, ground.slope_dir_deg, keep_states)
+            phase = ground_phase(*landing, ground.surface, ground.slope_deg, ground.slope_dir_deg, True)
             rest = _rest(phase, 0, carry)
-            states = None if states is None else _through_rest(states, phase, 0, flight_time)
+            states = _through_rest(states, phase, 0, flight_time)
         return ShotFlight(
             land[0], land[1], carry, land[0], apex, apex_time, flight_time, angle, speed, spin, states, rest
         )

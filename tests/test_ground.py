@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from flight.constants import BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, FOOT_M, GRAVITY_MPS2, RPM_TO_RADPS
-from flight.ground import SURFACES, Surface, ground_phase, holding_slope_deg, surface
+from flight.ground import SURFACES, Surface, ground_phase, ground_phase_one, holding_slope_deg, surface
 from flight.ground.impact import impact
 from flight.ground.phase import plane_normals
 from flight.ground.surfaces import STIMPMETER_EXIT_SPEED_MPS, green_rolling_resistance
@@ -166,3 +166,21 @@ def test_surface_presets_are_overridable_and_stimp_is_for_greens_only():
         surface("rough", 10.0)
     with pytest.raises(ValueError, match="not one of"):
         surface("carpet")
+
+
+def test_one_ball_on_plain_floats_is_the_batch():
+    """`ground_phase_one` (the engine's one-shot path) runs the batch's formulas on floats: same rest and hops."""
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        speed, angle, heading = rng.uniform(3, 35), rng.uniform(2, 80), rng.uniform(0, 360)
+        a, h = math.radians(angle), math.radians(heading)
+        across, down = speed * math.cos(a), -speed * math.sin(a)
+        velocity = np.array([across * math.sin(h), across * math.cos(h), down])
+        spin, position = rng.normal(0, 400, 3), rng.uniform(-3, 3, 3)
+        where = SURFACES[rng.choice(list(SURFACES))]
+        slope = 0.0 if rng.random() < 0.5 else rng.uniform(0, 0.9) * float(holding_slope_deg(where.rolling_resistance))
+        slope_dir = rng.uniform(0, 360)
+        batch = ground_phase(position[None], velocity[None], spin[None], where, slope, slope_dir)
+        one = ground_phase_one(tuple(position), tuple(velocity), tuple(spin), where, slope, slope_dir)
+        np.testing.assert_allclose(one.position, batch.rest_position[0], atol=1e-6)
+        assert one.bounces == batch.bounces[0] and one.time_s == pytest.approx(batch.time_s[0], abs=1e-6)

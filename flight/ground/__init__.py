@@ -2,7 +2,7 @@
 point, level or sloped. Pure NumPy, batch-first; `ground_phase` is the entry point, `SURFACES` the one table of
 surface parameters."""
 
-from flight.ground.phase import GroundPath, GroundPhase, ground_phase
+from flight.ground.phase import GroundPath, GroundPhase, OneRest, ground_phase, ground_phase_one
 from flight.ground.spec import LEVEL_FAIRWAY, GroundSpec
 from flight.ground.surfaces import SURFACES, Surface, green_rolling_resistance, holding_slope_deg, surface
 
@@ -12,9 +12,11 @@ __all__ = [
     "GroundPath",
     "GroundPhase",
     "GroundSpec",
+    "OneRest",
     "Surface",
     "green_rolling_resistance",
     "ground_phase",
+    "ground_phase_one",
     "holding_slope_deg",
     "surface",
 ]

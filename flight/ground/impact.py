@@ -20,10 +20,13 @@ friction impulse opposes the slip and never overshoots it.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from flight.constants import BALL_MASS_KG, BALL_RADIUS_M, BALL_INERTIA_KG_M2
+from flight.constants import BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M
 from flight.ground.surfaces import Surface
+from flight.ground.vectors import TINY, add, atan2, cos, cross, dot, maximum, minimum, norm, sin, times
 
 PENNER_MAX_NORMAL_SPEED_MPS = 20.0
 """Penner's restitution fit holds up to 20 m/s normal speed; faster impacts keep its value there (about 0.12)."""
@@ -36,41 +39,37 @@ SPIN_PER_IMPULSE = BALL_MASS_KG * BALL_RADIUS_M / BALL_INERTIA_KG_M2
 """Change of spin (rad/s) per unit tangential speed change (m/s) from an impulse at the contact point: m R / I."""
 
 
-def penner_restitution(normal_speed_mps: np.ndarray) -> np.ndarray:
+def penner_restitution(normal_speed_mps):
     """Penner's coefficient of restitution of a golf ball on a fairway: 0.510 - 0.0375 v_n + 0.000903 v_n^2."""
-    v = np.minimum(normal_speed_mps, PENNER_MAX_NORMAL_SPEED_MPS)
+    v = minimum(normal_speed_mps, PENNER_MAX_NORMAL_SPEED_MPS)
     return 0.510 - 0.0375 * v + 0.000903 * v * v
 
 
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.einsum("ij,ij->i", a, b)
-
-
-NEXT, AFTER = [1, 2, 0], [2, 0, 1]
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise a x b of [N,3] arrays (np.cross costs several times more on the few rows of one shot)."""
-    return a[:, NEXT] * b[:, AFTER] - a[:, AFTER] * b[:, NEXT]
+def impact_components(velocity: tuple, spin: tuple, normal: tuple, surface: Surface) -> tuple[tuple, tuple]:
+    """Velocity and spin just after an impact, as (x, y, z) tuples of floats (one ball) or [N] arrays (a batch;
+    `surface` then holds floats or [N] arrays): the ball hits the ground with `velocity` and `spin` against a plane
+    of unit `normal` (pointing up out of the ground)."""
+    normal_speed = -dot(velocity, normal)
+    tangential = add(velocity, normal, normal_speed)
+    tangential_speed = norm(tangential)
+    along = times(1.0 / maximum(tangential_speed, TINY), tangential)
+    depth = minimum(normal_speed / REFERENCE_NORMAL_SPEED_MPS, 1.0)
+    critical = surface.critical_angle_deg * (math.pi / 180.0)
+    tilt = minimum(critical * depth, atan2(tangential_speed, normal_speed))
+    contact_normal = add(times(cos(tilt), normal), along, -sin(tilt))
+    incoming = -dot(velocity, contact_normal)
+    restitution = minimum(maximum(surface.restitution_scale * penner_restitution(incoming), 0.0), 1.0)
+    sliding = add(velocity, contact_normal, incoming)
+    slip = add(sliding, cross(contact_normal, spin), BALL_RADIUS_M)
+    slip_speed = norm(slip)
+    impulse = minimum(2.0 / 7.0 * slip_speed, surface.friction * (1.0 + restitution) * incoming)
+    friction = times(-impulse / maximum(slip_speed, TINY), slip)
+    velocity_out = add(add(sliding, friction), contact_normal, restitution * incoming)
+    spin_out = add(spin, cross(contact_normal, friction), -SPIN_PER_IMPULSE)
+    return velocity_out, spin_out
 
 
 def impact(velocity: np.ndarray, spin: np.ndarray, normal: np.ndarray, surface: Surface) -> tuple[np.ndarray, ...]:
-    """Velocity and spin [N,3] just after balls hit the ground with `velocity`, `spin` [N,3] against planes of unit
-    `normal` [N,3] (pointing up out of the ground); `surface` holds floats or [N] arrays."""
-    normal_speed = -_dot(velocity, normal)
-    tangential = velocity + normal_speed[:, None] * normal
-    tangential_speed = np.linalg.norm(tangential, axis=-1)
-    along = tangential / np.maximum(tangential_speed, 1e-12)[:, None]
-    depth = np.minimum(normal_speed / REFERENCE_NORMAL_SPEED_MPS, 1.0)
-    tilt = np.minimum(np.radians(surface.critical_angle_deg) * depth, np.arctan2(tangential_speed, normal_speed))
-    contact_normal = np.cos(tilt)[:, None] * normal - np.sin(tilt)[:, None] * along
-    incoming = -_dot(velocity, contact_normal)
-    restitution = np.clip(surface.restitution_scale * penner_restitution(incoming), 0.0, 1.0)
-    sliding = velocity + incoming[:, None] * contact_normal
-    slip = sliding + BALL_RADIUS_M * _cross(contact_normal, spin)
-    slip_speed = np.linalg.norm(slip, axis=-1)
-    impulse = np.minimum(2.0 / 7.0 * slip_speed, surface.friction * (1.0 + restitution) * incoming)
-    friction = -(impulse / np.maximum(slip_speed, 1e-12))[:, None] * slip
-    velocity_out = sliding + friction + (restitution * incoming)[:, None] * contact_normal
-    spin_out = spin - SPIN_PER_IMPULSE * _cross(contact_normal, friction)
-    return velocity_out, spin_out
+    """`impact_components` on [N,3] arrays: velocity and spin [N,3] just after the impact."""
+    out, spin_out = impact_components(tuple(velocity.T), tuple(spin.T), tuple(normal.T), surface)
+    return np.stack(out, -1), np.stack(spin_out, -1)

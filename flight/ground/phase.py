@@ -11,6 +11,10 @@ c_r g cos(phi) and grass drag k v against its motion, plus 5/7 of gravity along 
 closed form; a slope is stepped (ROLL_STEP_S, midpoint steps) until the ball stops, which it does on any slope the
 surface holds (`holding_slope_deg`; steeper slopes are refused).
 
+The formulas are written once on (x, y, z) tuples of floats or arrays (`flight.ground.vectors`): `ground_phase` runs
+them on a batch, `ground_phase_one` on one ball's plain floats (the engine's one-shot latency path, where NumPy's
+per-call cost on arrays of one row would cost more than the physics).
+
 Every state of the phase can be kept (`keep_path`): after each impact, each touchdown, each roll step and the rest,
 with velocities, and a level roll's states every ROLL_STEP_S, so a renderer's cubic Hermite resampling follows the
 hops exactly (parabolas) and the roll closely.
@@ -18,13 +22,16 @@ hops exactly (parabolas) and the roll closely.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
-from flight.ground.impact import _cross, _dot, impact
+from flight.ground.impact import impact, impact_components
 from flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, holding_slope_deg
+from flight.ground.vectors import TINY, add, cross, dot, expm1, log1p, maximum, norm, times, where
 
 MIN_HOP_SPEED_MPS = 0.5
 """Rebounds slower than this off the plane (a hop under 13 mm high: a skip the turf soaks up) end the bounces: the
@@ -65,6 +72,14 @@ class GroundPhase:
     paths: list[GroundPath] | None = None
 
 
+class OneRest(NamedTuple):
+    """Where one ball came to rest: the point (x, y, z), hops, time on the ground."""
+
+    position: tuple[float, float, float]
+    bounces: int
+    time_s: float
+
+
 def plane_normals(slope_deg: np.ndarray | float, slope_dir_deg: np.ndarray | float, n: int) -> np.ndarray:
     """Unit normals [n,3] of planes falling at `slope_deg` towards `slope_dir_deg` (clockwise from the target line
     seen from behind the golfer: 0 = falls away towards the target, 90 = falls to the right, 180 = rises towards
@@ -72,6 +87,83 @@ def plane_normals(slope_deg: np.ndarray | float, slope_dir_deg: np.ndarray | flo
     phi = np.broadcast_to(np.radians(slope_deg), (n,))
     beta = np.broadcast_to(np.radians(slope_dir_deg), (n,))
     return np.stack([np.sin(phi) * np.sin(beta), np.sin(phi) * np.cos(beta), np.cos(phi)], -1)
+
+
+def _check_slopes(slope: np.ndarray, resistance: np.ndarray) -> None:
+    steep = slope >= holding_slope_deg(resistance)
+    if np.any(steep):
+        i = int(np.flatnonzero(np.atleast_1d(steep))[0])
+        raise ValueError(
+            f"slope_deg {np.atleast_1d(slope)[i]:g} is steeper than the surface holds a ball on "
+            f"({float(np.atleast_1d(holding_slope_deg(resistance))[i]):.2f} deg): it would never come to rest"
+        )
+
+
+def _hop(position: tuple, velocity: tuple, duration) -> tuple[tuple, tuple]:
+    """Position and velocity after a hop of `duration` under gravity alone."""
+    fall = 0.5 * GRAVITY_MPS2 * duration * duration
+    moved = add(position, velocity, duration)
+    return (moved[0], moved[1], moved[2] - fall), (velocity[0], velocity[1], velocity[2] - GRAVITY_MPS2 * duration)
+
+
+def _rolling(velocity: tuple, spin: tuple, normal: tuple) -> tuple:
+    """The velocity a ball rolls off with, its slip taken out with the angular momentum about the contact point kept:
+    5/7 v_t - 2/7 R n x omega, in the plane."""
+    on_plane = add(velocity, normal, -dot(velocity, normal))
+    rolling = add(times(5.0 / 7.0, on_plane), cross(normal, spin), -2.0 / 7.0 * BALL_RADIUS_M)
+    return add(rolling, normal, -dot(rolling, normal))
+
+
+def _ratios(x):
+    """log(1 + x) / x and (x - log(1 + x)) / x^2 for x >= 0, without cancellation near 0 (limits 1 and 1/2)."""
+    small = x < 1e-4
+    safe = where(small, 1.0, x)
+    log = log1p(safe)
+    return where(small, 1.0 - x / 2.0, log / safe), where(small, 0.5 - x / 3.0, (safe - log) / (safe * safe))
+
+
+def _stop(speed, braking, drag):
+    """(distance, time) to stop from `speed` under a constant deceleration `braking` plus drag k v: the ball stops
+    after T = ln(1 + k v0 / a) / k, having run v0 / k - a T / k (v0^2 / 2a without drag)."""
+    time_ratio, distance_ratio = _ratios(drag * speed / braking)
+    return speed * speed / braking * distance_ratio, speed / braking * time_ratio
+
+
+def _decay(drag, t):
+    """E1 = (1 - exp(-k t)) / k and E2 = (t - E1) / k, without cancellation for small k t (limits t and t^2 / 2):
+    under a constant acceleration A and drag k v, v(t) = v0 (1 - k E1) + A E1 and x(t) = x0 + v0 E1 + A E2."""
+    kt = drag * t
+    small = kt < 1e-6
+    safe_k = where(small, 1.0, drag)
+    e1 = where(small, t - 0.5 * kt * t, -expm1(-kt) / safe_k)
+    e2 = where(small, 0.5 * t * t - kt * t / 6.0 * t, (t - e1) / safe_k)
+    return e1, e2
+
+
+def _slope_step(position: tuple, velocity: tuple, downhill: tuple, brake, drag):
+    """One ROLL_STEP_S of a roll on a slope: (stops, time taken, rest point, position, velocity after the step).
+    Gravity and the rolling resistance act along the direction of motion at the step's middle (a midpoint step:
+    errors fall as the step squared), grass drag exactly (`_decay`); a ball that would stop within the step stops
+    as on level ground, so the stepped roll meets the closed form as the slope vanishes."""
+    speed = norm(velocity)
+    direction = times(1.0 / maximum(speed, TINY), velocity)
+    acceleration = add(downhill, direction, -brake)
+    braking = maximum(-dot(acceleration, direction), TINY)
+    run, stop_time = _stop(speed, braking, drag)
+    stops = stop_time <= ROLL_STEP_S
+    half_e1, _ = _decay(drag, 0.5 * ROLL_STEP_S)
+    half = add(times(1.0 - drag * half_e1, velocity), acceleration, half_e1)
+    midpoint = add(downhill, times(1.0 / maximum(norm(half), TINY), half), -brake)
+    e1, e2 = _decay(drag, ROLL_STEP_S)
+    moved = add(add(position, velocity, e1), midpoint, e2)
+    after = add(times(1.0 - drag * e1, velocity), midpoint, e1)
+    return stops, where(stops, stop_time, ROLL_STEP_S), add(position, direction, run), moved, after
+
+
+def _downhill(normal: tuple) -> tuple:
+    """5/7 of gravity's component along the plane: what accelerates a rolling ball down a slope."""
+    along = add((0.0, 0.0, -GRAVITY_MPS2), normal, GRAVITY_MPS2 * normal[2])
+    return times(ROLLING_GRAVITY_FRACTION, along)
 
 
 class _Recorder:
@@ -95,6 +187,10 @@ class _Recorder:
         ]
 
 
+def _columns(a: np.ndarray) -> tuple:
+    return tuple(a.T)
+
+
 def _bounce(position, velocity, spin, normal, surface: Surface, record: _Recorder):
     """Impacts and hops until every ball rolls: (roll-start position, rolling velocity, time, hops)."""
     n = len(position)
@@ -105,53 +201,21 @@ def _bounce(position, velocity, spin, normal, surface: Surface, record: _Recorde
     while bouncing.size:
         ids = bouncing
         v_out, w_out = impact(velocity[ids], spin[ids], normal[ids], surface.take(ids))
-        rebound = _dot(v_out, normal[ids])
+        rebound = np.einsum("ij,ij->i", v_out, normal[ids])
         hop = (rebound > MIN_HOP_SPEED_MPS) & (hops[ids] < MAX_BOUNCES)
         velocity[ids], spin[ids] = v_out, w_out
         flying = ids[hop]
         if flying.size:
             record.add(flying, time[flying], position[flying], velocity[flying])
             duration = 2.0 * rebound[hop] / (GRAVITY_MPS2 * normal[flying, 2])
-            position[flying] += velocity[flying] * duration[:, None] + 0.5 * GRAVITY * duration[:, None] ** 2
-            velocity[flying] += GRAVITY * duration[:, None]
+            landed, incoming = _hop(_columns(position[flying]), _columns(velocity[flying]), duration)
+            position[flying], velocity[flying] = np.stack(landed, -1), np.stack(incoming, -1)
             time[flying] += duration
             hops[flying] += 1
             record.add(flying, time[flying], position[flying], velocity[flying])
         bouncing = flying
-    on_plane = velocity - _dot(velocity, normal)[:, None] * normal
-    rolling = 5.0 / 7.0 * on_plane - 2.0 / 7.0 * BALL_RADIUS_M * _cross(normal, spin)
-    rolling -= _dot(rolling, normal)[:, None] * normal
+    rolling = np.stack(_rolling(_columns(velocity), _columns(spin), _columns(normal)), -1)
     return position, rolling, time, hops
-
-
-def _ratios(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """log(1 + x) / x and (x - log(1 + x)) / x^2 for x >= 0, without cancellation near 0 (limits 1 and 1/2)."""
-    small = x < 1e-4
-    safe = np.where(small, 1.0, x)
-    log = np.log1p(safe)
-    return np.where(small, 1.0 - x / 2.0, log / safe), np.where(small, 0.5 - x / 3.0, (safe - log) / safe**2)
-
-
-def _roll_level(position, velocity, resistance, drag):
-    """Rest point and roll time on level ground under a constant deceleration a = c_r g plus k v: the ball stops
-    after T = ln(1 + k v0 / a) / k, having run v0 / k - a T / k (v0^2 / 2a without grass drag)."""
-    deceleration = resistance * GRAVITY_MPS2
-    speed = np.linalg.norm(velocity, axis=-1)
-    time_ratio, distance_ratio = _ratios(drag * speed / deceleration)
-    distance = speed * speed / deceleration * distance_ratio
-    direction = velocity / np.maximum(speed, 1e-12)[:, None]
-    return position + direction * distance[:, None], speed / deceleration * time_ratio
-
-
-def _decay(drag, t):
-    """E1 = (1 - exp(-k t)) / k and E2 = (t - E1) / k, without cancellation for small k t (limits t and t^2 / 2):
-    under a constant acceleration A and drag k v, v(t) = v0 (1 - k E1) + A E1 and x(t) = x0 + v0 E1 + A E2."""
-    kt = drag * t
-    small = kt < 1e-6
-    safe_k = np.where(small, 1.0, drag)
-    e1 = np.where(small, t - 0.5 * kt * t, -np.expm1(-kt) / safe_k)
-    e2 = np.where(small, 0.5 * t * t - kt * t * t / 6.0, (t - e1) / safe_k)
-    return e1, e2
 
 
 def _level_states(speed, deceleration, drag, t):
@@ -167,19 +231,24 @@ def _record_level(record: _Recorder, ids, start_time, position, velocity, resist
     deceleration = resistance * GRAVITY_MPS2
     for k, i in enumerate(ids.tolist()):
         speed = float(np.linalg.norm(velocity[k]))
-        times = np.arange(ROLL_STEP_S, roll_time[k] - 1e-9, ROLL_STEP_S)
-        run, now = _level_states(speed, deceleration[k], drag[k], times)
-        direction = velocity[k] / max(speed, 1e-12)
-        record.add(np.full(len(times), i), start_time[k] + times, position[k] + run[:, None] * direction,
+        times_s = np.arange(ROLL_STEP_S, roll_time[k] - 1e-9, ROLL_STEP_S)
+        run, now = _level_states(speed, deceleration[k], drag[k], times_s)
+        direction = velocity[k] / max(speed, TINY)
+        record.add(np.full(len(times_s), i), start_time[k] + times_s, position[k] + run[:, None] * direction,
                    now[:, None] * direction)
 
 
+def _roll_level(position, velocity, resistance, drag):
+    """Rest point and roll time on level ground (closed form, `_stop`)."""
+    speed = np.linalg.norm(velocity, axis=-1)
+    distance, time = _stop(speed, resistance * GRAVITY_MPS2, drag)
+    direction = velocity / np.maximum(speed, TINY)[:, None]
+    return position + direction * distance[:, None], time
+
+
 def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder, ids, start):
-    """Rest point and roll time on slopes, stepped: in each step gravity and the rolling resistance along the
-    direction of motion at the step's middle (a midpoint step: errors fall as the step squared), grass drag exactly
-    (`_decay`); a step in which the ball would stop ends at the stop, found as on level ground, so the stepped roll
-    meets the closed form as the slope vanishes."""
-    downhill = ROLLING_GRAVITY_FRACTION * (GRAVITY - GRAVITY[2] * normal[:, 2:3] * normal)
+    """Rest point and roll time on slopes, in `_slope_step`s until every ball has stopped."""
+    downhill = np.stack(_downhill(_columns(normal)), -1)
     brake = resistance * GRAVITY_MPS2 * normal[:, 2]
     position, velocity = position.copy(), velocity.copy()
     rest, time = position.copy(), np.zeros(len(position))
@@ -187,26 +256,14 @@ def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder,
     for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
         if not moving.size:
             break
-        v, k = velocity[moving], drag[moving]
-        speed = np.linalg.norm(v, axis=-1)
-        direction = v / np.maximum(speed, 1e-12)[:, None]
-        acceleration = downhill[moving] - brake[moving, None] * direction
-        braking = np.maximum(-_dot(acceleration, direction), 1e-12)
-        time_ratio, distance_ratio = _ratios(k * speed / braking)
-        stop_time = speed / braking * time_ratio
-        stops = stop_time <= ROLL_STEP_S
+        stops, taken, stop_at, moved, after = _slope_step(
+            _columns(position[moving]), _columns(velocity[moving]), _columns(downhill[moving]), brake[moving],
+            drag[moving],
+        )
         stopped, going = moving[stops], moving[~stops]
-        run = speed[stops] ** 2 / braking[stops] * distance_ratio[stops]
-        rest[stopped] = position[stopped] + direction[stops] * run[:, None]
-        time[moving] += np.where(stops, stop_time, ROLL_STEP_S)
-        v, k = v[~stops], k[~stops]
-        half_e1, _ = _decay(k, 0.5 * ROLL_STEP_S)
-        half = v * (1.0 - k * half_e1)[:, None] + acceleration[~stops] * half_e1[:, None]
-        turned = half / np.maximum(np.linalg.norm(half, axis=-1), 1e-12)[:, None]
-        midpoint = downhill[going] - brake[going, None] * turned
-        e1, e2 = _decay(k, ROLL_STEP_S)
-        position[going] += v * e1[:, None] + midpoint * e2[:, None]
-        velocity[going] = v * (1.0 - k * e1)[:, None] + midpoint * e1[:, None]
+        rest[stopped] = np.stack(stop_at, -1)[stops]
+        time[moving] += taken
+        position[going], velocity[going] = np.stack(moved, -1)[~stops], np.stack(after, -1)[~stops]
         record.add(ids[going], start[going] + time[going], position[going], velocity[going])
         moving = going
     rest[moving] = position[moving]
@@ -230,13 +287,7 @@ def ground_phase(
     resistance = np.broadcast_to(np.asarray(surface.rolling_resistance, dtype=float), (n,))
     drag = np.broadcast_to(np.asarray(surface.grass_drag_per_s, dtype=float), (n,))
     slope = np.broadcast_to(np.asarray(slope_deg, dtype=float), (n,))
-    steep = slope >= holding_slope_deg(resistance)
-    if steep.any():
-        i = int(np.flatnonzero(steep)[0])
-        raise ValueError(
-            f"slope_deg {slope[i]:g} is steeper than the surface holds a ball on "
-            f"({float(holding_slope_deg(resistance[i])):.2f} deg): it would never come to rest"
-        )
+    _check_slopes(slope, resistance)
     normal = plane_normals(slope, slope_dir_deg, n)
     record = _Recorder(n, keep_path)
     start, rolling, time, hops = _bounce(position, velocity, spin, normal, surface, record)
@@ -254,3 +305,36 @@ def ground_phase(
     total = time + roll_time
     record.add(np.arange(n), total, rest, np.zeros_like(rest))
     return GroundPhase(rest, start, hops, total, record.paths())
+
+
+def ground_phase_one(
+    position: tuple, velocity: tuple, spin: tuple, surface: Surface, slope_deg: float = 0.0, slope_dir_deg: float = 0.0
+) -> OneRest:
+    """`ground_phase` of one ball on plain floats (the same formulas; no path): from its landing (x, y, z) tuples
+    to its rest. ValueError if the slope is steeper than the surface holds a ball on."""
+    _check_slopes(np.float64(slope_deg), np.float64(surface.rolling_resistance))
+    phi, beta = math.radians(slope_deg), math.radians(slope_dir_deg)
+    normal = (math.sin(phi) * math.sin(beta), math.sin(phi) * math.cos(beta), math.cos(phi))
+    time, hops = 0.0, 0
+    while True:
+        velocity, spin = impact_components(velocity, spin, normal, surface)
+        rebound = dot(velocity, normal)
+        if not (rebound > MIN_HOP_SPEED_MPS and hops < MAX_BOUNCES):
+            break
+        duration = 2.0 * rebound / (GRAVITY_MPS2 * normal[2])
+        position, velocity = _hop(position, velocity, duration)
+        time, hops = time + duration, hops + 1
+    rolling = _rolling(velocity, spin, normal)
+    drag = float(surface.grass_drag_per_s)
+    if slope_deg == 0.0:
+        speed = norm(rolling)
+        distance, roll_time = _stop(speed, surface.rolling_resistance * GRAVITY_MPS2, drag)
+        rest = add(position, rolling, float(distance) / max(speed, TINY))
+        return OneRest(rest, hops, time + float(roll_time))
+    downhill, brake = _downhill(normal), surface.rolling_resistance * GRAVITY_MPS2 * normal[2]
+    for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
+        stops, taken, stop_at, position, rolling = _slope_step(position, rolling, downhill, brake, drag)
+        time += float(taken)
+        if stops:
+            return OneRest(stop_at, hops, time)
+    return OneRest(position, hops, time)
