@@ -47,8 +47,6 @@ finer steps on 3-6 degree slopes."""
 MAX_ROLL_TIME_S = 120.0
 """Longest roll stepped on a slope (a safety net: on a slope the surface holds, every ball stops well before)."""
 
-GRAVITY = np.array([0.0, 0.0, -GRAVITY_MPS2])
-
 
 @dataclass(frozen=True)
 class GroundPath:
@@ -62,11 +60,10 @@ class GroundPath:
 
 @dataclass(frozen=True)
 class GroundPhase:
-    """Where a batch of balls came to rest after landing: rest and roll-start points [N,3], hops [N], time on the
-    ground [N] and, when kept, each ball's path."""
+    """Where a batch of balls came to rest after landing: rest points [N,3], hops [N], time on the ground [N] and,
+    when kept, each ball's path."""
 
     rest_position: np.ndarray
-    roll_start: np.ndarray
     bounces: np.ndarray
     time_s: np.ndarray
     paths: list[GroundPath] | None = None
@@ -304,7 +301,7 @@ def ground_phase(
         )
     total = time + roll_time
     record.add(np.arange(n), total, rest, np.zeros_like(rest))
-    return GroundPhase(rest, start, hops, total, record.paths())
+    return GroundPhase(rest, hops, total, record.paths())
 
 
 def ground_phase_one(
