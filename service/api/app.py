@@ -9,7 +9,8 @@ process each). The model loads in a background thread at startup; /healthz answe
 of the routes: a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and CORS only for configured origins
 ($GOLFFLIGHT_CORS_ORIGINS); every refusal is a 4xx whose body names the field, the value and the allowed range
 (`service.api.errors`). Given a connect address, the lifespan also opens GSPro Open Connect over TCP on the same
-loop (`service.open_connect`).
+loop (`service.open_connect`). Every shot flown, from any input, goes to the live viewer's feed (GET /viewer,
+`service.viewer`).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from __future__ import annotations
 import asyncio
 import os
 from contextlib import asynccontextmanager
+from functools import partial
 from importlib.metadata import version
 
 from fastapi import FastAPI
@@ -25,7 +27,7 @@ from fastapi.middleware.cors import CORSMiddleware
 from service.api import errors
 from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
 from service.api.latency import RequestTimer
-from service.api.routes import gspro, shots, status
+from service.api.routes import gspro, shots, status, viewer
 from service.api.state import ServiceState
 from service.model_location import model_dir
 from service.open_connect.server import ConnectAddress, OpenConnectServer
@@ -54,7 +56,7 @@ def create_app(
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        tcp = OpenConnectServer(state.gspro_reply) if connect else None
+        tcp = OpenConnectServer(partial(state.gspro_reply, source="open-connect")) if connect else None
         if tcp:
             await tcp.start(connect)  # before the model loads: a port that cannot be had stops the startup cleanly
         loading = asyncio.get_running_loop().run_in_executor(None, state.load)
@@ -83,6 +85,6 @@ def create_app(
         )
     app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)
     errors.install(app)
-    for router in (shots.router, gspro.router, status.router):
+    for router in (shots.router, gspro.router, status.router, viewer.router):
         app.include_router(router)
     return app

@@ -10,6 +10,7 @@ import hmac
 import json
 
 from service.api.models import body_detail
+from service.viewer.page import PUBLIC_PATHS
 
 API_KEY_ENV = "GOLFFLIGHT_API_KEY"
 """Environment variable holding the API key; when set (non-empty) every route but /healthz requires it."""
@@ -20,8 +21,9 @@ CORS_ORIGINS_ENV = "GOLFFLIGHT_CORS_ORIGINS"
 MAX_BODY_BYTES = 8 * 1024 * 1024
 """Largest request body accepted (a full 10,000-shot batch with every option is about 4.5 MB)."""
 
-OPEN_PATHS = frozenset({"/healthz"})
-"""Routes answered without the API key (load balancers and health checks hold no secret)."""
+OPEN_PATHS = frozenset({"/healthz", *PUBLIC_PATHS})
+"""Routes answered without the API key (load balancers and health checks hold no secret; the viewer page holds no
+data and asks for the key to open its event stream)."""
 
 
 async def _send_json(send, status: int, body: dict, headers: list[tuple[bytes, bytes]] = ()) -> None:

@@ -14,6 +14,8 @@ from service.api.batch_process import BatchProcess
 from service.api.gspro import GSProMessage, GSProReply, fly_message
 from service.api.latency import Rolling
 from service.engine import FlightEngine
+from service.viewer.event import Source
+from service.viewer.feed import ShotFeed
 
 
 class NotReady(Exception):
@@ -21,7 +23,8 @@ class NotReady(Exception):
 
 
 class ServiceState:
-    """The engine once loaded (or why it failed), the batch process and the rolling latency figures."""
+    """The engine once loaded (or why it failed), the batch process, the rolling latency figures and the shots
+    the viewer shows."""
 
     def __init__(self, bundle_dir: Path):
         self.bundle_dir = bundle_dir
@@ -31,6 +34,7 @@ class ServiceState:
         self.requests = Rolling()
         self.loaded = threading.Event()
         self.batches = BatchProcess(bundle_dir)
+        self.feed = ShotFeed()
 
     def load(self) -> None:
         """Load the model here and in the batch process; either failing leaves the service up to say why."""
@@ -45,15 +49,18 @@ class ServiceState:
         finally:
             self.loaded.set()
 
-    def gspro_reply(self, message: GSProMessage) -> GSProReply:
-        """A GSPro shot's reply over HTTP and TCP alike (timed into /v1/latency); Code 503 until the model is ready."""
+    def gspro_reply(self, message: GSProMessage, source: Source = "gspro-http") -> GSProReply:
+        """A GSPro shot's reply over HTTP and TCP alike (timed into /v1/latency, shown by the viewer as coming from
+        `source`); Code 503 until the model is ready."""
         if self.engine is None:
             return GSProReply(Code=503, Message=self.error or "the model is still loading")
         started = time.perf_counter()
         try:
-            return fly_message(self.engine, message)
+            reply = fly_message(self.engine, message)
         finally:
             self.simulation.add(time.perf_counter() - started)
+        self.feed.publish_gspro(source, message, reply)
+        return reply
 
 
 async def service_state(request: Request) -> ServiceState:

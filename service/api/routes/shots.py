@@ -47,6 +47,7 @@ async def shot(
         return JSONResponse({"detail": [body_detail(str(error), "flight_error")]}, 422)
     finally:
         state.simulation.add(time.perf_counter() - started)
+    state.feed.publish("http", request, result)
     return json_response(result)
 
 
@@ -67,4 +68,5 @@ async def batch(request: BatchRequest, http: Request, state: ServiceState = Depe
     except BrokenProcessPool:
         return JSONResponse({"detail": BATCH_PROCESS_DIED}, 503)
     state.simulation.add(seconds)
+    state.feed.publish_batch(request.shots)
     return Response(body, media_type="application/json")

@@ -1,0 +1,304 @@
+"""The live shot viewer: the feed's bounds, the event stream over a real uvicorn server (HTTP and Open Connect shots
+reach it in milliseconds; a stalled viewer never delays a shot), the page's key handling, and the page itself in a
+real headless Chromium (Debian's package, driven by Playwright; skipped where either is missing)."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import socket
+import statistics
+import time
+from functools import partial
+
+import browser
+import httpx
+import pytest
+from servers import free_port, running
+
+from service.api.app import create_app
+from service.api.models import ShotRequest
+from service.api.routes import viewer as viewer_routes
+from service.api.shots import fly_shot
+from service.engine import FlightEngine
+from service.model_location import model_dir
+from service.open_connect.server import ConnectAddress
+from service.viewer.event import SCHEMA_PATH, ShotEvent, schema_text
+from service.viewer.feed import HISTORY, MAX_POINTS, ShotFeed, TooManyViewers, thin
+from service.viewer.stream import events
+
+KEY = "viewer-test-key"
+KEYED = {"x-api-key": KEY}
+DRIVER = {"ball_speed_mph": 167.0, "launch_angle_deg": 10.9, "back_spin_rpm": 2686.0, "side_spin_rpm": -250.0}
+WEDGE_BALL = {"Speed": 102.0, "VLA": 24.0, "HLA": -1.5, "TotalSpin": 8600.0, "SpinAxis": 2.0}
+
+
+@pytest.fixture(scope="module")
+def engine() -> FlightEngine:
+    return FlightEngine(model_dir())
+
+
+@pytest.fixture(scope="module")
+def service():
+    """(client, Open Connect port, app) of one keyed service listening on HTTP and TCP."""
+    port = free_port()
+    app = create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))
+    with running(app) as http:
+        yield http, port, app
+
+
+def gspro_over_tcp(port: int, number: int, ball: dict) -> dict:
+    """A connector's shot over TCP and its reply."""
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as connector:
+        connector.sendall(json.dumps({"ShotNumber": number, "APIversion": "1", "BallData": ball}).encode())
+        received = b""
+        while True:
+            received += connector.recv(65536)
+            try:
+                return json.loads(received)
+            except ValueError:
+                continue
+
+
+def next_event(lines, deadline_s: float = 5.0) -> ShotEvent:
+    """The next shot event from an SSE stream's lines (validated against the event model)."""
+    started = time.monotonic()
+    for line in lines:
+        if line.startswith("data: "):
+            return ShotEvent.model_validate_json(line.removeprefix("data: "))
+        assert time.monotonic() - started < deadline_s, "no shot event in time"
+    raise AssertionError("the stream ended before a shot event")
+
+
+def test_the_event_schema_is_current():
+    assert SCHEMA_PATH.read_text() == schema_text(), "event.schema.json is stale: run `python -m service.viewer`"
+
+
+def test_thin_keeps_both_ends_and_at_most_the_limit():
+    points = list(range(20_001))
+    kept = thin(points)
+    assert len(kept) <= MAX_POINTS and kept[0] == 0 and kept[-1] == 20_000
+    assert thin(points[:10]) == points[:10]
+
+
+def test_the_feed_keeps_its_last_shots_and_a_full_viewer_drops_its_oldest(engine):
+    request = ShotRequest(**DRIVER)
+    result = fly_shot(engine, request)
+    feed = ShotFeed(history=5)
+    stalled = feed.subscribe()
+    for _ in range(12):
+        feed.publish("http", request, result)
+    assert [entry.id for entry in stalled.pending] == [8, 9, 10, 11, 12] and stalled.dropped == 7
+    assert [entry.id for entry in feed.subscribe().pending] == [8, 9, 10, 11, 12]
+    assert [entry.id for entry in feed.subscribe(after_id=10).pending] == [11, 12]
+    restarted = feed.subscribe(after_id=400)  # an id from before a restart: everything kept
+    assert len(restarted.pending) == 5
+    for viewer in feed.viewers:
+        feed.unsubscribe(viewer)
+    assert feed.viewers == ()
+
+
+def test_too_many_viewers_are_refused():
+    feed = ShotFeed(max_viewers=2)
+    feed.subscribe(), feed.subscribe()
+    with pytest.raises(TooManyViewers):
+        feed.subscribe()
+
+
+def test_each_input_is_rendered_from_its_own_result_with_a_trajectory_to_rest(engine):
+    plain = ShotRequest(**DRIVER)
+    traced = ShotRequest(**DRIVER, trajectory={"rate_hz": 1000})
+    feed = ShotFeed()
+    feed.publish("http", plain, fly_shot(engine, plain))
+    feed.publish("http", traced, fly_shot(engine, traced))
+    feed.publish_batch([plain] * (HISTORY + 7))
+    entries = list(feed.subscribe().pending)
+    assert len(entries) == HISTORY and [e.source for e in entries[-2:]] == ["batch", "batch"]
+    own = fly_shot(engine, plain)
+    for entry in (*entries[:2], entries[-1]):
+        event = ShotEvent.model_validate_json(feed.frame(entry, engine).split("data: ", 1)[1])
+        flight = event.flight
+        assert flight.carry_yd == own.carry_yd and flight.apex_m == own.apex_m
+        assert event.launch.ball_speed_mps == pytest.approx(167.0 * 0.44704)
+        assert 30 <= len(flight.trajectory) <= MAX_POINTS
+        end = flight.trajectory[-1]  # through the bounces and the roll
+        assert (end.x_m, end.y_m, end.z_m) == pytest.approx((flight.rest.x_m, flight.rest.y_m, 0.0), abs=1e-6)
+        assert flight.total_yd == own.total_yd and flight.bounces == own.bounces
+        assert entry.shot is None and entry.result is None and entry.path is None  # only the event is kept
+
+
+def test_a_stream_ends_after_its_lifetime_and_lets_its_viewer_go(engine):
+    request = ShotRequest(**DRIVER)
+
+    async def stream() -> tuple[ShotFeed, list[str], float]:
+        feed = ShotFeed()
+        viewer = feed.subscribe()
+        feed.publish("http", request, fly_shot(engine, request))
+        started = time.monotonic()
+        frames = [frame async for frame in events(feed, viewer, engine, lifetime_s=0.3)]
+        return feed, frames, time.monotonic() - started
+
+    feed, frames, seconds = asyncio.run(stream())
+    assert frames[0].startswith("retry: ") and frames[1].startswith("id: 1\nevent: shot\ndata: {")
+    assert len(frames) == 2 and 0.3 <= seconds < 1.0 and feed.viewers == ()
+
+
+def test_the_page_is_open_but_the_stream_needs_the_key_and_neither_is_in_the_openapi(service):
+    http, _, _ = service
+    page = http.get("/viewer")
+    assert page.status_code == 200 and page.headers["content-type"].startswith("text/html")
+    assert "default-src 'self'" in page.headers["content-security-policy"]
+    for name, kind in (("viewer.js", "text/javascript"), ("viewer.css", "text/css")):
+        asset = http.get(f"/viewer/{name}")
+        assert asset.status_code == 200 and asset.headers["content-type"].startswith(kind)
+        assert "http://" not in asset.text.replace("http://www.w3.org/2000/svg", "") and "https://" not in asset.text
+    assert http.get("/viewer/viewer.html").status_code == 401  # only the names the page uses are open
+    assert http.get("/viewer/model_card.json", headers=KEYED).status_code == 404
+    assert http.get("/v1/events").status_code == 401
+    paths = http.get("/openapi.json", headers=KEYED).json()["paths"]
+    assert "/v1/events" not in paths and "/viewer" not in paths
+
+
+def test_shots_over_http_batch_and_tcp_reach_an_open_stream_in_milliseconds(service):
+    http, port, _ = service
+    headers = {**KEYED, "last-event-id": str(10**9)}  # from "before a restart": replays what is kept, then live
+    with (
+        httpx.Client(base_url=http.base_url, timeout=10) as viewer,
+        viewer.stream("GET", "/v1/events", headers=KEYED) as stream,
+    ):
+        assert stream.headers["content-type"].startswith("text/event-stream")
+        lines = stream.iter_lines()
+        started = time.perf_counter()
+        reply = http.post("/v1/shots", json=DRIVER, headers=KEYED).json()
+        event = next_event(lines)
+        http_s = time.perf_counter() - started
+        assert event.source == "http" and event.flight.carry_yd == reply["carry_yd"]
+
+        started = time.perf_counter()
+        tcp = gspro_over_tcp(port, 7, WEDGE_BALL)
+        event = next_event(lines)
+        tcp_s = time.perf_counter() - started
+        assert event.source == "open-connect" and event.shot_number == 7
+        assert event.flight.carry_yd == tcp["Flight"]["carry_yd"] and event.flight.trajectory
+
+        batch = http.post(
+            "/v1/shots/batch", json={"shots": [DRIVER, {**DRIVER, "ball_speed_mph": 120.0}]}, headers=KEYED
+        ).json()
+        firsts = [next_event(lines), next_event(lines)]
+        assert [e.source for e in firsts] == ["batch", "batch"]
+        assert [e.flight.carry_yd for e in firsts] == pytest.approx([r["carry_yd"] for r in batch["results"]])
+    with (
+        httpx.Client(base_url=http.base_url, timeout=10) as viewer,
+        viewer.stream("GET", "/v1/events", headers=headers) as stream,
+    ):
+        assert next_event(stream.iter_lines()).id == 1  # a restarted service's history, from its start
+    print(f"shot to stream: HTTP {http_s * 1e3:.1f} ms, Open Connect {tcp_s * 1e3:.1f} ms (reply included)")
+    assert http_s < 1.0 and tcp_s < 1.0
+
+
+def test_a_stalled_viewer_never_delays_a_shot(service, monkeypatch):
+    http, _, app = service
+    feed = app.state.service.feed
+    monkeypatch.setattr(viewer_routes, "events", partial(events, lifetime_s=120))  # stalled, not just slow to close
+
+    def timed(shot: dict, n: int) -> list[float]:
+        seconds = []
+        for _ in range(n):
+            started = time.perf_counter()
+            assert http.post("/v1/shots", json=shot, headers=KEYED).status_code == 200
+            seconds.append(time.perf_counter() - started)
+        return seconds
+
+    def until(condition, what: str, within_s: float = 10.0) -> None:
+        deadline = time.monotonic() + within_s
+        while not condition():
+            assert time.monotonic() < deadline, what
+            time.sleep(0.01)
+
+    until(lambda: not feed.viewers, "an earlier test's stream is still open")
+    alone = timed(DRIVER, 60)
+    stalled = socket.socket()
+    stalled.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)  # and it never reads
+    stalled.connect(("127.0.0.1", http.base_url.port))
+    stalled.sendall(f"GET /v1/events HTTP/1.1\r\nhost: x\r\nx-api-key: {KEY}\r\n\r\n".encode())
+    until(lambda: feed.viewers, "the stalled viewer never subscribed")
+    timed({**DRIVER, "trajectory": {"rate_hz": 1000}}, 100)  # about 50 KB an event: the socket's buffers fill
+    (viewer,) = feed.viewers
+    during = timed(DRIVER, 60)
+    assert len(viewer.pending) == HISTORY and viewer.dropped > 0  # bounded, the oldest gone
+    stalled.close()
+    until(lambda: not feed.viewers, "a closed viewer was never let go")
+    p50_alone, p50_during = statistics.median(alone), statistics.median(during)
+    print(
+        f"POST /v1/shots p50 {p50_alone * 1e3:.2f} ms alone, {p50_during * 1e3:.2f} ms with a stalled viewer "
+        f"(max {max(during) * 1e3:.1f} ms; the viewer's queue held {HISTORY}, dropped {viewer.dropped})"
+    )
+    assert p50_during < 3 * p50_alone + 0.010 and max(during) < 0.5  # a blocked shot would take seconds
+
+
+def test_too_many_viewers_get_503_saying_so(service):
+    http, _, app = service
+    state = app.state.service
+    kept, state.feed = state.feed, ShotFeed(max_viewers=0)
+    try:
+        answer = http.get("/v1/events", headers=KEYED)
+    finally:
+        state.feed = kept
+    assert answer.status_code == 503 and "viewers are open already" in answer.json()["detail"]
+
+
+@pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
+def test_the_page_in_chromium_draws_shots_from_http_and_open_connect(tmp_path):
+    port = free_port()
+    with running(create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))) as http:
+        base = str(http.base_url).rstrip("/")
+        with browser.headless_page() as page:
+            errors: list[str] = []
+            page.on("pageerror", lambda error: errors.append(str(error)))
+            page.goto(f"{base}/viewer#key={KEY}")
+            page.wait_for_selector("#status[data-state=live]", timeout=10_000)
+            assert "key=" not in page.url  # taken off the address bar
+
+            page.select_option("#club", "Driver")
+            started = time.perf_counter()
+            driver = http.post("/v1/shots", json=DRIVER, headers=KEYED).json()
+            page.wait_for_selector("#shots tbody tr[data-shot='1']", timeout=10_000)
+            seen_s = time.perf_counter() - started
+            assert page.inner_text("#n-carry").startswith(f"{driver['carry_yd']:.1f}")
+
+            page.select_option("#club", "SW")
+            wedge = gspro_over_tcp(port, 7, WEDGE_BALL)["Flight"]
+            page.wait_for_selector("#shots tbody tr[data-shot='2']", timeout=10_000)
+            page.wait_for_selector("#side polyline.latest[data-done]", timeout=10_000)
+            assert page.inner_text("#last-source") == "#2 · Open Connect shot 7"
+            assert page.inner_text("#n-carry").startswith(f"{wedge['carry_yd']:.1f}")
+            assert page.inner_text("#n-apex").startswith(f"{wedge['apex_yd']:.1f}")
+            assert page.inner_text("#n-landing-angle").startswith(f"{wedge['landing_angle_deg']:.1f}")
+            assert page.inner_text("#n-ball-speed").startswith("102.0")
+            assert page.inner_text("#n-total").startswith(f"{wedge['total_yd']:.1f}")
+            assert page.inner_text("#n-roll").startswith(f"{wedge['roll_m'] / 0.9144:.1f}")
+
+            for view in ("behind", "side", "top"):
+                for shot in ("1", "2"):
+                    points = page.get_attribute(f"#{view} polyline[data-shot='{shot}']", "points").split()
+                    xs = [float(point.split(",")[0]) for point in points]
+                    assert len(points) >= 30 and max(xs) - min(xs) > 20, (view, shot)
+            assert page.locator("#dispersion circle.dot:not(.rest-dot)").count() == 2
+            assert "Driver: 1 shot" in page.inner_text("#legend") and "SW: 1 shot" in page.inner_text("#legend")
+
+            page.click(".units button[data-units=metric]")
+            assert page.inner_text("#n-carry").startswith(f"{wedge['carry_m']:.1f}")
+            page.screenshot(path=str(tmp_path / "viewer.png"), full_page=True)
+
+            second = page.context.new_page()  # another screen in the bay: the kept shots, then live ones
+            second.goto(f"{base}/viewer")  # the key is in this tab session's storage only: asked for
+            second.wait_for_selector("#key-form:not([hidden])", timeout=10_000)
+            second.fill("#key", KEY)
+            second.click("#key-form button")
+            second.wait_for_selector("#shots tbody tr[data-shot='2']", timeout=10_000)
+            gspro_over_tcp(port, 8, {**WEDGE_BALL, "Speed": 110.0})
+            for each in (page, second):
+                each.wait_for_selector("#shots tbody tr[data-shot='3']", timeout=10_000)
+            assert errors == []
+    print(f"shot to the page's table: {seen_s * 1e3:.0f} ms")
+    assert (tmp_path / "viewer.png").stat().st_size > 20_000
