@@ -3,7 +3,7 @@
 Publishing never waits and costs a few appends: a slow or dead viewer only loses the oldest shots it has not been
 sent yet (its queue drops them), it never holds up a shot's reply. A shot's event is rendered once, by the first
 viewer stream that sends it, not on the shot's path: a result without a trajectory is flown again with one on the
-engine's single-shot path (about half a millisecond); a batch's results come back from the batch process as bytes
+engine's single-shot path (about a millisecond on an idle machine); a batch's results come back from the batch process as bytes
 that the worker does not parse, so its last HISTORY shots (the most a viewer keeps) are flown again whole.
 Everything here runs on the service's event loop.
 """
@@ -32,7 +32,7 @@ MAX_POINTS = 600
 """Most trajectory points an event carries (a trajectory asked for at 1 kHz is thinned to this)."""
 
 VIEW_RATE_HZ = 30.0
-"""Rate of the trajectory flown for a shot whose result has none: smooth on screen, about 5 KB a driver."""
+"""Rate of the trajectory flown for a shot whose result has none: smooth on screen; a driver's event is about 23 kB."""
 
 
 class TooManyViewers(Exception):
@@ -40,7 +40,7 @@ class TooManyViewers(Exception):
 
 
 Point = tuple[float, float, float, float]
-"""A trajectory point kept as (t_s, x_m, y_m, z_m): a tenth of a TrajectoryPoint object's memory."""
+"""A trajectory point kept as (t_s, x_m, y_m, z_m): about a third of a TrajectoryPoint object's memory."""
 
 
 @dataclass(eq=False)
