@@ -159,8 +159,9 @@ def test_the_page_is_open_but_the_stream_needs_the_key_and_neither_is_in_the_ope
     assert "/v1/events" not in paths and "/viewer" not in paths
 
 
-def test_shots_over_http_batch_and_tcp_reach_an_open_stream_in_milliseconds(service):
+def test_shots_over_http_batch_and_tcp_reach_an_open_stream_in_milliseconds(service, monkeypatch):
     http, port, _ = service
+    monkeypatch.setattr(viewer_routes, "events", partial(events, lifetime_s=60))  # one stream for the whole test
     headers = {**KEYED, "last-event-id": str(10**9)}  # from "before a restart": replays what is kept, then live
     with (
         httpx.Client(base_url=http.base_url, timeout=10) as viewer,
