@@ -1,4 +1,5 @@
-"""Recordings with a known effect hidden in them: synthetic sessions flown through the reference world.
+"""Recordings with a known effect hidden in them: synthetic sessions flown through the reference world, or through
+the model being diagnosed (its own flights, as the service flies them, so clean sets are its own output plus noise).
 
 The base sessions are the synthetic generator's (players and robots, several clubs, realistic launch scatter and
 launch-monitor noise) but in calm air at ICAO standard conditions, the air the shipped model assumes, so the hidden
@@ -15,12 +16,15 @@ import numpy as np
 from pydantic import ValidationError
 
 from discovery.effects import Context, equivalent_altitude_m
+from discovery.model import FlightModel
 from discovery.noise import RADAR_NOISE
+from discovery.outside import term_and_weights
+from discovery.simulator import Setup
 from flight.air import Air
 from flight.outcomes import Flight
 from flight.physics import initial_state
 from flight.reference_aero import CALIBRATED
-from flight.wind import Wind, uniform_equivalent_factor
+from flight.wind import Wind, uniform_equivalent_factor, wind_vector
 from shots.records import ShotRecord, ShotSet
 from shots.reference_world import fly_reference
 from shots.synth import MIN_APEX_M, LaunchTable, MeasurementNoise, SynthConfig, draw_launches, draw_sessions, measure
@@ -64,11 +68,14 @@ def conceal(
     noise: MeasurementNoise = RADAR_NOISE,
     trajectories: bool = False,
     wind_profile: Literal["uniform", "log"] = "uniform",
+    model: FlightModel | None = None,
 ) -> Concealed:
-    """Draw sessions, fly them with the hidden effects through the reference world and record them with noise.
+    """Draw sessions, fly them with the hidden effects through the reference world (or `model`) and record them
+    with noise.
 
     hidden uses the report's parameter conventions, e.g. {"wind": {"speed_mps": 4, "from_deg": 0}}, plus
-    {"critical_reynolds": {"value": 9e4}} for the effect outside the library.
+    {"critical_reynolds": {"value": 9e4}} for the reference world's effect outside the library, or one of
+    `discovery.outside.OUTSIDE` for a model's.
     """
     rng = np.random.default_rng(seed)
     config = SynthConfig(n_shots=n_shots, seed=seed, calm=True)
@@ -94,7 +101,10 @@ def conceal(
     if OUTSIDE_EFFECT in hidden:
         params = replace(params, critical_reynolds=hidden[OUTSIDE_EFFECT]["value"])
     keep = trajectories or wind_profile == "log"
-    flight = fly_reference(initial_state(**true.launch()), air, wind, ground, keep_states=keep, params=params)
+    if model is None:
+        flight = fly_reference(initial_state(**true.launch()), air, wind, ground, keep_states=keep, params=params)
+    else:
+        flight = _fly_model(model, hidden, true, wind_profile, trajectories)
     values = measure(rng, recorded, flight, noise)
     records, dropped, paths, kept = [], 0, {}, []
     order = np.zeros(len(sessions), dtype=int)
@@ -123,6 +133,34 @@ def conceal(
     return Concealed(ShotSet(records), hidden, dropped, paths, factor)
 
 
+def _fly_model(
+    model: FlightModel,
+    hidden: dict[str, dict[str, float]],
+    true: LaunchTable,
+    wind_profile: str,
+    trajectories: bool,
+) -> Flight:
+    """The true launches flown through the model with the hidden effects, in its flight core."""
+    unknown = set(hidden) - set(KNOBS) - set(LAUNCH_BIASES) - {"air_density", "wind", "landing_elevation"}
+    unknown -= {name for name in hidden if term_and_weights({name: hidden[name]}, np.ones(1))[0] is not None}
+    if unknown or wind_profile != "uniform":
+        raise ValueError(f"a model's own flights take library effects, uniform wind and discovery.outside: {unknown}")
+    n = len(true.club)
+    scale = np.ones((n, 3))
+    for column, name in enumerate(("lift_scale", "drag_scale", "spin_decay")):
+        if name in hidden:
+            scale[:, column] = hidden[name]["scale"]
+    wind = np.zeros((n, 2))
+    if "wind" in hidden:
+        wind[:] = wind_vector(hidden["wind"]["speed_mps"], hidden["wind"]["from_deg"])[:2]
+    ratio = np.full(n, hidden.get("air_density", {"ratio": 1.0})["ratio"])
+    density = np.full(n, model.density_kg_m3)
+    term, weights = term_and_weights(hidden, density * ratio)
+    ground = np.full(n, hidden.get("landing_elevation", {"height_m": 0.0})["height_m"])
+    setup = Setup(true.launch(), ratio, density, wind, ground, scale, weights)
+    return model.fly(setup, term, keep_states=trajectories)
+
+
 def _mean_wind_factor(flight: Flight, wind: Wind, shots: np.ndarray) -> float:
     """The hidden log profile's uniform-equivalent factor along the recorded shots' flights."""
     heights = np.stack([state.position[shots, 2] for state in flight.states])
@@ -137,4 +175,3 @@ def _path(flight: Flight, shot: int, rng: np.random.Generator, every: int = 10, 
     inside = times <= flight.flight_time_s[shot]
     samples = np.column_stack([times[inside], xyz[inside] + rng.normal(0, noise_m, xyz[inside].shape)])
     return samples
-

@@ -1,13 +1,18 @@
 """`diagnose`: locate the mismatch, fit every library effect (and combinations, and a learned correction) through
 the simulator, choose by held-out error with a parameter penalty, and assemble the report.
 
+The mismatch is called systematic only when the systematic test finds structure that noise and the model's own
+error do not make (`discovery.locate`: shifts of means against their standard errors, trends with the launch values
+and shot order, differences between clubs and sessions, scatter beyond the expected; one Holm family) AND a fitted
+correction removes a material share of the excess on held-out sessions beyond doubt. Noise alone passes neither;
+a consistent shift fails the first however large the expected per-shot error is.
+
 Selection: every single effect is fitted (from a Gauss-Newton start); the best is combined with the other effects
 that most reduce the linearised cost. A candidate replaces a simpler one only if its held-out error is lower beyond
 doubt (the lower end of a session-bootstrap interval of the improvement is above zero) and by a material share, and,
 against a controlled model, by more than the model's own error of response to the simpler explanation
-(`Diagnoser.response_error`). The mismatch is called systematic when it exceeds the expected error (model error +
-launch-monitor noise, or the recordings' own scatter where that is clearly larger) by a material share AND some
-fitted correction removes a material share of it on held-out sessions beyond doubt: noise alone satisfies neither.
+(`Diagnoser.response_error`). Structure the library explanation leaves (the test run again on its residuals) leads
+to the learned correction; a library effect stays beside it only if it beats the correction alone beyond doubt.
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ from discovery.fit import (
     linear_starts,
     per_shot,
 )
-from discovery.locate import locate, trajectory_residuals, trajectory_stats
+from discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
 from discovery.model import FlightModel
 from discovery.noise import (
     RADAR_NOISE,
@@ -65,9 +70,6 @@ PAIR_ANCHORS = 3
 
 PAIR_FITS = 2
 """Pairs per anchor fitted through the simulator: the most promising by linearised cost."""
-
-CORRECTION_TRIGGER = 1.1
-"""The learned correction is tried when the best library explanation leaves a held-out error above this (1 = noise)."""
 
 
 @dataclass
@@ -132,16 +134,18 @@ class Diagnoser:
         return Scored(result, z, error, error * result.k * np.log(n) / n)
 
     def better(
-        self, rich: Scored, simple: Scored, level: float, tolerance: float = 0.0
+        self, rich: Scored, simple: Scored, level: float, tolerance: float = 0.0, against: float | None = None
     ) -> tuple[bool, float, float, float]:
-        """Whether `rich` beats `simple` on held-out error beyond doubt, materially and by more than `tolerance`
-        (the model's own error of response to `simple`, see `response_error`); (flag, gain, low, high)."""
+        """Whether `rich` beats `simple` on held-out error beyond doubt, materially (a share of `against`, default
+        `simple`'s error) and by more than `tolerance` (the model's own error of response to `simple`, see
+        `response_error`); (flag, gain, low, high)."""
         a, count = per_shot(simple.heldout_z)
         b, _ = per_shot(rich.heldout_z)
         draws = cluster_bootstrap(a - b, count, self.recordings.session, self.rng)
         gain = float((a - b).sum() / count.sum())
         low, high = np.quantile(draws, [1 - level, level])
-        material = gain >= max(MIN_RELATIVE_IMPROVEMENT * simple.error, tolerance)
+        against = simple.error if against is None else against
+        material = gain >= max(MIN_RELATIVE_IMPROVEMENT * against, tolerance)
         return bool(low > 0 and material and rich.score < simple.score), gain, float(low), float(high)
 
     def response_error(self, candidate: Scored) -> float:
@@ -187,9 +191,10 @@ class Diagnoser:
         return sorted(pairs, key=lambda s: s.score)
 
     def choose(self, null: Scored, singles: list[Scored], pairs: list[Scored]) -> tuple[Scored, dict]:
-        """No effect, the best single, or the best pair: each step only when it beats the simpler one."""
+        """No effect, the best single, or the best pair: each step only when it beats the simpler one (the first
+        by a material share of the excess over the expected error: a shift hides in a large expected error)."""
         chosen, test = null, {}
-        flag, gain, low, _ = self.better(singles[0], null, SINGLE_LEVEL)
+        flag, gain, low, _ = self.better(singles[0], null, SINGLE_LEVEL, against=max(null.error - 1.0, 0.0))
         test.update(best_single=singles[0].fit.name, best_single_gain=gain, best_single_gain_low=low)
         if flag:
             chosen = singles[0]
@@ -209,23 +214,44 @@ class Diagnoser:
     def try_correction(
         self, null: Scored, chosen: Scored, rows: np.ndarray, scored: list[Scored], test: dict
     ) -> Scored:
-        """The learned correction on top of the chosen explanation and alone; it replaces the choice if better."""
+        """The learned correction on top of the chosen explanation and alone; it replaces the choice if better. A
+        library effect is kept beside it only if that beats the correction alone beyond doubt: an effect that
+        explains the size of the mismatch but not its structure is not named."""
         tolerance = self.response_error(chosen)
         if tolerance:
             test[f"model_response_error_of_{chosen.fit.name}"] = tolerance
+        library, alone = chosen, None
         for foundation in {id(chosen): chosen, id(null): null}.values():
             term = learned.fit_correction(self.problem, rows, foundation.fit)
             if term is None:
                 continue
             candidate = self.score(term)
             scored.append(candidate)
-            level = SINGLE_LEVEL if chosen is null else COMBINATION_LEVEL
-            flag, gain, low, _ = self.better(candidate, chosen, level, tolerance)
+            level = SINGLE_LEVEL if library is null else COMBINATION_LEVEL
+            against = max(null.error - 1.0, 0.0) if library is null else None
+            flag, gain, low, _ = self.better(candidate, library, level, tolerance, against)
             test[f"correction_on_{foundation.fit.name}_gain"] = gain
             test[f"correction_on_{foundation.fit.name}_gain_low"] = low
-            if flag:
+            if foundation is null:
+                alone = candidate
+            if flag and candidate.error < chosen.error:
                 chosen = candidate
+        if alone is not None and chosen is not alone and chosen is not library:
+            flag, gain, low, _ = self.better(chosen, alone, COMBINATION_LEVEL, tolerance)
+            test["library_beside_correction_gain"], test["library_beside_correction_gain_low"] = gain, low
+            if not flag:
+                chosen = alone
         return chosen
+
+    def structure_left(self, explanation: Scored) -> bool:
+        """Whether the systematic test still finds structure in the residuals that `explanation` leaves."""
+        if explanation.fit.k == 0:
+            return True
+        everyone = np.arange(len(self.recordings))
+        after = self.problem.predict(explanation.fit.effects, explanation.fit.theta, everyone)[0]
+        residual = self.recordings.observed - after
+        use = self.problem.use & np.isfinite(after)
+        return has_structure(locate(self.recordings, residual, self.problem.sigma, use, [], {}, self.dilution))
 
     def run(self) -> Diagnosis:
         started = time.perf_counter()
@@ -254,7 +280,10 @@ class Diagnoser:
             trajectory_residuals(recordings, flown.positions, flown.dt_s) if flown.positions is not None else []
         )
         outliers = {name: int(wild[:, j].sum()) for j, name in enumerate(OBSERVABLES) if wild[:, j].any()}
-        located = locate(recordings, residual, expected.sigma, use, trajectory_stats(trajectory_rows), outliers)
+        self.dilution = expected.dilution
+        located = locate(
+            recordings, residual, expected.sigma, use, trajectory_stats(trajectory_rows), outliers, self.dilution
+        )
 
         null_z = self.problem.standardize(predicted, everyone)
         null = Scored(
@@ -267,18 +296,18 @@ class Diagnoser:
         pairs = self.fit_pairs(singles, rows)
         scored = singles + pairs
         chosen, test = self.choose(null, singles, pairs)
+        structure = has_structure(located)
         unlisted = None
-        if self.with_correction and chosen.error > CORRECTION_TRIGGER:
+        if self.with_correction and structure and self.structure_left(chosen):
             library_best = chosen
             chosen = self.try_correction(null, chosen, rows, scored, test)
             if chosen is not library_best:
                 unlisted = learned.summary(chosen.fit, chosen.error, library_best.error)
 
-        excess = null.error >= 1.0 + MIN_RELATIVE_IMPROVEMENT
-        systematic = chosen is not null and excess
+        systematic = structure and chosen is not null
         test.update(
             before_error=null.error,
-            excess_beyond_expected=excess,
+            structure_found=structure,
             decision="systematic" if systematic else "consistent with noise and the model's own error",
         )
         if not systematic:
@@ -381,13 +410,17 @@ class Diagnoser:
                 *map(float, np.quantile(obs_draws, [0.025, 0.975])),
             )
         improvement = null.error - chosen.error
-        fraction, fraction_ci = None, None
-        if null.error > 1.0 and chosen is not null:
+        share = np.where(np.isfinite(null.heldout_z), (expected.noise_sigma / sigma) ** 2, 0.0).sum(axis=1)
+        noise_floor = float(share.sum() / max(count.sum(), 1.0))
+        fraction, fraction_ci, absorbs = None, None, False
+        if null.error > noise_floor and chosen is not null:
             before_draws = cluster_bootstrap(a, count, sessions, np.random.default_rng(1))
             gain_draws = cluster_bootstrap(a - b, count, sessions, np.random.default_rng(1))
-            fraction = improvement / (null.error - 1.0)
-            ratio = gain_draws / np.maximum(before_draws - 1.0, 1e-9)
+            floor_draws = cluster_bootstrap(share, count, sessions, np.random.default_rng(1))
+            fraction = improvement / (null.error - noise_floor)
+            ratio = gain_draws / np.maximum(before_draws - floor_draws, 1e-9)
             fraction_ci = tuple(float(q) for q in np.quantile(ratio, [0.025, 0.975]))
+            absorbs = fraction_ci[0] > 1.0
         return Heldout(
             grouping=grouping,
             n_folds=int(self.fold.max()) + 1,
@@ -399,8 +432,10 @@ class Diagnoser:
             improvement=improvement,
             improvement_ci=tuple(float(q) for q in np.quantile(draws, [0.025, 0.975])),
             improvement_by_observable=by_observable,
+            noise_floor=noise_floor,
             explained_fraction=fraction,
             explained_fraction_ci=fraction_ci,
+            absorbs_noise=absorbs,
         )
 
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from discovery.simulator import Setup, Correction
+from discovery.simulator import Correction, Setup
 from flight.air import DRY_AIR_GAS_CONSTANT, ZERO_CELSIUS_K, altitude_for_pressure
 
 

@@ -144,8 +144,10 @@ def locate(
     use: np.ndarray,
     trajectory: list[TrajectoryStat],
     outliers: dict[str, int],
+    dilution: dict[str, np.ndarray] | None = None,
 ) -> Located:
-    """All locate statistics of residuals [N, 5] (recorded - model) with expected sigmas [N, 5]."""
+    """All locate statistics of residuals [N, 5] (recorded - model) with expected sigmas [N, 5]. A launch value's
+    trend is tested after taking out the trend its own recording noise makes (`discovery.noise.dilution_slopes`)."""
     pending: list[tuple[type, dict, list[int]]] = []
     pvalues: list[float] = []
 
@@ -180,7 +182,11 @@ def locate(
             p_excess,
         )
         for covariate in COVARIATES:
-            slope, t, p = slope_test(r, recordings.covariate(covariate)[rows], sessions)
+            x = recordings.covariate(covariate)[rows]
+            expected = 0.0
+            if dilution is not None and covariate in dilution:
+                expected = -dilution[covariate][rows, j] * (x - recordings.covariate(covariate).mean())
+            slope, t, p = slope_test(r - expected, x, sessions)
             add(CovariateStat, {"observable": name, "covariate": covariate, "slope_per_sd": slope, "t": t, "p": p}, p)
         for grouping in ("club", "session"):
             labels = getattr(recordings, grouping)[rows]
@@ -208,6 +214,11 @@ def locate(
         alpha=ALPHA,
         summary=summarise(observables, covariates, groups, trajectory),
     )
+
+
+def has_structure(located: Located) -> bool:
+    """Whether any test of the family found what noise and the model's own error do not make."""
+    return any(stat.significant for stat in (*located.observables, *located.covariates, *located.groups))
 
 
 def summarise(

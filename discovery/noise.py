@@ -31,10 +31,16 @@ class ExpectedError:
     """Per-shot 1-sigma scales [N, 5] and their parts (RMS over shots per observable) for the report."""
 
     sigma: np.ndarray
+    noise_sigma: np.ndarray
+    """The part of sigma [N, 5] that measurement noise alone makes (no model error): the floor that no correction
+    of the physics can go below on held-out shots."""
     model: dict[str, float]
     model_source: dict[str, str]
     outcome_noise: dict[str, float]
     launch_noise: dict[str, float]
+    dilution: dict[str, np.ndarray]
+    """Per launch value [N, 5]: the residual's expected change per unit of that recorded launch value under the
+    null, divided by the value's spread about its mean (`dilution_slopes`)."""
 
 
 def base_conditions(recordings: Recordings, model: FlightModel) -> Setup:
@@ -112,7 +118,31 @@ def expected_error(
     floor = np.array([FLOOR[name] for name in OBSERVABLES])
     sigma = np.sqrt(model_part[None] ** 2 + outcome**2 + launch_var)
     sigma = np.maximum(np.where(np.isfinite(sigma), sigma, np.nanmax(sigma, axis=0)), floor)
-    return ExpectedError(sigma, model_sigma, source, _rms(outcome), _rms(np.sqrt(launch_var)))
+    noise_sigma = np.minimum(np.nan_to_num(np.sqrt(outcome**2 + launch_var), nan=np.inf), sigma)
+    responses = {name: moved[k] - predicted for k, name in enumerate(steps)}
+    return ExpectedError(
+        sigma,
+        noise_sigma,
+        model_sigma,
+        source,
+        _rms(outcome),
+        _rms(np.sqrt(launch_var)),
+        dilution_slopes(base, responses, steps),
+    )
+
+
+def dilution_slopes(
+    base: Setup, responses: dict[str, np.ndarray], steps: dict[str, np.ndarray]
+) -> dict[str, np.ndarray]:
+    """Under the null, a recorded launch value x = true + e predicts with e in it, so the residual carries
+    -(response to a 1-sigma step) e / sigma, which correlates with x: E[residual | x] = -response sigma (x - mean)
+    / var(x) per shot (errors in variables). Per launch value, response x sigma / var(x) [N, 5]: the trend the
+    systematic test must not mistake for left-out physics (a noisy spin axis alone gave t = 6 on clean sets)."""
+    out = {}
+    for name, response in responses.items():
+        spread = float(np.var(base.launch[name]))
+        out[name] = np.nan_to_num(response * steps[name][:, None] / max(spread, 1e-12))
+    return out
 
 
 SCATTER_MATERIAL = 1.5
@@ -174,4 +204,4 @@ def recording_scatter(recordings: Recordings, z: np.ndarray, rng: np.random.Gene
 def with_scatter(expected: ExpectedError, scatter: Scatter) -> ExpectedError:
     """The expected error with each `applied` observable's sigma scaled by the recordings' own scatter."""
     scale = np.array([scatter.applied.get(name, 1.0) for name in OBSERVABLES])
-    return replace(expected, sigma=expected.sigma * scale[None])
+    return replace(expected, sigma=expected.sigma * scale[None], noise_sigma=expected.noise_sigma * scale[None])

@@ -7,6 +7,7 @@ import numpy as np
 
 from discovery.effects import Context
 from discovery.fit import Fit, Problem, Scored, cluster_bootstrap, per_shot
+from discovery.locate import has_structure
 from discovery.recordings import LABELS, OBSERVABLES
 from discovery.schema import (
     AirAltitude,
@@ -261,18 +262,18 @@ def statement(
             if best
             else ""
         )
-        if heldout.before_error >= 1.0 + MATERIAL:
+        if has_structure(located):
             return (
-                f"The recordings depart from the model well beyond its expected error (mean squared standardized "
-                f"residual {heldout.before_error:.3g}; worst {worst.name} at {worst.rms_ratio:.1f}x its expected "
-                "error), but no candidate explains the departure consistently on held-out groups: it varies from "
-                "shot to shot or group to group (changing wind, mixed conditions or noisier measurements than "
-                "assumed) rather than being one systematic effect." + gain
+                f"The systematic test finds structure the expected error does not make ({located.summary[0]}), but "
+                "no candidate explains it consistently on held-out groups: it varies from shot to shot or group to "
+                "group (changing wind, mixed conditions or noisier measurements than assumed) rather than being one "
+                "systematic effect." + gain
             )
         tail = f" The largest departure is {worst.name} at {worst.rms_ratio:.2f}x its expected error." if worst else ""
         return (
-            "No systematic mismatch: the recordings agree with the model within its own validation error and the "
-            "launch monitor's noise." + tail + gain
+            "No systematic mismatch: no shift of a mean, trend with the launch, difference between clubs or "
+            "sessions, or scatter beyond the model's own error and the launch monitor's noise (Holm, family-wise "
+            f"{located.alpha:g})." + tail + gain
         )
     sentences = [_mismatch(located) + "."]
     contrast = _contrast(chosen, scored, {a.effects[1] for a in ambiguities})
@@ -284,8 +285,11 @@ def statement(
             f" explains {100 * heldout.explained_fraction:.0f} % (95 % interval {100 * low:.0f}–{100 * high:.0f} %) "
             "of the excess error on held-out shots"
         )
-        if heldout.explained_fraction > 1:
-            explains += " (over 100 %: it also absorbs part of the error the model is expected to have)"
+        if heldout.absorbs_noise:
+            explains += (
+                " (over 100 % beyond doubt: it goes below what measurement noise alone leaves, so it absorbs noise "
+                "and the share is no measure of success)"
+            )
     if unlisted is not None:
         lead = (
             f"No library effect explains it ({' plus '.join(named) + ' leaves' if named else 'the best leaves'} a held-out "

@@ -8,7 +8,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-SCHEMA_VERSION = "1.0"
+SCHEMA_VERSION = "1.1"
+"""1.1: the held-out noise floor and absorbs_noise; the systematic test decides (structure_found)."""
 SCHEMA_PATH = Path(__file__).with_name("report.schema.json")
 
 
@@ -114,10 +115,18 @@ class Heldout(_Strict):
     improvement_by_observable: dict[str, tuple[float, float, float]] = Field(
         description="per observable: improvement of the mean squared standardized residual and its 95 % interval"
     )
+    noise_floor: float = Field(
+        description="held-out error that measurement noise alone leaves (no model error): what a perfect "
+        "explanation reaches"
+    )
     explained_fraction: float | None = Field(
-        description="share of the excess error (above 1) removed on held-out shots"
+        description="share of the excess error (above the noise floor) removed on held-out shots"
     )
     explained_fraction_ci: tuple[float, float] | None
+    absorbs_noise: bool = Field(
+        description="the explained share is above 100 % beyond doubt: the fit goes below what measurement noise "
+        "alone leaves, so part of what it removes is noise, not physics"
+    )
 
 
 class Ambiguity(_Strict):
@@ -213,7 +222,7 @@ class ModelInfo(_Strict):
 class Report(_Strict):
     """report.json of `golfflight diagnose`."""
 
-    schema_version: Literal["1.0"] = SCHEMA_VERSION
+    schema_version: Literal["1.1"] = SCHEMA_VERSION
     recordings: str
     n_shots: int
     n_sessions: int

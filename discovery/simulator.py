@@ -92,6 +92,28 @@ class Flown:
         )
 
 
+def fly_setup(
+    setup: Setup,
+    coefficients_for: CoefficientsFor,
+    dt_s: float,
+    t_max_s: float,
+    method: Method = "euler",
+    correction: Correction | None = None,
+    keep_states: bool = False,
+) -> Flight:
+    """The flight core's `Flight` of every shot down through its landing ground (or t_max): what `simulate_setup`
+    summarises, and what `discovery.conceal` records when it hides effects in the diagnosed model's own flights."""
+    density = setup.density_kg_m3 * setup.density_ratio
+    coefficients = ScaledCoefficients(coefficients_for(setup.density_ratio), setup.coefficient_scale)
+    wind = Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1])
+    extra = None if correction is None else WeightedCorrection(correction, setup.correction_weights)
+    field = BallInAir(coefficients, density, wind, extra)
+    record = "states" if keep_states else "summary"
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        start, ground = initial_state(**setup.launch), GroundPlane(setup.ground_height_m)
+        return integrate(start, field, dt_s, round(t_max_s / dt_s), method, ground, record)
+
+
 def simulate_setup(
     setup: Setup,
     coefficients_for: CoefficientsFor,
@@ -105,15 +127,8 @@ def simulate_setup(
 
     A parameter set far outside reality may make a ball diverge; its outcome is then NaN (not landed), silently.
     """
-    density = setup.density_kg_m3 * setup.density_ratio
-    coefficients = ScaledCoefficients(coefficients_for(setup.density_ratio), setup.coefficient_scale)
-    wind = Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1])
-    extra = None if correction is None else WeightedCorrection(correction, setup.correction_weights)
-    field = BallInAir(coefficients, density, wind, extra)
-    record = "states" if keep_positions else "summary"
+    flight = fly_setup(setup, coefficients_for, dt_s, t_max_s, method, correction, keep_positions)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        start, ground = initial_state(**setup.launch), GroundPlane(setup.ground_height_m)
-        flight = integrate(start, field, dt_s, round(t_max_s / dt_s), method, ground, record)
         landing_angle = flight.landing_angle_deg
     landing_xy, apex, flight_time = flight.landing_position[:, :2].copy(), flight.apex_m, flight.flight_time_s
     apex[~flight.landed] = np.nan

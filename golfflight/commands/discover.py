@@ -23,10 +23,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", required=True, help="folder for report.json, report.html, service_settings.json")
     parser.add_argument("--seed", type=int, default=0, help="seed of the fitting subsample and the bootstraps")
     parser.add_argument(
-        "--no-control",
+        "--reference-control",
         action="store_true",
-        help="do not take the bundle's difference from the reference world out first (for a bundle fine-tuned on "
-        "real shots, which no longer imitates the reference world); its card's error is expected instead",
+        help="add the bundle's difference from the reference world on the recorded launches to every prediction: "
+        "this measures how the recordings differ from the reference world (as seen through the bundle), not from "
+        "the model the service flies (the default)",
     )
     parser.add_argument(
         "--assumed-noise",
@@ -54,7 +55,7 @@ def run_diagnose(args: argparse.Namespace) -> int:
     recordings = read_recordings(args.recordings)
     if len(recordings) < 3:
         raise ValueError(f"{args.recordings}: {len(recordings)} shots with an observed outcome; at least 3 are needed")
-    model = load_model(args.model, controlled=not args.no_control)
+    model = load_model(args.model, control=args.reference_control)
     diagnosis = diagnose(recordings, model, seed=args.seed, estimate_scatter=not args.assumed_noise)
     paths = write_diagnosis(diagnosis, args.out)
     print(diagnosis.report.statement)

@@ -1,0 +1,78 @@
+"""Discovery against the model as the service flies it (issue 14): recordings made by the served bundle's own
+flights plus launch-monitor noise. Clean sets raise no alarm, a consistent shift hidden in a large expected error is
+found, a physics outside the library is reported as unlisted, and a fit below the noise floor is flagged."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from discovery.conceal import conceal
+from discovery.diagnose import diagnose
+from discovery.model import DEFAULT_BUNDLE, load_model
+from discovery.noise import RADAR_NOISE
+from discovery.recordings import from_shot_set
+from discovery.simulator import Setup
+from service.engine import FlightEngine, Launch
+
+SHOTS = 200
+
+
+@pytest.fixture(scope="module")
+def served():
+    """The default bundle, whichever it is, flown as the service flies it."""
+    return load_model(None)
+
+
+def _diagnose(model, hidden, seed, noise=RADAR_NOISE, correction=False):
+    concealed = conceal(hidden, SHOTS, seed=seed, model=model, noise=noise)
+    return diagnose(from_shot_set(concealed.shots), model, seed=0, with_correction=correction).report
+
+
+def test_discovery_flies_the_launches_as_the_engine_does(served):
+    """Same integrator, coefficients and air: discovery's prediction is the engine's batch flight."""
+    launches = [Launch(70.0, 11.0, 1.0, 2600.0, 4.0), Launch(45.0, 20.0, -2.0, 7000.0, -8.0)]
+    flights = FlightEngine(DEFAULT_BUNDLE).fly_batch(launches)
+    columns = {name: np.array(values, dtype=float) for name, values in zip(Launch._fields, zip(*launches))}
+    setup = Setup(columns, np.ones(2), np.full(2, served.density_kg_m3), np.zeros((2, 2)), np.zeros(2), np.ones((2, 3)))
+    flown = served.simulate(setup).outcomes()
+    for column, field in enumerate(("landing_y_m", "landing_x_m", "apex_m", "flight_time_s", "landing_angle_deg")):
+        assert flown[:, column] == pytest.approx([getattr(f, field) for f in flights], abs=1e-9)
+
+
+@pytest.mark.parametrize("seed", [31, 32])
+def test_clean_sets_flown_by_the_served_model_raise_no_alarm(served, seed):
+    report = _diagnose(served, {}, seed)
+    assert not report.systematic and report.effects == []
+    assert not report.systematic_test["structure_found"]
+    assert "No systematic mismatch" in report.statement
+
+
+@pytest.mark.parametrize(("effect", "offset"), [("launch_direction_bias", 1.8), ("spin_axis_bias", 3.6)])
+def test_a_consistent_shift_is_found_and_measured(served, effect, offset):
+    report = _diagnose(served, {effect: {"offset_deg": offset}}, seed=33)
+    assert report.systematic and [e.name for e in report.effects] == [effect]
+    assert report.effects[0].parameters["offset_deg"] == pytest.approx(offset, rel=0.1)
+    assert not report.heldout.absorbs_noise
+    assert report.heldout.explained_fraction == pytest.approx(1.0, abs=0.25)
+
+
+def test_a_drag_rise_at_low_speed_is_reported_as_unlisted(served):
+    report = _diagnose(served, {"low_speed_drag": {"rise": 0.15, "speed_mps": 40.0}}, seed=34, correction=True)
+    assert report.systematic and report.unlisted is not None
+    assert [e.name for e in report.effects] == ["unlisted"], "no library effect explains its structure"
+    assert "unlisted" in report.statement and report.unlisted.expression
+
+
+def test_a_fit_below_the_noise_floor_is_flagged(served):
+    """Recordings a quarter as noisy as assumed: the fitted drag scale leaves less than the assumed noise alone
+    must, more than 100 % of the excess beyond doubt, which is said, not celebrated."""
+    quiet = dataclasses.replace(
+        RADAR_NOISE, **{f.name: getattr(RADAR_NOISE, f.name) / 4 for f in dataclasses.fields(RADAR_NOISE)}
+    )
+    report = _diagnose(served, {"drag_scale": {"scale": 1.06}}, seed=35, noise=quiet)
+    assert report.systematic and report.heldout.absorbs_noise
+    assert report.heldout.explained_fraction_ci[0] > 1.0
+    assert "absorbs noise" in report.statement
