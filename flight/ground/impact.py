@@ -1,4 +1,4 @@
-"""Penner's impact of a spinning ball on turf (Can. J. Phys. 80, 931 (2002); NOTES.md section 7), batch-wise.
+"""Penner's impact of a spinning ball on turf (Can. J. Phys. 80, 931 (2002); NOTES.md section 7), one ball or many.
 
 The turf gives under the ball, so it bounces off a contact plane tilted back towards it by the critical angle
 theta_c: the normal n' = cos(tilt) n - sin(tilt) t, t the direction of the incoming tangential velocity. Against
@@ -10,12 +10,11 @@ balls leave the turf still slipping). Back spin is reduced, or reversed into a b
 The tilt grows with the depth the ball presses into the turf: Penner's fit grows theta_c with impact speed and
 angle; here it grows in proportion to the normal speed up to theta_c at REFERENCE_NORMAL_SPEED_MPS and no further
 (faster, a steep wedge would meet a wall and shoot back metres), so a ball skimming the ground at a shallow angle is
-not thrown up by a crater it never made. It is capped at theta_1, the
-incoming angle from the normal, so the tangential speed against the tilted plane, v sin(theta_1 - tilt), never
-turns negative: taking theta_1 as the landing angle from the horizontal instead makes that sine negative on every
-landing shallower than theta_c and "kills all rollout" of drivers (an open simulator's bug); and a vertical drop is
-not kicked sideways. Energy never grows: |normal| shrinks by e <= 1 and the
-friction impulse opposes the slip and never overshoots it.
+not thrown up by a crater it never made. It is capped at theta_1, the incoming angle from the normal, so the
+tangential speed against the tilted plane, v sin(theta_1 - tilt), never turns negative: taking theta_1 as the
+landing angle from the horizontal instead makes that sine negative on every landing shallower than theta_c and
+"kills all rollout" of drivers (an open simulator's bug); and a vertical drop is not kicked sideways. Energy never
+grows: |normal| shrinks by e <= 1 and the friction impulse opposes the slip and never overshoots it.
 """
 
 from __future__ import annotations
