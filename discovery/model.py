@@ -64,14 +64,18 @@ class FlightModel:
 
 
 def from_bundle(directory: str | os.PathLike, control: bool = False) -> FlightModel:
-    """The bundle as the service flies it. Its own error is not known per launch, so `discovery.noise` estimates
-    it (no card value is taken: the card's validation error is mostly its data's unrecorded weather). With
-    `control`, its difference from the reference world on the recorded launches is added to every prediction
-    instead: that diagnoses the reference world as seen through the bundle, not the model the service runs."""
+    """The bundle as the service flies it, expecting its card's own error (`own_error`, measured where the truth is
+    known), or, on a card without one, letting `discovery.noise` estimate it; never the card's validation error,
+    which is mostly its data's noise and unrecorded weather. With `control`, its difference from the reference
+    world on the recorded launches is added to every prediction instead: that diagnoses the reference world as
+    seen through the bundle, not the model the service runs."""
     coefficients = OnnxCoefficients(directory)
     card = coefficients.card
     error: dict[str, float] = {}
     source: dict[str, str] = {}
+    if card.own_error is not None:
+        error = dict(card.own_error.sigma)
+        source = {name: f"model card: own error against {card.own_error.measured_against}" for name in error}
     if control:
         error = {name: 0.0 for name in OBSERVABLES}
         source = {

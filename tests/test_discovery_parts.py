@@ -87,7 +87,7 @@ def test_plus_minus_uses_the_uncertainty_digits():
 
 def test_every_case_draws_a_size_and_scores_its_error():
     rng = np.random.default_rng(1)
-    for case, effects in cases():
+    for case, effects in cases("model") + cases("reference"):
         for name in effects:
             hidden = draw_effect(name, rng)
             if name in EFFECTS:
@@ -113,12 +113,13 @@ def test_tables_and_section_replacement():
         12.0,
         1.0,
         1.0,
+        False,
         {"carry_y_m": 9.0},
         {"carry_y_m": 1.0},
         [],
         3.0,
     )
-    clean = Run("clean", 0, {}, 300, 4, False, "none", True, {}, {}, {}, 1.0, 1.0, None, {}, {}, [], 3.0)
+    clean = Run("clean", 0, {}, 300, 4, False, "none", True, {}, {}, {}, 1.0, 1.0, None, False, {}, {}, [], 3.0)
     text = tables([clean, run], "test model")
     assert "| false alarms on clean sets | 0 of 1 | 0 |" in text and "| wind | 1/1 | 1/1 |" in text
     doc = replace_section("# Title\n\nhand text\n", text, "<!-- BEGIN x -->")
@@ -133,10 +134,10 @@ def test_prove_runs_only_the_cases_asked_for_into_their_own_section(tmp_path):
 
     out = tmp_path / "discovery.md"
     out.write_text("# Discovery\n\nhand-written\n")
-    args = ["prove", "--model", "reference", "--cases", "^clean$", "--seeds", "1", "--shots", "40", "--out", str(out)]
-    assert main(args) == 0
+    args = ["prove", "--model", "reference", "--cases", "^clean$", "--clean-sets", "1", "--shots", "40"]
+    assert main([*args, "--out", str(out)]) == 0
     page = out.read_text()
-    assert "hand-written" in page and "--cases '^clean$' --seeds 1" in page
+    assert "hand-written" in page and "--truth model --cases '^clean$'" in page
     assert "| false alarms on clean sets | 0 of 1 | 0 |" in page and "detection" not in page and "nan" not in page
     assert main(["prove", "--cases", "^nothing$", "--out", str(out)]) == 2
     assert main(["prove", "--cases", "clean(", "--out", str(out)]) == 2

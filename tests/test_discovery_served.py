@@ -5,17 +5,21 @@ found, a physics outside the library is reported as unlisted, and a fit below th
 from __future__ import annotations
 
 import dataclasses
+import shutil
 
 import numpy as np
 import pytest
 
 from discovery.conceal import conceal
 from discovery.diagnose import diagnose
-from discovery.model import DEFAULT_BUNDLE, load_model
+from discovery.model import DEFAULT_BUNDLE, from_bundle, load_model
 from discovery.noise import RADAR_NOISE
+from discovery.own_error import measure_own_error, write_own_error
 from discovery.recordings import from_shot_set
 from discovery.simulator import Setup
 from service.engine import FlightEngine, Launch
+from shots.paths import REPO_ROOT
+from weights_schema.bundle import load_bundle
 
 SHOTS = 200
 
@@ -76,3 +80,18 @@ def test_a_fit_below_the_noise_floor_is_flagged(served):
     assert report.systematic and report.heldout.absorbs_noise
     assert report.heldout.explained_fraction_ci[0] > 1.0
     assert "absorbs noise" in report.statement
+
+
+def test_the_cards_own_error_is_what_diagnose_expects_of_the_model(tmp_path):
+    """Measured against the teacher on clean launches (schema 1.3), metres not the validation error's yards; a card
+    without it still loads and the error is estimated."""
+    bundle = tmp_path / "bundle"
+    shutil.copytree(REPO_ROOT / "models" / "synthetic", bundle)
+    assert from_bundle(bundle).model_error == {}
+    own = measure_own_error(bundle, n_shots=120)
+    assert own.n_shots > 100 and 0.0 < own.sigma["carry_y_m"] < 3.0
+    write_own_error(bundle, own)
+    card = load_bundle(bundle)[0]
+    assert card.schema_version == "1.3" and card.own_error == own
+    model = from_bundle(bundle)
+    assert model.model_error == own.sigma and "own error" in model.error_source["carry_y_m"]

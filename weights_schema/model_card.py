@@ -12,10 +12,11 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-SCHEMA_VERSION = "1.2"
-SUPPORTED_SCHEMA_VERSIONS = ("1.1", "1.2")
+SCHEMA_VERSION = "1.3"
+SUPPORTED_SCHEMA_VERSIONS = ("1.1", "1.2", "1.3")
 """1.1 added physics.kinematic_viscosity_m2_s (the Reynolds scale of the graph's inputs); 1.0 cards lack it.
-1.2 added the real-data sections (training_data.sources, training.latent_conditions, held_out), all optional."""
+1.2 added the real-data sections (training_data.sources, training.latent_conditions, held_out), all optional.
+1.3 added own_error (the model's own error per observable where the truth is known), optional."""
 SCHEMA_PATH = Path(__file__).with_name("model_card.schema.json")
 
 ExportableVariant = Literal["phys-nn", "phys-nn-pm", "phys-nn-pm-cq", "phys-nn+", "phys-q"]
@@ -172,6 +173,19 @@ class HeldOutResult(_Strict):
     note: str
 
 
+class OwnError(_Strict):
+    """The model's own 1-sigma error per observable, measured where the truth is known (against its teacher on
+    clean launches, or on held-out real data with the measurement noise taken out): what `golfflight diagnose`
+    expects of the model itself, beside the launch monitor's noise. Not the validation error, which also holds its
+    data's noise and unrecorded weather."""
+
+    sigma: dict[str, NonNegative] = Field(
+        description="RMS error per observable: carry_y_m, carry_x_m, apex_m, flight_time_s, landing_angle_deg"
+    )
+    measured_against: str = Field(description="the truth it was measured against, and how")
+    n_shots: int = Field(ge=1)
+
+
 class ExportCheck(_Strict):
     """ONNX Runtime against the training framework on a probe batch, checked at export."""
 
@@ -194,7 +208,7 @@ class Producer(_Strict):
 class ModelCard(_Strict):
     """model_card.json of a model bundle."""
 
-    schema_version: Literal["1.1", "1.2"]
+    schema_version: Literal["1.1", "1.2", "1.3"]
     variant: ExportableVariant
     architecture: Architecture
     onnx: OnnxGraph
@@ -205,6 +219,7 @@ class ModelCard(_Strict):
     export_check: ExportCheck
     producer: Producer
     held_out: list[HeldOutResult] | None = Field(default=None, description="error on each held-out real set")
+    own_error: OwnError | None = Field(default=None, description="the model's own error where the truth is known")
 
 
 def schema_text() -> str:

@@ -9,7 +9,8 @@ from pathlib import Path
 from discovery.diagnose import diagnose
 from discovery.model import REFERENCE, load_model
 from discovery.outputs import write_diagnosis
-from discovery.prove import cases, command, prove, write_tables
+from discovery.own_error import measure_own_error, write_own_error
+from discovery.prove import CLEAN_SETS, cases, command, prove, write_tables
 from discovery.recordings import read_recordings
 
 
@@ -39,9 +40,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     prove = subparsers.add_parser("prove", help="hide effects in synthetic recordings, diagnose them blind, score")
     prove.add_argument(
-        "--model", default=REFERENCE, help=f"'{REFERENCE}' (default: measures the method alone) or a bundle"
+        "--model", help=f"a bundle (default: the shipped models/default) or '{REFERENCE}' (the method alone)"
+    )
+    prove.add_argument(
+        "--truth",
+        choices=("model", "reference"),
+        default="model",
+        help="hide the effects in the diagnosed model's own flights (default) or in the reference world's (the "
+        "model-form campaign: what the model's own difference from that physics adds)",
     )
     prove.add_argument("--seeds", type=int, default=4, help="concealed sets per case")
+    prove.add_argument("--clean-sets", type=int, default=CLEAN_SETS, help="clean sets (false-alarm count)")
     prove.add_argument("--shots", type=int, default=300, help="shots per concealed set")
     prove.add_argument("--out", default="docs/discovery.md", help="markdown file whose generated section is replaced")
     prove.add_argument("--json", help="also write every run's truth and findings to this JSON file")
@@ -49,6 +58,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--cases", help="only the cases whose name matches this regular expression (e.g. '^clean$' for false alarms)"
     )
     prove.set_defaults(run=run_prove)
+
+    own = subparsers.add_parser(
+        "own-error", help="measure a reference-trained bundle's own error against its teacher, for its card"
+    )
+    own.add_argument("bundle", help="model bundle directory")
+    own.add_argument("--shots", type=int, default=2000, help="clean calm launches to fly")
+    own.add_argument("--write", action="store_true", help="write it into the bundle's card (schema 1.3)")
+    own.set_defaults(run=run_own_error)
 
 
 def run_diagnose(args: argparse.Namespace) -> int:
@@ -70,10 +87,21 @@ def run_prove(args: argparse.Namespace) -> int:
         except re.error as error:
             raise ValueError(f"--cases {args.cases!r} is not a regular expression: {error}") from None
     model = load_model(args.model)
-    results = prove(model, seeds=args.seeds, n_shots=args.shots, progress=print, only=args.cases)
+    results = prove(model, args.seeds, args.shots, print, only=args.cases, truth=args.truth, clean_sets=args.clean_sets)
     if not results:
-        raise ValueError(f"--cases {args.cases!r} matches none of: {', '.join(name for name, _ in cases())}")
-    section = command(args.model, args.cases, args.seeds if args.cases else None)
-    write_tables(results, Path(args.out), Path(args.json) if args.json else None, model.name, section)
+        names = ", ".join(name for name, _ in cases(args.truth))
+        raise ValueError(f"--cases {args.cases!r} matches none of: {names}")
+    spec = args.model or "models/default"
+    section = command(spec, args.truth, args.cases, args.seeds if args.cases else None)
+    json_path = Path(args.json) if args.json else None
+    write_tables(results, Path(args.out), json_path, model.name, section, args.truth)
     print(f"wrote the tables to {args.out}")
+    return 0
+
+
+def run_own_error(args: argparse.Namespace) -> int:
+    own = measure_own_error(args.bundle, args.shots)
+    print(own.model_dump_json(indent=2))
+    if args.write:
+        print(f"wrote {write_own_error(args.bundle, own)}")
     return 0
