@@ -139,5 +139,11 @@ def test_prove_runs_only_the_cases_asked_for_into_their_own_section(tmp_path):
     page = out.read_text()
     assert "hand-written" in page and "--truth model --cases '^clean$'" in page
     assert "| false alarms on clean sets | 0 of 1 | 0 |" in page and "detection" not in page and "nan" not in page
+    dump, again = tmp_path / "runs.json", tmp_path / "again.md"
+    assert main([*args, "--out", str(again), "--json", str(dump)]) == 0
+    written = again.read_text()
+    again.unlink()
+    assert main([*args, "--out", str(again), "--tables-from", str(dump)]) == 0
+    assert again.read_text() == written, "the tables of a dump are the tables of its run"
     assert main(["prove", "--cases", "^nothing$", "--out", str(out)]) == 2
     assert main(["prove", "--cases", "clean(", "--out", str(out)]) == 2

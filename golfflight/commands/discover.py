@@ -10,7 +10,7 @@ from discovery.diagnose import diagnose
 from discovery.model import REFERENCE, load_model
 from discovery.outputs import write_diagnosis
 from discovery.own_error import measure_own_error, write_own_error
-from discovery.prove import CLEAN_SETS, cases, command, prove, write_tables
+from discovery.prove import CLEAN_SETS, cases, command, prove, read_runs, write_tables
 from discovery.recordings import read_recordings
 
 
@@ -57,6 +57,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     prove.add_argument(
         "--cases", help="only the cases whose name matches this regular expression (e.g. '^clean$' for false alarms)"
     )
+    prove.add_argument("--tables-from", help="write the tables of the runs in this --json dump instead of flying")
     prove.set_defaults(run=run_prove)
 
     own = subparsers.add_parser(
@@ -87,7 +88,12 @@ def run_prove(args: argparse.Namespace) -> int:
         except re.error as error:
             raise ValueError(f"--cases {args.cases!r} is not a regular expression: {error}") from None
     model = load_model(args.model)
-    results = prove(model, args.seeds, args.shots, print, only=args.cases, truth=args.truth, clean_sets=args.clean_sets)
+    if args.tables_from:
+        results = read_runs(Path(args.tables_from))
+    else:
+        results = prove(
+            model, args.seeds, args.shots, print, only=args.cases, truth=args.truth, clean_sets=args.clean_sets
+        )
     if not results:
         names = ", ".join(name for name, _ in cases(args.truth))
         raise ValueError(f"--cases {args.cases!r} matches none of: {names}")
