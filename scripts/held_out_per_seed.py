@@ -1,0 +1,55 @@
+"""The held-out errors of every seed of a `golfflight train-real` run, for the spread between seeds that
+docs/training_real.md reports (the run itself picks its seed on validation only and measures the held-out sets for
+that one). Exports each seed's last epoch to WORK/seed-S/bundle and prints a markdown table.
+
+    python3 scripts/held_out_per_seed.py WORK [--data DIR] [--init models/synthetic]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from flight.constants import FOOT_M, YARD_M  # noqa: E402
+from model_export.held_out import record_held_out  # noqa: E402
+from model_export.real_data import DEFAULT_SOURCES, build  # noqa: E402
+from model_export.real_training import DATA_FILE, export_real  # noqa: E402
+from shots.markdown import table  # noqa: E402
+from shots.paths import shared_data_dir  # noqa: E402
+from weights_schema.bundle import load_bundle  # noqa: E402
+from weights_schema.model_card import ModelCard  # noqa: E402
+
+
+def cells(card: ModelCard) -> list[str]:
+    """TrackMan landing (yd), TOUR Championship apex (ft), PGA carry / max height (yd) / land angle (deg)."""
+    errors = {h.name.split(" ")[0]: h.errors for h in card.held_out or []}
+    trackman, tour, pga = errors["TrackMan"], errors["TOUR"], errors["PGA"]
+    return [f"{trackman['landing_point_m'] / YARD_M:.1f} yd", f"{tour['apex_m'] / FOOT_M:.1f} ft",
+            f"{pga['carry_m'] / YARD_M:.1f} yd / {pga['max_height_m'] / YARD_M:.1f} yd / "
+            f"{pga['landing_angle_deg']:.1f} deg"]
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("work", type=Path, help="the --work directory of a train-real run")
+    parser.add_argument("--data", type=Path, default=shared_data_dir(), help="the shared data folder")
+    parser.add_argument("--init", default="models/synthetic", help="the run's --init bundle (its architecture)")
+    args = parser.parse_args()
+    sources = build(args.data, args.work / "sources_for_cards.csv", DEFAULT_SOURCES)
+    init, _ = load_bundle(args.init)
+    rows = []
+    for seed_dir in sorted(args.work.glob("seed-*")):
+        bundle = seed_dir / "bundle"
+        export_real(seed_dir, args.work / DATA_FILE, sources, bundle, init.variant,
+                    tuple(init.architecture.hidden_units))
+        rows.append([seed_dir.name, *cells(record_held_out(bundle, args.data))])
+    print("\n".join(table(["seed", "TrackMan drivers, all: landing error", "TOUR Championship: apex MAE",
+                           "PGA averages: carry / max height / land angle MAE"], rows)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
