@@ -40,6 +40,8 @@ WIND_REFERENCE_HEIGHT_M = Range(0.5, 100.0, "m")
 TRAJECTORY_RATE_HZ = Range(1.0, 1000.0, "Hz")
 
 GROUND_ELEVATION_M = Range(-100.0, 100.0, "m")
-SLOPE_DEG = Range(0.0, 20.0, "deg")
+SLOPE_DEG = Range(0.0, 10.0, "deg")
+"""The ground is an endless plane: on steeper ones a fast ball skips downhill and runs away (hundreds of metres),
+which real hills end long before."""
 SLOPE_DIR_DEG = Range(0.0, 360.0, "deg")
 STIMP_FT = Range(4.0, 16.0, "ft")

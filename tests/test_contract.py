@@ -48,7 +48,7 @@ FIELDS = {
 
 SECTION_BASE = {"wind": {"speed_mps": 3.0}, "stimp_ft": {"surface": "green"}, "slope_deg": {"surface": "rough"}}
 """What a field's section needs besides it to be valid (by section or field name): a stimp reading is a green's,
-and slopes up to 20 degrees are held by the rough only."""
+and slopes up to 10 degrees are held by the rough, not by the fairway."""
 
 
 @pytest.fixture(scope="module")

@@ -1,19 +1,25 @@
 """The ground phase through the service's contract: `ground` in single, batch and normalized shots, its 422s, the
-trajectory to rest, GSPro replies (HTTP and the TCP server's `fly_message`) and `golfflight simulate`."""
+trajectory to rest, GSPro replies (HTTP and the TCP server's `fly_message`) and `golfflight simulate`; and in the
+engine, every valid shot comes to rest, one shot's float path agreeing with the batch (hypothesis)."""
 
 from __future__ import annotations
 
 import csv
 import json
+import math
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from servers import running
 
 from flight.constants import YARD_M
+from flight.ground import SURFACES, GroundSpec, holding_slope_deg
+from flight.limits import SLOPE_DEG
 from golfflight.cli import main
 from service.api.app import create_app
 from service.api.gspro import GSProMessage, fly_message
-from service.engine import FlightEngine
+from service.engine import FlightEngine, Launch
 from service.model_location import model_dir
 
 DRIVER = {"ball_speed_mph": 171.0, "launch_angle_deg": 10.4, "back_spin_rpm": 2545.0}
@@ -137,3 +143,31 @@ def test_simulate_takes_ground_columns_and_writes_the_rest(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps([{**WEDGE, "ground": {"surface": "green", "slope_deg": 9.0}}]))
     assert main(["simulate", str(bad)]) == 2
+
+
+@pytest.fixture(scope="module")
+def engine():
+    return FlightEngine(model_dir())
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    launch=st.tuples(st.floats(5.0, 90.0), st.floats(-5.0, 60.0), st.floats(-20.0, 20.0), st.floats(0.0, 12000.0),
+                     st.floats(-60.0, 60.0)),
+    name=st.sampled_from(list(SURFACES)),
+    slope_share=st.floats(0.0, 0.95),
+    slope_dir=st.floats(0.0, 360.0),
+    elevation=st.floats(-20.0, 0.0),
+)
+def test_every_shot_comes_to_rest_finite_and_the_batch_agrees(engine, launch, name, slope_share, slope_dir,
+                                                                elevation):
+    where = SURFACES[name]
+    steepest = min(float(holding_slope_deg(where.rolling_resistance)), SLOPE_DEG.high)
+    ground = GroundSpec(where, elevation, slope_share * steepest, slope_dir)
+    one = engine.fly(Launch(*launch), ground=ground)
+    batch = engine.fly_batch([Launch(*launch)] * 2, grounds=ground)[1]
+    rest = one.rest
+    assert all(math.isfinite(v) for v in (rest.x_m, rest.y_m, rest.total_m, rest.roll_m, rest.ground_time_s))
+    assert rest.bounces >= 0 and rest.ground_time_s >= 0.0
+    assert (rest.x_m, rest.y_m) == pytest.approx((batch.rest.x_m, batch.rest.y_m), rel=1e-9, abs=1e-6)
+    assert rest.bounces == batch.rest.bounces

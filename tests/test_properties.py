@@ -78,7 +78,7 @@ def engine() -> FlightEngine:
 
 
 def assert_sound(flight: ShotFlight) -> None:
-    values = [getattr(flight, name) for name in ShotFlight.__dataclass_fields__ if name != "states"]
+    values = [getattr(flight, name) for name in ShotFlight.__dataclass_fields__ if name not in ("states", "rest")]
     assert all(math.isfinite(v) for v in values), flight
     assert 0.0 <= flight.flight_time_s <= MAX_FLIGHT_TIME_S and 0.0 <= flight.apex_time_s <= flight.flight_time_s
     assert flight.carry_m >= 0.0 and flight.apex_m >= 0.0 and flight.landing_speed_mps >= 0.0

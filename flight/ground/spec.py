@@ -5,13 +5,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from flight.ground.surfaces import SURFACES, Surface, holding_slope_deg
+from flight.limits import SLOPE_DEG
 
 
 @dataclass(frozen=True)
 class GroundSpec:
     """A plane `elevation_m` above the tee's ground (z = 0; the flight lands where it comes down through it), sloped
     by `slope_deg` towards `slope_dir_deg` around the landing point (`flight.ground.phase.plane_normals`), of
-    `surface`. ValueError for a slope steeper than the surface holds a ball still on."""
+    `surface`. ValueError for a slope steeper than the surface holds a ball still on, or than SLOPE_DEG."""
 
     surface: Surface = field(default_factory=lambda: SURFACES["fairway"])
     elevation_m: float = 0.0
@@ -19,10 +20,10 @@ class GroundSpec:
     slope_dir_deg: float = 0.0
 
     def __post_init__(self) -> None:
-        limit = float(holding_slope_deg(self.surface.rolling_resistance))
-        if not 0.0 <= self.slope_deg < limit:
-            raise ValueError(f"slope_deg {self.slope_deg:g} is outside 0 to {limit:.2f} deg, the slopes this surface "
-                             "holds a ball still on")
+        holding = float(holding_slope_deg(self.surface.rolling_resistance))
+        if not (0.0 <= self.slope_deg <= SLOPE_DEG.high and self.slope_deg < holding):
+            raise ValueError(f"slope_deg {self.slope_deg:g} is outside {SLOPE_DEG.describe()} or not below "
+                             f"{holding:.2f} deg, the steepest slope this surface holds a ball still on")
 
 
 LEVEL_FAIRWAY = GroundSpec()
