@@ -32,7 +32,6 @@ import numpy as np
 
 from flight.air import Air
 from flight.physics import initial_state
-from shots.clubs import CLUBS
 from shots.heldout import check_training_rows
 from shots.pbp import load_pbp, recorded_apex
 from shots.records import ShotRecord, trajectories_path, write_shots, write_trajectories

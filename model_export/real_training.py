@@ -15,12 +15,12 @@ from typing import Any
 
 import numpy as np
 
+from flight.constants import YARD_M
 from model_export.export import export_bundle
 from model_export.joint import JointConfig, JointResult, train_joint
 from model_export.observations import NOISE, OBSERVABLES, PATH_OBSERVATIONS, PATH_SIGMA_M
 from model_export.real_data import SourceData, build
 from model_export.training import TrainConfig, load_checkpoint
-from flight.constants import YARD_M
 from shots.records import read_shots
 from weights_schema.bundle import sha256_of
 from weights_schema.model_card import ModelCard

@@ -13,23 +13,23 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from flight.constants import FOOT_M, YARD_M  # noqa: E402
-from model_export.held_out import record_held_out  # noqa: E402
-from model_export.real_data import DEFAULT_SOURCES, build  # noqa: E402
-from model_export.real_training import DATA_FILE, export_real  # noqa: E402
-from shots.markdown import table  # noqa: E402
-from shots.paths import shared_data_dir  # noqa: E402
-from weights_schema.bundle import load_bundle  # noqa: E402
-from weights_schema.model_card import ModelCard  # noqa: E402
+from flight.constants import FOOT_M, YARD_M
+from model_export.held_out import record_held_out
+from model_export.real_data import DEFAULT_SOURCES, build
+from model_export.real_training import DATA_FILE, export_real
+from shots.markdown import table
+from shots.paths import shared_data_dir
+from weights_schema.bundle import load_bundle
+from weights_schema.model_card import ModelCard
 
 
 def cells(card: ModelCard) -> list[str]:
     """TrackMan landing (yd), TOUR Championship apex (ft), PGA carry / max height (yd) / land angle (deg)."""
     errors = {h.name.split(" ")[0]: h.errors for h in card.held_out or []}
     trackman, tour, pga = errors["TrackMan"], errors["TOUR"], errors["PGA"]
-    return [f"{trackman['landing_point_m'] / YARD_M:.1f} yd", f"{tour['apex_m'] / FOOT_M:.1f} ft",
-            f"{pga['carry_m'] / YARD_M:.1f} yd / {pga['max_height_m'] / YARD_M:.1f} yd / "
-            f"{pga['landing_angle_deg']:.1f} deg"]
+    pga_cell = (f"{pga['carry_m'] / YARD_M:.1f} yd / {pga['max_height_m'] / YARD_M:.1f} yd / "
+                f"{pga['landing_angle_deg']:.1f} deg")
+    return [f"{trackman['landing_point_m'] / YARD_M:.1f} yd", f"{tour['apex_m'] / FOOT_M:.1f} ft", pga_cell]
 
 
 def main() -> int:
