@@ -124,8 +124,8 @@ class Heldout(_Strict):
     )
     explained_fraction_ci: tuple[float, float] | None
     absorbs_noise: bool = Field(
-        description="the explained share is above 100 % beyond doubt: the fit goes below what measurement noise "
-        "alone leaves, so part of what it removes is noise, not physics"
+        description="the explained share is above 100 % beyond doubt and the fit goes more than a quarter below what "
+        "measurement noise alone leaves (further than noise scatters by chance): part of what it removes is noise"
     )
 
 
