@@ -10,7 +10,7 @@ import pytest
 import schemathesis
 from hypothesis import HealthCheck, given, settings
 from schemathesis import GenerationMode
-from schemathesis.checks import positive_data_acceptance
+from schemathesis.checks import negative_data_rejection, positive_data_acceptance
 from servers import running
 
 from service.api.app import create_app
@@ -22,6 +22,16 @@ NOT_EXPRESSIBLE = [positive_data_acceptance]
 """Left out: some cross-field rules cannot be written in JSON Schema (back and side spin together within 15,000 rpm;
 a GSPro shot needs Speed, VLA and a spin; a ground's slope no steeper than its surface holds a ball on, a stimp
 reading for a green only), so a few schema-valid requests are rightly refused."""
+
+
+def _ball_data_ignored(label: str, body: object) -> bool:
+    """A GSPro message whose ShotDataOptions say it carries no ball data, or that it is a heartbeat, is answered
+    without reading its BallData (connectors fill it with zeros): an out-of-range BallData there is rightly
+    accepted, and the schema cannot tie BallData's ranges to those flags."""
+    options = body.get("ShotDataOptions") if isinstance(body, dict) else None
+    if label != "POST /v1/gspro" or not isinstance(options, dict):
+        return False
+    return options.get("ContainsBallData") is False or options.get("IsHeartBeat") is True
 
 
 @pytest.fixture(autouse=True)
@@ -64,6 +74,7 @@ def test_no_server_error_and_every_response_in_its_schema(base_url, mode):
         @given(case=operation.as_strategy(generation_mode=mode))
         @settings(max_examples=CASES_PER_ROUTE, deadline=None, suppress_health_check=list(HealthCheck), database=None)
         def check(case):
-            case.call_and_validate(base_url=base_url, excluded_checks=NOT_EXPRESSIBLE, timeout=30)
+            excluded = NOT_EXPRESSIBLE + ([negative_data_rejection] if _ball_data_ignored(label, case.body) else [])
+            case.call_and_validate(base_url=base_url, excluded_checks=excluded, timeout=30)
 
         check()
