@@ -18,7 +18,7 @@ from pydantic import ValidationError
 from discovery.effects import Context, equivalent_altitude_m
 from discovery.model import FlightModel
 from discovery.noise import RADAR_NOISE
-from discovery.outside import term_and_weights
+from discovery.outside import OUTSIDE, term_and_weights
 from discovery.simulator import Setup
 from flight.air import Air
 from flight.outcomes import Flight
@@ -141,8 +141,9 @@ def _fly_model(
     trajectories: bool,
 ) -> Flight:
     """The true launches flown through the model with the hidden effects, in its flight core."""
-    unknown = set(hidden) - set(KNOBS) - set(LAUNCH_BIASES) - {"air_density", "wind", "landing_elevation"}
-    unknown -= {name for name in hidden if term_and_weights({name: hidden[name]}, np.ones(1))[0] is not None}
+    unknown = (
+        set(hidden) - set(KNOBS) - set(LAUNCH_BIASES) - set(OUTSIDE) - {"air_density", "wind", "landing_elevation"}
+    )
     if unknown or wind_profile != "uniform":
         raise ValueError(f"a model's own flights take library effects, uniform wind and discovery.outside: {unknown}")
     n = len(true.club)
