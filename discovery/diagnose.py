@@ -67,7 +67,7 @@ COMBINATION_LEVEL = 0.975
 
 NOISE_SPREAD = 0.25
 """How far below the noise floor a held-out error may fall by chance: clean 300-shot sets flown by the served model
-scored 0.58-0.77 around a floor of about 0.70 (docs/discovery.md), so only a fit more than this share below it is
+scored 0.56-0.84 around a floor of about 0.70 (docs/discovery.md), so only a fit more than this share below it is
 said to absorb noise."""
 
 PAIR_ANCHORS = 3

@@ -293,7 +293,10 @@ def tables(runs: list[Run], model_name: str, truth: Truth = "model") -> str:
     if outside:
         rows.append(f"| outside effects reported as unlisted | {_share([r.correct for r in outside])} | ≥ 80 % |")
     if hidden:
-        rows.append(f"| fits flagged as absorbing noise (> 100 % explained beyond doubt) | {absorbing} | - |")
+        rows.append(
+            "| fits flagged as absorbing noise (over 100 % beyond doubt, error 25 % below the noise floor) | "
+            f"{absorbing} | - |"
+        )
     if errors:
         rows.append(
             f"| parameters within 10 % of the effect's size | {sum(e <= 0.1 for e in errors)} of {len(errors)} "
