@@ -13,13 +13,13 @@ Ids follow `shots.tourcast.shot_id`; a key that holds several radar rows (a prov
 from __future__ import annotations
 
 import csv
-import math
 import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
 
 from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from shots.cells import BadRow, MalformedCell, finite_number
 from shots.heldout import held_out_set
 from shots.records import RANGES, RecordError, ShotRecord, reading
 from shots.tourcast import shot_id, shot_key
@@ -86,30 +86,9 @@ class RestPosition:
     lie: str
 
 
-class _BadRow(Exception):
-    """A radar row that cannot become a canonical record; the message is the drop reason."""
-
-
-class _Malformed(_BadRow):
-    """A cell that is not what its column must hold; `cell` names the column and quotes the text."""
-
-    def __init__(self, reason: str, column: str, text: str):
-        super().__init__(reason)
-        self.cell = f"column '{column}': {text!r}"
-
-
 def _number(cells: dict[str, str], column: str) -> float | None:
-    """A cell as a float; None where NA or blank, _Malformed where it is not a finite number."""
-    text = (cells.get(column) or "").strip()
-    if text in MISSING:
-        return None
-    try:
-        value = float(text)
-    except ValueError:
-        raise _Malformed(f"'{column}' is not a number", column, text) from None
-    if not math.isfinite(value):
-        raise _Malformed(f"'{column}' is not a number", column, text)
-    return value
+    """A cell as a float; None where NA or blank, MalformedCell where it is not a finite number."""
+    return finite_number(cells.get(column) or "", column, MISSING)
 
 
 def _event(path: Path, rows: list[dict[str, str]]) -> tuple[str, str]:
@@ -165,7 +144,7 @@ def _identified(tournament: str, keyed: list[tuple[int, tuple, dict[str, str]]])
 def _in_range(column: str, canonical: str, value: float) -> float:
     allowed = RANGES[canonical]
     if not allowed.low <= value <= allowed.high:
-        raise _BadRow(f"'{column}' ({canonical}) outside the allowed range {allowed.describe()}")
+        raise BadRow(f"'{column}' ({canonical}) outside the allowed range {allowed.describe()}")
     return value
 
 
@@ -177,9 +156,9 @@ def _record(row: RadarRow, apex: bool) -> ShotRecord:
     for column, (canonical, factor) in columns.items():
         value = numbers[column]
         if value is None and column in LAUNCH:
-            raise _BadRow(f"'{column}' is NA")
+            raise BadRow(f"'{column}' is NA")
         if column == SPIN and value == 0:
-            raise _BadRow(f"no spin: '{SPIN}' is 0 (missing)")
+            raise BadRow(f"no spin: '{SPIN}' is 0 (missing)")
         if value is not None:
             values[canonical] = _in_range(column, canonical, value * factor)
     return ShotRecord(shot_id=row.shot_id, session=row.session, group=row.group, spin_axis_deg=0.0, **values)
@@ -199,9 +178,9 @@ def load_pbp(path: str | os.PathLike, *, apex: bool = True, skip_bad_rows: bool 
     for row in rows:
         try:
             records.append(_record(row, apex and reason is None))
-        except _Malformed as bad:
+        except MalformedCell as bad:
             report.bad_row(f"{path} line {row.line} {bad.cell}: {bad}", str(bad), row.line, skip_bad_rows)
-        except _BadRow as bad:
+        except BadRow as bad:
             report.drop(str(bad), row.line)
     report.refuse_bad_rows(skip_bad_rows)
     report.kept = len(records)
@@ -239,7 +218,7 @@ def _value(path: str | os.PathLike, row: RadarRow, column: str, factor: float) -
     """A cell in SI; None where NA; a RecordError naming line and column where it is not a number."""
     try:
         value = _number(row.cells, column)
-    except _Malformed as bad:
+    except MalformedCell as bad:
         raise RecordError(f"{path} line {row.line} {bad.cell}: {bad}") from None
     return None if value is None else value * factor
 

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from shots.cells import BadRow, MalformedCell, finite_number
 from shots.records import RANGES, RecordError, ShotRecord, reading
 
 SPEED = {"mph": MPH_TO_MPS, "m/s": 1.0, "km/h": 1.0 / 3.6}
@@ -112,18 +113,6 @@ class Conversion:
     trajectories: dict[str, np.ndarray] = field(default_factory=dict)
 
 
-class _BadRow(Exception):
-    """A row that cannot become a canonical record; the message is the drop reason."""
-
-
-class _Malformed(_BadRow):
-    """A cell that is not what its column must hold; `cell` names the column and quotes the text."""
-
-    def __init__(self, reason: str, column: str, text: str):
-        super().__init__(reason)
-        self.cell = f"column '{column}': {text!r}"
-
-
 def read_table(path: Path) -> tuple[list[str], list[str], list[tuple[int, list[str]]]]:
     """Header, units row and (line number, cells) of each data row; an optional 'sep=,' first line is skipped."""
     with reading(path), path.open(newline="", encoding="utf-8-sig") as handle:
@@ -162,23 +151,15 @@ def _column_factors(path: Path, header: list[str], units: list[str], wanted: dic
 
 def _number(cells: list[str], column: str, spec: tuple[int, float]) -> float | None:
     index, factor = spec
-    text = cells[index].strip() if index < len(cells) else ""
-    if text == "":
-        return None
-    try:
-        value = float(text)
-    except ValueError:
-        raise _Malformed(f"'{column}' is not a number", column, text) from None
-    if not math.isfinite(value):
-        raise _Malformed(f"'{column}' is not a number", column, text)
-    return value * factor
+    value = finite_number(cells[index] if index < len(cells) else "", column)
+    return None if value is None else value * factor
 
 
 def _in_range(column: str, canonical: str, value: float | None) -> float | None:
     allowed = RANGES[canonical]
     if value is not None and not allowed.low <= value <= allowed.high:
         reason = f"'{column}' ({canonical}) outside the allowed range {allowed.describe()}"
-        raise _Malformed(reason, column, f"{canonical} = {value:g}")
+        raise MalformedCell(reason, column, f"{canonical} = {value:g}")
     return value
 
 
@@ -187,7 +168,7 @@ def _carry(length: float | None, side: float | None) -> tuple[float | None, floa
     if length is None or side is None:
         return None, None
     if abs(side) > length:
-        raise _Malformed(
+        raise MalformedCell(
             f"'{CARRY_SIDE}' larger than '{CARRY_LENGTH}' (Length is the straight-line distance)",
             CARRY_SIDE,
             f"{side:g} m against a length of {length:g} m",
@@ -270,14 +251,14 @@ def load_trackman(path: str | os.PathLike, *, min_tracked_fraction: float | None
             for name, (canonical, _) in LAUNCH.items():
                 value = _number(cells, name, specs[name])
                 if value is None:
-                    raise _BadRow(f"'{name}' is blank")
+                    raise BadRow(f"'{name}' is blank")
                 values[canonical] = _in_range(name, canonical, value)
             if flight:
                 values.update(_outcome(cells, specs))
-        except _Malformed as bad:
+        except MalformedCell as bad:
             report.bad_row(f"{path} line {line} {bad.cell}: {bad}", str(bad), line, skip_bad_rows)
             continue
-        except _BadRow as bad:
+        except BadRow as bad:
             report.drop(str(bad), line)
             continue
         timestamp, day = _when(cell(cells, "Date")) if cell(cells, "Date") else (None, None)
