@@ -42,3 +42,10 @@ def running(app, ready_path: str = "/healthz", timeout_s: float = 20.0) -> Itera
     finally:
         server.should_exit = True
         thread.join(timeout=10)
+
+
+def shot(http: httpx.Client, **body) -> dict:
+    """POST one shot to /v1/shots, asserting a 200, and return its JSON."""
+    response = http.post("/v1/shots", json=body)
+    assert response.status_code == 200, response.text
+    return response.json()

@@ -7,9 +7,8 @@ import json
 import subprocess
 import sys
 
-import httpx
 import pytest
-from servers import running
+from servers import running, shot
 
 from flight.constants import MPH_TO_MPS, YARD_M
 from service.api.app import create_app
@@ -26,12 +25,6 @@ SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100
 def client():
     with running(create_app()) as http:
         yield http
-
-
-def shot(http: httpx.Client, **body) -> dict:
-    response = http.post("/v1/shots", json=body)
-    assert response.status_code == 200, response.text
-    return response.json()
 
 
 def test_health_reports_the_loaded_model_and_the_card(client):

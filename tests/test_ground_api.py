@@ -11,7 +11,7 @@ import math
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from servers import running
+from servers import running, shot
 
 from flight.constants import YARD_M
 from flight.ground import SURFACES, GroundSpec, holding_slope_deg
@@ -30,12 +30,6 @@ WEDGE = {"ball_speed_mps": 40.0, "launch_angle_deg": 30.0, "spin_rpm": 10000.0}
 def client():
     with running(create_app()) as http:
         yield http
-
-
-def shot(http, **body) -> dict:
-    response = http.post("/v1/shots", json=body)
-    assert response.status_code == 200, response.text
-    return response.json()
 
 
 def test_every_shot_rolls_to_rest_on_a_level_fairway_unless_told(client):
