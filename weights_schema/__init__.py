@@ -6,4 +6,4 @@ Pure pydantic + hashlib: the serving install imports this without torch.
 from weights_schema.bundle import BundleError, load_bundle
 from weights_schema.model_card import SCHEMA_VERSION, ModelCard
 
-__all__ = ["BundleError", "ModelCard", "SCHEMA_VERSION", "load_bundle"]
+__all__ = ["SCHEMA_VERSION", "BundleError", "ModelCard", "load_bundle"]
