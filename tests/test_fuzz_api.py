@@ -62,6 +62,7 @@ def test_the_schema_covers_every_route(base_url):
         "GET /healthz",
         "GET /v1/model",
         "GET /v1/latency",
+        "GET /metrics",
     }
 
 

@@ -5,6 +5,8 @@ where `ps` would show it); browser origins for CORS from --cors-origin or $GOLFF
 verified completely before any worker starts; SIGTERM or Ctrl-C lets in-flight requests finish (up to
 GRACEFUL_SHUTDOWN_S) before the workers exit. --connect-port also takes GSPro Open Connect over TCP in the same
 process (`service.open_connect`), on loopback unless --connect-host says otherwise: the protocol has no key.
+Several workers share their Prometheus metrics through files in $PROMETHEUS_MULTIPROC_DIR (a temporary directory
+unless set), so GET /metrics answers for the whole server whichever worker takes the scrape.
 """
 
 from __future__ import annotations
@@ -70,8 +72,9 @@ def _listenable(host: str, port: int) -> None:
 def run(args: argparse.Namespace) -> int:
     import uvicorn
 
-    from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
     from flight.bundle_check import verify_bundle
+    from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
+    from service.api.metrics import shared_across_workers
     from service.model_location import MODEL_ENV, model_dir
     from service.open_connect.server import CONNECT_HOST_ENV, CONNECT_PORT_ENV
 
@@ -107,14 +110,15 @@ def run(args: argparse.Namespace) -> int:
             f"{args.connect_port} can send shots (the protocol has no key)",
             file=sys.stderr,
         )
-    uvicorn.run(
-        "service.api.app:create_app",
-        factory=True,
-        host=args.host,
-        port=args.port,
-        workers=args.workers,
-        access_log=False,
-        log_level="warning",
-        timeout_graceful_shutdown=GRACEFUL_SHUTDOWN_S,
-    )
+    with shared_across_workers(args.workers):  # GET /metrics sums every worker's counts
+        uvicorn.run(
+            "service.api.app:create_app",
+            factory=True,
+            host=args.host,
+            port=args.port,
+            workers=args.workers,
+            access_log=False,
+            log_level="warning",
+            timeout_graceful_shutdown=GRACEFUL_SHUTDOWN_S,
+        )
     return 0

@@ -10,7 +10,8 @@ of the routes: a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and
 ($GOLFFLIGHT_CORS_ORIGINS); every refusal is a 4xx whose body names the field, the value and the allowed range
 (`service.api.errors`). Given a connect address, the lifespan also opens GSPro Open Connect over TCP on the same
 loop (`service.open_connect`). Every shot flown, from any input, goes to the live viewer's feed (GET /viewer,
-`service.viewer`).
+`service.viewer`). The outermost middleware counts and times every request for GET /metrics (Prometheus) and
+/v1/latency (`service.api.request_metrics`).
 """
 
 from __future__ import annotations
@@ -23,11 +24,12 @@ from importlib.metadata import version
 
 from fastapi import FastAPI
 from fastapi.middleware.cors import CORSMiddleware
+from starlette.routing import Route
 
 from service.api import errors
 from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
-from service.api.latency import RequestTimer
-from service.api.routes import gspro, shots, status, viewer
+from service.api.request_metrics import RequestMetrics
+from service.api.routes import gspro, metrics, shots, status, viewer
 from service.api.state import ServiceState
 from service.model_location import model_dir
 from service.open_connect.server import ConnectAddress, OpenConnectServer
@@ -73,7 +75,6 @@ def create_app(
         lifespan=lifespan,
     )
     app.state.service = state
-    app.add_middleware(RequestTimer, rolling=state.requests, prefixes=("/v1/shots", gspro.GSPRO_PATH))
     if api_key:
         app.add_middleware(ApiKey, key=api_key)
     if cors_origins:
@@ -85,6 +86,12 @@ def create_app(
         )
     app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)
     errors.install(app)
-    for router in (shots.router, gspro.router, status.router, viewer.router):
+    routers = (shots.router, gspro.router, status.router, metrics.router, viewer.router)
+    for router in routers:
         app.include_router(router)
+    routes = [route for router in routers for route in router.routes] + [r for r in app.routes if isinstance(r, Route)]
+    simulation_routes = {"/v1/shots", "/v1/shots/batch", gspro.GSPRO_PATH}
+    app.add_middleware(
+        RequestMetrics, metrics=state.metrics, routes=routes, rolling=state.requests, timed_routes=simulation_routes
+    )
     return app

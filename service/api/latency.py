@@ -1,8 +1,8 @@
-"""Rolling latency figures of the running service: server-side simulation time and whole requests."""
+"""Rolling latency figures of the running service (GET /v1/latency): server-side simulation time and whole requests,
+fed by the same measurements as /metrics' histograms (`service.api.metrics`)."""
 
 from __future__ import annotations
 
-import time
 from collections import deque
 
 import numpy as np
@@ -26,19 +26,3 @@ class Rolling:
         p50, p95, p99 = np.percentile(np.fromiter(self._samples, float), [50, 95, 99]) * 1e3
         return {"count": len(self._samples), "p50_ms": float(p50), "p95_ms": float(p95), "p99_ms": float(p99)}
 
-
-class RequestTimer:
-    """Pure ASGI middleware timing whole requests on the simulation routes (receipt to last byte sent)."""
-
-    def __init__(self, app, rolling: Rolling, prefixes: tuple[str, ...]):
-        self.app, self.rolling, self.prefixes = app, rolling, prefixes
-
-    async def __call__(self, scope, receive, send):
-        if scope["type"] != "http" or not scope["path"].startswith(self.prefixes):
-            await self.app(scope, receive, send)
-            return
-        started = time.perf_counter()
-        try:
-            await self.app(scope, receive, send)
-        finally:
-            self.rolling.add(time.perf_counter() - started)

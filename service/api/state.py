@@ -6,13 +6,16 @@ from __future__ import annotations
 import gc
 import threading
 import time
+from importlib.metadata import version
 from pathlib import Path
+from typing import Literal
 
 from fastapi import Depends, Request
 
 from service.api.batch_process import BatchProcess
 from service.api.gspro import GSProMessage, GSProReply, fly_message
 from service.api.latency import Rolling
+from service.api.metrics import ServiceMetrics
 from service.engine import FlightEngine
 from service.viewer.event import Source
 from service.viewer.feed import ShotFeed
@@ -23,8 +26,8 @@ class NotReady(Exception):
 
 
 class ServiceState:
-    """The engine once loaded (or why it failed), the batch process, the rolling latency figures and the shots
-    the viewer shows."""
+    """The engine once loaded (or why it failed), the batch process, the rolling latency figures, the Prometheus
+    metrics and the shots the viewer shows."""
 
     def __init__(self, bundle_dir: Path):
         self.bundle_dir = bundle_dir
@@ -35,6 +38,18 @@ class ServiceState:
         self.loaded = threading.Event()
         self.batches = BatchProcess(bundle_dir)
         self.feed = ShotFeed()
+        self.metrics = ServiceMetrics(self.model_labels)
+
+    def model_labels(self) -> dict[str, str] | None:
+        """The loaded model's variant and ONNX SHA-256 and the package version (/metrics' info labels)."""
+        if self.engine is None:
+            return None
+        return {"variant": self.engine.variant, "sha256": self.engine.sha256, "version": version("golfflight")}
+
+    def record_simulation(self, kind: Literal["shot", "batch"], seconds: float) -> None:
+        """One simulation's engine time, into /v1/latency's window and /metrics' histogram."""
+        self.simulation.add(seconds)
+        self.metrics.simulation_seconds.labels(kind).observe(seconds)
 
     def load(self) -> None:
         """Load the model here and in the batch process; either failing leaves the service up to say why."""
@@ -58,7 +73,7 @@ class ServiceState:
         try:
             reply = fly_message(self.engine, message)
         finally:
-            self.simulation.add(time.perf_counter() - started)
+            self.record_simulation("shot", time.perf_counter() - started)
         self.feed.publish_gspro(source, message, reply)
         return reply
 

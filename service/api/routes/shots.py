@@ -46,7 +46,7 @@ async def shot(
     except FlightError as error:
         return JSONResponse({"detail": [body_detail(str(error), "flight_error")]}, 422)
     finally:
-        state.simulation.add(time.perf_counter() - started)
+        state.record_simulation("shot", time.perf_counter() - started)
     state.feed.publish("http", request, result)
     return json_response(result)
 
@@ -67,6 +67,7 @@ async def batch(request: BatchRequest, http: Request, state: ServiceState = Depe
         body, seconds = await state.batches.submit(await http.body())
     except BrokenProcessPool:
         return JSONResponse({"detail": BATCH_PROCESS_DIED}, 503)
-    state.simulation.add(seconds)
+    state.record_simulation("batch", seconds)
+    state.metrics.batch_shots.observe(len(request.shots))
     state.feed.publish_batch(request.shots)
     return Response(body, media_type="application/json")

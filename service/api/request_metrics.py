@@ -1,0 +1,68 @@
+"""Pure ASGI middleware timing every HTTP request once, for /metrics and /v1/latency alike.
+
+It sits outside every other middleware, so requests the guards refuse (401, 413) are counted too. Labels stay
+bounded whatever clients send: the route's template (`/viewer/{name}`, never the raw path; `<unmatched>` for a path
+no route has) and the method among the standard ones (`other` for the rest).
+"""
+
+from __future__ import annotations
+
+import time
+
+from starlette.routing import BaseRoute, Match
+
+from service.api.latency import Rolling
+from service.api.metrics import ServiceMetrics
+
+UNMATCHED = "<unmatched>"
+"""Route label of a request whose path no route serves (a 404)."""
+
+METHODS = frozenset({"GET", "HEAD", "POST", "PUT", "PATCH", "DELETE", "OPTIONS"})
+"""Method labels kept as sent; any other method is labelled `other`."""
+
+
+def route_template(routes: list[BaseRoute], scope: dict) -> str:
+    """The path template of the route that serves `scope`: the one the router chose, or, for a request answered
+    before routing (a guard's refusal), the first of `routes` (every route of the app, each with its whole path)
+    that matches it."""
+    chosen = getattr(scope.get("route"), "path", None)
+    if chosen is not None:
+        return chosen
+    for route in routes:
+        match, _ = route.matches(scope)
+        if match is not Match.NONE:
+            return route.path
+    return UNMATCHED
+
+
+class RequestMetrics:
+    """Counts and times every HTTP request by route template, method and status; the requests on `timed_routes`
+    (the simulation routes) also go to `rolling`, /v1/latency's request window."""
+
+    def __init__(self, app, metrics: ServiceMetrics, routes: list[BaseRoute], rolling: Rolling, timed_routes: set[str]):
+        self.app, self.metrics, self.routes = app, metrics, routes
+        self.rolling, self.timed_routes = rolling, frozenset(timed_routes)
+
+    async def __call__(self, scope, receive, send):
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        status = 500  # what the client gets if the app raises before it answers
+
+        async def send_and_note_status(message):
+            nonlocal status
+            if message["type"] == "http.response.start":
+                status = message["status"]
+            await send(message)
+
+        started = time.perf_counter()
+        try:
+            await self.app(scope, receive, send_and_note_status)
+        finally:
+            seconds = time.perf_counter() - started
+            route = route_template(self.routes, scope)
+            method = scope["method"] if scope["method"] in METHODS else "other"
+            self.metrics.requests.labels(route, method, str(status)).inc()
+            self.metrics.request_seconds.labels(route, method).observe(seconds)
+            if route in self.timed_routes:
+                self.rolling.add(seconds)

@@ -1,0 +1,23 @@
+"""GET /metrics: the service's Prometheus metrics in the text exposition format (`service.api.metrics`), behind the
+API key like every route but /healthz. Answered while the model loads too (the model's info metric appears once it
+is loaded): a scrape should tell a loading server from a dead one."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, Depends
+from fastapi.responses import PlainTextResponse, Response
+
+from service.api.metrics import CONTENT_TYPE
+from service.api.routes.responses import ERROR_RESPONSES
+from service.api.state import ServiceState, service_state
+
+METRICS_PATH = "/metrics"
+
+router = APIRouter()
+
+
+@router.get(METRICS_PATH, response_class=PlainTextResponse, responses={401: ERROR_RESPONSES[401]})
+async def metrics(state: ServiceState = Depends(service_state)) -> Response:
+    """Requests and errors by route, request and simulation latency histograms, shots per batch and the model's
+    variant and hash (`golfflight_model_info`), summed over every worker of the server."""
+    return Response(state.metrics.exposition(), media_type=CONTENT_TYPE)
