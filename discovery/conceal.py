@@ -18,7 +18,7 @@ from pydantic import ValidationError
 from discovery.effects import Context, equivalent_altitude_m
 from discovery.model import FlightModel
 from discovery.noise import RADAR_NOISE
-from discovery.outside import OUTSIDE, term_and_weights
+from discovery.outside import OUTSIDE, air_motion, term_and_weights
 from discovery.simulator import Setup
 from flight.air import Air
 from flight.outcomes import Flight
@@ -75,7 +75,7 @@ def conceal(
 
     hidden uses the report's parameter conventions, e.g. {"wind": {"speed_mps": 4, "from_deg": 0}}, plus
     {"critical_reynolds": {"value": 9e4}} for the reference world's effect outside the library, or one of
-    `discovery.outside.OUTSIDE` for a model's.
+    `discovery.outside.OUTSIDE` for a model's (the gust, `height_gust`, is air motion: either world takes it).
     """
     rng = np.random.default_rng(seed)
     config = SynthConfig(n_shots=n_shots, seed=seed, calm=True)
@@ -102,6 +102,7 @@ def conceal(
         params = replace(params, critical_reynolds=hidden[OUTSIDE_EFFECT]["value"])
     keep = trajectories or wind_profile == "log"
     if model is None:
+        wind = air_motion(hidden, wind)
         flight = fly_reference(initial_state(**true.launch()), air, wind, ground, keep_states=keep, params=params)
     else:
         flight = _fly_model(model, hidden, true, wind_profile, trajectories)
@@ -159,7 +160,8 @@ def _fly_model(
     term, weights = term_and_weights(hidden, density * ratio)
     ground = np.full(n, hidden.get("landing_elevation", {"height_m": 0.0})["height_m"])
     setup = Setup(true.launch(), ratio, density, wind, ground, scale, weights)
-    return model.fly(setup, term, keep_states=trajectories)
+    air = air_motion(hidden, Wind.from_components(wind[:, 0], wind[:, 1]))
+    return model.fly(setup, term, keep_states=trajectories, air=air)
 
 
 def _mean_wind_factor(flight: Flight, wind: Wind, shots: np.ndarray) -> float:

@@ -1,8 +1,9 @@
 """The unlisted effect: a learned extra acceleration in the equations of motion, summarised as a short expression.
 
-The correction is a weighted sum of physical terms of the air-relative velocity v and the spin w: drag and
-Magnus-direction lift, each with weights on |v|^2, |v| and 1 (a coefficient change that depends on speed, i.e. on
-the Reynolds number), sideways-only drag, and constant side and vertical forces. It is learned
+The correction is a weighted sum of physical terms of the air-relative velocity v, the spin w and the height h: drag
+and Magnus-direction lift, each with weights on |v|^2, |v| and 1 (a coefficient change that depends on speed, i.e.
+on the Reynolds number), sideways-only drag, constant side and vertical forces, and a push across or along the line
+growing with height and speed (the drag of a wind that grows with height, which no uniform wind has). It is learned
 on top of the best library explanation: the full linearised term library is fitted first (ridge), then terms are
 removed one at a time, weakest first, while the weakest is not clearly needed (|t| < MIN_T), at most MAX_TERMS kept:
 as small as the fit allows. The kept terms are refitted through the simulator and read out as an expression.
@@ -47,12 +48,26 @@ TERMS: tuple[Term, ...] = (
     Term("|v|^2 x", "1/m", 1e-4, "a constant side force coefficient (+ pushes right)"),
     Term("|v|^2 z", "1/m", 1e-4, "vertical lift that does not depend on spin"),
     Term("z", "m/s^2", 0.2, "a constant vertical acceleration"),
+    Term(
+        "|v| h x",
+        "1/(m s)",
+        5e-4,
+        "a push to the right growing with height h and speed (a crosswind growing with height)",
+    ),
+    Term(
+        "|v| h y",
+        "1/(m s)",
+        5e-4,
+        "a push down the line growing with height h and speed (a tailwind growing with height)",
+    ),
 )
 
 
-def features(v: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Every term's acceleration per unit weight [N, len(TERMS), 3]."""
+def features(v: np.ndarray, w: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Every term's acceleration per unit weight [N, len(TERMS), 3] at air-relative velocity, spin and position
+    [N,3]."""
     speed = np.linalg.norm(v, axis=1)
+    sheared = speed * np.maximum(r[:, 2], 0.0)
     unit_v = v / np.maximum(speed, 1e-12)[:, None]
     magnus = np.cross(w, v)
     unit_m = magnus / np.maximum(np.linalg.norm(magnus, axis=1), 1e-12)[:, None]
@@ -68,6 +83,8 @@ def features(v: np.ndarray, w: np.ndarray) -> np.ndarray:
         np.stack([speed**2, zero, zero], 1),
         np.stack([zero, zero, speed**2], 1),
         np.stack([zero, zero, np.ones_like(speed)], 1),
+        np.stack([sheared, zero, zero], 1),
+        np.stack([zero, sheared, zero], 1),
     ]
     return np.stack(columns, axis=1)
 
@@ -76,8 +93,8 @@ def correction_effect(kept: tuple[int, ...]) -> Effect:
     """The learned term restricted to `kept` terms, as an effect the fitter treats like any other."""
     kept = tuple(kept)
 
-    def accelerate(v: np.ndarray, w: np.ndarray, weights: np.ndarray) -> np.ndarray:
-        return np.einsum("nk,nkc->nc", weights, features(v, w)[:, kept])
+    def accelerate(v: np.ndarray, w: np.ndarray, r: np.ndarray, weights: np.ndarray) -> np.ndarray:
+        return np.einsum("nk,nkc->nc", weights, features(v, w, r)[:, kept])
 
     def apply(theta: np.ndarray, conditions: Setup) -> Setup:
         out = conditions.copy()
@@ -120,7 +137,7 @@ def expression_of(kept: tuple[int, ...], theta: np.ndarray | None) -> str:
         parts.append(f"{coefficient} * [{TERMS[index].name}]")
     return (
         "a_extra = " + " + ".join(parts) + " (m/s^2; v air-relative velocity, m = unit (w x v) for spin w, "
-        "x right, y down the line, z up)"
+        "h height, x right, y down the line, z up)"
     )
 
 

@@ -248,15 +248,17 @@ class Diagnoser:
                 chosen = alone
         return chosen
 
-    def structure_left(self, explanation: Scored) -> bool:
-        """Whether the systematic test still finds structure in the residuals that `explanation` leaves."""
+    def structure_left(self, explanation: Scored) -> list[str]:
+        """What the systematic test still finds in the residuals that `explanation` leaves (its summary lines; empty
+        when nothing is left; "the whole mismatch" for no explanation)."""
         if explanation.fit.k == 0:
-            return True
+            return ["the whole mismatch"]
         everyone = np.arange(len(self.recordings))
         after = self.problem.predict(explanation.fit.effects, explanation.fit.theta, everyone)[0]
         residual = self.recordings.observed - after
         use = self.problem.use & np.isfinite(after)
-        return has_structure(locate(self.recordings, residual, self.problem.sigma, use, [], {}, self.dilution))
+        left = locate(self.recordings, residual, self.problem.sigma, use, [], {}, self.dilution)
+        return left.summary if has_structure(left) else []
 
     def run(self) -> Diagnosis:
         started = time.perf_counter()
@@ -281,14 +283,14 @@ class Diagnoser:
         self.fold, grouping = folds(recordings.session)
         rows = fit_rows(recordings, self.rng)
 
-        trajectory_rows = (
-            trajectory_residuals(recordings, flown.positions, flown.dt_s) if flown.positions is not None else []
+        along = (
+            trajectory_stats(list(trajectory_residuals(recordings, flown.positions, flown.dt_s).values()))
+            if flown.positions is not None
+            else []
         )
         outliers = {name: int(wild[:, j].sum()) for j, name in enumerate(OBSERVABLES) if wild[:, j].any()}
         self.dilution = expected.dilution
-        located = locate(
-            recordings, residual, expected.sigma, use, trajectory_stats(trajectory_rows), outliers, self.dilution
-        )
+        located = locate(recordings, residual, expected.sigma, use, along, outliers, self.dilution)
 
         null_z = self.problem.standardize(predicted, everyone)
         null = Scored(
@@ -302,12 +304,13 @@ class Diagnoser:
         scored = singles + pairs
         chosen, test = self.choose(null, singles, pairs)
         structure = has_structure(located)
-        unlisted = None
-        if self.with_correction and structure and self.structure_left(chosen):
+        unlisted, left = None, self.structure_left(chosen) if structure and self.with_correction else []
+        if left:
             library_best = chosen
             chosen = self.try_correction(null, chosen, rows, scored, test)
             if chosen is not library_best:
                 unlisted = learned.summary(chosen.fit, chosen.error, library_best.error)
+        unexplained = left if chosen.fit.k and unlisted is None else []
 
         systematic = structure and chosen is not null
         test.update(
@@ -380,6 +383,7 @@ class Diagnoser:
             ambiguities=ambiguities,
             heldout=heldout_block,
             statement=statement(systematic, located, effects, unlisted, heldout_block, ambiguities, scored, chosen)
+            + left_sentence(unexplained if systematic else [])
             + control_sentence(model, offset, self.response_error(chosen))
             + (scatter_sentence(scatter) if self.estimate_scatter else ""),
             service_settings=service_settings(effects, context, wind_factor),
@@ -465,6 +469,18 @@ def scatter_sentence(scatter: Scatter) -> str:
         f" The recordings scatter more from shot to shot than the assumed launch-monitor noise ({parts}, about a "
         "linear trend in the launch within each session and club), so that scatter is what they are expected to "
         "miss by."
+    )
+
+
+def left_sentence(left: list[str]) -> str:
+    """Structure the named library explanation leaves and the learned correction could not follow, in words (empty
+    where none is left): the explanation then accounts for the size of the mismatch, not all of its structure."""
+    if not left:
+        return ""
+    return (
+        f" Structure remains after it ({'; '.join(left[:2])}) that neither it nor a learned correction over speed, "
+        "spin and height explains: part of the mismatch may lie outside the library, so its parameters are "
+        "approximate."
     )
 
 

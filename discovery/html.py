@@ -1,21 +1,75 @@
-"""report.html: the statement, the tables and the plots an engineer looks at first (residuals against the
-covariates that matter, before/after held-out histograms, trajectory overlays, the candidates' scores)."""
+"""report.html: the statement, the tables and the interactive figures an engineer looks at first (`discovery.figures`:
+residuals against the covariates that matter and along the flight, per-session means, held-out residuals and
+trajectories before and after the correction, the candidates' scores).
+
+One self-contained file: plotly.js is embedded once in the page, nothing is fetched, so the report opens offline.
+The figures need plotly, the optional extra `report`; without it the page keeps every table and the statement and
+says which extra to install (`PLOTS_MISSING`), so a serving install can still diagnose.
+"""
 
 from __future__ import annotations
 
 import json
 from html import escape
 
-import numpy as np
-
-from discovery import svg
-from discovery.recordings import LABELS, OBSERVABLES
+from discovery.recordings import OBSERVABLES
 from discovery.schema import Report
 
 STYLE = """body{font-family:sans-serif;max-width:1280px;margin:1em auto;color:#222}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}
-th{background:#f2f2f2}td:first-child{text-align:left}.plots svg{margin:4px;border:1px solid #eee}
+th{background:#f2f2f2}td:first-child{text-align:left}.plots{display:flex;flex-wrap:wrap;gap:6px}
+.plots>div{border:1px solid #eee}.missing{background:#fff4e5;padding:.6em;border-left:4px solid #ff7f0e}
 .statement{font-size:1.1em;background:#f7f7f0;padding:.6em;border-left:4px solid #1f77b4}"""
+
+PLOTS_MISSING = (
+    "The interactive figures need plotly, which is not installed: pip install 'golfflight[report]' (the tables and "
+    "the statement are complete without it)."
+)
+
+
+def plots_available() -> bool:
+    """Whether plotly (the extra `report`) can be imported, so report.html gets its figures."""
+    try:
+        import plotly  # noqa: F401
+    except ModuleNotFoundError:
+        return False
+    return True
+
+
+class Plots:
+    """The report's figures as HTML fragments by section (each a plotly div and its script, no plotly.js) plus the
+    plotly.js bundle the page embeds once; empty, with `PLOTS_MISSING`, where plotly is not installed."""
+
+    def __init__(self, diagnosis) -> None:
+        self.sections: dict[str, list[str]] = {}
+        self.bundle = ""
+        if not plots_available():
+            return
+        from plotly.offline import get_plotlyjs
+
+        from discovery.figures import report_figures
+
+        self.bundle = get_plotlyjs()
+        count = 0
+        for section, figures in report_figures(diagnosis).items():
+            self.sections[section] = []
+            for figure in figures:
+                config = {"displaylogo": False}
+                html = figure.to_html(full_html=False, include_plotlyjs=False, div_id=f"figure-{count}", config=config)
+                self.sections[section].append(html)
+                count += 1
+
+    def div(self, section: str) -> str:
+        """The section's figures in one flex row ("" without plotly or figures)."""
+        figures = self.sections.get(section, [])
+        return f"<div class='plots'>{''.join(figures)}</div>" if figures else ""
+
+    def head(self) -> str:
+        """The page head's script: the plotly.js bundle, inline (never a CDN link)."""
+        return f"<script type='text/javascript'>{self.bundle}</script>" if self.bundle else ""
+
+    def notice(self) -> str:
+        return "" if self.bundle else f"<p class='missing'>{escape(PLOTS_MISSING)}</p>"
 
 
 def _table(header: list[str], rows: list[list[object]]) -> str:
@@ -25,67 +79,6 @@ def _table(header: list[str], rows: list[list[object]]) -> str:
     head = "".join(f"<th>{escape(h)}</th>" for h in header)
     body = "".join("<tr>" + "".join(f"<td>{cell(v)}</td>" for v in row) + "</tr>" for row in rows)
     return f"<table><tr>{head}</tr>{body}</table>"
-
-
-def _covariate_plots(diagnosis) -> list[str]:
-    report, rec = diagnosis.report, diagnosis.recordings
-    ranked = sorted(report.located.covariates, key=lambda c: (not c.significant, -abs(c.t)))
-    plots = []
-    for item in ranked[:4]:
-        j = OBSERVABLES.index(item.observable)
-        x = rec.covariate(item.covariate)
-        before = rec.observed[:, j] - diagnosis.before[:, j]
-        series = [(x, before, "model as is")]
-        if diagnosis.chosen is not None:
-            series.append((x, rec.observed[:, j] - diagnosis.after[:, j], "corrected"))
-        plots.append(
-            svg.scatter(
-                f"{item.observable} residual vs {item.covariate} (t = {item.t:.1f})",
-                item.covariate,
-                f"recorded - model, {LABELS[item.observable]}",
-                series,
-            )
-        )
-    return plots
-
-
-def _histograms(diagnosis) -> list[str]:
-    plots = []
-    for j, name in enumerate(OBSERVABLES):
-        before = diagnosis.heldout_before[:, j]
-        if not np.isfinite(before).any():
-            continue
-        series = [(before, "held out, model as is")]
-        if diagnosis.chosen is not None:
-            series.append((diagnosis.heldout_after[:, j], "held out, corrected"))
-        plots.append(svg.histogram(f"held-out residual: {name}", LABELS[name], series))
-    return plots
-
-
-def _trajectories(diagnosis, count: int = 6) -> list[str]:
-    rec = diagnosis.recordings
-    if not rec.trajectories or diagnosis.positions_before is None:
-        return []
-    index = {shot: i for i, shot in enumerate(rec.shot_id)}
-    shots = [s for s in rec.trajectories if s in index][:count]
-    side, height = [], []
-    for k, shot in enumerate(shots):
-        samples = rec.trajectories[shot]
-        i = index[shot]
-        before = diagnosis.positions_before[:, i]
-        label = k == 0
-        height.append((samples[:, 2], samples[:, 3], "recorded" if label else None, 0, False))
-        height.append((before[:, 1], before[:, 2], "model as is" if label else None, 2, True))
-        side.append((samples[:, 2], samples[:, 1], "recorded" if label else None, 0, False))
-        side.append((before[:, 1], before[:, 0], "model as is" if label else None, 2, True))
-        if diagnosis.positions_after is not None:
-            after = diagnosis.positions_after[:, i]
-            height.append((after[:, 1], after[:, 2], "corrected" if label else None, 1, False))
-            side.append((after[:, 1], after[:, 0], "corrected" if label else None, 1, False))
-    return [
-        svg.lines("trajectories: height", "down the line (m)", "height (m)", height),
-        svg.lines("trajectories: side", "down the line (m)", "right of the line (m)", side),
-    ]
 
 
 def render(diagnosis) -> str:
@@ -147,13 +140,14 @@ def render(diagnosis) -> str:
         else f"; explained share of the excess error {100 * held.explained_fraction:.0f} % "
         f"(95 % interval {100 * held.explained_fraction_ci[0]:.0f}–{100 * held.explained_fraction_ci[1]:.0f} %)"
     )
-    scored = sorted(report.candidates, key=lambda c: c.score)[:15]
+    plots = Plots(diagnosis)
     sections = [
         (
             f"<h1>Mismatch diagnosis</h1><p>{escape(report.recordings)}: {report.n_shots} shots, {report.n_sessions} "
             f"sessions, observed {', '.join(report.observables)}, {report.trajectories} trajectories. Model: "
             f"{escape(report.model.name)}. {report.seconds:.1f} s.</p>"
         ),
+        plots.notice(),
         f"<p class='statement'>{escape(report.statement)}</p>",
         f"<p><b>Systematic:</b> {report.systematic}. Test: {escape(json.dumps(report.systematic_test, default=str))}</p>",
         "<h2>Where the mismatch is</h2><ul>"
@@ -179,25 +173,20 @@ def render(diagnosis) -> str:
             f"{held.after_error:.3g}, improvement {held.improvement:.3g} (95 % interval {held.improvement_ci[0]:.3g} to "
             f"{held.improvement_ci[1]:.3g}){fraction}.</p>"
         ),
-        "<div class='plots'>" + "".join(_covariate_plots(diagnosis)) + "</div>",
-        "<h2>Before and after, held-out shots</h2><div class='plots'>" + "".join(_histograms(diagnosis)) + "</div>",
+        plots.div("residuals"),
+        "<h2>Before and after, held-out shots</h2>" + plots.div("heldout"),
     ]
-    trajectory_plots = _trajectories(diagnosis)
-    if trajectory_plots or trajectory_rows:
+    if trajectory_rows or plots.div("along"):
         sections.append(
             "<h2>Along the flight</h2>"
             + _table(
                 ["phase", "height band", "samples", "shots", "across (m)", "along (m)", "height (m)", "RMS (m)"],
                 trajectory_rows,
             )
-            + "<div class='plots'>"
-            + "".join(trajectory_plots)
-            + "</div>"
+            + plots.div("along")
         )
     sections += [
-        "<h2>Candidates</h2><div class='plots'>"
-        + svg.bars("held-out score (lower is better)", "score", [c.name for c in scored], [c.score for c in scored])
-        + "</div>",
+        "<h2>Candidates</h2>" + plots.div("candidates"),
         _table(["candidate", "fitted parameters", "k", "held-out error", "penalty", "score"], candidates),
     ]
     if report.ambiguities:
@@ -250,5 +239,5 @@ def render(diagnosis) -> str:
     ]
     return (
         f"<!doctype html><html><head><meta charset='utf-8'><title>golfflight diagnose</title><style>{STYLE}</style>"
-        f"</head><body>{''.join(sections)}</body></html>"
+        f"{plots.head()}</head><body>{''.join(sections)}</body></html>"
     )

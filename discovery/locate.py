@@ -86,9 +86,22 @@ def holm(pvalues: list[float], alpha: float = ALPHA) -> list[bool]:
     return reject
 
 
-def trajectory_residuals(recordings: Recordings, positions: np.ndarray, dt_s: float) -> list[np.ndarray]:
-    """Per shot with a recorded trajectory: rows of (t, recorded x, y, z, residual x, y, z), recorded - model."""
-    rows = []
+def binned_means(x: np.ndarray, y: np.ndarray, bins: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Means of y in quantile bins of x (the trend line drawn over a scatter)."""
+    keep = np.isfinite(x) & np.isfinite(y)
+    x, y = x[keep], y[keep]
+    if x.size < 2 * bins:
+        return np.zeros(0), np.zeros(0)
+    edges = np.unique(np.quantile(x, np.linspace(0, 1, bins + 1)))
+    which = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, len(edges) - 2)
+    centres = np.array([x[which == b].mean() for b in range(len(edges) - 1) if (which == b).any()])
+    means = np.array([y[which == b].mean() for b in range(len(edges) - 1) if (which == b).any()])
+    return centres, means
+
+
+def trajectory_residuals(recordings: Recordings, positions: np.ndarray, dt_s: float) -> dict[str, np.ndarray]:
+    """Per shot id with a recorded trajectory: rows of (t, recorded x, y, z, residual x, y, z), recorded - model."""
+    rows = {}
     index = {shot: i for i, shot in enumerate(recordings.shot_id)}
     for shot, samples in recordings.trajectories.items():
         if shot not in index:
@@ -102,7 +115,7 @@ def trajectory_residuals(recordings: Recordings, positions: np.ndarray, dt_s: fl
             continue
         t, recorded = t[inside], samples[inside, 1:4]
         model = np.stack([np.interp(t, times, path[valid, k]) for k in range(3)], axis=1)
-        rows.append(np.column_stack([t, recorded, recorded - model]))
+        rows[shot] = np.column_stack([t, recorded, recorded - model])
     return rows
 
 

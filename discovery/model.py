@@ -23,6 +23,7 @@ from flight.limits import FLIGHT_TIME_S
 from flight.onnx_coefficients import OnnxCoefficients
 from flight.outcomes import Flight
 from flight.reference_aero import CALIBRATED, ReferenceAerodynamics, ReferenceParameters
+from flight.wind import Wind
 
 DEFAULT_BUNDLE = Path(__file__).resolve().parents[1] / "models" / "default"
 REFERENCE = "reference"
@@ -58,9 +59,13 @@ class FlightModel:
         settings = (self.dt_s, self.t_max_s, self.method, correction, keep_positions)
         return simulate_setup(setup, self.coefficients_for, *settings)
 
-    def fly(self, setup: Setup, correction: Correction | None = None, keep_states: bool = False) -> Flight:
-        """The flight core's own `Flight` of a setup through this model (`discovery.simulator.fly_setup`)."""
-        return fly_setup(setup, self.coefficients_for, self.dt_s, self.t_max_s, self.method, correction, keep_states)
+    def fly(
+        self, setup: Setup, correction: Correction | None = None, keep_states: bool = False, air: Wind | None = None
+    ) -> Flight:
+        """The flight core's own `Flight` of a setup through this model (`discovery.simulator.fly_setup`; `air`
+        replaces the setup's uniform wind)."""
+        settings = (self.dt_s, self.t_max_s, self.method, correction, keep_states, air)
+        return fly_setup(setup, self.coefficients_for, *settings)
 
 
 def from_bundle(directory: str | os.PathLike, control: bool = False) -> FlightModel:

@@ -26,7 +26,7 @@ from discovery.conceal import OUTSIDE_EFFECT, conceal
 from discovery.diagnose import diagnose
 from discovery.effects import EFFECTS, LIBRARY
 from discovery.model import FlightModel
-from discovery.outside import HIGH_SPIN_LIFT_LOSS, LOW_SPEED_DRAG, OUTSIDE
+from discovery.outside import HEIGHT_GUST, HIGH_SPIN_LIFT_LOSS, LOW_SPEED_DRAG, OUTSIDE
 from discovery.recordings import from_shot_set
 from flight.reference_aero import CALIBRATED
 from flight.wind import wind_vector
@@ -71,6 +71,12 @@ def draw_effect(name: str, rng: np.random.Generator) -> dict[str, float]:
         return {"rise": float(rng.uniform(0.08, 0.2)), "speed_mps": float(rng.uniform(35.0, 50.0))}
     if name == HIGH_SPIN_LIFT_LOSS:
         return {"loss": float(rng.uniform(0.15, 0.35)), "spin_ratio": float(rng.uniform(0.2, 0.28))}
+    if name == HEIGHT_GUST:
+        return {
+            "rate_mps_per_m": float(rng.uniform(0.15, 0.35)),
+            "height_m": float(rng.uniform(6.0, 14.0)),
+            "from_deg": float(rng.uniform(0.0, 360.0)),
+        }
     ranges = {
         "launch_angle_bias": ("offset_deg", 0.7, 2.0, 0.0),
         "launch_direction_bias": ("offset_deg", 1.0, 3.0, 0.0),
@@ -89,11 +95,12 @@ def draw_effect(name: str, rng: np.random.Generator) -> dict[str, float]:
 
 def cases(truth: Truth = "model") -> list[tuple[str, tuple[str, ...]]]:
     """(case name, hidden effects): clean, every library effect, the combination, the effects outside the library
-    (and, in the reference world, a log-profile wind)."""
+    (the reference world takes the moved drag crisis and the gust that grows with height; the model's own flights
+    every one of `discovery.outside.OUTSIDE`) and, in the reference world, a log-profile wind."""
     library = [(e.name, (e.name,)) for e in LIBRARY]
     if truth == "reference":
         library.append((LOG_WIND, ("wind",)))
-    outside = (OUTSIDE_EFFECT,) if truth == "reference" else OUTSIDE
+    outside = (OUTSIDE_EFFECT, HEIGHT_GUST) if truth == "reference" else OUTSIDE
     return (
         [("clean", ())]
         + library

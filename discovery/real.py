@@ -19,6 +19,7 @@ import numpy as np
 
 from discovery import svg
 from discovery.diagnose import Diagnosis, diagnose
+from discovery.locate import binned_means
 from discovery.model import FlightModel, load_model
 from discovery.outputs import write_diagnosis
 from discovery.recordings import LABELS, OBSERVABLES, Recordings, from_shot_set
@@ -182,7 +183,7 @@ def figures(diagnosis: Diagnosis) -> dict[str, str]:
     for j, name in enumerate(OBSERVABLES):
         if name not in rec.observed_names:
             continue
-        x, y = svg.binned_means(speed, rec.observed[:, j] - diagnosis.before[:, j])
+        x, y = binned_means(speed, rec.observed[:, j] - diagnosis.before[:, j])
         scale = diagnosis.report.heldout.expected[name]
         trend.append((x, y / scale, name, j, False))
     out["residual_vs_speed"] = svg.lines(

@@ -21,8 +21,8 @@ from flight.wind import Wind
 CoefficientsFor = Callable[[np.ndarray], CoefficientModel]
 """Builds the model's coefficient function for shots whose air density is `ratio` x the assumed one (per shot)."""
 
-Correction = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
-"""Extra acceleration [N,3] from (air-relative velocity [N,3], spin [N,3], per-shot weights [N,K])."""
+Correction = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+"""Extra acceleration [N,3] from (air-relative velocity [N,3], spin [N,3], position [N,3], per-shot weights [N,K])."""
 
 
 @dataclass
@@ -100,12 +100,16 @@ def fly_setup(
     method: Method = "euler",
     correction: Correction | None = None,
     keep_states: bool = False,
+    air: Wind | None = None,
 ) -> Flight:
     """The flight core's `Flight` of every shot down through its landing ground (or t_max): what `simulate_setup`
-    summarises, and what `discovery.conceal` records when it hides effects in the diagnosed model's own flights."""
+    summarises, and what `discovery.conceal` records when it hides effects in the diagnosed model's own flights.
+
+    `air` replaces the setup's uniform wind with air whose motion depends on the ball's height (an outside effect's,
+    `discovery.outside.HeightGust`: the extra acceleration sees only velocity and spin)."""
     density = setup.density_kg_m3 * setup.density_ratio
     coefficients = ScaledCoefficients(coefficients_for(setup.density_ratio), setup.coefficient_scale)
-    wind = Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1])
+    wind = air if air is not None else Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1])
     extra = None if correction is None else WeightedCorrection(correction, setup.correction_weights)
     field = BallInAir(coefficients, density, wind, extra)
     record = "states" if keep_states else "summary"

@@ -1,4 +1,6 @@
-"""Tiny inline-SVG charts (scatter, histogram, lines, horizontal bars) so report.html needs no plotting library."""
+"""Tiny static SVG charts (lines, histograms) for the docs' figures of the real sets (`python -m discovery.real
+--figures`): files a markdown page shows as images, made without a plotting library. report.html's interactive
+figures are `discovery.figures`."""
 
 from __future__ import annotations
 
@@ -43,15 +45,6 @@ class Chart:
     def y(self, v: np.ndarray) -> np.ndarray:
         lo, hi = self.ylim
         return HEIGHT - BOTTOM - (np.asarray(v, dtype=float) - lo) / (hi - lo) * (HEIGHT - TOP - BOTTOM)
-
-    def points(self, x: np.ndarray, y: np.ndarray, color: str, label: str, radius: float = 1.8) -> None:
-        keep = np.isfinite(x) & np.isfinite(y)
-        cx, cy = self.x(x[keep]), self.y(y[keep])
-        self.parts += [
-            f'<circle cx="{a:.1f}" cy="{b:.1f}" r="{radius}" fill="{color}" fill-opacity="0.45"/>'
-            for a, b in zip(cx, cy)
-        ]
-        self.legend.append((label, color))
 
     def line(
         self,
@@ -134,28 +127,6 @@ def _limits(*arrays: np.ndarray, pad: float = 0.05) -> tuple[float, float]:
     return float(lo - pad * span), float(hi + pad * span)
 
 
-def binned_means(x: np.ndarray, y: np.ndarray, bins: int = 8) -> tuple[np.ndarray, np.ndarray]:
-    """Means of y in quantile bins of x (the trend line drawn over a scatter)."""
-    keep = np.isfinite(x) & np.isfinite(y)
-    x, y = x[keep], y[keep]
-    if x.size < 2 * bins:
-        return np.zeros(0), np.zeros(0)
-    edges = np.unique(np.quantile(x, np.linspace(0, 1, bins + 1)))
-    which = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, len(edges) - 2)
-    centres = np.array([x[which == b].mean() for b in range(len(edges) - 1) if (which == b).any()])
-    means = np.array([y[which == b].mean() for b in range(len(edges) - 1) if (which == b).any()])
-    return centres, means
-
-
-def scatter(title: str, xlabel: str, ylabel: str, series: list[tuple[np.ndarray, np.ndarray, str]]) -> str:
-    """Points of each (x, y, label) series with its binned-mean trend."""
-    chart = Chart(title, xlabel, ylabel, _limits(*[s[0] for s in series]), _limits(*[s[1] for s in series]))
-    for (x, y, label), color in zip(series, COLORS):
-        chart.points(x, y, color, label)
-        chart.line(*binned_means(x, y), color=color, width=2.2)
-    return chart.render()
-
-
 def histogram(title: str, xlabel: str, series: list[tuple[np.ndarray, str]], bins: int = 30) -> str:
     """Overlaid density histograms of each (values, label)."""
     lo, hi = _limits(*[s[0] for s in series], pad=0.0)
@@ -177,29 +148,3 @@ def lines(title: str, xlabel: str, ylabel: str, series: list[tuple[np.ndarray, n
     for x, y, label, color, dashed in series:
         chart.line(x, y, COLORS[color % len(COLORS)], label, dashed)
     return chart.render()
-
-
-def bars(title: str, xlabel: str, labels: list[str], values: list[float]) -> str:
-    """Horizontal bars, one per label (e.g. candidates' held-out scores)."""
-    height = TOP + BOTTOM + 16 * len(labels)
-    hi = max(max(values, default=1.0), 1e-9) * 1.05
-    width = WIDTH + 140
-    scale = (width - 200 - RIGHT) / hi
-    out = [
-        (
-            f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" font-family="sans-serif" '
-            f'font-size="10"><rect width="100%" height="100%" fill="white"/>'
-        ),
-        f'<text x="{width / 2}" y="15" text-anchor="middle" font-size="12">{escape(title)}</text>',
-    ]
-    for i, (label, value) in enumerate(zip(labels, values)):
-        y = TOP + 16 * i
-        out.append(
-            f'<text x="196" y="{y + 11}" text-anchor="end">{escape(label)}</text>'
-            f'<rect x="200" y="{y + 2}" width="{max(value, 0) * scale:.1f}" height="12" fill="{COLORS[1]}"/>'
-            f'<text x="{204 + max(value, 0) * scale:.1f}" y="{y + 11}">{value:.3g}</text>'
-        )
-    out.append(
-        f'<text x="{200 + (width - 200) / 2}" y="{height - 8}" text-anchor="middle">{escape(xlabel)}</text></svg>'
-    )
-    return "".join(out)

@@ -67,14 +67,14 @@ class ScaledCoefficients:
 
 @dataclass(frozen=True)
 class WeightedCorrection:
-    """An extra acceleration term(v_rel, omega, weights) [N,3] with per-ball weights [N,K]: discovery's learned
-    correction, corrected flights being the equations plus this term."""
+    """An extra acceleration term(v_rel, omega, position, weights) [N,3] with per-ball weights [N,K]: discovery's
+    learned correction, corrected flights being the equations plus this term."""
 
-    term: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+    term: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
     weights: np.ndarray
 
-    def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
-        return self.term(v_rel, omega, self.weights)
+    def __call__(self, v_rel: np.ndarray, omega: np.ndarray, position: np.ndarray) -> np.ndarray:
+        return self.term(v_rel, omega, position, self.weights)
 
     def take(self, index: np.ndarray) -> WeightedCorrection:
         return WeightedCorrection(self.term, self.weights[index])

@@ -46,9 +46,10 @@ class CoefficientModel(Protocol):
 
 
 class ExtraAcceleration(Protocol):
-    """An acceleration [N,3] added to the equations from (air-relative velocity, spin) [N,3]; `take` as above."""
+    """An acceleration [N,3] added to the equations from (air-relative velocity, spin, position) [N,3] (the position
+    for an effect that changes with height); `take` as above."""
 
-    def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray: ...
+    def __call__(self, v_rel: np.ndarray, omega: np.ndarray, position: np.ndarray) -> np.ndarray: ...
 
 
 @dataclass
@@ -152,13 +153,13 @@ def derivatives(
     extra: ExtraAcceleration | None = None,
 ) -> State:
     """d/dt of (position, velocity, spin): the right-hand side of the equations of motion (paper eq. 14), plus an
-    optional extra acceleration of the air-relative velocity and spin (discovery's learned correction)."""
+    optional extra acceleration of the air-relative velocity, spin and position (discovery's learned correction)."""
     v_rel = state.velocity if wind.is_calm else state.velocity - wind.velocity(state.position[:, 2])
     coefficients = coefficient_model(v_rel, state.spin)
     acceleration, spin_acceleration = aerodynamics(v_rel, state.spin, coefficients, density)
     acceleration[:, 2] -= GRAVITY_MPS2
     if extra is not None:
-        acceleration += extra(v_rel, state.spin)
+        acceleration += extra(v_rel, state.spin, state.position)
     return State(state.velocity, acceleration, spin_acceleration)
 
 

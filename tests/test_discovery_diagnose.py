@@ -47,7 +47,7 @@ def test_diagnose_names_and_measures_a_concealed_wind(windy, tmp_path):
     assert settings["wind"]["profile"] == "uniform"
     assert settings["wind"]["speed_mps"] == pytest.approx(4.5, rel=0.1)
     html = (tmp_path / "report.html").read_text()
-    assert html.count("<svg") >= 8 and "trajectories: height" in html
+    assert html.count('class="plotly-graph-div"') >= 8 and "trajectories: height" in html
     assert {c.name for c in report.candidates} >= {"none", "wind", "air_density", "drag_scale"}
 
 

@@ -30,13 +30,17 @@ def test_term_selection_keeps_the_terms_that_made_the_data():
 def test_correction_features_are_accelerations_per_unit_weight():
     v = np.array([[0.0, 40.0, 10.0], [3.0, 25.0, -8.0]])
     w = np.array([[300.0, 0.0, 0.0], [250.0, 0.0, -20.0]])
-    f = features(v, w)
+    r = np.array([[0.0, 50.0, 20.0], [1.0, 80.0, 0.0]])
+    f = features(v, w, r)
     assert f.shape == (2, len(TERMS), 3)
     drag = f[:, [t.name for t in TERMS].index("-|v| v")]
     np.testing.assert_allclose(drag, -np.linalg.norm(v, axis=1)[:, None] * v)
     lift = f[:, [t.name for t in TERMS].index("m")]
     np.testing.assert_allclose(np.linalg.norm(lift, axis=1), 1.0)
     assert lift[0, 2] > 0
+    across = f[:, [t.name for t in TERMS].index("|v| h x")]
+    np.testing.assert_allclose(across[:, 0], np.linalg.norm(v, axis=1) * r[:, 2])
+    assert across[1, 0] == 0.0 and not across[:, 1:].any(), "nothing at the ground, and only sideways"
 
 
 def test_equivalent_altitude_of_a_density_ratio():

@@ -7,6 +7,7 @@ import re
 from pathlib import Path
 
 from discovery.diagnose import diagnose
+from discovery.html import PLOTS_MISSING, plots_available
 from discovery.model import REFERENCE, load_model
 from discovery.outputs import write_diagnosis
 from discovery.own_error import measure_own_error, write_own_error
@@ -78,6 +79,8 @@ def run_diagnose(args: argparse.Namespace) -> int:
     paths = write_diagnosis(diagnosis, args.out)
     print(diagnosis.report.statement)
     print(f"wrote {', '.join(str(p) for p in paths)} ({diagnosis.report.seconds:.1f} s)")
+    if not plots_available():
+        print(f"report.html has no figures: {PLOTS_MISSING}")
     return 0
 
 

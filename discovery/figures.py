@@ -1,0 +1,260 @@
+"""The interactive figures of report.html (plotly, the optional extra `report`): residuals against the launch values
+that matter and along the flight, per-session means with their standard errors, held-out residuals and trajectories
+before and after the suggested correction, and the candidates' scores.
+
+Every point that is one shot carries its shot id, session and club in `customdata` (`SHOT_FIELDS`), shown on
+hover, so a reader goes from an odd point straight to the shot in the recordings. Plain SVG scatter traces (not
+WebGL): they render in any browser, headless ones included, and a few thousand points stay quick.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import plotly.graph_objects as go
+from plotly.subplots import make_subplots
+
+from discovery.locate import binned_means, trajectory_residuals
+from discovery.recordings import LABELS, OBSERVABLES, Recordings
+
+SHOT_FIELDS = ("shot", "session", "club")
+"""What each shot-level point's `customdata` row holds, in this order."""
+
+BEFORE, AFTER = "#888888", "#1f77b4"
+"""Colours of the model as is and of the corrected model, in every figure."""
+
+SIZE = {"width": 620, "height": 400}
+
+
+def _shots(recordings: Recordings, index: np.ndarray | None = None) -> np.ndarray:
+    """customdata rows (shot id, session, club) [N, 3] of the shots at `index` (all by default)."""
+    rows = np.column_stack([recordings.shot_id, recordings.session, recordings.club]).astype(str)
+    return rows if index is None else rows[index]
+
+
+def _hover(x_label: str, y_label: str) -> str:
+    lines = [f"{name} %{{customdata[{k}]}}" for k, name in enumerate(SHOT_FIELDS)]
+    return "<br>".join(lines + [f"{x_label}: %{{x:.4g}}", f"{y_label}: %{{y:.4g}}"]) + "<extra>%{fullData.name}</extra>"
+
+
+def _points(x: np.ndarray, y: np.ndarray, shots: np.ndarray, name: str, color: str, hover: str) -> go.Scatter:
+    keep = np.isfinite(x) & np.isfinite(y)
+    return go.Scatter(
+        x=x[keep],
+        y=y[keep],
+        customdata=shots[keep],
+        mode="markers",
+        name=name,
+        marker={"color": color, "size": 5, "opacity": 0.5},
+        hovertemplate=hover,
+    )
+
+
+def _layout(figure: go.Figure, title: str, x_label: str, y_label: str) -> go.Figure:
+    figure.update_layout(
+        title={"text": title}, hovermode="closest", margin={"l": 60, "r": 10, "t": 50, "b": 50}, **SIZE
+    )
+    figure.update_xaxes(title_text=x_label)
+    figure.update_yaxes(title_text=y_label)
+    return figure
+
+
+def covariate_figures(diagnosis, count: int = 4) -> list[go.Figure]:
+    """Residual (recorded - model) against the `count` launch values with the strongest trends, as is and corrected,
+    each with its binned means."""
+    report, rec = diagnosis.report, diagnosis.recordings
+    ranked = sorted(report.located.covariates, key=lambda c: (not c.significant, -abs(c.t)))
+    shots = _shots(rec)
+    out = []
+    for item in ranked[:count]:
+        j = OBSERVABLES.index(item.observable)
+        x = rec.covariate(item.covariate)
+        y_label = f"recorded - model, {LABELS[item.observable]}"
+        series = [("model as is", diagnosis.before, BEFORE)]
+        if diagnosis.chosen is not None:
+            series.append(("corrected", diagnosis.after, AFTER))
+        figure = go.Figure()
+        for name, predicted, color in series:
+            residual = rec.observed[:, j] - predicted[:, j]
+            figure.add_trace(_points(x, residual, shots, name, color, _hover(item.covariate, "residual")))
+            centres, means = binned_means(x, residual)
+            figure.add_trace(
+                go.Scatter(
+                    x=centres,
+                    y=means,
+                    mode="lines",
+                    name=f"{name}, binned mean",
+                    line={"color": color, "width": 3},
+                    hovertemplate="binned mean %{y:.4g}<extra></extra>",
+                )
+            )
+        title = f"{item.observable} residual vs {item.covariate} (t = {item.t:.1f})"
+        out.append(_layout(figure, title, item.covariate, y_label))
+    return out
+
+
+def session_figure(diagnosis) -> go.Figure:
+    """Mean residual of every session with its standard error, per observed observable, as is and corrected: a
+    shift shared by a session (its weather) stands out from the rest."""
+    rec = diagnosis.recordings
+    names = [(j, n) for j, n in enumerate(OBSERVABLES) if n in rec.observed_names]
+    sessions = np.unique(rec.session)
+    figure = make_subplots(rows=len(names), cols=1, shared_xaxes=True, subplot_titles=[LABELS[n] for _, n in names])
+    series = [("model as is", diagnosis.before, BEFORE)]
+    if diagnosis.chosen is not None:
+        series.append(("corrected", diagnosis.after, AFTER))
+    for row, (j, name) in enumerate(names, start=1):
+        for label, predicted, color in series:
+            means, errors, details = [], [], []
+            for session in sessions:
+                residual = (rec.observed[:, j] - predicted[:, j])[rec.session == session]
+                residual = residual[np.isfinite(residual)]
+                means.append(residual.mean() if residual.size else np.nan)
+                errors.append(residual.std(ddof=1) / np.sqrt(residual.size) if residual.size > 1 else np.nan)
+                clubs = ", ".join(np.unique(rec.club[rec.session == session]).astype(str))
+                details.append([str(session), residual.size, clubs])
+            figure.add_trace(
+                go.Scatter(
+                    x=sessions.astype(str),
+                    y=means,
+                    error_y={"type": "data", "array": errors, "visible": True},
+                    customdata=details,
+                    mode="markers",
+                    name=label,
+                    legendgroup=label,
+                    showlegend=row == 1,
+                    marker={"color": color, "size": 8},
+                    hovertemplate="session %{customdata[0]}<br>%{customdata[1]} shots<br>clubs %{customdata[2]}"
+                    "<br>mean %{y:.4g} ± %{error_y.array:.2g}<extra>%{fullData.name}</extra>",
+                ),
+                row=row,
+                col=1,
+            )
+        figure.update_yaxes(title_text="mean residual", row=row, col=1)
+    figure.update_layout(
+        title={"text": "mean residual per session (± 1 standard error)"},
+        hovermode="closest",
+        width=SIZE["width"],
+        height=170 * len(names) + 100,
+        margin={"l": 60, "r": 10, "t": 70, "b": 50},
+    )
+    return figure
+
+
+def phase_figure(diagnosis) -> go.Figure | None:
+    """Position residuals (recorded - model) of the recorded trajectories against the share of the flight, as is and
+    corrected: where along the flight a left-out effect acts (None without trajectories)."""
+    rec = diagnosis.recordings
+    if not rec.trajectories or diagnosis.positions_before is None:
+        return None
+    index = {shot: i for i, shot in enumerate(rec.shot_id)}
+    shots = _shots(rec)
+    series = [("model as is", diagnosis.positions_before, BEFORE)]
+    if diagnosis.positions_after is not None:
+        series.append(("corrected", diagnosis.positions_after, AFTER))
+    figure = make_subplots(rows=2, cols=1, shared_xaxes=True, subplot_titles=["height", "across the line (+ right)"])
+    dt_s = diagnosis.report.model.dt_s
+    for label, positions, color in series:
+        residuals = trajectory_residuals(rec, positions, dt_s)
+        if not residuals:
+            continue
+        share = np.concatenate([r[:, 0] / r[-1, 0] for r in residuals.values()])
+        data = np.concatenate(list(residuals.values()))
+        who = np.concatenate([np.repeat(shots[[index[s]]], len(r), axis=0) for s, r in residuals.items()])
+        for row, column, name in ((1, 6, "height residual (m)"), (2, 4, "across residual (m)")):
+            trace = _points(share, data[:, column], who, label, color, _hover("share of the flight", name))
+            trace.update(legendgroup=label, showlegend=row == 1)
+            figure.add_trace(trace, row=row, col=1)
+    figure.update_xaxes(title_text="share of the recorded flight (0 = launch, 1 = last sample)", row=2, col=1)
+    figure.update_yaxes(title_text="recorded - model (m)")
+    figure.update_layout(
+        title={"text": "trajectory residuals along the flight"},
+        hovermode="closest",
+        width=SIZE["width"],
+        height=560,
+        margin={"l": 60, "r": 10, "t": 70, "b": 50},
+    )
+    return figure
+
+
+def heldout_figures(diagnosis) -> list[go.Figure]:
+    """Histograms of the held-out residuals of each observed observable, as is and corrected."""
+    out = []
+    for j, name in enumerate(OBSERVABLES):
+        before = diagnosis.heldout_before[:, j]
+        if not np.isfinite(before).any():
+            continue
+        figure = go.Figure(go.Histogram(x=before, name="held out, model as is", marker_color=BEFORE, opacity=0.6))
+        if diagnosis.chosen is not None:
+            after = diagnosis.heldout_after[:, j]
+            figure.add_trace(go.Histogram(x=after, name="held out, corrected", marker_color=AFTER, opacity=0.6))
+        figure.update_layout(barmode="overlay")
+        out.append(_layout(figure, f"held-out residual: {name}", LABELS[name], "shots"))
+    return out
+
+
+def trajectory_figures(diagnosis, count: int = 6) -> list[go.Figure]:
+    """The first `count` recorded trajectories against the model's flights (as is and corrected): height and side
+    against the distance down the line."""
+    rec = diagnosis.recordings
+    if not rec.trajectories or diagnosis.positions_before is None:
+        return []
+    index = {shot: i for i, shot in enumerate(rec.shot_id)}
+    chosen = [s for s in rec.trajectories if s in index][:count]
+    shots = _shots(rec)
+    figures = {"height": go.Figure(), "side": go.Figure()}
+    axes = {"height": (2, "height (m)"), "side": (0, "right of the line (m)")}
+    for k, shot in enumerate(chosen):
+        i = index[shot]
+        lines = [("recorded", rec.trajectories[shot][:, 1:4], "#d62728", "solid")]
+        lines.append(("model as is", diagnosis.positions_before[:, i], BEFORE, "dash"))
+        if diagnosis.positions_after is not None:
+            lines.append(("corrected", diagnosis.positions_after[:, i], AFTER, "solid"))
+        for view, figure in figures.items():
+            column, label = axes[view]
+            for name, path, color, dash in lines:
+                keep = np.isfinite(path).all(axis=1)
+                figure.add_trace(
+                    go.Scatter(
+                        x=path[keep, 1],
+                        y=path[keep, column],
+                        customdata=np.repeat(shots[[i]], keep.sum(), axis=0),
+                        mode="lines",
+                        name=name,
+                        legendgroup=name,
+                        showlegend=k == 0,
+                        line={"color": color, "dash": dash, "width": 1.5},
+                        hovertemplate=_hover("down the line (m)", label),
+                    )
+                )
+    return [
+        _layout(figures[view], f"trajectories: {view}", "down the line (m)", axes[view][1])
+        for view in ("height", "side")
+    ]
+
+
+def candidates_figure(diagnosis, count: int = 15) -> go.Figure:
+    """The `count` best candidates' held-out scores (lower is better)."""
+    scored = sorted(diagnosis.report.candidates, key=lambda c: c.score)[:count]
+    figure = go.Figure(
+        go.Bar(
+            x=[c.score for c in scored],
+            y=[c.name for c in scored],
+            orientation="h",
+            marker_color=AFTER,
+            hovertemplate="%{y}: score %{x:.4g}<extra></extra>",
+        )
+    )
+    figure.update_yaxes(autorange="reversed")
+    _layout(figure, "held-out score (lower is better)", "score", "")
+    return figure.update_layout(height=120 + 22 * len(scored), margin={"l": 220})
+
+
+def report_figures(diagnosis) -> dict[str, list[go.Figure]]:
+    """Every figure of the report, by the section it goes in."""
+    phase = phase_figure(diagnosis)
+    return {
+        "residuals": covariate_figures(diagnosis) + [session_figure(diagnosis)],
+        "heldout": heldout_figures(diagnosis),
+        "along": ([phase] if phase is not None else []) + trajectory_figures(diagnosis),
+        "candidates": [candidates_figure(diagnosis)],
+    }
