@@ -1,12 +1,15 @@
-"""Calibrate the reference world against TrackMan's tour averages and spin-decay figures, and report the fit.
+"""Calibrate the reference world on recordings that may be trained on, and check it on TrackMan's tour averages.
 
-The fit is a bounded least squares over the 12 clubs' carry, max height and land angle (flown at
-CALIBRATION_AIR, launch direction and spin axis 0) plus TrackMan's Pro V1x spin losses after 1/3/5 s.
+The fit is a bounded least squares over calibration cells (one source's shots in one ball-speed band, each shot
+flown with its own launch) plus TrackMan's Pro V1x spin losses after 1/3/5 s. A cell contributes the difference
+between the mean of the model's outcomes and the mean of the recorded ones, per observable it has. The PGA TOUR
+2023 averages are held out (NOTES section 9): `evaluate_clubs` flies them as a check only, never inside the fit.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,14 +28,28 @@ from flight.reference_aero import (
     REFERENCE_T_MAX_S,
     ReferenceParameters,
 )
+from shots.clubs import CLUBS
+from shots.records import ShotRecord
 from shots.reference_world import CALIBRATION_AIR, ClubAverage, fly_reference
 
 DECAY_TIMES_S = (1.0, 3.0, 5.0)
 TRACKMAN_SPIN_LOSS_PCT = {"Driver": (3.1, 8.8, 12.8), "5-iron": (3.4, 9.7, 15.5), "8-iron": (3.6, 9.0, 13.3)}
-"""Spin lost (%) after 1/3/5 s, TrackMan on a Pro V1x (NOTES.md section 2), flown with these clubs' tour launch."""
+"""Spin lost (%) after 1/3/5 s, TrackMan on a Pro V1x (NOTES.md section 2), flown with these clubs' launch in
+`shots.clubs.CLUBS`."""
 
-RESIDUAL_SCALES = {"carry_yd": 3.0, "max_height_yd": 2.0, "land_angle_deg": 2.0, "spin_loss_pct": 0.5}
-"""Each residual is divided by its scale: the MAE targets for the flight, half a percentage point for spin."""
+OBSERVABLES = ("carry_m", "apex_m", "landing_angle_deg")
+"""What a cell can match, in the order of every per-cell array."""
+
+RESIDUAL_SCALES = {"carry_m": 3.0 * YARD_M, "apex_m": 2.0 * YARD_M, "landing_angle_deg": 2.0, "spin_loss_pct": 0.5}
+"""Each residual is divided by its scale: the flight targets of the product (3 yd, 2 yd, 2 deg), half a percentage
+point for spin."""
+
+SPEED_BANDS_MPS = (0.0, 52.0, 60.0, 66.0, 72.0, 200.0)
+"""Ball-speed bands a source's shots are grouped into: wedges and short irons, mid irons, long irons and hybrids,
+fairway woods, drivers (the 2020 pbp files name no club)."""
+
+MIN_CELL_SHOTS = 15
+"""A band with fewer recorded values of an observable leaves that observable out (its mean is mostly wind)."""
 
 BOUNDS: dict[str, tuple[float, float]] = {
     "drag_base": (0.05, 0.30),
@@ -47,39 +64,104 @@ BOUNDS: dict[str, tuple[float, float]] = {
 }
 """Search box of the fit; critical Re kept inside Lyu 2018's crisis (C_D 0.5 at 5e4, 0.2 by 1e5)."""
 
-@dataclass(frozen=True)
-class Evaluation:
-    """Model outcomes for the table's clubs (arrays in file order) and the spin losses of the decay clubs."""
 
-    clubs: list[ClubAverage]
-    carry_yd: np.ndarray
-    max_height_yd: np.ndarray
-    land_angle_deg: np.ndarray
+@dataclass(frozen=True)
+class CalibrationCell:
+    """Shots of one source in one ball-speed band: their launches, the air they are flown in, what was recorded."""
+
+    name: str
+    launch: dict[str, np.ndarray]
+    air: Air
+    recorded: np.ndarray
+    """[n_shots, len(OBSERVABLES)]; NaN where a shot has no record of an observable."""
+
+    @property
+    def n_shots(self) -> int:
+        return len(self.recorded)
+
+    def used(self) -> np.ndarray:
+        """Which observables this cell has enough recorded values of to enter the fit [len(OBSERVABLES)]."""
+        return np.sum(np.isfinite(self.recorded), axis=0) >= MIN_CELL_SHOTS
+
+
+def cells_from_records(
+    source: str, records: list[ShotRecord], air: Air, bands: tuple[float, ...] = SPEED_BANDS_MPS
+) -> list[CalibrationCell]:
+    """Split one source's records by ball-speed band; bands without any usable observable are left out."""
+    speed = np.array([r.ball_speed_mps for r in records])
+    cells = []
+    for low, high in itertools.pairwise(bands):
+        chosen = [r for r, s in zip(records, speed) if low <= s < high]
+        if not chosen:
+            continue
+        launch = {
+            key: np.array([getattr(r, key) for r in chosen])
+            for key in ("ball_speed_mps", "launch_angle_deg", "launch_direction_deg", "spin_rpm", "spin_axis_deg")
+        }
+        recorded = np.array([[_value(r.carry_y_m), _value(r.apex_m), _value(r.landing_angle_deg)]
+                             for r in chosen])
+        cell = CalibrationCell(f"{source} {low:g}-{high:g} m/s" if high < bands[-1] else f"{source} >= {low:g} m/s",
+                               launch, air, recorded)
+        if cell.used().any():
+            cells.append(cell)
+    return cells
+
+
+def _value(x: float | None) -> float:
+    return np.nan if x is None else float(x)
+
+
+@dataclass(frozen=True)
+class CellEvaluation:
+    """Model and recorded means per cell and observable (NaN where a cell does not use one) and the spin losses."""
+
+    cells: list[CalibrationCell]
+    model_mean: np.ndarray
+    recorded_mean: np.ndarray
     spin_loss_pct: dict[str, np.ndarray]
 
-    def targets(self) -> np.ndarray:
-        """TrackMan's carry, max height, land angle [12, 3]."""
-        return np.array([[c.carry_yd, c.max_height_yd, c.land_angle_deg] for c in self.clubs])
-
-    def outcomes(self) -> np.ndarray:
-        """The model's carry, max height, land angle [12, 3]."""
-        return np.stack([self.carry_yd, self.max_height_yd, self.land_angle_deg], axis=1)
-
-    def mean_absolute_error(self) -> np.ndarray:
-        """MAE over the clubs of carry (yd), max height (yd), land angle (deg)."""
-        return np.mean(np.abs(self.outcomes() - self.targets()), axis=0)
+    def scaled_errors(self) -> np.ndarray:
+        """(model - recorded) / scale per cell and observable [n_cells, 3]; NaN where unused."""
+        scales = np.array([RESIDUAL_SCALES[k] for k in OBSERVABLES])
+        return (self.model_mean - self.recorded_mean) / scales
 
 
-def launch_state(clubs: list[ClubAverage]) -> State:
-    """Initial state of each club's average launch, straight at the target with no spin-axis tilt."""
-    zeros = np.zeros(len(clubs))
-    return initial_state(
-        np.array([c.ball_speed_mps for c in clubs]),
-        np.array([c.launch_angle_deg for c in clubs]),
-        zeros,
-        np.array([c.spin_rpm for c in clubs]),
-        zeros,
-    )
+def _fly_cells(cells: list[CalibrationCell], params: ReferenceParameters) -> list[np.ndarray]:
+    """Carry, apex, landing angle [n_shots, 3] per cell, flown as one batch (each shot in its cell's air)."""
+    launch = {key: np.concatenate([c.launch[key] for c in cells]) for key in cells[0].launch}
+    air = Air(np.concatenate([np.full(c.n_shots, c.air.density_kg_m3) for c in cells]),
+              np.concatenate([np.full(c.n_shots, c.air.kinematic_viscosity_m2_s) for c in cells]))
+    flight = fly_reference(initial_state(**launch), air, params=params)
+    ends = np.cumsum([c.n_shots for c in cells])
+    outcomes = np.stack([flight.carry_m, flight.apex_m, flight.landing_angle_deg], axis=1)
+    return np.split(outcomes, ends[:-1])
+
+
+def evaluate(cells: list[CalibrationCell], params: ReferenceParameters = CALIBRATED) -> CellEvaluation:
+    """Fly every cell's shots and the spin-decay launches through the reference world."""
+    model_mean = np.full((len(cells), len(OBSERVABLES)), np.nan)
+    recorded_mean = np.full_like(model_mean, np.nan)
+    for i, (cell, model) in enumerate(zip(cells, _fly_cells(cells, params))):
+        for k in np.flatnonzero(cell.used()):
+            has = np.isfinite(cell.recorded[:, k])
+            model_mean[i, k] = np.mean(model[has, k])
+            recorded_mean[i, k] = np.mean(cell.recorded[has, k])
+    return CellEvaluation(cells, model_mean, recorded_mean, spin_losses(params))
+
+
+def decay_launch() -> State:
+    """The launches of the spin-decay clubs (`shots.clubs.CLUBS`), straight, no spin-axis tilt."""
+    clubs = {c.name: c for c in CLUBS}
+    chosen = [clubs[name] for name in TRACKMAN_SPIN_LOSS_PCT]
+    zeros = np.zeros(len(chosen))
+    return initial_state(np.array([c.ball_speed_mps for c in chosen]), np.array([c.launch_angle_deg for c in chosen]),
+                         zeros, np.array([c.spin_rpm for c in chosen]), zeros)
+
+
+def spin_losses(params: ReferenceParameters = CALIBRATED, air: Air = CALIBRATION_AIR) -> dict[str, np.ndarray]:
+    """Percentage of the launch spin each decay club has lost after DECAY_TIMES_S."""
+    flight = fly_reference(decay_launch(), air, keep_states=True, params=params)
+    return dict(zip(TRACKMAN_SPIN_LOSS_PCT, spin_loss_pct(flight, list(range(len(TRACKMAN_SPIN_LOSS_PCT))))))
 
 
 def spin_loss_pct(flight: Flight, rows: list[int], times_s: tuple[float, ...] = DECAY_TIMES_S) -> np.ndarray:
@@ -91,49 +173,17 @@ def spin_loss_pct(flight: Flight, rows: list[int], times_s: tuple[float, ...] = 
     return 100.0 * (1.0 - spin[index].T / spin[0][:, None])
 
 
-def _outcome(flight: Flight, clubs: list[ClubAverage]) -> Evaluation:
-    index = {c.club: i for i, c in enumerate(clubs)}
-    missing = [name for name in TRACKMAN_SPIN_LOSS_PCT if name not in index]
-    if missing:
-        raise ValueError(f"the tour-averages table has no rows for {missing}, needed for the spin-decay figures")
-    losses = spin_loss_pct(flight, [index[name] for name in TRACKMAN_SPIN_LOSS_PCT])
-    return Evaluation(
-        clubs,
-        flight.carry_m / YARD_M,
-        flight.apex_m / YARD_M,
-        flight.landing_angle_deg,
-        dict(zip(TRACKMAN_SPIN_LOSS_PCT, losses)),
-    )
-
-
-def evaluate(
-    clubs: list[ClubAverage], params: ReferenceParameters = CALIBRATED, air: Air = CALIBRATION_AIR
-) -> Evaluation:
-    """Fly every club's average launch through the reference world."""
-    return _outcome(fly_reference(launch_state(clubs), air, keep_states=True, params=params), clubs)
-
-
-def evaluate_ferguson(clubs: list[ClubAverage], air: Air = CALIBRATION_AIR) -> Evaluation:
-    """The same shots with Ferguson 2022's quadratics (the open-model baseline), same integrator and air."""
-    flight = simulate(
-        launch_state(clubs), QuadraticSpinRatio(), air.density_kg_m3, dt=REFERENCE_DT_S,
-        t_max=REFERENCE_T_MAX_S, method="rk4", keep_states=True,
-    )
-    return _outcome(flight, clubs)
-
-
-def residuals(params: ReferenceParameters, clubs: list[ClubAverage]) -> np.ndarray:
-    """Scaled misfits: (model - TrackMan) / scale for every club's three outcomes, then the nine spin losses."""
-    result = evaluate(clubs, params)
-    flight_scale = np.array([RESIDUAL_SCALES[k] for k in ("carry_yd", "max_height_yd", "land_angle_deg")])
-    flight = ((result.outcomes() - result.targets()) / flight_scale).ravel()
+def residuals(params: ReferenceParameters, cells: list[CalibrationCell]) -> np.ndarray:
+    """Scaled misfits: every used (cell, observable) mean difference, then the nine spin losses."""
+    result = evaluate(cells, params)
+    flight = result.scaled_errors()
+    flight = flight[np.isfinite(result.recorded_mean)]
     spin = np.concatenate([result.spin_loss_pct[name] - np.array(pct) for name, pct in TRACKMAN_SPIN_LOSS_PCT.items()])
-    spin /= RESIDUAL_SCALES["spin_loss_pct"]
-    return np.nan_to_num(np.concatenate([flight, spin]), nan=1e3)
+    return np.nan_to_num(np.concatenate([flight, spin / RESIDUAL_SCALES["spin_loss_pct"]]), nan=1e3)
 
 
 def fit_reference(
-    clubs: list[ClubAverage], start: ReferenceParameters = CALIBRATED, max_evaluations: int = 200
+    cells: list[CalibrationCell], start: ReferenceParameters = CALIBRATED, max_evaluations: int = 200
 ) -> ReferenceParameters:
     """Least-squares fit of FREE_PARAMETERS (each scaled by its start value) inside BOUNDS; knobs stay as in start."""
     typical = np.array([abs(getattr(start, name)) or 1.0 for name in FREE_PARAMETERS])
@@ -145,9 +195,58 @@ def fit_reference(
 
     x0 = np.clip(np.array([getattr(start, name) for name in FREE_PARAMETERS]) / typical, low, high)
     solution = least_squares(
-        lambda x: residuals(with_values(x), clubs), x0, bounds=(low, high), diff_step=1e-3, max_nfev=max_evaluations
+        lambda x: residuals(with_values(x), cells), x0, bounds=(low, high), diff_step=1e-3, max_nfev=max_evaluations
     )
     return with_values(solution.x)
+
+
+@dataclass(frozen=True)
+class ClubCheck:
+    """A model's outcomes for the tour-averages table's clubs (held out: a check, never a fit target)."""
+
+    clubs: list[ClubAverage]
+    carry_yd: np.ndarray
+    max_height_yd: np.ndarray
+    land_angle_deg: np.ndarray
+
+    def targets(self) -> np.ndarray:
+        """TrackMan's carry, max height, land angle [n_clubs, 3]."""
+        return np.array([[c.carry_yd, c.max_height_yd, c.land_angle_deg] for c in self.clubs])
+
+    def outcomes(self) -> np.ndarray:
+        """The model's carry, max height, land angle [n_clubs, 3]."""
+        return np.stack([self.carry_yd, self.max_height_yd, self.land_angle_deg], axis=1)
+
+    def mean_absolute_error(self) -> np.ndarray:
+        """MAE over the clubs of carry (yd), max height (yd), land angle (deg)."""
+        return np.mean(np.abs(self.outcomes() - self.targets()), axis=0)
+
+
+def club_launch_state(clubs: list[ClubAverage]) -> State:
+    """Initial state of each club's average launch, straight at the target with no spin-axis tilt."""
+    zeros = np.zeros(len(clubs))
+    return initial_state(np.array([c.ball_speed_mps for c in clubs]), np.array([c.launch_angle_deg for c in clubs]),
+                         zeros, np.array([c.spin_rpm for c in clubs]), zeros)
+
+
+def _club_check(flight: Flight, clubs: list[ClubAverage]) -> ClubCheck:
+    return ClubCheck(clubs, flight.carry_m / YARD_M, flight.apex_m / YARD_M, flight.landing_angle_deg)
+
+
+def evaluate_clubs(
+    clubs: list[ClubAverage], params: ReferenceParameters = CALIBRATED, air: Air = CALIBRATION_AIR
+) -> ClubCheck:
+    """Fly every club's average launch through the reference world (the held-out check)."""
+    return _club_check(fly_reference(club_launch_state(clubs), air, params=params), clubs)
+
+
+def evaluate_clubs_ferguson(clubs: list[ClubAverage], air: Air = CALIBRATION_AIR) -> ClubCheck:
+    """The same shots with Ferguson 2022's quadratics (the open-model baseline), same integrator and air."""
+    flight = simulate(
+        club_launch_state(clubs), QuadraticSpinRatio(), air.density_kg_m3, dt=REFERENCE_DT_S,
+        t_max=REFERENCE_T_MAX_S, method="rk4",
+    )
+    return _club_check(flight, clubs)
 
 
 def parameters_literal(params: ReferenceParameters) -> str:
@@ -165,31 +264,52 @@ def _signed(value: float) -> str:
     return f"{value:+.1f}"
 
 
-def render_markdown(evaluation: Evaluation, params: ReferenceParameters, baseline: Evaluation | None = None) -> str:
-    """Markdown: the parameters, the per-club table (model vs TrackMan, errors, MAE) and the spin-decay table."""
+def render_markdown(evaluation: CellEvaluation, params: ReferenceParameters, check: ClubCheck | None = None,
+                    ferguson: ClubCheck | None = None) -> str:
+    """Markdown: the parameters, the per-cell fit table, the spin-decay table and the held-out tour-averages check."""
     out = ["### Parameters", "", "| parameter | value |", "|---|---|"]
     out += [f"| `{name}` | {_round(getattr(params, name)):g} |" for name in FREE_PARAMETERS]
     out += [
         "",
-        "### PGA TOUR 2023 averages: model vs TrackMan",
+        "### Calibration cells: mean of the model's flights vs mean of the recordings",
         "",
-        "| club | carry model | carry TM | err | max h model | max h TM | err | land model | land TM | err |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        ("| cell | shots | carry model (yd) | carry recorded | err | max h model (yd) | recorded | err "
+         "| land model (°) | recorded | err |"),
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
-    for club, model, target in zip(evaluation.clubs, evaluation.outcomes(), evaluation.targets()):
-        cells = [f"{m:.1f} | {t:g} | {_signed(m - t)}" for m, t in zip(model, target)]
-        out.append(f"| {club.club} | " + " | ".join(cells) + " |")
-    mae = evaluation.mean_absolute_error()
-    out.append(f"| **MAE** | | | **{mae[0]:.2f} yd** | | | **{mae[1]:.2f} yd** | | | **{mae[2]:.2f}°** |")
-    if baseline is not None:
-        ref = baseline.mean_absolute_error()
-        bias = np.mean(baseline.outcomes() - baseline.targets(), axis=0)
-        cells = [f"{error:.2f} ({_signed(b)})" for error, b in zip(ref, bias)]
-        out.append("| Ferguson 2022 MAE (bias) | | | " + " | | | ".join(cells) + " |")
+    units = np.array([YARD_M, YARD_M, 1.0])
+    for cell, model, recorded in zip(evaluation.cells, evaluation.model_mean / units, evaluation.recorded_mean / units):
+        cells = ["—| —| —" if np.isnan(m) else f"{m:.1f} | {r:.1f} | {_signed(m - r)}" for m, r in zip(model, recorded)]
+        out.append(f"| {cell.name} | {cell.n_shots} | " + " | ".join(cells) + " |")
     header = " | ".join(f"{t:g} s model | {t:g} s TM" for t in DECAY_TIMES_S)
     out += ["", "### Spin lost (%) after 1 / 3 / 5 s: model vs TrackMan (Pro V1x)", "", f"| shot | {header} |"]
     out.append("|---|" + "---:|" * (2 * len(DECAY_TIMES_S)))
     for name, target in TRACKMAN_SPIN_LOSS_PCT.items():
         cells = [f"{m:.1f} | {t:g}" for m, t in zip(evaluation.spin_loss_pct[name], target)]
         out.append(f"| {name} | " + " | ".join(cells) + " |")
+    if check is not None:
+        out += _club_check_markdown(check, ferguson)
     return "\n".join(out) + "\n"
+
+
+def _club_check_markdown(check: ClubCheck, ferguson: ClubCheck | None) -> list[str]:
+    out = [
+        "",
+        "### Held-out check, never fitted: PGA TOUR 2023 averages, model vs TrackMan",
+        "",
+        "| club | carry model | carry TM | err | max h model | max h TM | err | land model | land TM | err |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for club, model, target in zip(check.clubs, check.outcomes(), check.targets()):
+        cells = [f"{m:.1f} | {t:g} | {_signed(m - t)}" for m, t in zip(model, target)]
+        out.append(f"| {club.club} | " + " | ".join(cells) + " |")
+    mae = check.mean_absolute_error()
+    bias = np.mean(check.outcomes() - check.targets(), axis=0)
+    out.append("| **MAE (bias)** | | | " + " | | | ".join(
+        f"**{e:.2f}** ({_signed(b)})" for e, b in zip(mae, bias)) + " |")
+    if ferguson is not None:
+        ref = ferguson.mean_absolute_error()
+        ref_bias = np.mean(ferguson.outcomes() - ferguson.targets(), axis=0)
+        out.append("| Ferguson 2022 MAE (bias) | | | " + " | | | ".join(
+            f"{e:.2f} ({_signed(b)})" for e, b in zip(ref, ref_bias)) + " |")
+    return out
