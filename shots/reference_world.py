@@ -1,7 +1,8 @@
 """The high-fidelity "reference world": the flight model synthetic sessions are generated from.
 
 Its aerodynamics (`flight.reference_aero`) flown by the flight core with RK4 at 0.01 s, the air it is calibrated
-in, and the PGA TOUR averages table it is calibrated against (`shots.calibrate_reference` fits the free parameters).
+in, and the reader of the PGA TOUR averages table, a held-out check (`shots.calibrate_reference` fits the free
+parameters on recordings that may be trained on).
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ from flight.wind import CALM, Wind
 from shots.paths import shared_data_dir
 
 CALIBRATION_AIR = Air.from_conditions(temperature_c=25.0, altitude_m=0.0, humidity_pct=50.0)
-"""The air the tour-average table is fitted in: TrackMan's normalize temperature (77 F), sea level, 50 % humidity."""
+"""The air the unrecorded-air sources are calibrated and the tour-average table checked in: TrackMan's normalize
+temperature (77 F), sea level, 50 % humidity."""
 
 TOUR_AVERAGES_FILE = Path("reference") / "trackman_tour_averages_pga_2023.csv"
 """The PGA TOUR 2023 averages, relative to the shared data folder."""
