@@ -12,6 +12,7 @@ from golfflight.commands import (
     ground_fit,
     serve,
     simulate,
+    sweep,
     synth,
     train,
     train_real,
@@ -19,5 +20,5 @@ from golfflight.commands import (
 
 COMMANDS = [
     fly, synth, convert, calibrate, train, train_real, export, evaluate, finetune, accuracy, ground_fit, serve,
-    simulate, discover,
+    simulate, sweep, discover,
 ]

@@ -20,43 +20,7 @@ import sys
 from pathlib import Path
 
 from shots.records import reading
-
-AIR_COLUMNS = {name: name for name in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct", "density_kg_m3")}
-WIND_COLUMNS = {
-    "wind_speed_mps": "speed_mps",
-    "wind_from_deg": "from_deg",
-    "wind_profile": "profile",
-    "wind_reference_height_m": "reference_height_m",
-}
-GROUND_COLUMNS = {
-    "ground_surface": "surface",
-    "stimp_ft": "stimp_ft",
-    "ground_elevation_m": "elevation_m",
-    "slope_deg": "slope_deg",
-    "slope_dir_deg": "slope_dir_deg",
-}
-LAUNCH_COLUMNS = (
-    "ball_speed_mps",
-    "ball_speed_mph",
-    "launch_angle_deg",
-    "launch_direction_deg",
-    "spin_rpm",
-    "spin_axis_deg",
-    "back_spin_rpm",
-    "side_spin_rpm",
-)
-PASSED_OVER = (
-    "session",
-    "club",
-    "timestamp",
-    "split",
-    "carry_x_m",
-    "carry_y_m",
-    "apex_m",
-    "flight_time_s",
-    "landing_angle_deg",
-)
-"""Canonical shot-record columns that say nothing about the launch or its conditions."""
+from sweep.columns import cell_value, check, columns_message, flat_row, request_of_cells
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -70,32 +34,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(run=run)
 
 
-def _number_or_text(text: str):
-    try:
-        return float(text)
-    except ValueError:
-        return text
-
-
-REQUEST_TO_COLUMN = {
-    **{f"air.{field}": column for column, field in AIR_COLUMNS.items()},
-    **{f"wind.{field}": column for column, field in WIND_COLUMNS.items()},
-    **{f"ground.{field}": column for column, field in GROUND_COLUMNS.items()},
-}
-"""Request field -> CSV column, to name the column of a refused value."""
-
-
 def shots_from_csv(path: Path) -> tuple[list[dict], list[str | None], list[str], list[str]]:
     """Request dicts, shot ids (None where the file has none), where each shot is ("FILE line N") and the problems
     found while reading (extra cells, repeated shot ids) of a launches CSV."""
     with reading(path), open(path, newline="") as handle:
         reader = csv.DictReader(handle)
-        known = {"shot_id", "normalized", *LAUNCH_COLUMNS, *AIR_COLUMNS, *WIND_COLUMNS, *GROUND_COLUMNS, *PASSED_OVER}
-        unknown = [c for c in reader.fieldnames or [] if c not in known]
-        if not reader.fieldnames:
-            raise ValueError(f"{path} line 1: no header row; launch columns are {', '.join(LAUNCH_COLUMNS)}")
-        if unknown:
-            raise ValueError(f"{path}: unknown columns {unknown}; launch columns are {', '.join(LAUNCH_COLUMNS)}")
+        refused = columns_message(str(path), list(reader.fieldnames or []))
+        if refused:
+            raise ValueError(refused)
         shots, ids, places, problems, seen = [], [], [], [], {}
         for line, row in enumerate(reader, start=2):
             place = f"{path} line {line}"
@@ -108,17 +54,7 @@ def shots_from_csv(path: Path) -> tuple[list[dict], list[str | None], list[str],
                 continue
             if shot_id:
                 seen[shot_id] = line
-            cells = {k: _number_or_text(v.strip()) for k, v in row.items() if v is not None and v.strip() != ""}
-            shot = {k: cells[k] for k in LAUNCH_COLUMNS if k in cells}
-            air = {AIR_COLUMNS[k]: cells[k] for k in AIR_COLUMNS if k in cells}
-            wind = {WIND_COLUMNS[k]: cells[k] for k in WIND_COLUMNS if k in cells}
-            ground = {GROUND_COLUMNS[k]: cells[k] for k in GROUND_COLUMNS if k in cells}
-            for name, part in (("air", air), ("wind", wind), ("ground", ground)):
-                if part:
-                    shot[name] = part
-            if "normalized" in cells:
-                shot["normalized"] = str(cells["normalized"]).lower() in ("1", "1.0", "true", "yes")
-            shots.append(shot)
+            shots.append(request_of_cells({k: cell_value(v) for k, v in row.items()}))
             ids.append(shot_id)
             places.append(place)
     return shots, ids, places, problems
@@ -126,20 +62,14 @@ def shots_from_csv(path: Path) -> tuple[list[dict], list[str | None], list[str],
 
 def validate(raw: list, places: list[str], csv_columns: bool) -> tuple[list, list[int], list[str]]:
     """(valid ShotRequests, their indices in `raw`, one problem line per invalid value naming where and which field)."""
-    from pydantic import ValidationError
-
-    from service.api.models import ShotRequest, describe_errors
-
     shots, kept, problems = [], [], []
     for index, (item, place) in enumerate(zip(raw, places, strict=True)):
-        try:
-            shots.append(ShotRequest.model_validate(item))
+        checked = check(item, csv_columns)
+        if isinstance(checked, list):
+            problems += [f"{place} {problem}" for problem in checked]
+        else:
+            shots.append(checked)
             kept.append(index)
-        except ValidationError as error:
-            for detail in describe_errors(error.errors()):
-                field = detail["field"]
-                where = f"column '{REQUEST_TO_COLUMN.get(field, field)}'" if csv_columns else f"field '{field}'"
-                problems.append(f"{place} {where}: {detail['message'].split(': ', 1)[-1]}")
     return shots, kept, problems
 
 
@@ -151,20 +81,6 @@ def shots_from_json(text: str, source: str) -> list[dict]:
     if isinstance(data, dict) and "shots" in data:
         data = data["shots"]
     return data if isinstance(data, list) else [data]
-
-
-def flat_row(result: dict) -> dict:
-    """One CSV row of a result: the flight's numbers, then normalized_* and flat_* ones, or the error."""
-    row = {}
-    for prefix, flight in (("", result), ("normalized_", result.get("normalized")), ("flat_", result.get("flat"))):
-        if not flight:
-            continue
-        for key, value in flight.items():
-            if key in ("landing", "rest"):
-                row[f"{prefix}{key}_x_m"], row[f"{prefix}{key}_y_m"] = value["x_m"], value["y_m"]
-            elif key not in ("trajectory", "normalized", "flat", "conditions"):
-                row[prefix + key] = value
-    return row
 
 
 def run(args: argparse.Namespace) -> int:

@@ -1,0 +1,166 @@
+"""The flat, one-row-per-shot form of the flight contract: launch and condition columns in, result columns out.
+
+`golfflight simulate` (CSV) and `golfflight sweep` (CSV, Parquet, grids) read and write the same columns, so both
+go through this module: a row's cells become a `ShotRequest` dict (`request_of_cells`), are validated by the
+request model with every problem naming its column and allowed range (`check`), and a result comes back as one
+flat row (`flat_row`). Standard library and the service's own modules only: the serving install runs `simulate`.
+"""
+
+from __future__ import annotations
+
+from pydantic import ValidationError
+
+from service.api.models import FlatFlight, FlightResult, ShotRequest, describe_errors
+
+AIR_COLUMNS = {name: name for name in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct", "density_kg_m3")}
+WIND_COLUMNS = {
+    "wind_speed_mps": "speed_mps",
+    "wind_from_deg": "from_deg",
+    "wind_profile": "profile",
+    "wind_reference_height_m": "reference_height_m",
+}
+GROUND_COLUMNS = {
+    "ground_surface": "surface",
+    "stimp_ft": "stimp_ft",
+    "ground_elevation_m": "elevation_m",
+    "slope_deg": "slope_deg",
+    "slope_dir_deg": "slope_dir_deg",
+}
+LAUNCH_COLUMNS = (
+    "ball_speed_mps",
+    "ball_speed_mph",
+    "launch_angle_deg",
+    "launch_direction_deg",
+    "spin_rpm",
+    "spin_axis_deg",
+    "back_spin_rpm",
+    "side_spin_rpm",
+)
+PASSED_OVER = (
+    "session",
+    "club",
+    "timestamp",
+    "split",
+    "carry_x_m",
+    "carry_y_m",
+    "apex_m",
+    "flight_time_s",
+    "landing_angle_deg",
+)
+"""Canonical shot-record columns that say nothing about the launch or its conditions."""
+
+REQUEST_COLUMNS = ("normalized", *LAUNCH_COLUMNS, *AIR_COLUMNS, *WIND_COLUMNS, *GROUND_COLUMNS)
+"""Every column that goes into a shot's request."""
+
+KNOWN_COLUMNS = frozenset({"shot_id", *REQUEST_COLUMNS, *PASSED_OVER})
+
+TEXT_COLUMNS = frozenset({"shot_id", "session", "club", "timestamp", "split", "wind_profile", "ground_surface"})
+"""Columns whose cells are words (echoed as text); `normalized` is a flag; every other known column is a number."""
+
+REQUEST_TO_COLUMN = {
+    **{f"air.{field}": column for column, field in AIR_COLUMNS.items()},
+    **{f"wind.{field}": column for column, field in WIND_COLUMNS.items()},
+    **{f"ground.{field}": column for column, field in GROUND_COLUMNS.items()},
+}
+"""Request field -> column, to name the column of a refused value."""
+
+
+def unknown_columns(columns: list[str]) -> list[str]:
+    return [c for c in columns if c not in KNOWN_COLUMNS]
+
+
+def columns_message(source: str, columns: list[str]) -> str | None:
+    """Why a table with these columns cannot be read (no columns, or unknown ones), or None."""
+    if not columns:
+        return f"{source} line 1: no header row; launch columns are {', '.join(LAUNCH_COLUMNS)}"
+    unknown = unknown_columns(columns)
+    if unknown:
+        return f"{source}: unknown columns {unknown}; launch columns are {', '.join(LAUNCH_COLUMNS)}"
+    return None
+
+
+def number_or_text(text: str) -> float | str:
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def cell_value(value):
+    """A cell as the request sees it: text stripped and read as a number where it is one, blanks None."""
+    if isinstance(value, str):
+        value = value.strip()
+        return number_or_text(value) if value else None
+    return value
+
+
+def is_flag_set(value) -> bool:
+    """The `normalized` column: 1, true or yes (any case) ask for the normalized flight."""
+    return str(value).lower() in ("1", "1.0", "true", "yes")
+
+
+def request_of_cells(cells: dict) -> dict:
+    """A ShotRequest dict from one row's cells (as `cell_value` reads them; None or missing = not given)."""
+    shot = {k: cells[k] for k in LAUNCH_COLUMNS if cells.get(k) is not None}
+    for name, columns in (("air", AIR_COLUMNS), ("wind", WIND_COLUMNS), ("ground", GROUND_COLUMNS)):
+        part = {field: cells[column] for column, field in columns.items() if cells.get(column) is not None}
+        if part:
+            shot[name] = part
+    if cells.get("normalized") is not None:
+        shot["normalized"] = is_flag_set(cells["normalized"])
+    return shot
+
+
+def check(item, csv_columns: bool = True) -> ShotRequest | list[str]:
+    """The validated request, or one problem per invalid value naming its column (or request field) and range."""
+    try:
+        return ShotRequest.model_validate(item)
+    except ValidationError as error:
+        problems = []
+        for detail in describe_errors(error.errors()):
+            field = detail["field"]
+            where = f"column '{REQUEST_TO_COLUMN.get(field, field)}'" if csv_columns else f"field '{field}'"
+            problems.append(f"{where}: {detail['message'].split(': ', 1)[-1]}")
+        return problems
+
+
+NESTED_POINTS = ("landing", "rest")
+"""Result fields that are points, flattened to NAME_x_m and NAME_y_m."""
+
+LEFT_OUT = ("trajectory", "normalized", "flat", "conditions")
+"""Result fields that are not flat numbers of the flight (the nested flights get prefixed columns instead)."""
+
+
+def flat_row(result: dict) -> dict:
+    """One flat row of a result: the flight's numbers, then normalized_* and flat_* ones, or the error."""
+    row = {}
+    for prefix, flight in (("", result), ("normalized_", result.get("normalized")), ("flat_", result.get("flat"))):
+        if not flight:
+            continue
+        for key, value in flight.items():
+            if key in NESTED_POINTS:
+                row[f"{prefix}{key}_x_m"], row[f"{prefix}{key}_y_m"] = value["x_m"], value["y_m"]
+            elif key not in LEFT_OUT:
+                row[prefix + key] = value
+    return row
+
+
+def _flat_names(fields, prefix: str = "") -> list[str]:
+    names = []
+    for key in fields:
+        if key in NESTED_POINTS:
+            names += [f"{prefix}{key}_x_m", f"{prefix}{key}_y_m"]
+        elif key not in LEFT_OUT:
+            names.append(prefix + key)
+    return names
+
+
+def result_columns(normalized: bool, flat: bool) -> list[str]:
+    """The columns `flat_row` can give, in its order: the flight's, then normalized_* (if asked for) and flat_* (if
+    any ground lies off the tee's elevation), then `error` for a shot the engine could not fly."""
+    names = _flat_names(FlightResult.model_fields)
+    if normalized:
+        names += _flat_names(FlightResult.model_fields, "normalized_")
+    if flat:
+        names += _flat_names(FlatFlight.model_fields, "flat_")
+    return [*names, "error"]

@@ -1,0 +1,119 @@
+"""The worker side of a sweep: a table of input rows in, a table of the same rows with their flights out.
+
+One `Flyer` holds one FlightEngine (ONNX Runtime on one thread: the workers are the parallelism) and is what every
+engine runs: called in each process of the local pool, and as Ray Data's callable class (one per actor). Each row
+goes through the request model and `service.api.shots.fly_shots` exactly as `golfflight simulate` flies it, so the
+numbers are the same; a row the request model refuses keeps its place with the reason in `problem` and no flight,
+for the driver to report with the row's place in the input (only the driver knows it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+from sweep.columns import TEXT_COLUMNS, cell_value, check, flat_row, is_flag_set, request_of_cells, result_columns
+
+PROBLEM = "problem"
+"""Column of a worker's table: why the request model refused the row (lines), null for a row that flew."""
+
+ROW = "row"
+"""First column of the results: the row's index in the input, from 0 (a grid's row number)."""
+
+OBSERVED_PREFIX = "observed_"
+"""An input column with a result's name (a canonical file's observed apex_m, flight_time_s, landing_angle_deg) is
+written with this prefix."""
+
+
+@dataclass(frozen=True)
+class Layout:
+    """The columns of a sweep's input and so of its results: the input's, echoed, then the flight's."""
+
+    columns: tuple[str, ...]
+
+    @cached_property
+    def results(self) -> list[str]:
+        return result_columns(normalized="normalized" in self.columns, flat="ground_elevation_m" in self.columns)
+
+    @cached_property
+    def echoed(self) -> list[str]:
+        """Output names of the input columns."""
+        return [OBSERVED_PREFIX + c if c in self.results else c for c in self.columns]
+
+    def schema(self, with_problem: bool = False):
+        """The results' Arrow schema (with a worker's `problem` column, or the file's leading `row`)."""
+        import pyarrow as pa
+
+        def kind(column: str):
+            if column in TEXT_COLUMNS or column == "error":
+                return pa.string()
+            if column == "normalized":
+                return pa.bool_()
+            return pa.int64() if column.endswith("bounces") else pa.float64()
+
+        fields = [pa.field(name, kind(column)) for name, column in zip(self.echoed, self.columns, strict=True)]
+        fields += [pa.field(name, kind(name)) for name in self.results]
+        return pa.schema([*fields, pa.field(PROBLEM, pa.string())] if with_problem else [pa.field(ROW, pa.int64()), *fields])
+
+
+def _number(value) -> float | None:
+    """A numeric column's value, or None where the cell is blank or not a number."""
+    value = cell_value(value)
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
+def echo(column: str, value):
+    """An input cell as its results column holds it: text, a flag, or a number (None where blank)."""
+    if column in TEXT_COLUMNS:
+        return None if value is None or value == "" else str(value)
+    if column == "normalized":
+        return None if cell_value(value) is None else is_flag_set(cell_value(value))
+    return _number(value)
+
+
+class Flyer:
+    """A flight engine for one worker: `flyer(piece)` flies a piece of a source (module docstring)."""
+
+    def __init__(self, bundle_dir: str, sha256: str, source):
+        """Load the bundle at `bundle_dir` (its own path on each node of a cluster) and refuse it unless its ONNX
+        graph is the one the driver checked (`sha256`); `source` (`sweep.sources`) turns pieces into rows."""
+        from service.engine import FlightEngine
+
+        self.engine = FlightEngine(bundle_dir, batch_threads=1)
+        if self.engine.sha256 != sha256:
+            raise ValueError(f"{bundle_dir}: this worker's model ({self.engine.sha256[:12]}) is not the driver's "
+                             f"({sha256[:12]}); every node needs the same bundle at the same path")
+        self.source = source
+        self.layout = Layout(tuple(source.columns))
+
+    def __call__(self, piece):
+        return self.fly_table(self.source.expand(piece))
+
+    def fly_table(self, table):
+        """The rows of `table` (the layout's input columns) with their flights, in order (a pyarrow.Table)."""
+        import pyarrow as pa
+
+        from service.api.shots import fly_shots
+
+        layout = self.layout
+        columns = table.select(list(layout.columns)).to_pydict()
+        rows = [dict(zip(layout.columns, values, strict=True)) for values in zip(*columns.values(), strict=True)]
+        problems: list[str | None] = [None] * len(rows)
+        shots, flown = [], []
+        for i, row in enumerate(rows):
+            checked = check(request_of_cells({k: cell_value(v) for k, v in row.items()}))
+            if isinstance(checked, list):
+                problems[i] = "\n".join(checked)
+            else:
+                shots.append(checked)
+                flown.append(i)
+        out: dict[str, list] = {name: [None] * len(rows) for name in (*layout.echoed, *layout.results)}
+        for name, column in zip(layout.echoed, layout.columns, strict=True):
+            values = out[name]
+            for i in flown:
+                values[i] = echo(column, rows[i][column])
+        for i, result in zip(flown, fly_shots(self.engine, shots), strict=True):
+            for name, value in flat_row(result.model_dump(exclude_none=True)).items():
+                out[name][i] = value
+        out[PROBLEM] = problems
+        return pa.table(out, schema=layout.schema(with_problem=True))

@@ -1,0 +1,114 @@
+"""The driver of a sweep: result tables from an engine, in input order, checked for refused rows and streamed into
+one Parquet file, whole or not at all.
+
+Memory stays bounded: each result table is written as a row group as soon as it arrives (pyarrow's ParquetWriter)
+and dropped. A row the request model refuses stops the sweep with every problem of that piece, each naming the
+row's place in the input, its column and the allowed range, and nothing is written; with `skip_bad_rows` such rows
+are left out and each is reported. The file is written beside its target and renamed over it at the end
+(`shots.files.write_atomic`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from contextlib import closing
+from dataclasses import dataclass
+from typing import Literal
+
+from service.model_location import model_dir
+from shots.files import write_atomic
+from sweep.flyer import PROBLEM, ROW, Layout
+from sweep.sources import Source
+
+SHOWN_PROBLEMS = 20
+"""Problems listed when a sweep is refused (the rest are counted)."""
+
+Engine = Literal["local", "ray"]
+
+
+@dataclass(frozen=True)
+class Summary:
+    rows: int
+    written: int
+    skipped: int
+    failed: int
+    """Shots the engine could not fly to the ground (their `error` column says why)."""
+    seconds: float
+
+    @property
+    def shots_per_second(self) -> float:
+        return self.rows / self.seconds if self.seconds > 0 else 0.0
+
+
+def _tables(source: Source, engine: Engine, workers: int, model: str | None, ray_address: str | None) -> Iterator:
+    """Result tables from the chosen engine, its workers loading the bundle the driver verified here."""
+    from flight.bundle_check import verify_bundle
+    from sweep.engines import local_tables, ray_tables
+
+    bundle = model_dir(model).resolve()
+    sha256 = verify_bundle(bundle).onnx.sha256
+    if engine == "ray":
+        return ray_tables(source, str(bundle), sha256, workers, ray_address)
+    return local_tables(source, str(bundle), sha256, workers)
+
+
+def _refused(source: Source, table, start: int) -> list[str]:
+    """One line per problem of the refused rows of `table`, whose first row is input row `start`."""
+    lines = []
+    for i, problem in enumerate(table[PROBLEM].to_pylist()):
+        if problem is not None:
+            lines += [f"{source.place(start + i)} {line}" for line in problem.split("\n")]
+    return lines
+
+
+def run_sweep(
+    source: Source,
+    out: str,
+    engine: Engine = "local",
+    workers: int = 2,
+    model: str | None = None,
+    ray_address: str | None = None,
+    skip_bad_rows: bool = False,
+    progress: bool = True,
+    skipped: Callable[[str], None] = print,
+) -> Summary:
+    """Fly every row of `source` on `engine` and write `out` (Parquet): the input row's number, its columns, its
+    flight (module docstring). `skipped` gets each problem of a row left out under `skip_bad_rows`."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+    import pyarrow.parquet as pq
+    from tqdm import tqdm
+
+    started = time.perf_counter()
+    schema = Layout(tuple(source.columns)).schema()
+    counts = {"rows": 0, "written": 0, "skipped": 0, "failed": 0}
+
+    def write(path: str) -> None:
+        tables = _tables(source, engine, workers, model, ray_address)
+        bar = tqdm(total=source.total_rows, unit="shot", unit_scale=True, disable=not progress, desc="sweep")
+        with closing(tables), bar, pq.ParquetWriter(path, schema) as writer:
+            for table in tables:
+                start, count = counts["rows"], table.num_rows
+                table = table.add_column(0, ROW, pa.array(range(start, start + count), pa.int64()))
+                problems = _refused(source, table, start)
+                if problems and not skip_bad_rows:
+                    shown = "\n  ".join(problems[:SHOWN_PROBLEMS])
+                    more = f"\n  ... and {len(problems) - SHOWN_PROBLEMS} more" if len(problems) > SHOWN_PROBLEMS else ""
+                    raise ValueError(
+                        f"{len(problems)} invalid values in rows {start} to {start + count - 1} (nothing written; "
+                        f"--skip-bad-rows flies the rest):\n  {shown}{more}"
+                    )
+                for problem in problems:
+                    skipped(problem)
+                if problems:
+                    table = table.filter(pc.is_null(table[PROBLEM]))
+                writer.write_table(table.drop_columns([PROBLEM]))
+                counts["rows"] += count
+                counts["written"] += table.num_rows
+                counts["skipped"] += count - table.num_rows
+                counts["failed"] += table.num_rows - table["error"].null_count
+                bar.update(count)
+
+    write_atomic(out, write)
+    return Summary(**counts, seconds=time.perf_counter() - started)

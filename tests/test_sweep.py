@@ -1,0 +1,210 @@
+"""`golfflight sweep`: grids, files (CSV and Parquet) and both engines give the numbers `golfflight simulate` gives
+for the same rows, streamed in chunks; bad rows are refused with their place, column and range (nothing written)
+or skipped on request. Real engines throughout: spawned processes, a local Ray instance, ONNX Runtime."""
+
+from __future__ import annotations
+
+import csv
+import math
+
+import numpy as np
+import pytest
+
+from golfflight.cli import main
+from sweep.grid import Grid, GridError, parse_axis
+
+pa = pytest.importorskip("pyarrow")
+pq = pytest.importorskip("pyarrow.parquet")
+
+CONDITIONS = ("altitude_m", "temperature_c", "wind_speed_mps", "wind_from_deg", "wind_profile", "normalized",
+              "ground_elevation_m", "ground_surface")
+
+
+def launch_rows(n: int, seed: int = 0) -> list[dict]:
+    """Mixed launches and conditions in every form simulate's CSV takes (mph and back/side spin on some rows, blank
+    cells, the canonical file's observed apex_m), wedges to drivers."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for i in range(n):
+        speed = rng.uniform(30.0, 75.0)
+        row = {"shot_id": f"s{i}", "ball_speed_mps": speed, "ball_speed_mph": "",
+               "launch_angle_deg": rng.uniform(9.0, 25.0), "launch_direction_deg": rng.uniform(-5.0, 5.0),
+               "spin_rpm": rng.uniform(2000.0, 8000.0), "spin_axis_deg": rng.uniform(-15.0, 15.0),
+               "back_spin_rpm": "", "side_spin_rpm": "", "apex_m": rng.uniform(5.0, 30.0),
+               "altitude_m": rng.choice([0.0, 1600.0]), "temperature_c": "", "wind_speed_mps": rng.uniform(0.0, 8.0),
+               "wind_from_deg": rng.uniform(0.0, 360.0), "wind_profile": rng.choice(["uniform", "log"]),
+               "normalized": "true" if i % 7 == 0 else "", "ground_elevation_m": rng.choice([0.0, -4.0, 3.0]),
+               "ground_surface": rng.choice(["fairway", "green", ""])}
+        if i % 5 == 1:
+            row.update(ball_speed_mps="", ball_speed_mph=speed / 0.44704, spin_rpm="", spin_axis_deg="",
+                       back_spin_rpm=3000.0, side_spin_rpm=-400.0, temperature_c=31.0)
+        rows.append(row)
+    return rows
+
+
+def write_csv(path, rows: list[dict]):
+    with open(path, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, rows[0].keys())
+        writer.writeheader()
+        writer.writerows(rows)
+    return path
+
+
+def simulated(tmp_path, source) -> list[dict]:
+    """`golfflight simulate`'s CSV results for `source`, numbers as floats."""
+    out = tmp_path / "simulated.csv"
+    assert main(["simulate", str(source), "--out", str(out)]) == 0
+    with open(out) as handle:
+        return [{k: v if k in ("shot_id", "error") else float(v) for k, v in r.items() if v != ""}
+                for r in csv.DictReader(handle)]
+
+
+def assert_same_as_simulate(swept: list[dict], expected: list[dict], sample: int = 60) -> None:
+    """Every figure simulate gives for a sample of rows is in the sweep's row, equal to float rounding."""
+    assert len(swept) == len(expected)
+    for i in np.random.default_rng(1).choice(len(expected), min(sample, len(expected)), replace=False):
+        row, want = swept[i], expected[i]
+        assert row["shot_id"] == want["shot_id"] and row["row"] == i
+        for key, value in want.items():
+            if key != "shot_id":
+                assert row[key] == pytest.approx(value, rel=1e-9, abs=1e-9), (i, key)
+        flown = {k for k, v in row.items() if v is not None and k.startswith(("normalized_", "flat_"))}
+        assert flown == {k for k in want if k.startswith(("normalized_", "flat_"))}, i
+
+
+@pytest.fixture(scope="module")
+def launches(tmp_path_factory):
+    """300 launches as CSV, and as Parquet with numbers typed, with simulate's results for them."""
+    folder = tmp_path_factory.mktemp("launches")
+    rows = launch_rows(300)
+    source = write_csv(folder / "launches.csv", rows)
+    typed = [{k: (None if v == "" else v) for k, v in row.items()} for row in rows]
+    parquet = folder / "launches.parquet"
+    pq.write_table(pa.Table.from_pylist(typed), parquet)
+    return source, parquet, simulated(folder, source)
+
+
+def sweep(*argv) -> int:
+    return main(["sweep", *map(str, argv), "--no-progress"])
+
+
+def test_grid_axes_ranges_lists_and_single_values():
+    assert parse_axis("ball_speed_mps=30:80:11").values == tuple(30.0 + 5.0 * i for i in range(11))
+    assert parse_axis("wind_from_deg=0, 90,180").values == (0.0, 90.0, 180.0)
+    assert parse_axis("ground_surface=fairway,green").values == ("fairway", "green")
+    assert parse_axis("altitude_m=1600").values == (1600.0,)
+    grid = Grid.parse(["ball_speed_mps=40:60:3", "launch_angle_deg=10,14", "spin_rpm=3000"])
+    assert len(grid) == 6 and grid.columns == ["ball_speed_mps", "launch_angle_deg", "spin_rpm"]
+    rows = grid.rows(0, 6)
+    assert rows["ball_speed_mps"] == [40.0, 40.0, 50.0, 50.0, 60.0, 60.0]  # the first axis varies slowest
+    assert rows["launch_angle_deg"] == [10.0, 14.0] * 3
+    assert grid.rows(3, 5) == {k: v[3:5] for k, v in rows.items()}
+
+
+@pytest.mark.parametrize(
+    ("axes", "message"),
+    [
+        (["ball_speed_mps"], "COLUMN=START:STOP:COUNT"),
+        (["club_speed_mph=1:2:3"], "not a launch or condition column"),
+        (["ball_speed_mps=30:80"], "START:STOP:COUNT"),
+        (["ball_speed_mps=30:80:2.5"], "whole number"),
+        (["ball_speed_mps=30:fast:3"], "'fast' is not a number"),
+        (["ball_speed_mps=30,30"], "listed twice"),
+        (["ball_speed_mps=40", "ball_speed_mps=50", "launch_angle_deg=10", "spin_rpm=3000"], "more than once"),
+        (["launch_angle_deg=10", "spin_rpm=3000"], "ball speed: give exactly one of"),
+        (["ball_speed_mps=40:120:3", "launch_angle_deg=10", "spin_rpm=3000"],
+         ("--grid ball_speed_mps=120.0: column 'ball_speed_mps': Input should be less than or equal to 100 "
+          "(got 120.0); allowed 0.5 to 100 m/s")),
+    ],
+)
+def test_grid_errors_name_the_axis_and_the_allowed_range(axes, message):
+    with pytest.raises(GridError) as refused:
+        Grid.parse(axes)
+    assert message in str(refused.value)
+
+
+def test_a_grid_is_written_in_chunks_in_order(tmp_path, capsys):
+    out = tmp_path / "grid.parquet"
+    axes = ["ball_speed_mps=40:70:25", "launch_angle_deg=8:20:4", "spin_rpm=2500,5000", "wind_from_deg=0,180",
+            "wind_speed_mps=5", "ground_surface=green,rough"]
+    assert sweep("--grid", *axes, "--out", out, "--workers", 2, "--chunk-rows", 64) == 0
+    assert "800 shots written" in capsys.readouterr().out
+    written = pq.ParquetFile(out)
+    assert written.metadata.num_rows == 800 and written.metadata.num_row_groups == math.ceil(800 / 64)
+    table = written.read()
+    assert table["row"].to_pylist() == list(range(800))
+    assert table.column_names[:7] == ["row", "ball_speed_mps", "launch_angle_deg", "spin_rpm", "wind_from_deg",
+                                      "wind_speed_mps", "ground_surface"]
+    assert table["ground_surface"].to_pylist()[:4] == ["green", "rough", "green", "rough"]
+    assert table["error"].null_count == 800 and min(table["carry_m"].to_pylist()) > 50
+    drives = {(r["wind_from_deg"], r["ground_surface"]): r for r in table.to_pylist()
+              if r["ball_speed_mps"] == 70 and r["launch_angle_deg"] == 12 and r["spin_rpm"] == 2500}
+    assert drives[0.0, "green"]["carry_m"] + 10 < drives[180.0, "green"]["carry_m"]  # 5 m/s of head and tail wind
+    assert drives[180.0, "rough"]["roll_m"] < drives[180.0, "green"]["roll_m"]
+
+
+def test_local_sweep_of_csv_and_parquet_equals_simulate(launches, tmp_path):
+    source, parquet, expected = launches
+    for name, path in (("csv", source), ("parquet", parquet)):
+        out = tmp_path / f"{name}.parquet"
+        assert sweep(path, "--out", out, "--workers", 2, "--chunk-rows", 64) == 0
+        table = pq.read_table(out)
+        assert "observed_apex_m" in table.column_names  # the file's apex beside the flown one
+        assert_same_as_simulate(table.to_pylist(), expected)
+
+
+def test_a_bad_row_refuses_the_sweep_with_its_line_column_and_range(launches, tmp_path, capsys):
+    rows = launch_rows(40)
+    rows[3]["spin_rpm"], rows[17]["wind_speed_mps"], rows[30]["ball_speed_mps"] = 99999, 45, "fast"
+    source, out = write_csv(tmp_path / "bad.csv", rows), tmp_path / "out.parquet"
+    assert sweep(source, "--out", out, "--workers", 1, "--chunk-rows", 16) == 2
+    err = capsys.readouterr().err
+    assert "golfflight sweep: error: 1 invalid values in rows 0 to 15 (nothing written" in err
+    assert "bad.csv line 5 column 'spin_rpm': " in err and "allowed 0 to 15000 rpm" in err
+    assert not out.exists() and list(tmp_path.iterdir()) == [source]  # no result and no temporary file
+    assert sweep(source, "--out", out, "--workers", 1, "--chunk-rows", 16, "--skip-bad-rows") == 0
+    captured = capsys.readouterr()
+    assert captured.err.count("golfflight sweep: skipped: ") == 3
+    assert "bad.csv line 19 column 'wind_speed_mps': " in captured.err and "allowed 0 to 30 m/s" in captured.err
+    assert "bad.csv line 32 column 'ball_speed_mps': " in captured.err and "'fast'" in captured.err
+    assert "37 shots written" in captured.out and "3 rows skipped" in captured.out
+    assert pq.read_table(out)["row"].to_pylist() == [i for i in range(40) if i not in (3, 17, 30)]
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ("ball_speed_mps,launch_angle_deg,spin_rpm,club_head_mph\n55,16,7100,90\n", "unknown columns ['club_head_mph']"),
+        ("", "no header row"),
+    ],
+)
+def test_a_file_that_cannot_be_swept_gets_one_line(tmp_path, capsys, content, message):
+    source = tmp_path / "launches.csv"
+    source.write_text(content)
+    assert sweep(source, "--out", tmp_path / "out.parquet") == 2
+    assert message in capsys.readouterr().err
+    assert sweep(tmp_path / "missing.csv", "--out", tmp_path / "out.parquet") == 2
+    assert sweep(source, "--grid", "spin_rpm=3000", "--out", tmp_path / "out.parquet") == 2
+    assert "one of the two" in capsys.readouterr().err
+
+
+@pytest.fixture(scope="module")
+def local_ray():
+    """A local Ray instance of 3 CPUs (2 actors and a reader), shut down after the module."""
+    ray = pytest.importorskip("ray")
+    ray.init(num_cpus=3, include_dashboard=False, logging_level="WARNING")
+    yield ray
+    ray.shutdown()
+
+
+def test_ray_sweep_with_two_actors_equals_simulate(local_ray, launches, tmp_path):
+    source, parquet, expected = launches
+    for name, path in (("csv", source), ("parquet", parquet)):
+        out = tmp_path / f"{name}.parquet"
+        assert sweep(path, "--out", out, "--engine", "ray", "--workers", 2, "--chunk-rows", 64) == 0
+        assert_same_as_simulate(pq.read_table(out).to_pylist(), expected)
+    grid = ["ball_speed_mps=40:70:10", "launch_angle_deg=10,14", "spin_rpm=3000,5000"]
+    for engine in ("local", "ray"):
+        assert sweep("--grid", *grid, "--out", tmp_path / f"{engine}.parquet", "--engine", engine,
+                     "--workers", 2, "--chunk-rows", 8) == 0
+    assert pq.read_table(tmp_path / "ray.parquet").equals(pq.read_table(tmp_path / "local.parquet"))
