@@ -1,16 +1,21 @@
-"""Discovery: the learned correction's term selection, the reported conventions and the proof's bookkeeping."""
+"""Discovery: the learned correction's term selection, the reported conventions, the gust outside the library and
+the proof's bookkeeping."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from discovery.conceal import conceal
 from discovery.correction import TERMS, features, select_terms
 from discovery.effects import EFFECTS, Context, equivalent_altitude_m
+from discovery.model import reference
+from discovery.outside import HEIGHT_GUST, OUTSIDE, HeightGust, air_motion
 from discovery.prove import Run, cases, draw_effect, expected_label, relative_error, tables
 from discovery.report import plus_minus, service_settings
 from discovery.schema import EffectResult
 from flight.air import pressure_at_altitude
+from flight.wind import Wind, wind_vector
 from shots.markdown import replace_section
 
 ICAO = Context(1.225, 15.0)
@@ -99,6 +104,31 @@ def test_every_case_draws_a_size_and_scores_its_error():
     assert expected_label(()) == "none" and expected_label(("wind", "ball_speed_bias")) == "ball_speed_bias+wind"
     wind = {"speed_mps": 5.0, "from_deg": 0.0}
     assert relative_error("wind", {"speed_mps": 5.5, "from_deg": 0.0}, wind) == pytest.approx(0.1)
+
+
+def test_the_gust_blows_only_above_its_height_and_grows_with_it():
+    base = Wind.from_components(np.array([1.0, -2.0]), np.array([0.5, 0.0]))
+    gust = air_motion({HEIGHT_GUST: {"rate_mps_per_m": 0.2, "height_m": 10.0, "from_deg": 90.0}}, base)
+    assert isinstance(gust, HeightGust) and not gust.is_calm and HEIGHT_GUST in OUTSIDE
+    heights = np.array([5.0, 30.0])
+    extra = gust.velocity(heights) - base.velocity(heights)
+    np.testing.assert_allclose(extra, [[0.0, 0.0, 0.0], wind_vector(0.2 * 20.0, 90.0)], atol=1e-12)
+    np.testing.assert_allclose(gust.take(np.array([1])).velocity(np.array([30.0])), gust.velocity(heights)[1:])
+    assert air_motion({}, base) is base
+    calm_below = HeightGust(rate_mps_per_m=0.2, threshold_m=10.0)
+    assert not calm_below.is_calm and not calm_below.velocity(np.array([9.0])).any()
+
+
+def test_a_crosswind_gust_moves_the_model_flights_sideways_and_the_high_ones_more():
+    """Hidden in the model's own flights (here the reference world as the model): from the right, so every shot
+    lands left of its clean twin, and the higher its apex the more."""
+    gust = {HEIGHT_GUST: {"rate_mps_per_m": 0.25, "height_m": 10.0, "from_deg": 90.0}}
+    clean, gusty = (conceal(hidden, 60, seed=3, model=reference()).shots.records for hidden in ({}, gust))
+    assert [r.shot_id for r in clean] == [r.shot_id for r in gusty]
+    drift = np.array([g.carry_x_m - c.carry_x_m for c, g in zip(clean, gusty)])
+    apex = np.array([c.apex_m for c in clean])
+    assert np.all(drift < 0) and np.median(drift) < -1.0
+    assert np.corrcoef(apex, drift)[0, 1] < -0.5
 
 
 def test_tables_and_section_replacement():

@@ -1,6 +1,7 @@
 """Discovery against the model as the service flies it (issue 14): recordings made by the served bundle's own
 flights plus launch-monitor noise. Clean sets raise no alarm, a consistent shift hidden in a large expected error is
-found, a physics outside the library is reported as unlisted, and a fit below the noise floor is flagged."""
+found, a physics outside the library is reported as unlisted (a gust growing with height at least not passed off as
+a complete library explanation), and a fit below the noise floor is flagged."""
 
 from __future__ import annotations
 
@@ -68,6 +69,15 @@ def test_a_drag_rise_at_low_speed_is_reported_as_unlisted(served):
     assert report.systematic and report.unlisted is not None
     assert [e.name for e in report.effects] == ["unlisted"], "no library effect explains its structure"
     assert "unlisted" in report.statement and report.unlisted.expression
+
+
+def test_a_gust_growing_with_height_is_not_passed_off_as_a_library_effect(served):
+    """A headwind above 10 m growing by 0.3 m/s per metre: no uniform wind has its structure. Either the learned
+    correction takes it (unlisted) or the statement says the named explanation leaves structure it cannot follow."""
+    gust = {"height_gust": {"rate_mps_per_m": 0.3, "height_m": 10.0, "from_deg": 0.0}}
+    report = _diagnose(served, gust, seed=36, correction=True)
+    assert report.systematic
+    assert report.unlisted is not None or "Structure remains after it" in report.statement
 
 
 def test_a_fit_below_the_noise_floor_is_flagged(served):
