@@ -111,7 +111,7 @@ def session_figure(diagnosis) -> go.Figure:
                 means.append(residual.mean() if residual.size else np.nan)
                 errors.append(residual.std(ddof=1) / np.sqrt(residual.size) if residual.size > 1 else np.nan)
                 clubs = ", ".join(np.unique(rec.club[rec.session == session]).astype(str))
-                details.append([str(session), residual.size, clubs])
+                details.append([str(session), residual.size, clubs, errors[-1]])
             figure.add_trace(
                 go.Scatter(
                     x=sessions.astype(str),
@@ -124,7 +124,7 @@ def session_figure(diagnosis) -> go.Figure:
                     showlegend=row == 1,
                     marker={"color": color, "size": 8},
                     hovertemplate="session %{customdata[0]}<br>%{customdata[1]} shots<br>clubs %{customdata[2]}"
-                    "<br>mean %{y:.4g} ± %{error_y.array:.2g}<extra>%{fullData.name}</extra>",
+                    "<br>mean %{y:.4g} ± %{customdata[3]:.2g}<extra>%{fullData.name}</extra>",
                 ),
                 row=row,
                 col=1,

@@ -4,7 +4,7 @@ trajectories before and after the correction, the candidates' scores).
 
 One self-contained file: plotly.js is embedded once in the page, nothing is fetched, so the report opens offline.
 The figures need plotly, the optional extra `report`; without it the page keeps every table and the statement and
-says which extra to install (`PLOTS_MISSING`), so a serving install can still diagnose.
+says which extra to install (`PLOTS_MISSING`): diagnose works without it.
 """
 
 from __future__ import annotations
@@ -69,6 +69,7 @@ class Plots:
         return f"<script type='text/javascript'>{self.bundle}</script>" if self.bundle else ""
 
     def notice(self) -> str:
+        """The line that names the extra to install, where the figures are missing ("" otherwise)."""
         return "" if self.bundle else f"<p class='missing'>{escape(PLOTS_MISSING)}</p>"
 
 
