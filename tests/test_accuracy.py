@@ -25,7 +25,6 @@ from golfflight.cli import main
 from model_export.accuracy import (
     DRIVER_FILE,
     PATH_FIGURE,
-    PGA_TARGETS,
     TOURCAST_PBP,
     TOURCAST_TRAJECTORIES,
     ModelFlyer,
@@ -51,11 +50,13 @@ from model_export.accuracy_winds import (
     training_winds,
 )
 from model_export.export import export_checkpoint
+from model_export.held_out import held_out_results
 from model_export.training import TrainConfig, train
 from shots.heldout import HELD_OUT
 from shots.paths import shared_data_dir
 from shots.records import ShotRecord, ShotSet
-from shots.reference_world import TOUR_AVERAGES_FILE, ClubAverage, fly_reference, read_tour_averages
+from shots.reference_world import TOUR_AVERAGES_FILE, ClubAverage, fly_reference
+from weights_schema.bundle import load_bundle
 
 torch.set_num_threads(1)
 FIXTURES = Path(__file__).parent / "fixtures"
@@ -440,14 +441,18 @@ def test_missing_data_is_announced(bundle, tmp_path, capsys):
     assert "Slow shots" in text and "4.75" in text, "the context needs no data"
 
 
-def test_default_model_lands_the_pga_averages():
-    """The committed default model against TrackMan's PGA 2023 table, calm in the card's air: what the service
-    answers for these launches when a shot comes without conditions (docs/accuracy.md has the other air too)."""
-    averages, model = shared_data_dir() / TOUR_AVERAGES_FILE, REPO / "models" / "default"
-    if not averages.is_file() or not (model / "model_card.json").is_file():
-        pytest.skip("needs the shared PGA 2023 table and the committed models/default bundle")
-    mae = compare_clubs(ModelFlyer(model), read_tour_averages(averages)).mean_absolute_error
-    assert np.all(mae <= PGA_TARGETS), f"MAE carry {mae[0]:.2f} yd, max height {mae[1]:.2f} yd, land {mae[2]:.2f} deg"
+def test_default_models_card_tells_its_held_out_errors_as_the_runtime_flies_them():
+    """The shipped card's held-out errors are what the runtime path measures now: a stale or flattering card fails.
+    The PGA 2023 table is one of them, a check that is reported, never a target the model is tuned to (NOTES §9)."""
+    model, data = REPO / "models" / "default", shared_data_dir()
+    if not (data / TOUR_AVERAGES_FILE).is_file() or not (model / "model_card.json").is_file():
+        pytest.skip("needs the shared data and the committed models/default bundle")
+    card, _ = load_bundle(model)
+    recorded = {h.name: h.errors for h in card.held_out or []}
+    measured = {h.name: h.errors for h in held_out_results(model, data)}
+    assert set(recorded) == set(measured) == {h.name for h in HELD_OUT}
+    for name, errors in measured.items():
+        assert errors == pytest.approx(recorded[name], rel=1e-6), name
 
 
 @pytest.mark.parametrize("first_line", ["", "sep=,\n"])

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 import json
 import subprocess
 import sys
@@ -11,10 +10,13 @@ import pytest
 from servers import running, shot
 
 from flight.constants import MPH_TO_MPS, YARD_M
+from model_export.accuracy_flyers import ModelFlyer
+from model_export.accuracy_sets import compare_clubs
 from service.api.app import create_app
 from service.api.models import MAX_BATCH_SHOTS
 from service.model_location import model_dir
 from shots.paths import shared_data_dir
+from shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
 from weights_schema.bundle import load_bundle
 
 DRIVER_MPH = {"ball_speed_mph": 171.0, "launch_angle_deg": 10.4, "back_spin_rpm": 2545.0}
@@ -65,24 +67,21 @@ def test_single_shot_in_both_unit_forms(client):
     assert faded["lateral_m"] > 1.0
 
 
-def test_pga_tour_averages_within_a_few_yards(client):
-    path = shared_data_dir() / "reference" / "trackman_tour_averages_pga_2023.csv"
+def test_pga_tour_launches_answer_what_docs_accuracy_reports(client):
+    """The tour averages' launches, posted as a launch monitor would (mph, no conditions), get the numbers the
+    accuracy report flies for the served bundle in its card's air; SI and imperial input agree."""
+    path = shared_data_dir() / TOUR_AVERAGES_FILE
     if not path.is_file():
         pytest.skip(f"no {path}")
-    with open(path) as handle:
-        clubs = {row["club"]: row for row in csv.DictReader(handle)}
-    for name in ("Driver", "7-iron", "PW"):  # posted as a launch monitor would: no conditions, standard air
-        row = {k: float(v) for k, v in clubs[name].items() if k != "club"}
-        launch = {"launch_angle_deg": row["launch_angle_deg"]}
-        si = shot(client, **launch, ball_speed_mps=row["ball_speed_mph"] * MPH_TO_MPS, spin_rpm=row["spin_rpm"])
-        mph = shot(client, **launch, ball_speed_mph=row["ball_speed_mph"], back_spin_rpm=row["spin_rpm"])
-        assert mph["carry_yd"] == pytest.approx(si["carry_yd"], abs=1e-6)
-        print(
-            f"{name}: carry {si['carry_yd']:.1f} yd (TrackMan {row['carry_yd']:g}), apex {si['apex_yd']:.1f} yd "
-            f"({row['max_height_yd']:g}), land {si['landing_angle_deg']:.1f} deg ({row['land_angle_deg']:g})"
-        )
-        assert si["carry_yd"] == pytest.approx(row["carry_yd"], abs=6.0)
-        assert si["apex_yd"] == pytest.approx(row["max_height_yd"], abs=4.0)
+    clubs = read_tour_averages(path)
+    expected = compare_clubs(ModelFlyer(model_dir()), clubs).model
+    for club, (carry_yd, apex_yd, land_deg) in zip(clubs, expected):
+        launch = {"launch_angle_deg": club.launch_angle_deg}
+        si = shot(client, **launch, ball_speed_mps=club.ball_speed_mps, spin_rpm=club.spin_rpm)
+        mph = shot(client, **launch, ball_speed_mph=club.ball_speed_mph, back_spin_rpm=club.spin_rpm)
+        assert mph["carry_yd"] == pytest.approx(si["carry_yd"], abs=1e-6), club.club
+        assert (si["carry_yd"], si["apex_yd"], si["landing_angle_deg"]) == pytest.approx(
+            (carry_yd, apex_yd, land_deg), abs=0.01), club.club
 
 
 def test_batch_returns_the_single_shot_numbers_in_order(client):
