@@ -1,3 +1,3 @@
 """Sweeps: millions of launches and conditions, from a file or a grid, flown on a pool of local processes or on Ray
-and streamed to Parquet (`golfflight sweep`, docs/sweep.md). pyarrow, tqdm and ray are imported where they are used,
-so the serving install (no extras) imports `sweep.columns` without them."""
+and streamed to Parquet (`golfflight sweep`, docs/sweep.md). Needs the `sweep` extra (pyarrow, tqdm), and `ray`
+for the Ray engine; nothing here is on the serving path, which shares only `service.columns` with it."""

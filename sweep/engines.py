@@ -66,6 +66,8 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int, address: str 
     import ray
     import ray.data
 
+    from sweep.ray_input import PiecesDatasource
+
     if "RAY_DATA_LOG_LEVEL" not in os.environ:  # Ray Data's INFO lines and its note that our tqdm replaced its bars
         logging.getLogger("ray.data").setLevel(logging.WARNING)
         logging.getLogger("ray.data._internal.progress").setLevel(logging.ERROR)
@@ -81,11 +83,11 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int, address: str 
         context = ray.data.DataContext.get_current()
         context.execution_options.preserve_order = True
         context.enable_progress_bars = False
-        dataset = source.ray_dataset().map_batches(
+        dataset = ray.data.read_datasource(PiecesDatasource(source)).map_batches(
             Flyer,
             fn_constructor_args=(bundle_dir, sha256, source),
             compute=ray.data.ActorPoolStrategy(size=workers),
-            batch_size=source.ray_batch_size,
+            batch_size=1,  # one piece (one row) a call: one engine batch of --chunk-rows shots
             batch_format="pyarrow",
             num_cpus=1,
         )

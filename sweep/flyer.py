@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 
-from sweep.columns import TEXT_COLUMNS, cell_value, check, flat_row, is_flag_set, request_of_cells, result_columns
+from service.columns import TEXT_COLUMNS, cell_value, check, flat_row, is_flag_set, request_of_cells, result_columns
 
 PROBLEM = "problem"
 """Column of a worker's table: why the request model refused the row (lines), null for a row that flew."""

@@ -1,12 +1,12 @@
 """Where a sweep's rows come from: a CSV or Parquet file of launches, or a grid, read as Arrow tables of a bounded
 number of rows.
 
-Every source gives the same three things: `pieces()`, small Arrow tables the driver hands out in order (the rows
-themselves, or for a grid just the range of row numbers, so a pool worker is sent a few bytes); `expand(piece)`,
-which a worker turns into the input rows; and `ray_dataset()`, the same pieces as a Ray Dataset (Ray's own readers
-for files, so on a cluster each node reads its part from storage it can reach, cut into blocks of a piece's rows so
-that every actor gets some of a single file). CSV cells are read as text and
-parsed as `golfflight simulate` parses them (`sweep.columns.cell_value`), whichever engine reads them.
+Every source gives the same two things. `pieces()`: the input in order as pieces of one row each, read where the
+driver runs by both engines (`sweep.ray_input` for Ray): a file's chunk of rows packed into one cell (Arrow IPC), a
+grid's range of row numbers; one row, so that Ray Data, which regroups rows into blocks as it likes, hands each actor
+call exactly one piece (`batch_size=1`), and a pool worker is sent a few bytes for a grid. `expand(piece)`: the
+input rows of a piece, which the worker flies as one engine batch. CSV cells are read as text and parsed as
+`golfflight simulate` parses them (`service.columns.cell_value`).
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+from service.columns import columns_message
 from shots.records import reading
-from sweep.columns import columns_message
 from sweep.grid import Grid
 
 
@@ -39,6 +39,24 @@ def rebatch(batches, rows: int) -> Iterator:
         yield pa.Table.from_batches(held)
 
 
+def packed(tables: Iterator) -> Iterator:
+    """Each table as a one-row piece: its Arrow IPC stream in the cell `rows`."""
+    import pyarrow as pa
+
+    for table in tables:
+        sink = pa.BufferOutputStream()
+        with pa.ipc.new_stream(sink, table.schema) as writer:
+            writer.write_table(table)
+        yield pa.table({"rows": pa.array([sink.getvalue().to_pybytes()], pa.large_binary())})
+
+
+def unpacked(piece):
+    """The rows of one or more pieces from `packed`, in order."""
+    import pyarrow as pa
+
+    return pa.concat_tables([pa.ipc.open_stream(cell.as_buffer()).read_all() for cell in piece["rows"]])
+
+
 @dataclass(frozen=True)
 class GridSource:
     grid: Grid
@@ -55,15 +73,12 @@ class GridSource:
     def place(self, row: int) -> str:
         return f"grid row {row}"
 
-    def _ranges(self) -> list[dict]:
-        total, step = len(self.grid), self.chunk_rows
-        return [{"start": start, "stop": min(start + step, total)} for start in range(0, total, step)]
-
     def pieces(self) -> Iterator:
         import pyarrow as pa
 
-        for piece in self._ranges():
-            yield pa.Table.from_pylist([piece])
+        total, step = len(self.grid), self.chunk_rows
+        for start in range(0, total, step):
+            yield pa.table({"start": [start], "stop": [min(start + step, total)]})
 
     def expand(self, piece):
         """The grid's rows of the ranges in `piece` (a table of start and stop row numbers)."""
@@ -71,14 +86,6 @@ class GridSource:
 
         ranges = zip(piece["start"].to_pylist(), piece["stop"].to_pylist(), strict=True)
         return pa.concat_tables([pa.table(self.grid.rows(start, stop)) for start, stop in ranges])
-
-    def ray_dataset(self):
-        """One item per range of rows (`map_batches` with batch_size=1 expands and flies one range a call)."""
-        import ray.data
-
-        return ray.data.from_items(self._ranges())
-
-    ray_batch_size = 1
 
 
 @dataclass(frozen=True)
@@ -115,21 +122,12 @@ class CsvSource:
 
         try:
             reader = pyarrow.csv.open_csv(self.path, convert_options=self._convert_options())
-            yield from rebatch(reader, self.chunk_rows)
+            yield from packed(rebatch(reader, self.chunk_rows))
         except pa.ArrowInvalid as error:
             raise ValueError(f"{self.path}: {error}") from None
 
     def expand(self, piece):
-        return piece
-
-    def ray_dataset(self):
-        import ray.data
-
-        return ray.data.read_csv(self.path, convert_options=self._convert_options()).repartition(target_num_rows_per_block=self.chunk_rows)
-
-    @property
-    def ray_batch_size(self) -> int:
-        return self.chunk_rows
+        return unpacked(piece)
 
 
 @dataclass(frozen=True)
@@ -163,19 +161,10 @@ class ParquetSource:
         import pyarrow.parquet as pq
 
         with pq.ParquetFile(self.path) as handle:
-            yield from rebatch(handle.iter_batches(batch_size=self.chunk_rows), self.chunk_rows)
+            yield from packed(rebatch(handle.iter_batches(batch_size=self.chunk_rows), self.chunk_rows))
 
     def expand(self, piece):
-        return piece
-
-    def ray_dataset(self):
-        import ray.data
-
-        return ray.data.read_parquet(self.path).repartition(target_num_rows_per_block=self.chunk_rows)
-
-    @property
-    def ray_batch_size(self) -> int:
-        return self.chunk_rows
+        return unpacked(piece)
 
 
 Source = GridSource | CsvSource | ParquetSource

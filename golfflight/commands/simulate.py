@@ -19,8 +19,8 @@ import json
 import sys
 from pathlib import Path
 
+from service.columns import cell_value, check, columns_message, flat_row, request_of_cells
 from shots.records import reading
-from sweep.columns import cell_value, check, columns_message, flat_row, request_of_cells
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

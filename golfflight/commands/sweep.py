@@ -40,8 +40,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from sweep.run import run_sweep
-    from sweep.sources import open_source
+    try:
+        from sweep.run import run_sweep
+        from sweep.sources import open_source
+    except ImportError as missing:  # the serving install and image carry neither pyarrow nor the sweep package
+        raise ValueError(f"needs the sweep extra: pip install 'golfflight[sweep]' ({missing})") from None
 
     if args.workers < 1 or args.chunk_rows < 1:
         raise ValueError("--workers and --chunk-rows take a whole number of at least 1")

@@ -3,7 +3,7 @@
 `golfflight simulate` (CSV) and `golfflight sweep` (CSV, Parquet, grids) read and write the same columns, so both
 go through this module: a row's cells become a `ShotRequest` dict (`request_of_cells`), are validated by the
 request model with every problem naming its column and allowed range (`check`), and a result comes back as one
-flat row (`flat_row`). Standard library and the service's own modules only: the serving install runs `simulate`.
+flat row (`flat_row`). The standard library and the request models only: the serving install runs `simulate`.
 """
 
 from __future__ import annotations
