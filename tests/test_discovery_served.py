@@ -6,6 +6,7 @@ a complete library explanation), and a fit below the noise floor is flagged."""
 from __future__ import annotations
 
 import dataclasses
+import json
 import shutil
 
 import numpy as np
@@ -97,6 +98,11 @@ def test_the_cards_own_error_is_what_diagnose_expects_of_the_model(tmp_path):
     without it still loads and the error is estimated."""
     bundle = tmp_path / "bundle"
     shutil.copytree(REPO_ROOT / "models" / "synthetic", bundle)
+    shipped = load_bundle(bundle)[0]
+    assert shipped.own_error is not None and from_bundle(bundle).model_error == shipped.own_error.sigma
+    card_file = bundle / "model_card.json"
+    without = {k: v for k, v in json.loads(card_file.read_text()).items() if k != "own_error"}
+    card_file.write_text(json.dumps({**without, "schema_version": "1.2"}))
     assert from_bundle(bundle).model_error == {}
     own = measure_own_error(bundle, n_shots=120)
     assert own.n_shots > 100 and 0.0 < own.sigma["carry_y_m"] < 3.0

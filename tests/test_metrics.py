@@ -191,6 +191,9 @@ def test_several_workers_report_the_whole_server_whichever_takes_the_scrape(tmp_
                     answers = list(pool.map(lambda _: _post_shot(base), range(8)))
                     flown += answers.count(200)
                     assert set(answers) <= {NOT_LISTENING, 200, 503}, answers  # 503: a worker still loads its model
+            while sum(_per_worker_shots(directory).values()) < flown:  # counted once the response has gone out
+                assert time.monotonic() < deadline, (_per_worker_shots(directory), flown)
+                time.sleep(0.05)
             assert sum(_per_worker_shots(directory).values()) == flown
             for _ in range(6):
                 with httpx.Client(base_url=base) as http:
