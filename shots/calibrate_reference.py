@@ -37,10 +37,11 @@ TRACKMAN_SPIN_LOSS_PCT = {"Driver": (3.1, 8.8, 12.8), "5-iron": (3.4, 9.7, 15.5)
 """Spin lost (%) after 1/3/5 s, TrackMan on a Pro V1x (NOTES.md section 2), flown with these clubs' launch in
 `shots.clubs.CLUBS`."""
 
-OBSERVABLES = ("carry_m", "apex_m", "landing_angle_deg")
-"""What a cell can match, in the order of every per-cell array."""
+OBSERVABLES = ("carry_y_m", "apex_m", "landing_angle_deg")
+"""What a cell can match, in the order of every per-cell array: the carry along the launch monitor's target line
+(what the records hold, not the straight-line distance), the apex (max height), the landing angle."""
 
-RESIDUAL_SCALES = {"carry_m": 3.0 * YARD_M, "apex_m": 2.0 * YARD_M, "landing_angle_deg": 2.0, "spin_loss_pct": 0.5}
+RESIDUAL_SCALES = {"carry_y_m": 3.0 * YARD_M, "apex_m": 2.0 * YARD_M, "landing_angle_deg": 2.0, "spin_loss_pct": 0.5}
 """Each residual is divided by its scale: the flight targets of the product (3 yd, 2 yd, 2 deg), half a percentage
 point for spin."""
 
@@ -133,7 +134,7 @@ def _fly_cells(cells: list[CalibrationCell], params: ReferenceParameters) -> lis
               np.concatenate([np.full(c.n_shots, c.air.kinematic_viscosity_m2_s) for c in cells]))
     flight = fly_reference(initial_state(**launch), air, params=params)
     ends = np.cumsum([c.n_shots for c in cells])
-    outcomes = np.stack([flight.carry_m, flight.apex_m, flight.landing_angle_deg], axis=1)
+    outcomes = np.stack([flight.landing_position[:, 1], flight.apex_m, flight.landing_angle_deg], axis=1)
     return np.split(outcomes, ends[:-1])
 
 

@@ -199,10 +199,11 @@ def test_a_cell_of_the_worlds_own_flights_has_no_error():
     records = _records([50.0 + i for i in range(MIN_CELL_SHOTS)], carry_m=1.0, apex_m=1.0)
     (cell,) = cells_from_records("own", records, CALIBRATION_AIR, bands=(0.0, 200.0))
     flight = fly_reference(initial_state(**cell.launch), CALIBRATION_AIR)
-    own = dataclasses.replace(cell, recorded=np.stack([flight.carry_m, flight.apex_m, flight.landing_angle_deg], 1))
+    own = dataclasses.replace(cell, recorded=np.stack([flight.landing_position[:, 1], flight.apex_m,
+                                                       flight.landing_angle_deg], 1))
     result = evaluate([own])
     assert np.allclose(result.scaled_errors(), 0.0, atol=1e-12)
-    shorter = dataclasses.replace(own, recorded=own.recorded - np.array([RESIDUAL_SCALES["carry_m"], 0.0, 0.0]))
+    shorter = dataclasses.replace(own, recorded=own.recorded - np.array([RESIDUAL_SCALES["carry_y_m"], 0.0, 0.0]))
     assert evaluate([shorter]).scaled_errors()[0] == pytest.approx([1.0, 0.0, 0.0])
 
 
