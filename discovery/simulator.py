@@ -106,7 +106,7 @@ def fly_setup(
     summarises, and what `discovery.conceal` records when it hides effects in the diagnosed model's own flights.
 
     `air` replaces the setup's uniform wind with air whose motion depends on the ball's height (an outside effect's,
-    `discovery.outside.HeightGust`: the extra acceleration sees only velocity and spin)."""
+    `discovery.outside.HeightGust`), so the gust acts through the model's own coefficients like any wind."""
     density = setup.density_kg_m3 * setup.density_ratio
     coefficients = ScaledCoefficients(coefficients_for(setup.density_ratio), setup.coefficient_scale)
     wind = air if air is not None else Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1])
