@@ -18,7 +18,7 @@ import os
 import threading
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from functools import lru_cache
 from pathlib import Path
 from typing import NamedTuple
@@ -141,6 +141,47 @@ def _rest(phase: GroundPhase, i: int, carry: float) -> Rest:
     x, y, _ = phase.rest_position[i].tolist()
     total = math.hypot(x, y)
     return Rest(x, y, total, total - carry, int(phase.bounces[i]), float(phase.time_s[i]))
+
+
+def _rests(phase: GroundPhase | None, shots: np.ndarray, n: int, carry: np.ndarray) -> Rest:
+    """The rests of a batch's `shots` (rolled, in order) as a Rest of [n] arrays, NaN (bounces -1) for the others."""
+    x, y, total, ground_time = (np.full(n, np.nan) for _ in range(4))
+    bounces = np.full(n, -1, dtype=np.int64)
+    if phase is not None:
+        x[shots], y[shots] = phase.rest_position[:, 0], phase.rest_position[:, 1]
+        total[shots] = [math.hypot(a, b) for a, b in zip(x[shots].tolist(), y[shots].tolist(), strict=True)]
+        bounces[shots], ground_time[shots] = phase.bounces, phase.time_s
+    return Rest(x, y, total, total - carry, bounces, ground_time)
+
+
+@dataclass(frozen=True)
+class BatchFlights:
+    """A batch's outcomes as [N] arrays, named as ShotFlight's fields: what `FlightEngine.fly_batch` turns into one
+    ShotFlight a shot, for callers that want columns. `rest` holds arrays too (NaN, bounces -1, where `rolled` is
+    False: a flight alone, or a shot that failed); `errors` maps a failed shot to why (its numbers are meaningless)."""
+
+    landing_x_m: np.ndarray
+    landing_y_m: np.ndarray
+    carry_m: np.ndarray
+    lateral_m: np.ndarray
+    apex_m: np.ndarray
+    apex_time_s: np.ndarray
+    flight_time_s: np.ndarray
+    landing_angle_deg: np.ndarray
+    landing_speed_mps: np.ndarray
+    landing_spin_rpm: np.ndarray
+    rest: Rest
+    rolled: np.ndarray
+    errors: dict[int, str]
+
+    def take(self, shots) -> BatchFlights:
+        """The flights of `shots` (indices), in that order."""
+        shots = np.asarray(shots, dtype=np.intp)
+        where = {int(s): k for k, s in enumerate(shots.tolist())}
+        rest = Rest(*(getattr(self.rest, f.name)[shots] for f in fields(Rest)))
+        arrays = {f.name: getattr(self, f.name)[shots] for f in fields(self) if f.name not in ("rest", "errors")}
+        errors = {where[i]: message for i, message in self.errors.items() if i in where}
+        return BatchFlights(**arrays, rest=rest, errors=errors)
 
 
 def _through_rest(states: EulerStates, phase: GroundPhase, i: int, flight_time: float) -> EulerStates:
@@ -310,17 +351,61 @@ class FlightEngine:
         (grounds None: the flights alone, down to z = 0).
 
         Results are in the order of `launches`; a shot that has not landed by MAX_FLIGHT_TIME_S (or whose flight is
-        not finite) gets a FlightError.
+        not finite) gets a FlightError. The numbers are `fly_columns`'s, one object a shot.
         """
-        n = len(launches)
-        if n == 0:
+        if len(launches) == 0:
             return []
+        columns, flight, phase = self._batch(launches, conditions, keep_states, grounds)
+        history = None
+        if flight.states is not None:
+            history = (np.stack([s.position for s in flight.states]), np.stack([s.velocity for s in flight.states]))
+        numbers = (columns.landing_x_m, columns.landing_y_m, columns.carry_m, columns.apex_m, columns.apex_time_s,
+                   columns.flight_time_s, columns.landing_angle_deg, columns.landing_speed_mps, columns.landing_spin_rpm)
+        rest = columns.rest
+        rests = zip(*(a.tolist() for a in (rest.x_m, rest.y_m, rest.total_m, rest.roll_m, rest.bounces,
+                                           rest.ground_time_s)), strict=True)
+        rolled = columns.rolled.tolist()
+        row = np.cumsum(columns.rolled) - 1
+        results: list[ShotFlight | FlightError] = []
+        for i, ((xi, yi, c, h, th, tf, a, v, w), r) in enumerate(zip(zip(*(a.tolist() for a in numbers)), rests)):
+            if i in columns.errors:
+                results.append(FlightError(columns.errors[i]))
+                continue
+            states = None if history is None else self._shot_states(history, flight, i)
+            shot_rest = None
+            if rolled[i]:
+                shot_rest = Rest(*r)
+                states = None if states is None else _through_rest(states, phase, int(row[i]), tf)
+            flown = ShotFlight(xi, yi, c, xi, h, th, tf, a, v, w, states, shot_rest)
+            results.append(flown if self._states_finite(states) else FlightError(NON_FINITE))
+        return results
+
+    def fly_columns(
+        self,
+        launches: Sequence[Launch] | np.ndarray,
+        conditions: Sequence[Conditions] | Conditions = STANDARD,
+        grounds: Sequence[GroundSpec | None] | GroundSpec | None = None,
+    ) -> BatchFlights:
+        """`fly_batch` without the per-shot objects: its numbers as arrays over the shots (launches an [N, 5] array
+        or a sequence of Launch), for callers that want columns (`golfflight sweep`)."""
+        return self._batch(launches, conditions, False, grounds)[0]
+
+    def _batch(
+        self,
+        launches: Sequence[Launch] | np.ndarray,
+        conditions: Sequence[Conditions] | Conditions,
+        keep_states: bool,
+        grounds: Sequence[GroundSpec | None] | GroundSpec | None,
+    ) -> tuple[BatchFlights, Flight, GroundPhase | None]:
+        """The batch flight behind `fly_batch` and `fly_columns`: its columns, the integrator's flight and the ground
+        phase of the rolled shots (in shot order)."""
+        n = len(launches)
         per_shot = [conditions] * n if isinstance(conditions, Conditions) else list(conditions)
         shot_grounds = [grounds] * n if grounds is None or isinstance(grounds, GroundSpec) else list(grounds)
         if len(per_shot) != n or len(shot_grounds) != n:
             raise ValueError(f"{len(per_shot)} conditions and {len(shot_grounds)} grounds for {n} launches")
         heights = np.array([0.0 if g is None else g.elevation_m for g in shot_grounds])
-        start = initial_state(*np.array(launches, dtype=float).reshape(n, 5).T)
+        start = initial_state(*np.asarray(launches, dtype=float).reshape(n, 5).T)
         field = _batch_field(self._batch_model, per_shot)
         record = "states" if keep_states else "summary"
         flight = integrate(start, field, self.dt, self.max_steps, "euler", GroundPlane(heights), record)
@@ -328,28 +413,17 @@ class FlightEngine:
         carry, angle, speed, spin = _summary(x, y, *flight.landing_velocity.T, *flight.landing_spin.T)
         numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
         finite = np.isfinite(np.stack(numbers)).all(axis=0)
-        history = None
-        if flight.states is not None:
-            history = (np.stack([s.position for s in flight.states]), np.stack([s.velocity for s in flight.states]))
-        rolled = np.flatnonzero(flight.landed & finite & np.array([g is not None for g in shot_grounds]))
-        phase = self._ground_phase(flight, rolled, [shot_grounds[i] for i in rolled], keep_states)
-        row = {shot: k for k, shot in enumerate(rolled.tolist())}
-        results: list[ShotFlight | FlightError] = []
-        for i, (xi, yi, c, h, th, tf, a, v, w) in enumerate(zip(*(a.tolist() for a in numbers))):
-            if not flight.landed[i]:
-                results.append(FlightError(self._unlanded_message(h, float(heights[i]))))
-                continue
-            if not finite[i]:
-                results.append(FlightError(NON_FINITE))
-                continue
-            states = None if history is None else self._shot_states(history, flight, i)
-            rest = None
-            if i in row:
-                rest = _rest(phase, row[i], c)
-                states = None if states is None else _through_rest(states, phase, row[i], tf)
-            flown = ShotFlight(xi, yi, c, xi, h, th, tf, a, v, w, states, rest)
-            results.append(flown if self._states_finite(states) else FlightError(NON_FINITE))
-        return results
+        errors = {}
+        for i in np.flatnonzero(~(flight.landed & finite)).tolist():
+            unlanded = not flight.landed[i]
+            errors[i] = self._unlanded_message(float(flight.apex_m[i]), float(heights[i])) if unlanded else NON_FINITE
+        rolled = flight.landed & finite & np.array([g is not None for g in shot_grounds])
+        shots = np.flatnonzero(rolled)
+        phase = self._ground_phase(flight, shots, [shot_grounds[i] for i in shots], keep_states)
+        rest = _rests(phase, shots, n, carry)
+        columns = BatchFlights(x, y, carry, x, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed,
+                               spin, rest, rolled, errors)
+        return columns, flight, phase
 
     @staticmethod
     def _ground_phase(

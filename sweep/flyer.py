@@ -2,8 +2,9 @@
 
 One `Flyer` holds one FlightEngine (ONNX Runtime on one thread: the workers are the parallelism) and is what every
 engine runs: called in each process of the local pool, and as Ray Data's callable class (one per actor). Each row
-goes through the request model and `service.api.shots.fly_shots` exactly as `golfflight simulate` flies it, so the
-numbers are the same; a row the request model refuses keeps its place with the reason in `problem` and no flight,
+goes through the request model and the batch `golfflight simulate` flies (`service.api.shots.fly_columns`: the
+same engine batch as `fly_shots`, its numbers straight into columns, no result object a shot), so the numbers are
+the same; a row the request model refuses keeps its place with the reason in `problem` and no flight,
 for the driver to report with the row's place in the input (only the driver knows it).
 """
 
@@ -12,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 
-from service.columns import TEXT_COLUMNS, cell_value, check, flat_row, is_flag_set, request_of_cells, result_columns
+from service.columns import TEXT_COLUMNS, cell_value, check, is_flag_set, request_of_cells, result_columns
 
 PROBLEM = "problem"
 """Column of a worker's table: why the request model refused the row (lines), null for a row that flew."""
@@ -91,29 +92,55 @@ class Flyer:
 
     def fly_table(self, table):
         """The rows of `table` (the layout's input columns) with their flights, in order (a pyarrow.Table)."""
+        import numpy as np
         import pyarrow as pa
 
-        from service.api.shots import fly_shots
+        from service.api.shots import fly_columns
 
         layout = self.layout
-        columns = table.select(list(layout.columns)).to_pydict()
-        rows = [dict(zip(layout.columns, values, strict=True)) for values in zip(*columns.values(), strict=True)]
-        problems: list[str | None] = [None] * len(rows)
+        table = table.select(list(layout.columns))
+        columns = table.to_pydict()
+        n = table.num_rows
+        problems: list[str | None] = [None] * n
         shots, flown = [], []
-        for i, row in enumerate(rows):
-            checked = check(request_of_cells({k: cell_value(v) for k, v in row.items()}))
+        for i, values in enumerate(zip(*columns.values(), strict=True)):
+            cells = {column: cell_value(value) for column, value in zip(layout.columns, values, strict=True)}
+            checked = check(request_of_cells(cells))
             if isinstance(checked, list):
                 problems[i] = "\n".join(checked)
             else:
                 shots.append(checked)
                 flown.append(i)
-        out: dict[str, list] = {name: [None] * len(rows) for name in (*layout.echoed, *layout.results)}
+        flew = np.zeros(n, dtype=bool)
+        flew[flown] = True
+        schema = layout.schema(with_problem=True)
+        out = {}
         for name, column in zip(layout.echoed, layout.columns, strict=True):
-            values = out[name]
-            for i in flown:
-                values[i] = echo(column, rows[i][column])
-        for i, result in zip(flown, fly_shots(self.engine, shots), strict=True):
-            for name, value in flat_row(result.model_dump(exclude_none=True)).items():
-                out[name][i] = value
-        out[PROBLEM] = problems
-        return pa.table(out, schema=layout.schema(with_problem=True))
+            out[name] = _echoed(table[column], columns[column], column, flew, schema.field(name).type)
+        flights = fly_columns(self.engine, shots)
+        for name in layout.results:
+            if name == "error":
+                errors: list[str | None] = [None] * n
+                for i, error in zip(flown, flights.errors, strict=True):
+                    errors[i] = error
+                out[name] = pa.array(errors, pa.string())
+                continue
+            values, present = flights.values[name], flights.present[name]
+            full, valid = np.zeros(n, dtype=values.dtype), np.zeros(n, dtype=bool)
+            full[flown], valid[flown] = values, present
+            out[name] = pa.array(full, schema.field(name).type, mask=~valid)
+        out[PROBLEM] = pa.array(problems, pa.string())
+        return pa.table(out, schema=schema)
+
+
+def _echoed(array, cells: list, column: str, flew, kind):
+    """An input column as the results hold it (`echo`), null where the row did not fly: a numeric Arrow column as it
+    is (cast to float64), any other cell by cell."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    if column not in TEXT_COLUMNS and column != "normalized" and (
+        pa.types.is_floating(array.type) or pa.types.is_integer(array.type)
+    ):
+        return pc.if_else(pa.array(flew), array.cast(pa.float64()), pa.scalar(None, pa.float64())).combine_chunks()
+    return pa.array([echo(column, value) if ok else None for value, ok in zip(cells, flew.tolist(), strict=True)], kind)

@@ -143,6 +143,32 @@ def test_a_grid_is_written_in_chunks_in_order(tmp_path, capsys):
     assert drives[180.0, "rough"]["roll_m"] < drives[180.0, "green"]["roll_m"]
 
 
+def test_the_column_path_gives_fly_shots_numbers_bit_for_bit():
+    """The sweep's flat path (`fly_columns`: the engine batch straight into columns) and `fly_shots` (a result
+    object a shot, as simulate and the HTTP batch route) fly the same batch: every number equal, not just close,
+    each column present exactly where the shot's flat row has it, the same errors (a ground the ball never reaches
+    fails its shot alone)."""
+    from service.api.shots import fly_columns, fly_shots
+    from service.columns import cell_value, check, flat_row, request_of_cells
+    from service.engine import FlightEngine
+    from service.model_location import model_dir
+
+    rows = launch_rows(200, seed=3)
+    rows[5].update(ground_elevation_m=90.0)  # never rises that high: a FlightError for this shot only
+    rows[12].update(ground_elevation_m=90.0, normalized="true")
+    shots = [check(request_of_cells({k: cell_value(v) for k, v in row.items()})) for row in rows]
+    assert all(not isinstance(shot, list) for shot in shots)
+    engine = FlightEngine(model_dir(None), batch_threads=1)
+    expected = [flat_row(result.model_dump(exclude_none=True)) for result in fly_shots(engine, shots)]
+    columns = fly_columns(engine, shots)
+    assert columns.errors[5] is not None and columns.errors[12] is not None
+    for i, want in enumerate(expected):
+        assert columns.errors[i] == want.get("error"), i
+        got = {name: values[i].item() for name, values in columns.values.items() if columns.present[name][i]}
+        assert got == {k: v for k, v in want.items() if k != "error"}, i
+        assert all(type(got[k]) is type(v) for k, v in want.items() if k != "error"), i
+
+
 def test_local_sweep_of_csv_and_parquet_equals_simulate(launches, tmp_path):
     source, parquet, expected = launches
     for name, path in (("csv", source), ("parquet", parquet)):

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+
+import numpy as np
 
 from flight.conditions import STANDARD, AirConditions, Conditions
 from flight.constants import MPH_TO_MPS, YARD_M
@@ -91,11 +94,13 @@ def _trajectory(flight: ShotFlight, request: TrajectoryRequest) -> list[Trajecto
     ]
 
 
-def flight_fields(flight: ShotFlight, trajectory: TrajectoryRequest | None) -> dict:
-    """The FlightResult fields of an engine flight rolled to rest (yards alongside metres)."""
+def flight_numbers(flight) -> dict:
+    """The flat numbers of a flight rolled to rest under their column names (yards alongside metres), from one
+    ShotFlight (floats) or a batch's `BatchFlights` (arrays): the one definition of both forms."""
     rest = flight.rest
     return {
-        "landing": Landing.model_construct(x_m=flight.landing_x_m, y_m=flight.landing_y_m),
+        "landing_x_m": flight.landing_x_m,
+        "landing_y_m": flight.landing_y_m,
         "carry_m": flight.carry_m,
         "carry_yd": flight.carry_m / YARD_M,
         "lateral_m": flight.lateral_m,
@@ -109,10 +114,37 @@ def flight_fields(flight: ShotFlight, trajectory: TrajectoryRequest | None) -> d
         "total_m": rest.total_m,
         "total_yd": rest.total_m / YARD_M,
         "roll_m": rest.roll_m,
-        "rest": RestPoint.model_construct(x_m=rest.x_m, y_m=rest.y_m),
+        "rest_x_m": rest.x_m,
+        "rest_y_m": rest.y_m,
         "bounces": rest.bounces,
-        "trajectory": None if trajectory is None else _trajectory(flight, trajectory),
     }
+
+
+def flat_numbers(flight) -> dict:
+    """The flat numbers of a flight flown down to z = 0, from a ShotFlight or a `BatchFlights` (`flight_numbers`)."""
+    return {
+        "landing_x_m": flight.landing_x_m,
+        "landing_y_m": flight.landing_y_m,
+        "carry_m": flight.carry_m,
+        "carry_yd": flight.carry_m / YARD_M,
+        "lateral_m": flight.lateral_m,
+        "flight_time_s": flight.flight_time_s,
+        "landing_angle_deg": flight.landing_angle_deg,
+    }
+
+
+def _points(numbers: dict) -> dict:
+    """A flight's numbers with NAME_x_m and NAME_y_m as the result's points."""
+    fields = dict(numbers)
+    for name, point in (("landing", Landing), ("rest", RestPoint)):
+        if f"{name}_x_m" in fields:
+            fields[name] = point.model_construct(x_m=fields.pop(f"{name}_x_m"), y_m=fields.pop(f"{name}_y_m"))
+    return fields
+
+
+def flight_fields(flight: ShotFlight, trajectory: TrajectoryRequest | None) -> dict:
+    """The FlightResult fields of an engine flight rolled to rest (yards alongside metres)."""
+    return {**_points(flight_numbers(flight)), "trajectory": None if trajectory is None else _trajectory(flight, trajectory)}
 
 
 def lands_off_the_flat(shot: ShotRequest) -> bool:
@@ -122,14 +154,7 @@ def lands_off_the_flat(shot: ShotRequest) -> bool:
 
 def flat_fields(flight: ShotFlight) -> FlatFlight:
     """The flat figures of a flight flown down to z = 0."""
-    return FlatFlight.model_construct(
-        landing=Landing.model_construct(x_m=flight.landing_x_m, y_m=flight.landing_y_m),
-        carry_m=flight.carry_m,
-        carry_yd=flight.carry_m / YARD_M,
-        lateral_m=flight.lateral_m,
-        flight_time_s=flight.flight_time_s,
-        landing_angle_deg=flight.landing_angle_deg,
-    )
+    return FlatFlight.model_construct(**_points(flat_numbers(flight)))
 
 
 def result_of(
@@ -157,8 +182,9 @@ def fly_shot(engine: FlightEngine, shot: ShotRequest) -> ShotResult:
     return result_of(shot, flight, normalized, flat)
 
 
-def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> list[ShotResult | ShotFailure]:
-    """One engine batch for `shots`, their normalized replays and their flat flights; results in order."""
+def _batch_of(shots: list[ShotRequest]) -> tuple[list[Launch], list[Conditions], list, list[int], list[int]]:
+    """One engine batch for `shots`: their launches, conditions and grounds, then their normalized replays' and flat
+    flights' appended, and which shots those are (in the order appended)."""
     launches = [launch_of(shot) for shot in shots]
     conditions = [conditions_of(shot) for shot in shots]
     grounds: list[GroundSpec | None] = [ground_of(shot.ground) for shot in shots]
@@ -167,6 +193,12 @@ def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> li
     launches += [launches[i] for i in replays + flats]
     conditions += [Conditions(air_of(reference_of(shots[i])), CALM) for i in replays] + [conditions[i] for i in flats]
     grounds += [grounds[i] for i in replays] + [None] * len(flats)
+    return launches, conditions, grounds, replays, flats
+
+
+def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> list[ShotResult | ShotFailure]:
+    """One engine batch for `shots`, their normalized replays and their flat flights; results in order."""
+    launches, conditions, grounds, replays, flats = _batch_of(shots)
     flights = engine.fly_batch(launches, conditions, keep, grounds)
     replayed = dict(zip(replays, flights[len(shots) : len(shots) + len(replays)], strict=True))
     flat = dict(zip(flats, flights[len(shots) + len(replays) :], strict=True))
@@ -176,6 +208,49 @@ def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> li
         failure = next((f for f in own if isinstance(f, FlightError)), None)
         results.append(ShotFailure(error=str(failure)) if failure else result_of(shot, *own))
     return results
+
+
+@dataclass(frozen=True)
+class ShotColumns:
+    """`fly_shots`'s results as columns over the shots, named as `service.columns.flat_row` names them: `values` holds
+    an array for each flight, normalized_* and flat_* column, valid where `present` is True (the shot flew and, for
+    normalized_* and flat_*, asked for that flight); `errors` the error column (None where the shot flew)."""
+
+    values: dict[str, np.ndarray]
+    present: dict[str, np.ndarray]
+    errors: list[str | None]
+
+
+def fly_columns(engine: FlightEngine, shots: list[ShotRequest]) -> ShotColumns:
+    """`fly_shots` without a result object a shot (the same batch, numbers and errors, straight into columns):
+    for many shots at once (`golfflight sweep`). No trajectories: a shot asking for one is refused."""
+    if any(shot.trajectory is not None for shot in shots):
+        raise ValueError("fly_columns flies no trajectories (fly_shots does)")
+    n = len(shots)
+    launches, conditions, grounds, replays, flats = _batch_of(shots)
+    flights = engine.fly_columns(np.array(launches, dtype=float).reshape(-1, 5), conditions, grounds)
+    replay_rows = np.arange(n, n + len(replays))
+    flat_rows = np.arange(n + len(replays), n + len(replays) + len(flats))
+    errors: list[str | None] = [None] * n
+    for shot, rows in ((range(n), range(n)), (replays, replay_rows.tolist()), (flats, flat_rows.tolist())):
+        for i, row in zip(shot, rows, strict=True):
+            if errors[i] is None and row in flights.errors:
+                errors[i] = flights.errors[row]
+    flew = np.array([e is None for e in errors], dtype=bool)
+    values, present = {}, {}
+    for prefix, numbers, rows, own in (
+        ("", flight_numbers, np.arange(n), np.arange(n)),
+        ("normalized_", flight_numbers, replay_rows, np.array(replays, dtype=np.intp)),
+        ("flat_", flat_numbers, flat_rows, np.array(flats, dtype=np.intp)),
+    ):
+        mask = np.zeros(n, dtype=bool)
+        mask[own] = True
+        mask &= flew
+        for name, column in numbers(flights.take(rows)).items():
+            full = np.zeros(n, dtype=column.dtype)
+            full[own] = column
+            values[prefix + name], present[prefix + name] = full, mask
+    return ShotColumns(values, present, errors)
 
 
 def fly_shots(engine: FlightEngine, shots: list[ShotRequest]) -> list[ShotResult | ShotFailure]:
