@@ -3,7 +3,10 @@
 The correction is a weighted sum of physical terms of the air-relative velocity v, the spin w and the height h: drag
 and Magnus-direction lift, each with weights on |v|^2, |v| and 1 (a coefficient change that depends on speed, i.e.
 on the Reynolds number), sideways-only drag, constant side and vertical forces, and a push across or along the line
-growing with height and speed (the drag of a wind that grows with height, which no uniform wind has). It is learned
+growing with height and speed (the drag of a wind that grows with height, which no uniform wind has): from the
+ground, and from each of two knots up (hinges, |v| max(0, h - H): a wind that only starts above the ground's
+shelter; the knots split the flights' median apex in thirds, a linear spline in height over the heights flown, set
+by the recordings' flights and not by any effect). It is learned
 on top of the best library explanation: the full linearised term library is fitted first (ridge), then terms are
 removed one at a time, weakest first, while the weakest is not clearly needed (|t| < MIN_T), at most MAX_TERMS kept:
 as small as the fit allows. The kept terms are refitted through the simulator and read out as an expression.
@@ -11,18 +14,25 @@ as small as the fit allows. The kept terms are refitted through the simulator an
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from discovery.effects import Context, Effect, Parameter, Reported
 from discovery.fit import Fit, Problem, fit, residuals_and_jacobian
+from discovery.recordings import OBSERVABLES
 from discovery.schema import Unlisted
 from discovery.simulator import Setup
 
 NAME = "unlisted"
 MIN_T = 4.0
 MAX_TERMS = 3
+KNOT_SHARES = (1.0 / 3.0, 2.0 / 3.0)
+"""The height terms' hinges, as shares of the median apex of the flights the correction is fitted on: with the
+shear from the ground, a linear spline in height with equally spaced knots over the heights the balls fly through."""
+MIN_KNOT_M = 1.0
+"""Below this a hinge is the shear from the ground again: no knots (e.g. putts, recordings that never leave it)."""
 BOUND = 20.0
 """Each weight stays within this many typical sizes: larger would be a different ball, not a correction."""
 
@@ -63,9 +73,66 @@ TERMS: tuple[Term, ...] = (
 )
 
 
-def features(v: np.ndarray, w: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """Every term's acceleration per unit weight [N, len(TERMS), 3] at air-relative velocity, spin and position
-    [N,3]."""
+HINGE = re.compile(r"^\|v\| \(h-(?P<knot>[0-9.]+)\)\+ (?P<axis>[xy])$")
+"""The name of a hinge term: '|v| (h-9.5)+ x'."""
+
+
+def hinge_terms(knots: tuple[float, ...]) -> tuple[Term, ...]:
+    """The height terms with a hinge at each knot (m): a push across, then along, the line growing with speed and with
+    the height above the knot, nothing below it."""
+    terms = []
+    for knot in knots:
+        terms.append(
+            Term(
+                f"|v| (h-{knot:g})+ x",
+                "1/(m s)",
+                5e-4,
+                f"a push to the right growing with speed and with height above {knot:g} m, none below (a crosswind "
+                f"that starts {knot:g} m up)",
+            )
+        )
+        terms.append(
+            Term(
+                f"|v| (h-{knot:g})+ y",
+                "1/(m s)",
+                5e-4,
+                f"a push down the line growing with speed and with height above {knot:g} m, none below (a tailwind "
+                f"that starts {knot:g} m up)",
+            )
+        )
+    return tuple(terms)
+
+
+def terms_for(knots: tuple[float, ...]) -> tuple[Term, ...]:
+    """The whole term library with hinges at `knots`: TERMS, then two terms per knot."""
+    return TERMS + hinge_terms(knots)
+
+
+def term_named(name: str) -> Term:
+    """A term of any library by its name (a hinge's knot is in its name)."""
+    for term in TERMS:
+        if term.name == name:
+            return term
+    match = HINGE.match(name)
+    if match is None:
+        raise KeyError(name)
+    x, y = hinge_terms((float(match["knot"]),))
+    return x if match["axis"] == "x" else y
+
+
+def knots_for(apex_m: np.ndarray) -> tuple[float, ...]:
+    """The hinges (m, to 0.1 m) at KNOT_SHARES of the median apex of the flights; none for low flights."""
+    apex = np.asarray(apex_m, dtype=float)
+    apex = apex[np.isfinite(apex)]
+    if not len(apex):
+        return ()
+    median = float(np.median(apex))
+    return tuple(round(share * median, 1) for share in KNOT_SHARES if share * median >= MIN_KNOT_M)
+
+
+def features(v: np.ndarray, w: np.ndarray, r: np.ndarray, knots: tuple[float, ...] = ()) -> np.ndarray:
+    """Every term's acceleration per unit weight [N, len(terms_for(knots)), 3] at air-relative velocity, spin and
+    position [N,3]."""
     speed = np.linalg.norm(v, axis=1)
     sheared = speed * np.maximum(r[:, 2], 0.0)
     unit_v = v / np.maximum(speed, 1e-12)[:, None]
@@ -86,15 +153,19 @@ def features(v: np.ndarray, w: np.ndarray, r: np.ndarray) -> np.ndarray:
         np.stack([sheared, zero, zero], 1),
         np.stack([zero, sheared, zero], 1),
     ]
+    for knot in knots:
+        hinged = speed * np.maximum(r[:, 2] - knot, 0.0)
+        columns += [np.stack([hinged, zero, zero], 1), np.stack([zero, hinged, zero], 1)]
     return np.stack(columns, axis=1)
 
 
-def correction_effect(kept: tuple[int, ...]) -> Effect:
-    """The learned term restricted to `kept` terms, as an effect the fitter treats like any other."""
-    kept = tuple(kept)
+def correction_effect(kept: tuple[int, ...], knots: tuple[float, ...] = ()) -> Effect:
+    """The learned term restricted to `kept` terms of `terms_for(knots)`, as an effect the fitter treats like any
+    other."""
+    kept, terms = tuple(kept), terms_for(knots)
 
     def accelerate(v: np.ndarray, w: np.ndarray, r: np.ndarray, weights: np.ndarray) -> np.ndarray:
-        return np.einsum("nk,nkc->nc", weights, features(v, w, r)[:, kept])
+        return np.einsum("nk,nkc->nc", weights, features(v, w, r, knots)[:, kept])
 
     def apply(theta: np.ndarray, conditions: Setup) -> Setup:
         out = conditions.copy()
@@ -102,7 +173,7 @@ def correction_effect(kept: tuple[int, ...]) -> Effect:
         return out
 
     def describe(theta: np.ndarray, covariance: np.ndarray, context: Context) -> Reported:
-        names = [TERMS[i].name for i in kept]
+        names = [terms[i].name for i in kept]
         return (
             {n: float(t) for n, t in zip(names, theta)},
             {n: float(np.sqrt(max(covariance[i, i], 0.0))) for i, n in enumerate(names)},
@@ -110,18 +181,19 @@ def correction_effect(kept: tuple[int, ...]) -> Effect:
 
     parameters = tuple(
         Parameter(
-            TERMS[i].name,
-            TERMS[i].unit,
+            terms[i].name,
+            terms[i].unit,
             0.0,
-            -BOUND * TERMS[i].typical,
-            BOUND * TERMS[i].typical,
-            TERMS[i].typical,
-            0.3 * TERMS[i].typical,
+            -BOUND * terms[i].typical,
+            BOUND * terms[i].typical,
+            terms[i].typical,
+            0.3 * terms[i].typical,
         )
         for i in kept
     )
+    names = tuple(terms[i].name for i in kept)
     return Effect(
-        NAME, parameters, apply, describe, "a learned extra acceleration: " + expression_of(kept, None), accelerate
+        NAME, parameters, apply, describe, "a learned extra acceleration: " + expression_of(names, None), accelerate
     )
 
 
@@ -129,15 +201,15 @@ def is_correction(effect: Effect) -> bool:
     return effect.name == NAME
 
 
-def expression_of(kept: tuple[int, ...], theta: np.ndarray | None) -> str:
+def expression_of(names: tuple[str, ...], theta: np.ndarray | None) -> str:
     """'a_extra = c1 * term1 + c2 * term2' (symbols where no values are given)."""
     parts = []
-    for i, index in enumerate(kept):
+    for i, name in enumerate(names):
         coefficient = f"c{i + 1}" if theta is None else f"{theta[i]:.3g}"
-        parts.append(f"{coefficient} * [{TERMS[index].name}]")
+        parts.append(f"{coefficient} * [{name}]")
     return (
         "a_extra = " + " + ".join(parts) + " (m/s^2; v air-relative velocity, m = unit (w x v) for spin w, "
-        "h height, x right, y down the line, z up)"
+        "h height, (h-H)+ = max(0, h - H), x right, y down the line, z up)"
     )
 
 
@@ -165,15 +237,17 @@ def select_terms(z: np.ndarray, jacobian: np.ndarray) -> tuple[int, ...]:
 
 
 def fit_correction(problem: Problem, rows: np.ndarray, base: Fit) -> Fit | None:
-    """The sparse learned correction on top of `base` (the best library explanation), or None if no term holds."""
-    everything = correction_effect(tuple(range(len(TERMS))))
+    """The sparse learned correction on top of `base` (the best library explanation), or None if no term holds. The
+    height terms' hinges come from the apex of the flights `base` predicts for these shots."""
+    knots = knots_for(problem.predict(base.effects, base.theta, rows)[0, :, OBSERVABLES.index("apex_m")])
+    everything = correction_effect(tuple(range(len(terms_for(knots)))), knots)
     effects = base.effects + (everything,)
     theta = np.concatenate([base.theta, everything.null])
     z, jacobian = residuals_and_jacobian(problem, effects, theta, rows)
     kept = select_terms(z, jacobian[..., base.k :])
     if not kept:
         return None
-    term = correction_effect(kept)
+    term = correction_effect(kept, knots)
     return fit(problem, base.effects + (term,), np.concatenate([base.theta, term.null]), rows)
 
 
@@ -184,12 +258,12 @@ def summary(result: Fit, error: float, library_error: float) -> Unlisted:
         if is_correction(effect):
             theta = result.theta[start : start + effect.size]
             cov = result.covariance[start : start + effect.size, start : start + effect.size]
-            kept = tuple(next(i for i, t in enumerate(TERMS) if t.name == p.name) for p in effect.parameters)
+            names = tuple(p.name for p in effect.parameters)
             return Unlisted(
-                expression=expression_of(kept, theta),
-                terms={TERMS[i].name: float(v) for i, v in zip(kept, theta)},
-                uncertainty={TERMS[i].name: float(np.sqrt(max(cov[j, j], 0.0))) for j, i in enumerate(kept)},
-                meaning={TERMS[i].name: TERMS[i].meaning for i in kept},
+                expression=expression_of(names, theta),
+                terms={n: float(v) for n, v in zip(names, theta)},
+                uncertainty={n: float(np.sqrt(max(cov[j, j], 0.0))) for j, n in enumerate(names)},
+                meaning={n: term_named(n).meaning for n in names},
                 heldout_error=error,
                 library_heldout_error=library_error,
             )

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from discovery.conceal import conceal
-from discovery.correction import TERMS, features, select_terms
+from discovery.correction import TERMS, correction_effect, features, knots_for, select_terms, term_named, terms_for
 from discovery.effects import EFFECTS, Context, equivalent_altitude_m
 from discovery.model import reference
 from discovery.outside import HEIGHT_GUST, OUTSIDE, HeightGust, air_motion
@@ -46,6 +46,42 @@ def test_correction_features_are_accelerations_per_unit_weight():
     across = f[:, [t.name for t in TERMS].index("|v| h x")]
     np.testing.assert_allclose(across[:, 0], np.linalg.norm(v, axis=1) * r[:, 2])
     assert across[1, 0] == 0.0 and not across[:, 1:].any(), "nothing at the ground, and only sideways"
+
+
+def test_hinge_terms_push_only_above_their_knot():
+    """By hand: v = (0, 40, 10) m/s, |v| = sqrt(1700) = 41.2311 m/s; at h = 20 m a hinge at 9.5 m gives
+    41.2311 x (20 - 9.5) = 432.93 along its axis, at h = 5 m (below the knot) nothing; the shear from the ground is
+    41.2311 x 20 = 824.62 at 20 m."""
+    v = np.array([[0.0, 40.0, 10.0], [0.0, 40.0, 10.0]])
+    w = np.array([[300.0, 0.0, 0.0], [300.0, 0.0, 0.0]])
+    r = np.array([[0.0, 50.0, 20.0], [0.0, 10.0, 5.0]])
+    names = [t.name for t in terms_for((9.5,))]
+    assert names[len(TERMS) :] == ["|v| (h-9.5)+ x", "|v| (h-9.5)+ y"]
+    f = features(v, w, r, (9.5,))
+    assert f.shape == (2, len(TERMS) + 2, 3)
+    np.testing.assert_allclose(f[0, names.index("|v| (h-9.5)+ x")], [432.93, 0.0, 0.0], atol=0.01)
+    np.testing.assert_allclose(f[0, names.index("|v| (h-9.5)+ y")], [0.0, 432.93, 0.0], atol=0.01)
+    np.testing.assert_allclose(f[0, names.index("|v| h y")], [0.0, 824.62, 0.0], atol=0.01)
+    assert not f[1, len(TERMS) :].any(), "nothing below the knot"
+    np.testing.assert_array_equal(features(v, w, r), f[:, : len(TERMS)])
+    assert (
+        term_named("|v| (h-9.5)+ y").meaning.startswith("a push down the line")
+        and "9.5 m" in term_named("|v| (h-9.5)+ y").meaning
+    )
+    assert term_named("-|v| v") is TERMS[0]
+    effect = correction_effect((len(TERMS) + 1,), (9.5,))
+    assert [p.name for p in effect.parameters] == ["|v| (h-9.5)+ y"]
+    np.testing.assert_allclose(
+        effect.correction(v, w, r, np.array([[0.002], [0.002]])), [[0, 0.86586, 0], [0, 0, 0]], atol=1e-5
+    )
+
+
+def test_hinge_knots_split_the_median_apex_in_thirds():
+    """Median apex 30 m (NaN ignored) -> knots 10 and 20 m; median 2 m -> 0.67 m is below MIN_KNOT_M (1 m), so only
+    1.33 m, to 0.1 m; nothing flown -> none."""
+    assert knots_for(np.array([27.0, 30.0, 33.0, np.nan])) == (10.0, 20.0)
+    assert knots_for(np.array([2.0])) == (1.3,)
+    assert knots_for(np.array([np.nan])) == ()
 
 
 def test_equivalent_altitude_of_a_density_ratio():
