@@ -1,0 +1,142 @@
+"""How much the models curve a drive per degree of spin axis, against TrackMan's outdoor drivers of the training lines
+(never the held-out ones): the side error regressed on the recorded spin axis and launch direction, next to each
+model's own side change per degree of axis, and what scaling a bundle's lift and drag would do. docs/training_real.md
+("What limits it") quotes the tables.
+
+    python3 scripts/side_curvature.py [--data DIR] [--model models/default] [--synthetic models/synthetic]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from flight.integrator import simulate
+from flight.physics import CoefficientModel, initial_state
+from model_export.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
+from model_export.accuracy_sets import outcome_errors
+from model_export.real_data import trackman_outdoor
+from shots.markdown import table
+from shots.paths import shared_data_dir
+from shots.records import ShotSet
+
+AXIS_STEP_DEG = 1.0
+"""The axis step of each model's own side sensitivity (a central difference)."""
+
+
+class ScaledCoefficients:
+    """A coefficient model with C_L and C_D multiplied by constants (the library's lift_scale and drag_scale)."""
+
+    def __init__(self, model: CoefficientModel, lift_scale: float, drag_scale: float) -> None:
+        self.model, self.lift_scale, self.drag_scale = model, lift_scale, drag_scale
+
+    def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
+        coefficients = np.array(self.model(v_rel, omega), dtype=float)
+        coefficients[:, 0] *= self.lift_scale
+        coefficients[:, 1] *= self.drag_scale
+        return coefficients
+
+    def take(self, index: np.ndarray) -> ScaledCoefficients:
+        inner = self.model.take(index) if hasattr(self.model, "take") else self.model
+        return ScaledCoefficients(inner, self.lift_scale, self.drag_scale)
+
+
+def axis_slope(errors: np.ndarray, launch: dict[str, np.ndarray]) -> tuple[float, float]:
+    """OLS slope (m per degree) and its standard error of the side error on the spin axis, with the launch
+    direction and a constant beside it."""
+    design = np.column_stack([np.ones(len(errors)), launch["spin_axis_deg"], launch["launch_direction_deg"]])
+    coef, *_ = np.linalg.lstsq(design, errors, rcond=None)
+    residual = errors - design @ coef
+    sigma2 = residual @ residual / (len(errors) - design.shape[1])
+    covariance = sigma2 * np.linalg.inv(design.T @ design)
+    return float(coef[1]), float(np.sqrt(covariance[1, 1]))
+
+
+def side_per_degree(flyer: Flyer, launch: dict[str, np.ndarray]) -> float:
+    """The model's own mean change of the landing side (m) per degree of spin axis."""
+    sides = []
+    for step in (-AXIS_STEP_DEG, AXIS_STEP_DEG):
+        tilted = dict(launch, spin_axis_deg=launch["spin_axis_deg"] + step)
+        sides.append(flyer.simulate(tilted).lateral_m)
+    return float(np.mean((sides[1] - sides[0]) / (2 * AXIS_STEP_DEG)))
+
+
+def model_rows(flyers: list[Flyer], shots: ShotSet) -> list[list[str]]:
+    """Per model: side MAE and bias, the side error's slope on the axis, the model's own slope, their ratio."""
+    rows = []
+    for flyer in flyers:
+        errors = outcome_errors(flyer.simulate(shots.launch()), shots)["side_m"]
+        slope, se = axis_slope(errors, shots.launch())
+        own = side_per_degree(flyer, shots.launch())
+        rows.append([flyer.label, f"{np.mean(np.abs(errors)):.2f}", f"{np.mean(errors):+.2f}",
+                     f"{slope:+.3f} ± {se:.3f}", f"{own:.2f}", f"{-slope / own:.0%}"])
+    return rows
+
+
+def scale_rows(flyer: ModelFlyer, shots: ShotSet, lift_scales: tuple[float, ...],
+               drag_scales: tuple[float, ...]) -> list[list[str]]:
+    """The bundle with its C_L and C_D scaled: side, carry, apex and landing-angle errors."""
+    rows = []
+    launch = shots.launch()
+    base = flyer.coefficients_in(None)
+    for lift in lift_scales:
+        for drag in drag_scales:
+            flight = simulate(initial_state(**launch), ScaledCoefficients(base, lift, drag), flyer.density_kg_m3,
+                              dt=flyer.dt_s, t_max=flyer.t_sim_s)
+            errors = outcome_errors(flight, shots)
+            slope, _ = axis_slope(errors["side_m"], launch)
+            rows.append([f"{lift:.2f}", f"{drag:.2f}", f"{np.mean(errors['landing_m']):.2f}",
+                         f"{np.mean(np.abs(errors['side_m'])):.2f}", f"{slope:+.3f}",
+                         f"{np.mean(errors['carry_m']):+.2f}", f"{np.mean(errors['apex_m']):+.2f}",
+                         f"{np.nanmean(errors['landing_angle_deg']):+.2f}"])
+    return rows
+
+
+def axis_scale_rows(flyers: list[Flyer], sets: dict[str, ShotSet], scales: tuple[float, ...]) -> list[list[str]]:
+    """Landing error and side MAE with the recorded spin axis multiplied by each scale (a launch-monitor reading
+    error, if that is what the missing curvature is)."""
+    rows = []
+    for name, shots in sets.items():
+        for flyer in flyers:
+            cells = []
+            for scale in scales:
+                launch = dict(shots.launch(), spin_axis_deg=shots.launch()["spin_axis_deg"] * scale)
+                errors = outcome_errors(flyer.simulate(launch), shots)
+                cells.append(f"{np.mean(errors['landing_m']):.2f} / {np.mean(np.abs(errors['side_m'])):.2f}")
+            rows.append([name, flyer.label, *cells])
+    return rows
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--data", type=Path, default=shared_data_dir(), help="the shared data folder")
+    parser.add_argument("--model", default="models/default", help="the bundle to scale")
+    parser.add_argument("--synthetic", default="models/synthetic", help="a second bundle to compare")
+    args = parser.parse_args()
+    records = trackman_outdoor(args.data).records
+    premium = ShotSet([r for r in records if r.ball == "Premium"])
+    range_balls = ShotSet([r for r in records if r.ball != "Premium"])
+    model = ModelFlyer(args.model)
+    flyers = [model, ModelFlyer(args.synthetic), ferguson_flyer(model.dt_s, model.t_sim_s)]
+    print(f"TrackMan outdoor drivers, training lines, Premium balls: {len(premium)} shots (train and validation "
+          "splits; every model calm, in its own air)\n")
+    print("\n".join(table(["model", "side MAE, m", "side bias, m", "side error per deg of axis, m",
+                           "model's side per deg of axis, m", "missing curvature"], model_rows(flyers, premium))))
+    print(f"\n{model.label} with C_L and C_D scaled:\n")
+    print("\n".join(table(["C_L x", "C_D x", "landing error, m", "side MAE, m", "side error per deg, m",
+                           "carry bias, m", "apex bias, m", "land angle bias, deg"],
+                          scale_rows(model, premium, (1.0, 1.05, 1.10, 1.15), (1.0, 1.06)))))
+    scales = (1.0, 1.1, 1.2, 1.3)
+    print("\nThe recorded spin axis multiplied by a scale: landing error / side MAE, m\n")
+    print("\n".join(table(["balls", "model", *(f"axis x {k:.1f}" for k in scales)],
+                          axis_scale_rows([model, flyers[2]], {"Premium": premium, "other": range_balls}, scales))))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

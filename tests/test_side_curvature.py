@@ -1,0 +1,31 @@
+"""The side-curvature analysis of docs/training_real.md: its regression and its scaled coefficients, on cases
+worked by hand."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+
+SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "side_curvature.py"
+spec = importlib.util.spec_from_file_location("side_curvature", SCRIPT)
+side_curvature = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(side_curvature)
+
+
+def test_axis_slope_recovers_a_known_slope_beside_the_direction():
+    rng = np.random.default_rng(0)
+    axis, direction = rng.normal(0, 10, 400), rng.normal(0, 3, 400)
+    errors = -0.2 * axis + 0.5 * direction + 1.0 + rng.normal(0, 0.1, 400)
+    slope, se = side_curvature.axis_slope(errors, {"spin_axis_deg": axis, "launch_direction_deg": direction})
+    assert abs(slope + 0.2) < 3 * se
+    assert 0.0003 < se < 0.002  # 0.1 / (10 * sqrt(400)) = 0.0005
+
+
+def test_scaled_coefficients_scale_lift_and_drag_only():
+    class Constant:
+        def __call__(self, v_rel, omega):
+            return np.tile([0.2, 0.3, 0.01, 0.5], (len(v_rel), 1))
+
+    scaled = side_curvature.ScaledCoefficients(Constant(), 1.1, 0.9).take(np.array([0, 1]))
+    out = scaled(np.ones((2, 3)), np.ones((2, 3)))
+    np.testing.assert_allclose(out, [[0.22, 0.27, 0.01, 0.5]] * 2)
