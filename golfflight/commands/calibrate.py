@@ -1,5 +1,5 @@
 """`golfflight calibrate-reference`: the reference world's fit to the recordings it is calibrated on, or a new fit,
-with the held-out PGA TOUR 2023 averages flown as a check."""
+with the held-out PGA TOUR 2023 averages flown as a check and the altitude and wind checks nothing is fitted to."""
 
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ from shots.calibrate_reference import (
 )
 from shots.markdown import write_generated_section
 from shots.paths import shared_data_dir
+from shots.reference_checks import render_checks_markdown
 from shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
 
 COMMAND = "calibrate-reference"
@@ -53,6 +54,7 @@ def run(args: argparse.Namespace) -> int:
         clubs = read_tour_averages(averages)
         check, ferguson = evaluate_clubs(clubs, params), evaluate_clubs_ferguson(clubs)
     text = render_markdown(evaluate(cells, params), params, check, ferguson)
+    text += "\n".join(render_checks_markdown(params)) + "\n"
     if args.out:
         write_generated_section(args.out, text, COMMAND)
         print(f"wrote {args.out}")

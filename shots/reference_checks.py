@@ -1,0 +1,99 @@
+"""Checks of the reference world that nothing is fitted to: a drive at altitude and in a 10 mph wind, against the
+rules of thumb of NOTES §2 and §3. `golfflight calibrate-reference` renders them under the calibration tables, so
+they always describe the committed parameters."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from flight.air import Air
+from flight.constants import MPH_TO_MPS, YARD_M
+from flight.physics import initial_state
+from flight.reference_aero import CALIBRATED, ReferenceParameters
+from flight.wind import CALM, Wind
+from shots.clubs import CLUBS
+from shots.reference_world import CALIBRATION_AIR, fly_reference
+
+HIGH_ALTITUDE_M = 2377.0
+"""7,800 ft, the altitude of NOTES §2's rule: a 282 yd drive at sea level flies about 306 yd there (apex −6 yd,
+land angle −9°)."""
+ALTITUDE_RULE = {"carry_yd": 24.0, "apex_yd": -6.0, "land_deg": -9.0}
+
+WIND_DRIVE = {"ball_speed_mps": 155.0 * MPH_TO_MPS, "launch_angle_deg": 12.0, "spin_rpm": 2800.0}
+"""The drive of the wind rule (NOTES §3: on a 250 yd drive a 10 mph headwind costs about 13 yd, a tailwind adds 9)."""
+WIND_SPEED_MPS = 10.0 * MPH_TO_MPS
+WIND_RULE_YD = {"headwind": -13.0, "tailwind": 9.0}
+WIND_FROM_DEG = {"headwind": 0.0, "tailwind": 180.0, "crosswind from the right": 90.0}
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """Carry along the target line, side (+ right), apex and land angle of one flight, in yards and degrees."""
+
+    carry_yd: float
+    side_yd: float
+    apex_yd: float
+    land_deg: float
+
+
+def _fly(launch: dict[str, float], air: Air, wind: Wind, params: ReferenceParameters) -> Outcome:
+    state = initial_state(**{k: np.array([v]) for k, v in launch.items()})
+    flight = fly_reference(state, air, wind, params=params)
+    return Outcome(float(flight.landing_position[0, 1]) / YARD_M, float(flight.lateral_m[0]) / YARD_M,
+                   float(flight.apex_m[0]) / YARD_M, float(flight.landing_angle_deg[0]))
+
+
+def driver_launch() -> dict[str, float]:
+    """The synthetic sessions' driver launch (`shots.clubs.CLUBS`), straight."""
+    club = next(c for c in CLUBS if c.name == "Driver")
+    return {"ball_speed_mps": club.ball_speed_mps, "launch_angle_deg": club.launch_angle_deg,
+            "launch_direction_deg": 0.0, "spin_rpm": club.spin_rpm, "spin_axis_deg": 0.0}
+
+
+def altitude_check(params: ReferenceParameters = CALIBRATED) -> tuple[Outcome, Outcome]:
+    """The driver at sea level and at HIGH_ALTITUDE_M, both in CALIBRATION_AIR's temperature and humidity."""
+    high = Air.from_conditions(temperature_c=25.0, altitude_m=HIGH_ALTITUDE_M, humidity_pct=50.0)
+    return (_fly(driver_launch(), CALIBRATION_AIR, CALM, params), _fly(driver_launch(), high, CALM, params))
+
+
+def wind_check(params: ReferenceParameters = CALIBRATED) -> tuple[Outcome, dict[tuple[str, str], Outcome]]:
+    """The rule's drive calm, and in a 10 mph wind (at the 10 m station height) from each side, uniform and with
+    the log profile over fairway grass."""
+    launch = dict(WIND_DRIVE, launch_direction_deg=0.0, spin_axis_deg=0.0)
+    calm = _fly(launch, CALIBRATION_AIR, CALM, params)
+    windy = {(name, profile): _fly(launch, CALIBRATION_AIR, Wind(WIND_SPEED_MPS, from_deg, profile), params)
+             for name, from_deg in WIND_FROM_DEG.items() for profile in ("uniform", "log")}
+    return calm, windy
+
+
+def render_checks_markdown(params: ReferenceParameters = CALIBRATED) -> list[str]:
+    """Markdown tables of both checks."""
+    sea, high = altitude_check(params)
+    change = (high.carry_yd - sea.carry_yd, high.apex_yd - sea.apex_yd, high.land_deg - sea.land_deg)
+    rule = (ALTITUDE_RULE["carry_yd"], ALTITUDE_RULE["apex_yd"], ALTITUDE_RULE["land_deg"])
+    out = ["", "### Other checks, not fitted: altitude and wind", "",
+           (f"The synthetic driver launch ({driver_launch()['ball_speed_mps']:g} m/s, "
+            f"{driver_launch()['launch_angle_deg']:g}°, {driver_launch()['spin_rpm']:g} rpm) at sea level and at "
+            f"{HIGH_ALTITUDE_M:,.0f} m (7,800 ft), both 25 °C, 50 % humidity:"), "",
+           "| | carry (yd) | max height (yd) | land angle (°) |", "|---|---:|---:|---:|",
+           f"| sea level | {sea.carry_yd:.1f} | {sea.apex_yd:.1f} | {sea.land_deg:.1f} |",
+           f"| {HIGH_ALTITUDE_M:,.0f} m | {high.carry_yd:.1f} | {high.apex_yd:.1f} | {high.land_deg:.1f} |",
+           "| change | " + " | ".join(_signed(c) for c in change) + " |",
+           "| rule (NOTES §2: 282 → 306 yd) | " + " | ".join(_signed(r) for r in rule) + " |"]
+    calm, windy = wind_check(params)
+    out += ["", (f"The wind rule's drive (155 mph, 12°, 2,800 rpm; calm carry {calm.carry_yd:.1f} yd) in a 10 mph "
+                 "wind at 10 m, uniform or with the log profile over fairway grass (z0 = 2 cm):"), "",
+            ("| wind | carry change, uniform (yd) | log profile (yd) | side, uniform (yd) | log profile (yd) "
+             "| rule (NOTES §3, yd) |"), "|---|---:|---:|---:|---:|---:|"]
+    for name in WIND_FROM_DEG:
+        uniform, log = windy[(name, "uniform")], windy[(name, "log")]
+        rule_cell = _signed(WIND_RULE_YD[name]) if name in WIND_RULE_YD else "–"
+        out.append(f"| {name} | {_signed(uniform.carry_yd - calm.carry_yd)} | {_signed(log.carry_yd - calm.carry_yd)} "
+                   f"| {_signed(uniform.side_yd)} | {_signed(log.side_yd)} | {rule_cell} |")
+    return out
+
+
+def _signed(value: float) -> str:
+    return f"{value:+.1f}"
