@@ -242,6 +242,18 @@ def _contrast(chosen: Scored, scored: list[Scored], ambiguous: set[str]) -> str:
     )
 
 
+SHARE_CEILING = 5.0
+"""Above this the upper end of an explained share's interval is not written as a number: a bootstrap draw whose
+excess over the noise floor is near zero makes the share of it anything (a real set once read '7–2825358664 %')."""
+
+
+def share_interval(low: float, high: float) -> str:
+    """'42–278 %', or '7 % to over 500 %' when the upper end is beyond SHARE_CEILING."""
+    if not np.isfinite(high) or high > SHARE_CEILING:
+        return f"{100 * low:.0f} % to over {100 * SHARE_CEILING:.0f} %"
+    return f"{100 * low:.0f}–{100 * high:.0f} %"
+
+
 def statement(
     systematic: bool,
     located: Located,
@@ -282,7 +294,7 @@ def statement(
     if heldout.explained_fraction is not None:
         low, high = heldout.explained_fraction_ci or (np.nan, np.nan)
         explains = (
-            f" explains {100 * heldout.explained_fraction:.0f} % (95 % interval {100 * low:.0f}–{100 * high:.0f} %) "
+            f" explains {100 * heldout.explained_fraction:.0f} % (95 % interval {share_interval(low, high)}) "
             "of the excess error on held-out shots"
         )
         if heldout.absorbs_noise:

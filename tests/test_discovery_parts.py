@@ -12,7 +12,7 @@ from discovery.effects import EFFECTS, Context, equivalent_altitude_m
 from discovery.model import reference
 from discovery.outside import HEIGHT_GUST, OUTSIDE, HeightGust, air_motion
 from discovery.prove import Run, cases, draw_effect, expected_label, relative_error, tables
-from discovery.report import plus_minus, service_settings
+from discovery.report import plus_minus, service_settings, share_interval
 from discovery.schema import EffectResult
 from flight.air import pressure_at_altitude
 from flight.wind import Wind, wind_vector
@@ -82,6 +82,12 @@ def test_hinge_knots_split_the_median_apex_in_thirds():
     assert knots_for(np.array([27.0, 30.0, 33.0, np.nan])) == (10.0, 20.0)
     assert knots_for(np.array([2.0])) == (1.3,)
     assert knots_for(np.array([np.nan])) == ()
+
+
+def test_an_explained_share_interval_without_a_bound_above_is_not_written_as_a_number():
+    assert share_interval(0.42, 2.78) == "42–278 %"
+    assert share_interval(0.07, 28253586.64) == "7 % to over 500 %"
+    assert share_interval(0.07, float("inf")) == "7 % to over 500 %"
 
 
 def test_equivalent_altitude_of_a_density_ratio():
