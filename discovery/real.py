@@ -2,9 +2,9 @@
 
 python -m discovery.real --out runs/discovery-real [--model DIR|reference]
 
-Sets: the outdoor, radar-tracked TrackMan driver shots (all balls and Premium only), the PGA TOUR TrackMan
-trajectories of the Sentry 2022 (spin from the play-by-play) and the Sony Open 2022 (spin estimated from the initial
-lift), each per event and per round, and TrackMan's PGA TOUR 2023 averages (one row per club).
+Sets: the outdoor, radar-tracked TrackMan driver shots (all balls, the held-out lines alone, and Premium only), the
+PGA TOUR TrackMan trajectories of the Sentry 2022 (spin from the play-by-play) and the Sony Open 2022 (spin estimated
+from the initial lift), each per event and per round, and TrackMan's PGA TOUR 2023 averages (one row per club).
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ from discovery.model import FlightModel, load_model
 from discovery.outputs import write_diagnosis
 from discovery.recordings import LABELS, OBSERVABLES, Recordings, from_shot_set
 from shots.files import write_text_atomic
+from shots.heldout import held_out_set
 from shots.markdown import table
 from shots.paths import shared_data_dir
 from shots.records import ShotRecord, ShotSet
@@ -76,6 +77,18 @@ def real_sets(shared: Path) -> list[RealSet]:
             "TrackMan driver shots, outdoor radar-tracked, all balls",
             from_shot_set(ShotSet(driver.records), source=str(shared / TRACKMAN)),
             "one session (no dates): held out in blocks of shots; ball types mixed",
+        )
+    )
+    held = held_out_set(TRACKMAN)  # shot_id is the line number in the export
+    assert held is not None, "the driver file's second half is held out (shots.heldout)"
+    unseen = [r for r in driver.records if held.holds(int(r.shot_id))]
+    sets.append(
+        RealSet(
+            "trackman_driver_heldout",
+            f"TrackMan driver shots, outdoor radar-tracked, all balls, held-out lines (from {held.first_line})",
+            from_shot_set(ShotSet(unseen), source=f"{shared / TRACKMAN} (lines from {held.first_line})"),
+            "the lines no model was trained on (NOTES section 9; the earlier ones may be): one session, held out in "
+            "blocks of shots; ball types mixed",
         )
     )
     premium = load_trackman(shared / TRACKMAN, balls=["Premium"], skip_bad_rows=True)

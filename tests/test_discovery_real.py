@@ -7,7 +7,8 @@ import json
 
 import pytest
 
-from discovery.real import TRACKMAN, main
+from discovery.real import TRACKMAN, main, real_sets
+from shots.heldout import held_out_set
 from shots.paths import shared_data_dir
 
 
@@ -21,3 +22,17 @@ def test_real_run_writes_a_summary_row_and_a_report(tmp_path):
     details = json.loads((tmp_path / "details.json").read_text())
     assert set(details) == {"pga_2023_averages"} and details["pga_2023_averages"]["statement"]
     assert (tmp_path / "pga_2023_averages" / "report.json").is_file()
+
+
+def test_the_driver_sets_held_out_lines_are_diagnosed_on_their_own():
+    """The served model was trained on the driver file's first lines (docs/training_real.md): its held-out lines
+    (shots.heldout) are a set of their own, holding every measured shot from the first held-out line and no other."""
+    shared = shared_data_dir()
+    if not (shared / TRACKMAN).is_file():
+        pytest.skip("needs the shared real data")
+    sets = {item.key: item for item in real_sets(shared)}
+    every, unseen = sets["trackman_driver"].recordings, sets["trackman_driver_heldout"].recordings
+    first = held_out_set(TRACKMAN).first_line
+    lines = [int(s) for s in unseen.shot_id]
+    assert min(lines) >= first == 2943
+    assert len(unseen) == sum(int(s) >= first for s in every.shot_id) > 0
