@@ -83,7 +83,10 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int, address: str 
         context = ray.data.DataContext.get_current()
         context.execution_options.preserve_order = True
         context.enable_progress_bars = False
-        dataset = ray.data.read_datasource(PiecesDatasource(source)).map_batches(
+        # The read task's worker exits when the input has been read (max_calls=1) instead of idling to the end with
+        # Ray Data imported and the pieces it wrote: about 240 MB of RSS less for the rest of the sweep.
+        read = ray.data.read_datasource(PiecesDatasource(source), ray_remote_args={"max_calls": 1})
+        dataset = read.map_batches(
             Flyer,
             fn_constructor_args=(bundle_dir, sha256, source),
             compute=ray.data.ActorPoolStrategy(size=workers),

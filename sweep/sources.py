@@ -20,6 +20,9 @@ from service.columns import columns_message
 from shots.records import reading
 from sweep.grid import Grid
 
+READ_BUFFER_BYTES = 1 << 20
+"""Parquet column data is read in buffers of this size, not a column chunk at a time."""
+
 
 def rebatch(batches, rows: int) -> Iterator:
     """Arrow record batches regrouped into tables of `rows` rows (the last one shorter), holding at most one table's
@@ -160,8 +163,11 @@ class ParquetSource:
     def pieces(self) -> Iterator:
         import pyarrow.parquet as pq
 
-        with pq.ParquetFile(self.path) as handle:
-            yield from packed(rebatch(handle.iter_batches(batch_size=self.chunk_rows), self.chunk_rows))
+        # Buffered column reads, one thread: a file of one big row group is decoded a chunk at a time (about 30 MB less
+        # held at 1,000,000 rows than reading each column chunk whole).
+        with pq.ParquetFile(self.path, buffer_size=READ_BUFFER_BYTES, pre_buffer=False) as handle:
+            batches = handle.iter_batches(batch_size=self.chunk_rows, use_threads=False)
+            yield from packed(rebatch(batches, self.chunk_rows))
 
     def expand(self, piece):
         return unpacked(piece)
