@@ -38,14 +38,23 @@ def write_launches(path: Path, shots: int) -> None:
     pq.write_table(pa.table({name: launches[:, i] for i, name in enumerate(names)}), path)
 
 
+def machine_in_use() -> int:
+    """Bytes of the machine's memory in use: total minus available."""
+    memory = psutil.virtual_memory()
+    return memory.total - memory.available
+
+
 class TreeUsage(threading.Thread):
     """Peak sums of RSS and PSS over a process and all its descendants, sampled every SAMPLE_S seconds, and the CPU
-    seconds they used (each process's last sample; a machine shared with other jobs stretches wall time, not CPU)."""
+    seconds they used (each process's last sample; a machine shared with other jobs stretches wall time, not CPU).
+    Beside them the machine's memory in use (total - available, which also counts shared memory no process maps,
+    such as objects left in Ray's store) above what it was at the start: on a quiet machine, what the run needs."""
 
     def __init__(self, pid: int):
         super().__init__(daemon=True)
         self.root = psutil.Process(pid)
         self.peak_rss = self.peak_pss = 0
+        self.machine_start = self.machine_peak = machine_in_use()
         self.peak_processes = 0
         self.cpu_s: dict[int, float] = {}
         self.done = threading.Event()
@@ -66,6 +75,7 @@ class TreeUsage(threading.Thread):
                 rss, pss = rss + memory.rss, pss + memory.pss
                 self.cpu_s[process.pid] = cpu.user + cpu.system
             self.peak_rss, self.peak_pss = max(self.peak_rss, rss), max(self.peak_pss, pss)
+            self.machine_peak = max(self.machine_peak, machine_in_use())
             self.peak_processes = max(self.peak_processes, len(tree))
             self.done.wait(SAMPLE_S)
 
@@ -91,6 +101,7 @@ def sweep_once(engine: str, launches: Path, out: Path, workers: int) -> dict:
         "cpu_s": sum(usage.cpu_s.values()),
         "peak_rss_mb": usage.peak_rss / 2**20,
         "peak_pss_mb": usage.peak_pss / 2**20,
+        "machine_mb": (usage.machine_peak - usage.machine_start) / 2**20,
         "processes": usage.peak_processes,
         "load_before": load_before,
         "load_after": os.getloadavg()[0],
@@ -116,7 +127,8 @@ def main() -> None:
                 assert pq.read_metadata(out).num_rows == args.shots
                 out.unlink()
                 runs.append({"round": round_number, **run})
-                print(f"round {round_number} {engine}: {run['seconds']:.1f} s, peak RSS {run['peak_rss_mb']:.0f} MB "
+                print(f"round {round_number} {engine}: {run['seconds']:.1f} s, peak RSS {run['peak_rss_mb']:.0f} MB, "
+                      f"PSS {run['peak_pss_mb']:.0f} MB, machine +{run['machine_mb']:.0f} MB "
                       f"(load {run['load_before']:.1f} -> {run['load_after']:.1f}); {run['summary']}", flush=True)
     rows = []
     for engine in ENGINES:
@@ -127,6 +139,7 @@ def main() -> None:
                      "shots_per_s": statistics.median(args.shots / r["seconds"] for r in mine),
                      "cpu_s": statistics.median(r["cpu_s"] for r in mine),
                      "peak_rss_mb": peak, "peak_pss_mb": max(r["peak_pss_mb"] for r in mine),
+                     "machine_mb": max(r["machine_mb"] for r in mine),
                      "processes": max(r["processes"] for r in mine),
                      "target": f"finishes, peak RSS < {PEAK_MB_TARGET} MB", "met": peak < PEAK_MB_TARGET})
     ray_runs, local_runs = ([r for r in runs if r["engine"] == e] for e in ("ray", "local"))
@@ -139,16 +152,17 @@ def main() -> None:
     rows.append({"name": "Ray's CPU seconds over local's (median of the rounds' ratios)", "ratio": statistics.median(cpu),
                  "per_round": cpu, "target": "(context)", "met": True})
     print(f"\n{args.shots:,} launches, {args.rounds} round(s), order alternating (medians of the rounds)\n")
-    print("| engine | wall time | shots/s | CPU time, process tree | peak RSS, process tree | peak PSS | processes | "
-          "target | met |")
-    print("|---|---:|---:|---:|---:|---:|---:|---|---|")
+    print("| engine | wall time | shots/s | CPU time, process tree | peak RSS, process tree | peak PSS | "
+          "machine memory, peak rise | processes | target | met |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---|---|")
     for row in rows[:2]:
         print(f"| {row['name']} | {row['seconds']:.1f} s | {row['shots_per_s']:,.0f} | {row['cpu_s']:.0f} s | "
-              f"{row['peak_rss_mb']:,.0f} MB | {row['peak_pss_mb']:,.0f} MB | {row['processes']} | {row['target']} | "
+              f"{row['peak_rss_mb']:,.0f} MB | {row['peak_pss_mb']:,.0f} MB | {row['machine_mb']:,.0f} MB | "
+              f"{row['processes']} | {row['target']} | "
               f"{'yes' if row['met'] else 'NO'} |")
     for row in rows[2:]:
         rounds = ", ".join(f"{r:.2f}" for r in row["per_round"])
-        print(f"| {row['name']} | | {row['ratio']:.2f}x ({rounds}) | | | | | {row['target']} | "
+        print(f"| {row['name']} | | {row['ratio']:.2f}x ({rounds}) | | | | | | {row['target']} | "
               f"{'yes' if row['met'] else 'NO'} |")
     write_results("sweep", [*rows, {"name": "runs", "runs": runs}])
 
