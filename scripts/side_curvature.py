@@ -47,15 +47,20 @@ class ScaledCoefficients:
         return ScaledCoefficients(inner, self.lift_scale, self.drag_scale)
 
 
-def axis_slope(errors: np.ndarray, launch: dict[str, np.ndarray]) -> tuple[float, float]:
+def axis_slope(errors: np.ndarray, launch: dict[str, np.ndarray],
+               groups: np.ndarray | None = None) -> tuple[float, float]:
     """OLS slope (m per degree) and its standard error of the side error on the spin axis, with the launch
-    direction and a constant beside it."""
-    design = np.column_stack([np.ones(len(errors)), launch["spin_axis_deg"], launch["launch_direction_deg"]])
+    direction beside it and a constant, or one constant per group (a range block's own crosswind) if given."""
+    if groups is None:
+        constants = np.ones((len(errors), 1))
+    else:
+        constants = (groups[:, None] == np.unique(groups)[None, :]).astype(float)
+    design = np.column_stack([launch["spin_axis_deg"], launch["launch_direction_deg"], constants])
     coef, *_ = np.linalg.lstsq(design, errors, rcond=None)
     residual = errors - design @ coef
     sigma2 = residual @ residual / (len(errors) - design.shape[1])
     covariance = sigma2 * np.linalg.inv(design.T @ design)
-    return float(coef[1]), float(np.sqrt(covariance[1, 1]))
+    return float(coef[0]), float(np.sqrt(covariance[0, 0]))
 
 
 def side_per_degree(flyer: Flyer, launch: dict[str, np.ndarray]) -> float:
@@ -67,15 +72,18 @@ def side_per_degree(flyer: Flyer, launch: dict[str, np.ndarray]) -> float:
     return float(np.mean((sides[1] - sides[0]) / (2 * AXIS_STEP_DEG)))
 
 
-def model_rows(flyers: list[Flyer], shots: ShotSet) -> list[list[str]]:
-    """Per model: side MAE and bias, the side error's slope on the axis, the model's own slope, their ratio."""
+def model_rows(flyers: list[Flyer], shots: ShotSet, groups: np.ndarray) -> list[list[str]]:
+    """Per model: side MAE and bias, the side error's slope on the axis (over all shots, and within groups), the
+    model's own slope, their ratio."""
     rows = []
     for flyer in flyers:
         errors = outcome_errors(flyer.simulate(shots.launch()), shots)["side_m"]
         slope, se = axis_slope(errors, shots.launch())
+        within, within_se = axis_slope(errors, shots.launch(), groups)
         own = side_per_degree(flyer, shots.launch())
         rows.append([flyer.label, f"{np.mean(np.abs(errors)):.2f}", f"{np.mean(errors):+.2f}",
-                     f"{slope:+.3f} ± {se:.3f}", f"{own:.2f}", f"{-slope / own:.0%}"])
+                     f"{slope:+.3f} ± {se:.3f}", f"{within:+.3f} ± {within_se:.3f}", f"{own:.2f}",
+                     f"{-slope / own:.0%}"])
     return rows
 
 
@@ -162,8 +170,10 @@ def main() -> int:
     flyers = [model, ModelFlyer(args.synthetic), ferguson_flyer(model.dt_s, model.t_sim_s)]
     print(f"TrackMan outdoor drivers, training lines, Premium balls: {len(premium)} shots (train and validation "
           "splits; every model calm, in its own air)\n")
+    blocks = np.array([r.group for r in records if r.ball == "Premium"])
     print("\n".join(table(["model", "side MAE, m", "side bias, m", "side error per deg of axis, m",
-                           "model's side per deg of axis, m", "missing curvature"], model_rows(flyers, premium))))
+                           "same, within range blocks, m", "model's side per deg of axis, m", "missing curvature"],
+                          model_rows(flyers, premium, blocks))))
     print(f"\n{model.label} with C_L and C_D scaled:\n")
     print("\n".join(table(["C_L x", "C_D x", "landing error, m", "side MAE, m", "side error per deg, m",
                            "carry bias, m", "apex bias, m", "land angle bias, deg"],

@@ -40,3 +40,16 @@ def test_monitor_profile_scales_the_axis_shifts_the_launch_and_scales_the_spin()
     assert read["spin_rpm"][0] == pytest.approx(2750.0)
     assert read["ball_speed_mps"][0] == 70.0 and read["launch_direction_deg"][0] == 1.0
     assert launch["spin_axis_deg"][0] == -8.0  # the recorded launch is left as it was
+
+
+def test_group_constants_take_out_a_crosswind_that_follows_the_groups_axes():
+    rng = np.random.default_rng(1)
+    groups = np.repeat(np.arange(10), 40)
+    axis = rng.normal(0, 5, 400) + 2.0 * groups  # later blocks fade more ...
+    wind_push = 0.5 * groups  # ... and had more crosswind
+    errors = -0.2 * axis + wind_push + rng.normal(0, 0.1, 400)
+    launch = {"spin_axis_deg": axis, "launch_direction_deg": rng.normal(0, 3, 400)}
+    pooled, _ = side_curvature.axis_slope(errors, launch)
+    within, se = side_curvature.axis_slope(errors, launch, groups)
+    assert pooled > -0.15  # the wind's trend with the block hides part of the slope
+    assert abs(within + 0.2) < 3 * se
