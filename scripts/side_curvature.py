@@ -17,6 +17,7 @@ from scipy.optimize import least_squares
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from flight.field import ScaledCoefficients
 from flight.integrator import simulate
 from flight.physics import CoefficientModel, initial_state
 from model_export.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
@@ -30,21 +31,9 @@ AXIS_STEP_DEG = 1.0
 """The axis step of each model's own side sensitivity (a central difference)."""
 
 
-class ScaledCoefficients:
-    """A coefficient model with C_L and C_D multiplied by constants (the library's lift_scale and drag_scale)."""
-
-    def __init__(self, model: CoefficientModel, lift_scale: float, drag_scale: float) -> None:
-        self.model, self.lift_scale, self.drag_scale = model, lift_scale, drag_scale
-
-    def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
-        coefficients = np.array(self.model(v_rel, omega), dtype=float)
-        coefficients[:, 0] *= self.lift_scale
-        coefficients[:, 1] *= self.drag_scale
-        return coefficients
-
-    def take(self, index: np.ndarray) -> ScaledCoefficients:
-        inner = self.model.take(index) if hasattr(self.model, "take") else self.model
-        return ScaledCoefficients(inner, self.lift_scale, self.drag_scale)
+def scaled(base: CoefficientModel, lift_scale: float, drag_scale: float, n_shots: int) -> ScaledCoefficients:
+    """`base` with C_L and C_D multiplied by constants for n_shots balls (the library's lift_scale and drag_scale)."""
+    return ScaledCoefficients(base, np.tile([lift_scale, drag_scale, 1.0], (n_shots, 1)))
 
 
 def axis_slope(errors: np.ndarray, launch: dict[str, np.ndarray],
@@ -95,7 +84,7 @@ def scale_rows(flyer: ModelFlyer, shots: ShotSet, lift_scales: tuple[float, ...]
     base = flyer.coefficients_in(None)
     for lift in lift_scales:
         for drag in drag_scales:
-            flight = simulate(initial_state(**launch), ScaledCoefficients(base, lift, drag), flyer.density_kg_m3,
+            flight = simulate(initial_state(**launch), scaled(base, lift, drag, len(shots)), flyer.density_kg_m3,
                               dt=flyer.dt_s, t_max=flyer.t_sim_s)
             errors = outcome_errors(flight, shots)
             slope, _ = axis_slope(errors["side_m"], launch)

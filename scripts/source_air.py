@@ -23,7 +23,7 @@ from flight.air import Air
 from flight.constants import YARD_M
 from flight.reference_aero import CALIBRATED, ReferenceParameters
 from model_export.reference_targets import calibration_cells
-from shots.calibrate_reference import BOUNDS, FREE_PARAMETERS, CalibrationCell, evaluate, residuals
+from shots.calibrate_reference import FREE_PARAMETERS, CalibrationCell, FitScaling, evaluate, residuals
 from shots.markdown import table
 from shots.paths import shared_data_dir
 from shots.reference_world import CALIBRATION_AIR
@@ -61,20 +61,19 @@ def fit_with_source_air(cells: list[CalibrationCell], prior_sd: float = PRIOR_SD
                         start: ReferenceParameters = CALIBRATED) -> tuple[ReferenceParameters, dict[str, float], float]:
     """The nine parameters and one density factor per unrecorded-air source, fitted together; and the cost."""
     sources = unrecorded_sources(cells)
-    typical = np.array([abs(getattr(start, name)) or 1.0 for name in FREE_PARAMETERS])
-    low = np.concatenate([[BOUNDS[n][0] for n in FREE_PARAMETERS] / typical, np.full(len(sources), -LOG_BOUND)])
-    high = np.concatenate([[BOUNDS[n][1] for n in FREE_PARAMETERS] / typical, np.full(len(sources), LOG_BOUND)])
+    scaling = FitScaling(start)
+    low, high = scaling.bounds()
+    low, high = np.append(low, np.full(len(sources), -LOG_BOUND)), np.append(high, np.full(len(sources), LOG_BOUND))
+    n = len(FREE_PARAMETERS)
 
     def unpack(x: np.ndarray) -> tuple[ReferenceParameters, dict[str, float]]:
-        params = dataclasses.replace(start, **{n: float(v) for n, v in zip(FREE_PARAMETERS, x[:9] * typical)})
-        return params, dict(zip(sources, np.exp(x[9:]).tolist()))
+        return scaling.parameters(x[:n]), dict(zip(sources, np.exp(x[n:]).tolist()))
 
     def misfit(x: np.ndarray) -> np.ndarray:
         params, factors = unpack(x)
-        return np.concatenate([residuals(params, with_factors(cells, factors)), x[9:] / prior_sd])
+        return np.concatenate([residuals(params, with_factors(cells, factors)), x[n:] / prior_sd])
 
-    x0 = np.clip(np.concatenate([[getattr(start, n) for n in FREE_PARAMETERS] / typical, np.zeros(len(sources))]),
-                 low, high)
+    x0 = np.append(scaling.start_values(), np.zeros(len(sources)))
     solution = least_squares(misfit, x0, bounds=(low, high), diff_step=1e-3, max_nfev=200)
     params, factors = unpack(solution.x)
     return params, factors, float(solution.cost)

@@ -29,6 +29,7 @@ from flight.reference_aero import (
     ReferenceParameters,
 )
 from shots.clubs import CLUBS
+from shots.markdown import signed
 from shots.records import ShotRecord
 from shots.reference_world import CALIBRATION_AIR, ClubAverage, fly_reference
 
@@ -183,22 +184,39 @@ def residuals(params: ReferenceParameters, cells: list[CalibrationCell]) -> np.n
     return np.nan_to_num(np.concatenate([flight, spin / RESIDUAL_SCALES["spin_loss_pct"]]), nan=1e3)
 
 
+@dataclass(frozen=True)
+class FitScaling:
+    """FREE_PARAMETERS as a least-squares fit sees them: each divided by its start value, inside BOUNDS; the knobs
+    and everything else stay as in `start`."""
+
+    start: ReferenceParameters
+
+    @property
+    def typical(self) -> np.ndarray:
+        return np.array([abs(getattr(self.start, name)) or 1.0 for name in FREE_PARAMETERS])
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds of the scaled values."""
+        return (np.array([BOUNDS[name][0] for name in FREE_PARAMETERS]) / self.typical,
+                np.array([BOUNDS[name][1] for name in FREE_PARAMETERS]) / self.typical)
+
+    def start_values(self) -> np.ndarray:
+        """The start's scaled values, clipped into the bounds."""
+        return np.clip(np.array([getattr(self.start, name) for name in FREE_PARAMETERS]) / self.typical, *self.bounds())
+
+    def parameters(self, x: np.ndarray) -> ReferenceParameters:
+        """The parameters of scaled values x."""
+        return dataclasses.replace(self.start, **{n: float(v) for n, v in zip(FREE_PARAMETERS, x * self.typical)})
+
+
 def fit_reference(
     cells: list[CalibrationCell], start: ReferenceParameters = CALIBRATED, max_evaluations: int = 200
 ) -> ReferenceParameters:
     """Least-squares fit of FREE_PARAMETERS (each scaled by its start value) inside BOUNDS; knobs stay as in start."""
-    typical = np.array([abs(getattr(start, name)) or 1.0 for name in FREE_PARAMETERS])
-    low = np.array([BOUNDS[name][0] for name in FREE_PARAMETERS]) / typical
-    high = np.array([BOUNDS[name][1] for name in FREE_PARAMETERS]) / typical
-
-    def with_values(x: np.ndarray) -> ReferenceParameters:
-        return dataclasses.replace(start, **{name: float(v) for name, v in zip(FREE_PARAMETERS, x * typical)})
-
-    x0 = np.clip(np.array([getattr(start, name) for name in FREE_PARAMETERS]) / typical, low, high)
-    solution = least_squares(
-        lambda x: residuals(with_values(x), cells), x0, bounds=(low, high), diff_step=1e-3, max_nfev=max_evaluations
-    )
-    return with_values(solution.x)
+    scaling = FitScaling(start)
+    solution = least_squares(lambda x: residuals(scaling.parameters(x), cells), scaling.start_values(),
+                             bounds=scaling.bounds(), diff_step=1e-3, max_nfev=max_evaluations)
+    return scaling.parameters(solution.x)
 
 
 @dataclass(frozen=True)
@@ -261,10 +279,6 @@ def _round(value: float) -> float:
     return float(f"{value:.5g}")
 
 
-def _signed(value: float) -> str:
-    return f"{value:+.1f}"
-
-
 def render_markdown(evaluation: CellEvaluation, params: ReferenceParameters, check: ClubCheck | None = None,
                     ferguson: ClubCheck | None = None) -> str:
     """Markdown: the parameters, the per-cell fit table, the spin-decay table and the held-out tour-averages check."""
@@ -280,7 +294,7 @@ def render_markdown(evaluation: CellEvaluation, params: ReferenceParameters, che
     ]
     units = np.array([YARD_M, YARD_M, 1.0])
     for cell, model, recorded in zip(evaluation.cells, evaluation.model_mean / units, evaluation.recorded_mean / units):
-        cells = ["—| —| —" if np.isnan(m) else f"{m:.1f} | {r:.1f} | {_signed(m - r)}" for m, r in zip(model, recorded)]
+        cells = ["—| —| —" if np.isnan(m) else f"{m:.1f} | {r:.1f} | {signed(m - r)}" for m, r in zip(model, recorded)]
         out.append(f"| {cell.name} | {cell.n_shots} | " + " | ".join(cells) + " |")
     header = " | ".join(f"{t:g} s model | {t:g} s TM" for t in DECAY_TIMES_S)
     out += ["", "### Spin lost (%) after 1 / 3 / 5 s: model vs TrackMan (Pro V1x)", "", f"| shot | {header} |"]
@@ -302,15 +316,15 @@ def _club_check_markdown(check: ClubCheck, ferguson: ClubCheck | None) -> list[s
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for club, model, target in zip(check.clubs, check.outcomes(), check.targets()):
-        cells = [f"{m:.1f} | {t:g} | {_signed(m - t)}" for m, t in zip(model, target)]
+        cells = [f"{m:.1f} | {t:g} | {signed(m - t)}" for m, t in zip(model, target)]
         out.append(f"| {club.club} | " + " | ".join(cells) + " |")
     mae = check.mean_absolute_error()
     bias = np.mean(check.outcomes() - check.targets(), axis=0)
     out.append("| **MAE (bias)** | | | " + " | | | ".join(
-        f"**{e:.2f}** ({_signed(b)})" for e, b in zip(mae, bias)) + " |")
+        f"**{e:.2f}** ({signed(b)})" for e, b in zip(mae, bias)) + " |")
     if ferguson is not None:
         ref = ferguson.mean_absolute_error()
         ref_bias = np.mean(ferguson.outcomes() - ferguson.targets(), axis=0)
         out.append("| Ferguson 2022 MAE (bias) | | | " + " | | | ".join(
-            f"{e:.2f} ({_signed(b)})" for e, b in zip(ref, ref_bias)) + " |")
+            f"{e:.2f} ({signed(b)})" for e, b in zip(ref, ref_bias)) + " |")
     return out

@@ -42,3 +42,8 @@ def table(header: Sequence[str], rows: Iterable[Sequence[object]], align: str | 
     lines = ["| " + " | ".join(header) + " |", rule]
     lines += ["| " + " | ".join(str(cell) for cell in row) + " |" for row in rows]
     return lines
+
+
+def signed(value: float) -> str:
+    """A difference to one decimal with its sign always shown: +1.5, -0.3, +0.0."""
+    return f"{value:+.1f}"

@@ -14,6 +14,7 @@ from flight.physics import initial_state
 from flight.reference_aero import CALIBRATED, ReferenceParameters
 from flight.wind import CALM, Wind
 from shots.clubs import CLUBS
+from shots.markdown import signed, table
 from shots.reference_world import CALIBRATION_AIR, fly_reference
 
 HIGH_ALTITUDE_M = 2377.0
@@ -73,27 +74,26 @@ def render_checks_markdown(params: ReferenceParameters = CALIBRATED) -> list[str
     sea, high = altitude_check(params)
     change = (high.carry_yd - sea.carry_yd, high.apex_yd - sea.apex_yd, high.land_deg - sea.land_deg)
     rule = (ALTITUDE_RULE["carry_yd"], ALTITUDE_RULE["apex_yd"], ALTITUDE_RULE["land_deg"])
+    launch = driver_launch()
     out = ["", "### Other checks, not fitted: altitude and wind", "",
-           (f"The synthetic driver launch ({driver_launch()['ball_speed_mps']:g} m/s, "
-            f"{driver_launch()['launch_angle_deg']:g}°, {driver_launch()['spin_rpm']:g} rpm) at sea level and at "
-            f"{HIGH_ALTITUDE_M:,.0f} m (7,800 ft), both 25 °C, 50 % humidity:"), "",
-           "| | carry (yd) | max height (yd) | land angle (°) |", "|---|---:|---:|---:|",
-           f"| sea level | {sea.carry_yd:.1f} | {sea.apex_yd:.1f} | {sea.land_deg:.1f} |",
-           f"| {HIGH_ALTITUDE_M:,.0f} m | {high.carry_yd:.1f} | {high.apex_yd:.1f} | {high.land_deg:.1f} |",
-           "| change | " + " | ".join(_signed(c) for c in change) + " |",
-           "| rule (NOTES §2: 282 → 306 yd) | " + " | ".join(_signed(r) for r in rule) + " |"]
+           (f"The synthetic driver launch ({launch['ball_speed_mps']:g} m/s, {launch['launch_angle_deg']:g}°, "
+            f"{launch['spin_rpm']:g} rpm) at sea level and at {HIGH_ALTITUDE_M:,.0f} m (7,800 ft), both 25 °C, 50 % "
+            "humidity:"), ""]
+    out += table(["", "carry (yd)", "max height (yd)", "land angle (°)"], [
+        ["sea level", f"{sea.carry_yd:.1f}", f"{sea.apex_yd:.1f}", f"{sea.land_deg:.1f}"],
+        [f"{HIGH_ALTITUDE_M:,.0f} m", f"{high.carry_yd:.1f}", f"{high.apex_yd:.1f}", f"{high.land_deg:.1f}"],
+        ["change", *(signed(c) for c in change)],
+        ["rule (NOTES §2: 282 → 306 yd)", *(signed(r) for r in rule)],
+    ])
     calm, windy = wind_check(params)
     out += ["", (f"The wind rule's drive (155 mph, 12°, 2,800 rpm; calm carry {calm.carry_yd:.1f} yd) in a 10 mph "
-                 "wind at 10 m, uniform or with the log profile over fairway grass (z0 = 2 cm):"), "",
-            ("| wind | carry change, uniform (yd) | log profile (yd) | side, uniform (yd) | log profile (yd) "
-             "| rule (NOTES §3, yd) |"), "|---|---:|---:|---:|---:|---:|"]
+                 "wind at 10 m, uniform or with the log profile over fairway grass (z0 = 2 cm):"), ""]
+    rows = []
     for name in WIND_FROM_DEG:
         uniform, log = windy[(name, "uniform")], windy[(name, "log")]
-        rule_cell = _signed(WIND_RULE_YD[name]) if name in WIND_RULE_YD else "–"
-        out.append(f"| {name} | {_signed(uniform.carry_yd - calm.carry_yd)} | {_signed(log.carry_yd - calm.carry_yd)} "
-                   f"| {_signed(uniform.side_yd)} | {_signed(log.side_yd)} | {rule_cell} |")
+        rows.append([name, signed(uniform.carry_yd - calm.carry_yd), signed(log.carry_yd - calm.carry_yd),
+                     signed(uniform.side_yd), signed(log.side_yd),
+                     signed(WIND_RULE_YD[name]) if name in WIND_RULE_YD else "–"])
+    out += table(["wind", "carry change, uniform (yd)", "log profile (yd)", "side, uniform (yd)", "log profile (yd)",
+                  "rule (NOTES §3, yd)"], rows)
     return out
-
-
-def _signed(value: float) -> str:
-    return f"{value:+.1f}"

@@ -15,10 +15,13 @@ from flight.physics import initial_state
 from flight.reference_aero import CALIBRATED, REFERENCE_DT_S, REFERENCE_T_MAX_S, ReferenceAerodynamics
 from model_export.reference_targets import NORMALIZED_7IRON_FILE, calibration_cells
 from shots.calibrate_reference import (
+    BOUNDS,
+    FREE_PARAMETERS,
     MIN_CELL_SHOTS,
     OBSERVABLES,
     RESIDUAL_SCALES,
     TRACKMAN_SPIN_LOSS_PCT,
+    FitScaling,
     cells_from_records,
     evaluate,
     evaluate_clubs,
@@ -249,3 +252,16 @@ def test_held_out_pga_check_is_rendered_apart_from_the_fit():
     text = render_markdown(evaluate(cells_from_records("src", records, CALIBRATION_AIR)), CALIBRATED, check)
     fit, held_out = text.split("### Held-out check, never fitted: PGA TOUR 2023 averages")
     assert "| src 0-52 m/s | 15 |" in fit and "| Driver |" in held_out and "**MAE (bias)**" in held_out
+
+
+def test_the_fit_sees_each_parameter_divided_by_its_start_value():
+    scaling = FitScaling(CALIBRATED)
+    x0 = scaling.start_values()
+    low, high = scaling.bounds()
+    k = FREE_PARAMETERS.index("drag_base")
+    assert x0[k] == pytest.approx(1.0)
+    assert low[k] == pytest.approx(BOUNDS["drag_base"][0] / CALIBRATED.drag_base)
+    assert np.all(low <= x0) and np.all(x0 <= high)  # critical_reynolds sits on its lower bound: x0 = low there
+    assert scaling.parameters(x0) == CALIBRATED
+    doubled = scaling.parameters(np.where(np.arange(len(x0)) == k, 2.0, x0))
+    assert doubled.drag_base == pytest.approx(2 * CALIBRATED.drag_base) and doubled.lift_max == CALIBRATED.lift_max
