@@ -36,7 +36,7 @@ from model_export.observations import (
     load_observed,
 )
 from model_export.torch_physics import DT_S, T_SIM_S, euler_rollout, hard_landing, positions_at
-from model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, save_checkpoint
+from model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, load_checkpoint, save_checkpoint
 from shots.files import write_text_atomic
 
 HUBER_DELTA = 2.0
@@ -329,22 +329,65 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
             steps += 1
         metrics = evaluate(model, data.val, config, data.sources)
         row = {"epoch": epoch, "train_loss": sums / max(steps, 1), "val_loss": metrics["loss"],
-               "val": metrics["sources"], "seconds": time.perf_counter() - started}
+               "val": metrics["sources"], "seconds": time.perf_counter() - started,
+               "selection_loss": selection_loss(metrics, config)}
         history.append(row)
         if progress:
             tqdm.write(f"epoch {epoch}: train {row['train_loss']:.3f}, val {row['val_loss']:.3f} " + ", ".join(
                 f"{k} {v.get('landing_error_m', float('nan')):.2f} m" for k, v in metrics["sources"].items()))
-        selected = [v for k, v in metrics["sources"].items() if k in config.select_on] or list(
-            metrics["sources"].values())
-        row["selection_loss"] = sum(v["loss"] for v in selected) / len(selected)
-        payload = {"format": CHECKPOINT_FORMAT, "kind": "joint", "epoch": epoch, "config": config.as_dict(),
-                   "model": model.state_dict(), "latent": latent.state_dict(), "noise": noise.state_dict(),
-                   "history": history}
-        save_checkpoint(out_dir / "last.pt", payload)
-        final = {"epoch": epoch, "val_loss": row["selection_loss"], "val": metrics["sources"]}
-        report = conditions_report(latent, data, train) | {"noise_factors": _noise_report(noise, data)}
-        write_text_atomic(out_dir / "conditions.json", json.dumps(report, indent=2) + "\n")
-        write_text_atomic(out_dir / "history.json",
-                          json.dumps({"config": config.as_dict(), "final": final, "epochs": history}, indent=2) + "\n")
+        final = _save_run(out_dir, epoch, config, model, latent, noise, data, history, metrics)
     return JointResult(out_dir, history, final)
+
+
+def selection_loss(metrics: dict[str, Any], config: JointConfig) -> float:
+    """The loss that compares runs: the mean of the `select_on` sources' validation losses, each counting equally."""
+    selected = [v for k, v in metrics["sources"].items() if k in config.select_on] or list(
+        metrics["sources"].values())
+    return sum(v["loss"] for v in selected) / len(selected)
+
+
+def _save_run(out_dir: Path, epoch: int, config: JointConfig, model: nn.Module, latent: LatentConditions,
+              noise: NoiseScales, data: ObservedData, history: list[dict[str, Any]],
+              metrics: dict[str, Any]) -> dict[str, Any]:
+    """Write OUT/last.pt, conditions.json and history.json of a run's latest epoch; its `final` record."""
+    payload = {"format": CHECKPOINT_FORMAT, "kind": "joint", "epoch": epoch, "config": config.as_dict(),
+               "model": model.state_dict(), "latent": latent.state_dict(), "noise": noise.state_dict(),
+               "history": history}
+    save_checkpoint(out_dir / "last.pt", payload)
+    final = {"epoch": epoch, "val_loss": selection_loss(metrics, config), "val": metrics["sources"]}
+    report = conditions_report(latent, data, data.train) | {"noise_factors": _noise_report(noise, data)}
+    write_text_atomic(out_dir / "conditions.json", json.dumps(report, indent=2) + "\n")
+    write_text_atomic(out_dir / "history.json",
+                      json.dumps({"config": config.as_dict(), "final": final, "epochs": history}, indent=2) + "\n")
+    return final
+
+
+def _mean_state(states: list[dict[str, torch.Tensor]]) -> dict[str, torch.Tensor]:
+    """The element-wise mean of state dicts with the same keys (integer buffers are taken from the first)."""
+    return {name: torch.stack([s[name] for s in states]).mean(0) if states[0][name].is_floating_point()
+            else states[0][name] for name in states[0]}
+
+
+@torch.no_grad()
+def soup_runs(data_path: str | os.PathLike, run_dirs: list[Path], out_dir: str | os.PathLike,
+              model: nn.Module) -> JointResult:
+    """A uniform model soup (Wortsman et al. 2022): the mean of the final weights of joint runs that started from
+    the same network on the same data (seeds), evaluated on the validation split exactly as a run's last epoch.
+    Its latent conditions and noise factors are the runs' means too. Written to OUT like a run (last.pt, ...)."""
+    payloads = [load_checkpoint(Path(d) / "last.pt") for d in run_dirs]
+    config = JointConfig(**payloads[0]["config"])
+    data = load_observed(Path(data_path), config.weights)
+    latent, noise = LatentConditions(data), NoiseScales(len(data.sources))
+    model.load_state_dict(_mean_state([p["model"] for p in payloads]))
+    latent.load_state_dict(_mean_state([p["latent"] for p in payloads]))
+    noise.load_state_dict(_mean_state([p["noise"] for p in payloads]))
+    model.eval()
+    metrics = evaluate(model, data.val, config, data.sources)
+    epoch = payloads[0]["epoch"]
+    row = {"epoch": epoch, "val_loss": metrics["loss"], "val": metrics["sources"],
+           "selection_loss": selection_loss(metrics, config), "soup_of": [str(d) for d in run_dirs]}
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    final = _save_run(out_dir, epoch, config, model, latent, noise, data, [row], metrics)
+    return JointResult(out_dir, [row], final)
 

@@ -11,13 +11,13 @@ import shutil
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from flight.constants import YARD_M
 from model_export.export import export_bundle
-from model_export.joint import JointConfig, JointResult, train_joint
+from model_export.joint import JointConfig, JointResult, soup_runs, train_joint
 from model_export.observations import NOISE, OBSERVABLES, PATH_OBSERVATIONS, PATH_SIGMA_M
 from model_export.real_data import SourceData, build
 from model_export.training import TrainConfig, load_checkpoint
@@ -25,20 +25,26 @@ from shots.records import read_shots
 from weights_schema.bundle import sha256_of
 from weights_schema.model_card import ModelCard
 
+if TYPE_CHECKING:
+    from torch import nn
+
 DATA_FILE = "real_flights.csv"
 CONDITIONS_FILE = "training_conditions.json"
 """The fitted latent conditions of the exported run, beside the bundle's card (read by `golfflight accuracy`)."""
 MEASURED_SOURCES = ("trackman-outdoor", "sentry-2022", "players-2020")
+SOUP = "soup"
+"""The run name (and WORK folder) of the seeds' weight average."""
 
 
 @dataclass
 class RealRun:
-    """What a `train_real` call leaves: the merged data, each seed's run, the chosen seed and the card."""
+    """What a `train_real` call leaves: the merged data, each run by name (seed-S, and the soup of the seeds when
+    there are several), the chosen run and the card."""
 
     data_file: Path
     sources: list[SourceData]
-    runs: dict[int, JointResult]
-    chosen_seed: int
+    runs: dict[str, JointResult]
+    chosen: str
     card: ModelCard | None
     seconds: float
 
@@ -131,6 +137,9 @@ def export_real(run_dir: Path, data_file: Path, sources: list[SourceData], out: 
     model.eval()
     history = json.loads((run_dir / "history.json").read_text())
     metrics = _validation_metrics(history["final"])
+    soup_of = history["epochs"][-1].get("soup_of")
+    which = f"the weight average (soup) of {len(soup_of)} seeds' last epochs" if soup_of else \
+        "the last epoch of the chosen seed"
     conditions = json.loads((run_dir / "conditions.json").read_text())
     data = _data_summary(data_file, sources)
     data["n_val"] = metrics.pop("n_shots")
@@ -145,7 +154,7 @@ def export_real(run_dir: Path, data_file: Path, sources: list[SourceData], out: 
         "split": "validation by conditions group, never a random shuffle: every 4th driver-range block in file "
                  "order, the Sentry's last round, every 4th hole of THE PLAYERS (one round), the last synthetic "
                  "sessions; the validation landing and max-height errors are over the measured sources' validation "
-                 "shots, flown calm (the last epoch of the chosen seed)",
+                 f"shots, flown calm ({which})",
         "loss_description": loss_description(config),
         "latent_conditions": latent_description(config, conditions),
     }, out)
@@ -153,15 +162,21 @@ def export_real(run_dir: Path, data_file: Path, sources: list[SourceData], out: 
     return card
 
 
+def _network(init: str | os.PathLike) -> nn.Module:
+    """A fresh copy of the network of the bundle INIT (a seed's start, or the module the soup's weights go into)."""
+    from model_export.bundle_model import model_from_bundle
+
+    model, _ = model_from_bundle(init)
+    return model
+
+
 def train_seed(data_file: Path, run_dir: Path, init: str | os.PathLike, config: JointConfig, threads: int,
                progress: bool) -> JointResult:
     """One seed's joint run from the bundle `init` (a process of its own when seeds run in parallel)."""
     import torch
 
-    from model_export.bundle_model import model_from_bundle
-
     torch.set_num_threads(threads)
-    model, _ = model_from_bundle(init)
+    model = _network(init)
     model.train()
     return train_joint(data_file, run_dir, config, model, progress)
 
@@ -171,8 +186,8 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
                source_names: tuple[str, ...] | None = None, progress: bool = True, jobs: int = 1,
                threads: int = 2) -> RealRun:
     """Build WORK/real_flights.csv from DATA_ROOT, train one joint run per seed from the bundle INIT (WORK/seed-S;
-    `jobs` seeds at a time, each with `threads` torch threads), and export the seed with the lowest validation loss
-    to OUT (if given)."""
+    `jobs` seeds at a time, each with `threads` torch threads), average several seeds' weights into a soup
+    (WORK/soup), and export the run with the lowest validation loss to OUT (if given)."""
     from concurrent.futures import ProcessPoolExecutor
 
     from weights_schema.bundle import load_bundle
@@ -182,14 +197,17 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     work.mkdir(parents=True, exist_ok=True)
     data_file = work / DATA_FILE
     sources = build(data_root, data_file, *(() if source_names is None else (source_names,)))
-    configs = {seed: replace(config, seed=seed) for seed in seeds}
+    configs = {f"seed-{seed}": replace(config, seed=seed) for seed in seeds}
     if jobs > 1:
         with ProcessPoolExecutor(jobs) as pool:
-            futures = {s: pool.submit(train_seed, data_file, work / f"seed-{s}", init, c, threads, False)
-                       for s, c in configs.items()}
-            runs = {s: f.result() for s, f in futures.items()}
+            futures = {name: pool.submit(train_seed, data_file, work / name, init, c, threads, False)
+                       for name, c in configs.items()}
+            runs = {name: f.result() for name, f in futures.items()}
     else:
-        runs = {s: train_seed(data_file, work / f"seed-{s}", init, c, threads, progress) for s, c in configs.items()}
+        runs = {name: train_seed(data_file, work / name, init, c, threads, progress) for name, c in configs.items()}
+    finished = [run.out_dir for run in runs.values() if run.final]
+    if len(finished) > 1:
+        runs[SOUP] = soup_runs(data_file, finished, work / SOUP, _network(init))
     chosen = min(runs, key=lambda s: runs[s].final["val_loss"] if runs[s].final else float("inf"))
     exported = None
     if out is not None:
@@ -200,3 +218,4 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
                     tuple(card.architecture.hidden_units))
         exported = record_held_out(out, data_root)
     return RealRun(data_file, sources, runs, chosen, exported, time.perf_counter() - started)
+

@@ -1,6 +1,7 @@
-"""The held-out errors of every seed of a `golfflight train-real` run, for the spread between seeds that
-docs/training_real.md reports (the run itself picks its seed on validation only and measures the held-out sets for
-that one). Exports each seed's last epoch to WORK/seed-S/bundle and prints a markdown table.
+"""The held-out errors of every seed (and of the seeds' soup) of a `golfflight train-real` run, for the spread
+between seeds that docs/training_real.md reports (the run itself picks its run on validation only and measures the
+held-out sets for that one). Exports each seed's last epoch to WORK/seed-S/bundle (the soup to WORK/soup/bundle)
+and prints a markdown table.
 
     python3 scripts/held_out_per_seed.py WORK [--data DIR] [--init models/synthetic]
 """
@@ -16,7 +17,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from flight.constants import FOOT_M, YARD_M
 from model_export.held_out import record_held_out
 from model_export.real_data import DEFAULT_SOURCES, build
-from model_export.real_training import DATA_FILE, export_real
+from model_export.real_training import DATA_FILE, SOUP, export_real
 from shots.markdown import table
 from shots.paths import shared_data_dir
 from weights_schema.bundle import load_bundle
@@ -41,12 +42,13 @@ def main() -> int:
     sources = build(args.data, args.work / "sources_for_cards.csv", DEFAULT_SOURCES)
     init, _ = load_bundle(args.init)
     rows = []
-    for seed_dir in sorted(args.work.glob("seed-*")):
+    soup = [args.work / SOUP] if (args.work / SOUP / "last.pt").is_file() else []
+    for seed_dir in sorted(args.work.glob("seed-*")) + soup:
         bundle = seed_dir / "bundle"
         export_real(seed_dir, args.work / DATA_FILE, sources, bundle, init.variant,
                     tuple(init.architecture.hidden_units))
         rows.append([seed_dir.name, *cells(record_held_out(bundle, args.data))])
-    print("\n".join(table(["seed", "TrackMan drivers, all: landing error", "TOUR Championship: apex MAE",
+    print("\n".join(table(["run", "TrackMan drivers, all: landing error", "TOUR Championship: apex MAE",
                            "PGA averages: carry / max height / land angle MAE"], rows)))
     return 0
 

@@ -3,6 +3,7 @@ loss falls, and the shipped model's card names its sources and held-out sets."""
 
 from __future__ import annotations
 
+import copy
 import csv
 import json
 from pathlib import Path
@@ -12,10 +13,11 @@ import pytest
 import torch
 
 from flight.physics import initial_state
-from model_export.joint import JointConfig, LatentConditions, cosine_factor, train_joint
+from model_export.joint import JointConfig, LatentConditions, cosine_factor, soup_runs, train_joint
 from model_export.observations import load_observed
 from model_export.real_data import DRIVER_FILE, PLAYERS_PBP, build, driver_groups, players, trackman_outdoor
 from model_export.torch_physics import euler_rollout, hard_landing, positions_at
+from model_export.training import load_checkpoint
 from model_export.variants import PhysNN, PhysQ
 from shots.heldout import HELD_OUT, HeldOutError, check_training_rows, held_out_set
 from shots.paths import REPO_ROOT, shared_data_dir
@@ -188,6 +190,24 @@ def test_a_tiny_joint_run_lowers_its_loss(tmp_path):
     losses = [row["train_loss"] for row in result.history]
     assert losses[-1] < 0.8 * losses[0]
     assert (tmp_path / "run" / "last.pt").is_file()
+
+
+def test_the_soup_of_seeds_is_their_mean_weights_scored_like_a_run(tmp_path):
+    _windy_set(tmp_path / "windy.csv", {"a": (0.0, 1.0), "b": (1.0, 0.0)}, n_per_group=8)
+    torch.manual_seed(0)
+    start = PhysNN("phys-nn+", (8,))
+    runs = [train_joint(tmp_path / "windy.csv", tmp_path / f"seed-{seed}",
+                        JointConfig(epochs=2, batch_size=4, lr=3e-3, seed=seed), copy.deepcopy(start), progress=False)
+            for seed in (0, 1)]
+    soup_runs(tmp_path / "windy.csv", [r.out_dir for r in runs], tmp_path / "soup", copy.deepcopy(start))
+    seeds = [load_checkpoint(r.out_dir / "last.pt")["model"] for r in runs]
+    souped = load_checkpoint(tmp_path / "soup" / "last.pt")["model"]
+    assert any(not torch.equal(seeds[0][name], seeds[1][name]) for name in souped)
+    for name, weight in souped.items():
+        torch.testing.assert_close(weight, (seeds[0][name] + seeds[1][name]) / 2)
+    assert json.loads((tmp_path / "soup" / "conditions.json").read_text())["wind"]
+    alone = soup_runs(tmp_path / "windy.csv", [runs[0].out_dir], tmp_path / "alone", copy.deepcopy(start))
+    assert alone.final["val_loss"] == pytest.approx(runs[0].final["val_loss"], rel=1e-5)
 
 
 REAL = REPO_ROOT / "models" / "real"

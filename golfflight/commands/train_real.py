@@ -21,13 +21,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     parser = subparsers.add_parser(
         "train-real",
-        help="train on the real flights of the shared data (held-out sets never read), export the seed with the lowest validation loss",
+        help="train on the real flights of the shared data (held-out sets never read), export the run with the lowest validation loss",
         description="Build WORK/real_flights.csv from every usable real source (docs/training_real.md), fine-tune "
         "the --init bundle on it jointly with a wind per conditions group, an air factor per air group and a scale "
-        "per ball type, once per seed, and export the seed with the lowest validation loss to --out.",
+        "per ball type, once per seed, average the seeds' weights into a soup, and export the run (a seed or the "
+        "soup) with the lowest validation loss to --out.",
     )
     parser.add_argument("--work", required=True, help="directory for the merged data and each seed's run")
-    parser.add_argument("--out", help="bundle directory to export the chosen seed to")
+    parser.add_argument("--out", help="bundle directory to export the chosen run to")
     parser.add_argument("--init", default="models/synthetic", help="bundle to start from (default models/synthetic)")
     parser.add_argument("--data-root", default=None, help="shared data folder (default ../shared/data)")
     parser.add_argument("--sources", default=",".join(DEFAULT_SOURCES),
@@ -56,11 +57,11 @@ def run(args: argparse.Namespace) -> int:
                         jobs=args.jobs, threads=args.threads)
     for data in result.sources:
         print(f"{data.name}: {len(data.records)} shots ({data.kind})")
-    for seed, run_result in result.runs.items():
+    for name, run_result in result.runs.items():
         final = run_result.final
-        print(f"seed {seed}: epoch {final['epoch']}, validation loss {final['val_loss']:.3f}" if final
-              else f"seed {seed}: no epoch finished")
-    print(f"chosen seed {result.chosen_seed}; {result.seconds / 60:.1f} min")
+        print(f"{name}: epoch {final['epoch']}, validation loss {final['val_loss']:.3f}" if final
+              else f"{name}: no epoch finished")
+    print(f"chosen {result.chosen}; {result.seconds / 60:.1f} min")
     if result.card is not None:
         print(f"exported {args.out} (validation landing error {result.card.validation.landing_error_yd:.2f} yd)")
     return 0
