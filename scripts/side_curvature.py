@@ -114,36 +114,60 @@ PROFILE_SCALES_M = {"carry_m": 3.0, "side_m": 3.0, "apex_m": 1.5}
 """How the profile fit weighs each outcome's error (m): the landing point's two axes and the apex."""
 
 
+AS_RECORDED = np.array([1.0, 0.0, 1.0, 0.0])
+"""The profile that changes nothing: (axis scale, launch-angle bias deg, spin scale, launch-direction bias deg)."""
+PROFILE_BOUNDS = (np.array([0.5, -5.0, 0.5, -5.0]), np.array([2.0, 5.0, 2.0, 5.0]))
+
+
 def monitor_profile(launch: dict[str, np.ndarray], profile: np.ndarray) -> dict[str, np.ndarray]:
     """Launches as a monitor profile reads them: spin axis x profile[0], launch angle + profile[1] deg, spin x
-    profile[2]."""
+    profile[2], launch direction + profile[3] deg."""
     return dict(launch, spin_axis_deg=launch["spin_axis_deg"] * profile[0],
-                launch_angle_deg=launch["launch_angle_deg"] + profile[1], spin_rpm=launch["spin_rpm"] * profile[2])
+                launch_angle_deg=launch["launch_angle_deg"] + profile[1], spin_rpm=launch["spin_rpm"] * profile[2],
+                launch_direction_deg=launch["launch_direction_deg"] + profile[3])
 
 
-def fit_monitor_profile(flyer: Flyer, shots: ShotSet) -> np.ndarray:
-    """The profile (axis scale, launch-angle bias, spin scale) that brings the flyer's carry, side and apex closest
-    to the recordings (bounded least squares)."""
+def fit_monitor_profile(flyer: Flyer, shots: ShotSet, free: list[int]) -> np.ndarray:
+    """The profile whose `free` entries (the others as recorded) bring the flyer's carry, side and apex closest to
+    the recordings (bounded least squares)."""
 
-    def residuals(profile: np.ndarray) -> np.ndarray:
-        errors = outcome_errors(flyer.simulate(monitor_profile(shots.launch(), profile)), shots)
+    def profile_of(values: np.ndarray) -> np.ndarray:
+        profile = AS_RECORDED.copy()
+        profile[free] = values
+        return profile
+
+    def residuals(values: np.ndarray) -> np.ndarray:
+        errors = outcome_errors(flyer.simulate(monitor_profile(shots.launch(), profile_of(values))), shots)
         return np.concatenate([errors[k] / scale for k, scale in PROFILE_SCALES_M.items()])
 
-    return least_squares(residuals, [1.0, 0.0, 1.0], diff_step=1e-2, bounds=([0.5, -5.0, 0.5], [2.0, 5.0, 2.0])).x
+    fit = least_squares(residuals, AS_RECORDED[free], diff_step=1e-2,
+                        bounds=(PROFILE_BOUNDS[0][free], PROFILE_BOUNDS[1][free]))
+    return profile_of(fit.x)
+
+
+PROFILES = {"axis, launch angle, spin": [0, 1, 2], "the same + launch direction": [0, 1, 2, 3]}
+"""The profiles fitted: which entries of (axis scale, launch-angle bias, spin scale, direction bias) are free."""
 
 
 def profile_rows(flyers: list[Flyer], fit_on: ShotSet, check_on: ShotSet) -> list[list[str]]:
-    """Per flyer: the profile fitted on `fit_on`, and the landing error / side MAE without and with it on both sets."""
+    """Per flyer and profile: the profile fitted on `fit_on`, and the landing error / side MAE without and with it
+    on both sets."""
     rows = []
     for flyer in flyers:
-        profile = fit_monitor_profile(flyer, fit_on)
-        cells = []
-        for shots in (fit_on, check_on):
-            for p in (np.array([1.0, 0.0, 1.0]), profile):
-                errors = outcome_errors(flyer.simulate(monitor_profile(shots.launch(), p)), shots)
-                cells.append(f"{np.mean(errors['landing_m']):.2f} / {np.mean(np.abs(errors['side_m'])):.2f}")
-        rows.append([flyer.label, f"x {profile[0]:.2f}, {profile[1]:+.2f}°, x {profile[2]:.2f}", *cells])
+        for free in PROFILES.values():
+            rows.append(_profile_row(flyer, fit_monitor_profile(flyer, fit_on, free), fit_on, check_on))
     return rows
+
+
+def _profile_row(flyer: Flyer, profile: np.ndarray, fit_on: ShotSet, check_on: ShotSet) -> list[str]:
+    """One flyer and profile: the profile, and the landing error / side MAE without and with it on both sets."""
+    cells = []
+    for shots in (fit_on, check_on):
+        for p in (AS_RECORDED, profile):
+            errors = outcome_errors(flyer.simulate(monitor_profile(shots.launch(), p)), shots)
+            cells.append(f"{np.mean(errors['landing_m']):.2f} / {np.mean(np.abs(errors['side_m'])):.2f}")
+    named = f"axis x {profile[0]:.2f}, launch {profile[1]:+.2f}°, spin x {profile[2]:.2f}, direction {profile[3]:+.2f}°"
+    return [flyer.label, named, *cells]
 
 
 def main() -> int:
@@ -173,7 +197,8 @@ def main() -> int:
                           axis_scale_rows([model, flyers[2]], {"Premium": premium, "other": range_balls}, scales))))
     train = ShotSet([r for r in records if r.ball == "Premium" and r.split == "train"])
     validation = ShotSet([r for r in records if r.ball == "Premium" and r.split == "val"])
-    print(f"\nA monitor profile (spin axis scale, launch angle bias, spin scale) fitted on the training split's "
+    print(f"\nA monitor profile (spin axis scale, launch angle bias, spin scale; then with a launch direction bias "
+          f"beside them) fitted on the training split's "
           f"{len(train)} Premium drives, checked on the validation split's {len(validation)} (other range blocks): "
           "landing error / side MAE, m\n")
     print("\n".join(table(["model", "profile", "train, as recorded", "train, profile", "validation, as recorded",

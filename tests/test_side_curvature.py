@@ -35,10 +35,12 @@ def test_scaled_coefficients_scale_lift_and_drag_only():
 def test_monitor_profile_scales_the_axis_shifts_the_launch_and_scales_the_spin():
     launch = {"ball_speed_mps": np.array([70.0]), "launch_angle_deg": np.array([12.0]),
               "launch_direction_deg": np.array([1.0]), "spin_rpm": np.array([2500.0]), "spin_axis_deg": np.array([-8.0])}
-    read = side_curvature.monitor_profile(launch, np.array([1.25, -0.5, 1.1]))
+    read = side_curvature.monitor_profile(launch, np.array([1.25, -0.5, 1.1, 0.0]))
     assert read["spin_axis_deg"][0] == -10.0 and read["launch_angle_deg"][0] == 11.5
     assert read["spin_rpm"][0] == pytest.approx(2750.0)
     assert read["ball_speed_mps"][0] == 70.0 and read["launch_direction_deg"][0] == 1.0
+    turned = side_curvature.monitor_profile(launch, np.array([1.0, 0.0, 1.0, -0.75]))
+    assert turned["launch_direction_deg"][0] == 0.25 and turned["spin_axis_deg"][0] == -8.0
     assert launch["spin_axis_deg"][0] == -8.0  # the recorded launch is left as it was
 
 
