@@ -222,18 +222,43 @@ def _series(errors: Errors) -> dict[str, np.ndarray | None]:
     return {"landing": errors.landing_m, "length": errors.length_m, "side": errors.side_m, "apex": errors.apex_m}
 
 
+HIGH_SPIN_RATIO = 0.5
+"""Figure 7's summary splits the effective lift's difference from the reference world at this spin ratio."""
+
+
+def coefficient_summary(samples: CoefficientSamples, scale: np.ndarray, model: nn.Module, label: str) -> str:
+    """Figure 7 in numbers: the raw heads, the learned dynamic pressure, and the effective coefficients against the
+    reference world's at the same states (the drag as a median relative difference, the lift as a median
+    difference below and above HIGH_SPIN_RATIO), and p_M where the model learns one."""
+    lift, drag = scale * samples.c_lift, scale * samples.c_drag
+    high = samples.spin_ratio > HIGH_SPIN_RATIO
+    relative_drag = np.median(drag / samples.reference_drag - 1.0)
+    lift_gap = lift - samples.reference_lift
+    low_c_q, high_c_q = np.percentile(samples.c_q, [5, 95])
+    text = (f"Figure 7 in numbers ({label}, {len(samples.spin_ratio)} in-flight steps): raw C_L median "
+            f"{np.median(samples.c_lift):.2f} (99.9th percentile {np.percentile(samples.c_lift, 99.9):.2f}); C_Q median "
+            f"{np.median(samples.c_q):.2f} (5th-95th percentile {low_c_q:.2f}-{high_c_q:.2f}); effective C_D against "
+            f"the reference world's at the same states: median relative difference {relative_drag:+.1%}; effective "
+            f"C_L minus the reference's: median {np.median(lift_gap[~high]):+.3f} below S = {HIGH_SPIN_RATIO:g}, "
+            f"{np.median(lift_gap[high]):+.3f} above ({int(high.sum())} steps)")
+    if hasattr(model, "log_p_m"):
+        text += f"; learned p_M = {float(model.p_m):.4f}"
+    return text + "."
+
+
 def write_figures(
     runs: list[RunEvaluation], floors: list[Floor], val: ValidationSet, air: Air, directory: str | os.PathLike
-) -> list[Path]:
+) -> tuple[list[Path], str]:
     """Figure 6 (error histograms of Phys-Q, NN, Phys-NN+ and the nominal floor) and Figure 7 (Phys-NN+ coefficients
-    with Phys-Q's curves), for the variants among `runs`. Figure 7's effective coefficients are C x 2 C_Q x
-    rho_trained / rho_air: the force the model applies, expressed in the reference world's (nominal) air."""
-    from model_export import figures
+    with Phys-Q's curves), for the variants among `runs`, and Figure 7's summary line (empty without a network
+    variant). Figure 7's effective coefficients are C x 2 C_Q x rho_trained / rho_air: the force the model applies,
+    expressed in the reference world's (nominal) air."""
     from flight.coefficients import FERGUSON_2022
+    from model_export import figures
 
     directory = Path(directory)
     by_variant = {run.variant: run for run in runs}
-    written = []
+    written, summary = [], ""
     series = {DISPLAY[v]: _series(by_variant[v].errors) for v in ("phys-q", "nn", "phys-nn+") if v in by_variant}
     if floors[0].errors is not None:
         series[f"noise floor ({floors[0].name})"] = _series(floors[0].errors)
@@ -259,7 +284,8 @@ def write_figures(
                 model_label=DISPLAY[phys_nn.variant],
             )
         )
-    return written
+        summary = coefficient_summary(samples, scale, phys_nn.model, DISPLAY[phys_nn.variant])
+    return written, summary
 
 
 def _order(run: RunEvaluation) -> int:
@@ -402,7 +428,7 @@ def run_evaluation(
     for evaluation in evaluations:
         evaluation.world_gap = gap(evaluation.prediction, floors[0].prediction)
     check = check_bundle(bundle, val) if bundle is not None else None
-    written = write_figures(evaluations, floors, val, air, out_dir / "figures")
-    markdown = render(evaluations, floors, val, check)
+    written, summary = write_figures(evaluations, floors, val, air, out_dir / "figures")
+    markdown = render(evaluations, floors, val, check) + (f"\n{summary}\n" if summary else "")
     write_generated_section(out_dir / "training.md", markdown, COMMAND)
     return EvaluationReport(evaluations, floors, check, markdown, written)

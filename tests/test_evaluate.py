@@ -14,7 +14,7 @@ from flight.physics import initial_state
 from flight.wind import Wind
 from golfflight.cli import main
 from model_export.data import load_training_data
-from model_export.evaluate import COMMAND, FIGURES, run_evaluation
+from model_export.evaluate import COMMAND, FIGURES, CoefficientSamples, coefficient_summary, run_evaluation
 from model_export.export import export_checkpoint
 from model_export.noise_floor import (
     expected_outcome_noise,
@@ -24,6 +24,7 @@ from model_export.noise_floor import (
     read_session_truth,
 )
 from model_export.training import TrainConfig, load_checkpoint, train
+from model_export.variants import PhysNN
 from model_export.validation import load_validation
 from shots.markdown import begin_marker
 from shots.records import ShotRecord, read_shots, write_csv_atomic, write_shots
@@ -183,3 +184,18 @@ def test_expected_outcome_noise_follows_the_noise_model(tmp_path):
     carry = np.hypot(*val.landing_m.T)
     assert landing == pytest.approx(np.mean(0.4 + 0.004 * carry) * math.sqrt(math.pi / 2))
     assert apex == pytest.approx(0.3 * math.sqrt(2 / math.pi))
+
+
+def test_figure_7_in_numbers_compares_the_effective_coefficients_with_the_reference_world():
+    samples = CoefficientSamples(spin_ratio=np.array([0.1, 0.2, 0.3, 0.6, 0.7]),
+                                 c_lift=np.array([0.20, 0.20, 0.20, 0.25, 0.25]),
+                                 c_drag=np.array([0.25, 0.25, 0.25, 0.30, 0.30]),
+                                 c_q=np.full(5, 0.5),
+                                 reference_lift=np.array([0.21, 0.20, 0.22, 0.20, 0.20]),
+                                 reference_drag=np.array([0.25, 0.25, 0.25, 0.25, 0.25]))
+    model = PhysNN("phys-nn+", (4,))
+    text = coefficient_summary(samples, np.ones(5), model, "Phys-NN+")
+    assert "raw C_L median 0.20" in text and "C_Q median 0.50" in text
+    assert "median relative difference +0.0%" in text  # drag 0.25 vs 0.25 on 3 of 5 steps: the median is 0
+    assert "median -0.010 below S = 0.5, +0.050 above (2 steps)" in text
+    assert f"learned p_M = {float(model.p_m):.4f}" in text
