@@ -24,8 +24,8 @@ from model_export.noise_floor import (
     read_session_truth,
 )
 from model_export.training import TrainConfig, load_checkpoint, train
-from model_export.variants import PhysNN
 from model_export.validation import load_validation
+from model_export.variants import PhysNN
 from shots.markdown import begin_marker
 from shots.records import ShotRecord, read_shots, write_csv_atomic, write_shots
 from shots.reference_world import fly_reference
