@@ -145,8 +145,9 @@ def fit_monitor_profile(flyer: Flyer, shots: ShotSet, free: list[int]) -> np.nda
     return profile_of(fit.x)
 
 
-PROFILES = {"axis, launch angle, spin": [0, 1, 2], "the same + launch direction": [0, 1, 2, 3]}
-"""The profiles fitted: which entries of (axis scale, launch-angle bias, spin scale, direction bias) are free."""
+PROFILES = ([0, 1, 2], [0, 1, 2, 3])
+"""The profiles fitted: which entries of (axis scale, launch-angle bias, spin scale, direction bias) are free (the
+first three, then all four)."""
 
 
 def profile_rows(flyers: list[Flyer], fit_on: ShotSet, check_on: ShotSet) -> list[list[str]]:
@@ -154,7 +155,7 @@ def profile_rows(flyers: list[Flyer], fit_on: ShotSet, check_on: ShotSet) -> lis
     on both sets."""
     rows = []
     for flyer in flyers:
-        for free in PROFILES.values():
+        for free in PROFILES:
             rows.append(_profile_row(flyer, fit_monitor_profile(flyer, fit_on, free), fit_on, check_on))
     return rows
 

@@ -49,10 +49,14 @@ def fitted_wind(flyer: Flyer, shots: ShotSet) -> np.ndarray:
                          diff_step=WIND_STEP_MPS).x
 
 
-def leave_one_out(flyer: Flyer, shots: ShotSet, blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per shot with enough block neighbours: its landing error calm, with the wind of the other shots of its block,
-    and that wind; NaN for a shot whose block is too small."""
-    calm = np.full(len(shots), np.nan)
+def calm_errors(flyer: Flyer, shots: ShotSet) -> np.ndarray:
+    """Per-shot landing error (m) flown calm."""
+    return np.linalg.norm(landing_errors(flyer, shots, np.zeros(2)), axis=1)
+
+
+def leave_one_out(flyer: Flyer, shots: ShotSet, blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per shot with enough block neighbours: its landing error with the wind of the other shots of its block, and
+    that wind; NaN for a shot whose block is too small."""
     windy = np.full(len(shots), np.nan)
     winds = np.full((len(shots), 2), np.nan)
     for block in np.unique(blocks):
@@ -62,11 +66,9 @@ def leave_one_out(flyer: Flyer, shots: ShotSet, blocks: np.ndarray) -> tuple[np.
         for i in members:
             others = ShotSet([shots.records[j] for j in members if j != i])
             wind = fitted_wind(flyer, others)
-            alone = ShotSet([shots.records[i]])
-            calm[i] = np.linalg.norm(landing_errors(flyer, alone, np.zeros(2))[0])
-            windy[i] = np.linalg.norm(landing_errors(flyer, alone, wind)[0])
+            windy[i] = np.linalg.norm(landing_errors(flyer, ShotSet([shots.records[i]]), wind)[0])
             winds[i] = wind
-    return calm, windy, winds
+    return windy, winds
 
 
 def block_spread_rows(flyers: list[Flyer], shots: ShotSet) -> list[list[str]]:
@@ -78,7 +80,7 @@ def block_spread_rows(flyers: list[Flyer], shots: ShotSet) -> list[list[str]]:
     big = names[counts > MIN_OTHERS]
     out = []
     for flyer in flyers:
-        errors = np.linalg.norm(landing_errors(flyer, shots, np.zeros(2)), axis=1)
+        errors = calm_errors(flyer, shots)
         means = np.array([np.mean(errors[blocks == b]) for b in big])
         low, median, high = np.percentile(means, [10, 50, 90])
         out.append([flyer.label, str(len(big)), f"{median:.2f}", f"{low:.2f} - {high:.2f}",
@@ -93,7 +95,8 @@ def rows(flyers: list[Flyer], splits: dict[str, ShotSet]) -> list[list[str]]:
     for name, shots in splits.items():
         blocks = np.array([r.group for r in shots.records])
         for flyer in flyers:
-            calm, windy, winds = leave_one_out(flyer, shots, blocks)
+            calm = calm_errors(flyer, shots)
+            windy, winds = leave_one_out(flyer, shots, blocks)
             kept = np.isfinite(windy)
             calm_m, windy_m = float(np.mean(calm[kept])), float(np.mean(windy[kept]))
             out.append([name, flyer.label, str(int(kept.sum())), f"{calm_m:.2f}", f"{windy_m:.2f}",
