@@ -10,6 +10,7 @@ from golfflight.commands import (
     finetune,
     fly,
     ground_fit,
+    physics_check,
     serve,
     simulate,
     sweep,
@@ -19,6 +20,6 @@ from golfflight.commands import (
 )
 
 COMMANDS = [
-    fly, synth, convert, calibrate, train, train_real, export, evaluate, finetune, accuracy, ground_fit, serve,
-    simulate, sweep, discover,
+    fly, synth, convert, calibrate, train, train_real, export, evaluate, finetune, accuracy, ground_fit, physics_check,
+    serve, simulate, sweep, discover,
 ]
