@@ -97,15 +97,15 @@ FREE_PARAMETERS: tuple[str, ...] = (
 # outdoor Premium drivers, the 2022 Sentry, THE PLAYERS 2020) and TrackMan's normalized 7-iron set, by ball-speed band,
 # plus TrackMan's spin decay. The held-out PGA 2023 averages are a check only (docs/reference_world.md).
 CALIBRATED = ReferenceParameters(
-    drag_base=0.15417,
-    drag_spin_span=0.25612,
-    lift_max=0.40202,
-    lift_half_spin_ratio=0.12854,
-    critical_reynolds=60000.0,
-    lift_spin_protection=2.0,
-    spin_decay_coefficient=0.011543,
-    spin_decay_spin_exponent=1.1724,
-    spin_decay_reynolds_exponent=0.50434,
+    drag_base=0.16041,
+    drag_spin_span=0.17797,
+    lift_max=0.45471,
+    lift_half_spin_ratio=0.17146,
+    critical_reynolds=74809.0,
+    lift_spin_protection=0.82059,
+    spin_decay_coefficient=0.011512,
+    spin_decay_spin_exponent=1.1771,
+    spin_decay_reynolds_exponent=0.48727,
 )
 
 

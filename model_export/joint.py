@@ -5,11 +5,13 @@ units of its measurement noise (`model_export.observations`), through a Huber fu
 Each conditions group gets a latent uniform wind, each air group a latent density factor, each non-reference ball
 type a latent lift and drag scale, all with Gaussian priors whose widths are the typical sizes of the matching
 discovery effects (`discovery.effects`: wind, air_density, lift_scale, drag_scale), so the network does not absorb
-a session's weather into the aerodynamics. Validation shots are flown in the air and wind the model assumes (calm,
-recorded or standard air), as the service would fly them. A run ends on its last epoch, where the cosine-decayed
-learning rates have settled it (picking the lowest of noisy per-epoch validation losses picked early, barely moved
-epochs); its validation loss, the mean over the measured sources (`JointConfig.select_on`, each counting equally)
-at the radar noise, compares seeds (the fitted noise scales change what a loss value means, so it does not use them).
+a session's weather into the aerodynamics. Each source's mean air is held at its stated air where it is known
+(`shots.source_air`) and fitted where it is not (range sessions), so the sources with known air set the level of a
+carry. Validation shots are flown calm in their recorded air (a range session's in its source's fitted mean air), as
+the service would fly them. A run ends on its last epoch, where the cosine-decayed learning rates have settled it
+(picking the lowest of noisy per-epoch validation losses picked early, barely moved epochs); runs are compared by
+`selection_loss`: per validation source the carry's mean absolute error plus its absolute bias (what a simulator
+player feels), averaged over the sources with each counting equally.
 """
 
 from __future__ import annotations
@@ -46,10 +48,16 @@ SOURCE_WEIGHTS = {
     "trackman-outdoor": 1.0,
     "sentry-2022": 1.0,
     "players-2020": 1.0,
+    "tour-championship-2020": 1.0,
     "trackman-model": 0.1,
+    "pga-2023-table": 20.0,
     "synthetic": 0.2,
 }
-"""Weight of one shot of each source in the loss: measured flights 1, TrackMan's model 0.1, the reference world 0.2."""
+"""Weight of one shot of each source in the loss: measured flights 1, TrackMan's model 0.1, the reference world 0.2,
+one club of the tour-averages table 20 (an average over thousands of shots in known air; docs/training_real.md says
+how the weights were chosen on validation)."""
+UNKNOWN_AIR_SOURCES = ("trackman-outdoor",)
+"""Sources that recorded no air (range sessions): their mean air is fitted, so they cannot set the level of a carry."""
 
 
 def _typical(effect: str) -> float:
@@ -78,10 +86,16 @@ class JointConfig:
     wind_prior_mps: float = field(default_factory=lambda: _typical("wind"))
     density_prior: float = field(default_factory=lambda: _typical("air_density"))
     ball_prior: float = field(default_factory=lambda: _typical("drag_scale"))
-    select_on: tuple[str, ...] = ("trackman-outdoor", "sentry-2022", "players-2020")
-    """Sources whose validation loss compares runs, each counting equally: the measured flights decide."""
+    select_on: tuple[str, ...] = ("trackman-outdoor", "sentry-2022", "players-2020", "tour-championship-2020",
+                                  "trackman-model", "pga-2023-table")
+    """Sources whose validation error compares runs, each counting equally (`selection_loss`)."""
     mean_wind_prior_mps: float = 0.3
     mean_density_prior: float = 0.01
+    """A known-air source's mean latent density stays within 1 % of its stated air."""
+    unknown_air_sources: tuple[str, ...] = UNKNOWN_AIR_SOURCES
+    unknown_mean_density_prior: float = 0.1
+    """An unknown-air source's mean density is free within about 10 %: its level is its air's and its balls', not the
+    network's."""
     grad_clip_norm: float = GRAD_CLIP_NORM
     dt_s: float = DT_S
     t_sim_s: float = T_SIM_S
@@ -117,21 +131,35 @@ class LatentConditions(nn.Module):
         scale = torch.cat([lift_drag, lift_drag.new_ones(len(shots), 2)], dim=1)
         return wind, density, scale
 
-    def prior(self, config: JointConfig, wind_source: torch.Tensor, air_source: torch.Tensor) -> torch.Tensor:
-        """Negative log prior (Gaussian, up to a constant): each value about zero, and each source's mean wind and
-        mean log density about zero within `mean_prior_*`. A source's average weather cannot be told apart from the
-        aerodynamics, so the sessions are assumed calm and standard on average; `*_source` [groups] name the
-        source of each wind and air group."""
+    def prior(self, config: JointConfig, wind_source: torch.Tensor, air_source: torch.Tensor,
+              sources: list[str]) -> torch.Tensor:
+        """Negative log prior (Gaussian, up to a constant): each value about zero, each source's mean wind about
+        calm, and each source's mean log density about its stated air: tightly where the air is known
+        (`mean_density_prior`), loosely for a source that recorded none (`unknown_mean_density_prior`), so that
+        the sources with known air set the level. `*_source` [groups] name the source of each wind and air group."""
         total = (
             (self.wind / config.wind_prior_mps).pow(2).sum()
             + (self.log_density / config.density_prior).pow(2).sum()
             + (self.log_ball_scale / config.ball_prior).pow(2).sum()
         )
-        for values, source, sd in ((self.wind, wind_source, config.mean_wind_prior_mps),
-                                   (self.log_density, air_source, config.mean_density_prior)):
-            for s in source.unique():
-                total = total + (values[source == s].mean(dim=0) / sd).pow(2).sum()
+        for s in wind_source.unique():
+            total = total + (self.wind[wind_source == s].mean(dim=0) / config.mean_wind_prior_mps).pow(2).sum()
+        for s in air_source.unique():
+            unknown = sources[int(s)] in config.unknown_air_sources
+            sd = config.unknown_mean_density_prior if unknown else config.mean_density_prior
+            total = total + (self.log_density[air_source == s].mean() / sd).pow(2)
         return 0.5 * total
+
+    @torch.no_grad()
+    def source_density_factors(self, config: JointConfig, air_source: torch.Tensor, sources: list[str]
+                               ) -> torch.Tensor:
+        """Per source [n_sources]: the fitted mean density factor of an unknown-air source, 1 for every other: the
+        air a validation shot of a range session is flown in (its source's, not one block's)."""
+        factors = torch.ones(len(sources))
+        for s in air_source.unique():
+            if sources[int(s)] in config.unknown_air_sources:
+                factors[int(s)] = self.log_density[air_source == s].mean().exp()
+        return factors
 
 
 class NoiseScales(nn.Module):
@@ -156,10 +184,13 @@ class Predicted:
     landed: torch.Tensor
 
 
-def fly(model: nn.Module, shots: ObservedShots, config: JointConfig, latent: LatentConditions | None) -> Predicted:
-    """Euler rollout of the shots (with their latent conditions, or as assumed when `latent` is None)."""
+def fly(model: nn.Module, shots: ObservedShots, config: JointConfig, latent: LatentConditions | None,
+        source_density: torch.Tensor | None = None) -> Predicted:
+    """Euler rollout of the shots: with their latent conditions, or, when `latent` is None, calm in their recorded
+    air times their source's fitted density factor (`source_density` [n_sources], where given)."""
     if latent is None:
-        wind, density, scale = None, shots.density, None
+        factor = 1.0 if source_density is None else source_density[shots.source]
+        wind, density, scale = None, shots.density * factor, None
     else:
         wind, density, scale = latent.for_shots(shots)
     trajectory = euler_rollout(shots.position, shots.velocity, shots.spin, model, density, config.dt_s,
@@ -207,13 +238,15 @@ def weighted_mean(values: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
 
 @torch.no_grad()
 def evaluate(model: nn.Module, shots: ObservedShots, config: JointConfig, sources: list[str],
-             latent: LatentConditions | None = None, scales: torch.Tensor | None = None) -> dict[str, Any]:
-    """Loss and per-source errors in physical units: landing error (m), mean absolute error of every observable,
-    path error (m), over the shots that have each."""
-    predicted = fly(model, shots, config, latent)
+             latent: LatentConditions | None = None, scales: torch.Tensor | None = None,
+             source_density: torch.Tensor | None = None) -> dict[str, Any]:
+    """Loss and per-source errors in physical units: landing error (m), mean absolute error and mean signed error
+    (bias) of every observable, path error (m), over the shots that have each."""
+    predicted = fly(model, shots, config, latent, source_density)
     losses = shot_losses(predicted, shots, config.huber_delta, scales)
     metrics: dict[str, Any] = {"loss": float(weighted_mean(losses, shots.weight)), "sources": {}}
-    error = (predicted.observables - shots.targets).abs()
+    signed = predicted.observables - shots.targets
+    error = signed.abs()
     ok = shots.target_mask & predicted.landed[:, None]
     landing_error = torch.linalg.vector_norm(predicted.observables[:, :2] - shots.targets[:, :2], dim=1)
     path_error = torch.linalg.vector_norm(predicted.path - shots.path_positions, dim=-1)
@@ -230,6 +263,7 @@ def evaluate(model: nn.Module, shots: ObservedShots, config: JointConfig, source
             has = mine & ok[:, column]
             if has.any():
                 row[f"{observable}_mae"] = float(error[has, column].mean())
+                row[f"{observable}_bias"] = float(signed[has, column].mean())
         on_path = shots.path_mask & mine[:, None]
         if on_path.any():
             row["path_error_m"] = float(path_error[on_path].mean())
@@ -318,7 +352,7 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
             optimizer.zero_grad(set_to_none=True)
             losses = shot_losses(fly(model, batch, config, latent), batch, config.huber_delta, noise.factors())
             loss = (losses * batch.weight).sum() / total_weight * (len(train) / len(batch))
-            loss = loss + latent.prior(config, wind_source, air_source) / len(train)
+            loss = loss + latent.prior(config, wind_source, air_source, data.sources) / len(train)
             if not torch.isfinite(loss):
                 continue
             loss.backward()
@@ -327,23 +361,34 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
             schedule.step()
             sums += float(loss.detach())
             steps += 1
-        metrics = evaluate(model, data.val, config, data.sources)
+        source_density = latent.source_density_factors(config, air_source, data.sources)
+        metrics = evaluate(model, data.val, config, data.sources, source_density=source_density)
         row = {"epoch": epoch, "train_loss": sums / max(steps, 1), "val_loss": metrics["loss"],
                "val": metrics["sources"], "seconds": time.perf_counter() - started,
-               "selection_loss": selection_loss(metrics, config)}
+               "selection_loss": selection_loss(metrics, config),
+               "source_density": dict(zip(data.sources, source_density.tolist()))}
         history.append(row)
         if progress:
-            tqdm.write(f"epoch {epoch}: train {row['train_loss']:.3f}, val {row['val_loss']:.3f} " + ", ".join(
-                f"{k} {v.get('landing_error_m', float('nan')):.2f} m" for k, v in metrics["sources"].items()))
+            tqdm.write(f"epoch {epoch}: train {row['train_loss']:.3f}, felt {row['selection_loss']:.2f} m " + ", ".join(
+                f"{k} {felt_error_m(v):.2f}" for k, v in metrics["sources"].items()))
         final = _save_run(out_dir, epoch, config, model, latent, noise, data, history, metrics)
     return JointResult(out_dir, history, final)
 
 
+def felt_error_m(row: dict[str, float]) -> float:
+    """What a simulator player feels of a source's validation error (m): the carry's mean absolute error plus its
+    absolute bias, so a model 8 m short on every shot (16) loses to one with 4 m more scatter and no bias (12); on
+    the apex where a source records no carry."""
+    key = "carry_y_m" if "carry_y_m_mae" in row else "apex_m"
+    return row[f"{key}_mae"] + abs(row[f"{key}_bias"])
+
+
 def selection_loss(metrics: dict[str, Any], config: JointConfig) -> float:
-    """The loss that compares runs: the mean of the `select_on` sources' validation losses, each counting equally."""
+    """What compares runs (weights, seeds, the soup): the mean over the `select_on` sources of their validation
+    `felt_error_m`, each source counting equally."""
     selected = [v for k, v in metrics["sources"].items() if k in config.select_on] or list(
         metrics["sources"].values())
-    return sum(v["loss"] for v in selected) / len(selected)
+    return sum(felt_error_m(v) for v in selected) / len(selected)
 
 
 def _save_run(out_dir: Path, epoch: int, config: JointConfig, model: nn.Module, latent: LatentConditions,
@@ -382,7 +427,9 @@ def soup_runs(data_path: str | os.PathLike, run_dirs: list[Path], out_dir: str |
     latent.load_state_dict(_mean_state([p["latent"] for p in payloads]))
     noise.load_state_dict(_mean_state([p["noise"] for p in payloads]))
     model.eval()
-    metrics = evaluate(model, data.val, config, data.sources)
+    air_source = _group_sources(data.train.air_group, data.train.source, len(data.air_groups))
+    metrics = evaluate(model, data.val, config, data.sources,
+                       source_density=latent.source_density_factors(config, air_source, data.sources))
     epoch = payloads[0]["epoch"]
     row = {"epoch": epoch, "val_loss": metrics["loss"], "val": metrics["sources"],
            "selection_loss": selection_loss(metrics, config), "soup_of": [str(d) for d in run_dirs]}

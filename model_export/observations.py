@@ -25,8 +25,12 @@ NOISE = MeasurementNoise()
 PATH_SIGMA_M = 0.3
 PATH_OBSERVATIONS = 3.0
 OBSERVABLES = ("carry_x_m", "carry_y_m", "apex_m", "flight_time_s", "landing_angle_deg")
-TOUR_SOURCES = ("sentry-2022", "players-2020")
+TOUR_SOURCES = ("sentry-2022", "players-2020", "tour-championship-2020")
 """Sources grouped by tour hole and round ('016-R2-H15'): one wind per hole and round, one air per round."""
+CALM_SOURCES = ("synthetic", "trackman-model", "pga-2023-table")
+"""Flown calm by construction (the reference world, TrackMan's model) or averaged over many winds (the table)."""
+FIXED_AIR_SOURCES = ("synthetic", "pga-2023-table")
+"""Flown in exactly their stated air: no latent air group (the synthetic sessions' standard air, the table's)."""
 REFERENCE_BALLS = (None, "Premium")
 """Ball types the network itself learns (tour balls are unnamed); every other type gets a latent drag/lift scale."""
 
@@ -134,8 +138,8 @@ def _tensors(shots: ShotSet, paths: dict[str, np.ndarray], weights: dict[str, fl
 
 def _air_key(source: str | None, group: str | None) -> str | None:
     """Air group of a shot: one day's air on tour (the round), one block's on a range, one for a modelled source;
-    none for synthetic shots (flown in exactly standard air)."""
-    if source == "synthetic" or group is None:
+    none for the sources flown in exactly their stated air."""
+    if source in FIXED_AIR_SOURCES or group is None:
         return None
     if source == "trackman-model":
         return source
@@ -159,8 +163,8 @@ def load_observed(path: str | os.PathLike, weights: dict[str, float]) -> Observe
     if not len(train) or not len(val):
         raise ValueError(f"{path}: need rows marked 'train' and 'val' (have {len(train)} and {len(val)})")
     sources = list(dict.fromkeys(shots.column("source")))
-    calm = {"synthetic", "trackman-model"}  # flown calm by construction: the reference world, TrackMan's model
-    wind = [g for g, s in dict.fromkeys(zip(train.column("group"), train.column("source"))) if g and s not in calm]
+    wind = [g for g, s in dict.fromkeys(zip(train.column("group"), train.column("source")))
+            if g and s not in CALM_SOURCES]
     air = [k for k in dict.fromkeys(_air_key(s, g) for s, g in zip(train.column("source"), train.column("group")))
            if k is not None]
     balls = sorted({b for b in train.column("ball") if b not in REFERENCE_BALLS})

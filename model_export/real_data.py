@@ -9,15 +9,23 @@ Sources (`SOURCES`), each with a weight per shot in the loss:
   players-2020      THE PLAYERS 2020 (round 1) pbp radar tee shots: launch and spin, and the carry, which this event
                     records in its apexRange field (its apexHeight is not an apex and is left out, docs/real_data.md);
                     no spin axis is recorded, so the side is not trained on.
-  trackman-model    the indoor rows of the driver file (lines 3-2942): TrackMan's own model of the flight, not a
-                    measurement; down-weighted and reported on its own; not in DEFAULT_SOURCES (docs/training_real.md).
+  trackman-model    the indoor rows of the driver file (lines 3-2942): TrackMan's own model of the flight in its
+                    normalisation air, not a measurement; labelled "modelled" and reported on its own.
+  tour-championship-2020  rounds 1-2 of the TOUR Championship 2020 (rounds 3-4 are held out): radar tee shots with
+                    launch, spin and the radar apex; tour irons on the par 3s.
+  pga-2023-table    TrackMan's PGA TOUR 2023 averages: each club's average launch and its average carry, max height and
+                    land angle, in the table's air (about 0.99 of ICAO standard, NOTES section 9).
   synthetic         calm reference-world flights of the other clubs and slower players, clean, where real data is
                     missing; shots inside the measured drivers' launch range are left out, so real data decides there.
+Every source with known air carries it in its records' condition columns (`shots.source_air`): the tour events their
+course's elevation and season, TrackMan's modelled rows its normalisation air, the table its 0.99; the range sessions
+recorded none and are trained in an air fitted to them.
 Groups (the `group` column) are the shots that shared one unrecorded wind and air: a tour hole in one round; for the
 driver file, which has no date or session column, a run of consecutive measured rows of one ball type (a new group
 where more than `GAP_LINES` lines separate two measured shots, or after `BLOCK_SHOTS` shots).
 Validation is by group, never a random shuffle: every `VAL_EVERY`-th driver group in file order, the last round of
-the Sentry, every `VAL_EVERY`-th hole of THE PLAYERS (one round was played), the synthetic generator's last sessions.
+the Sentry, every `VAL_EVERY`-th hole of THE PLAYERS (one round was played) and of the TOUR Championship's rounds 1-2,
+every `TABLE_VAL_EVERY`-th club of the table, the synthetic generator's last sessions.
 """
 
 from __future__ import annotations
@@ -31,11 +39,13 @@ from pathlib import Path
 import numpy as np
 
 from flight.air import Air
+from flight.constants import YARD_M
 from flight.physics import initial_state
 from shots.heldout import check_training_rows
 from shots.pbp import load_pbp, recorded_apex
 from shots.records import ShotRecord, trajectories_path, write_shots, write_trajectories
-from shots.reference_world import fly_reference
+from shots.reference_world import TOUR_AVERAGES_FILE, ClubAverage, fly_reference, read_tour_averages
+from shots.source_air import KNOWN_AIR
 from shots.synth import MIN_APEX_M, SynthConfig, draw_launches, draw_sessions
 from shots.tourcast import load_tourcast, read_flights
 from shots.trackman import ConversionReport, load_trackman
@@ -47,6 +57,11 @@ DRIVER_TRAIN_LINES = (3, 2942)
 SENTRY_TRAJECTORIES = Path("real/pga_tourcast_trackman/shot_trajectory/shot_trajectory_2021_016_656.csv")
 SENTRY_PBP = Path("real/pga_tourcast_trackman/pbp/pbp_2021_016_656.csv")
 PLAYERS_PBP = Path("real/pga_tourcast_trackman/pbp/pbp_2020_011_011.csv")
+TOUR_CHAMPIONSHIP_PBP = Path("real/pga_tourcast_trackman/pbp/pbp_2020_060_688.csv")
+TOUR_CHAMPIONSHIP_TRAIN_ROUNDS = (1, 2)
+"""Rounds of the TOUR Championship 2020 that may be trained on (NOTES section 9); `shots.heldout` refuses 3 and 4."""
+TABLE_VAL_EVERY = 3
+"""Every third club of the tour-averages table (3-wood, 3-iron, 6-iron, 9-iron) is validation."""
 
 GAP_LINES = 3
 BLOCK_SHOTS = 40
@@ -74,9 +89,12 @@ class SourceData:
 
 
 def _tag(records: list[ShotRecord], source: str, groups: list[str], val: set[str]) -> list[ShotRecord]:
+    """Source, group, split and prefixed id on every record, and the source's air where it is known."""
+    air = KNOWN_AIR.get(source)
+    conditions = {} if air is None else air.record_conditions()
     return [
         r.model_copy(update={"source": source, "group": g, "split": "val" if g in val else "train",
-                             "shot_id": f"{source}:{r.shot_id}"})
+                             "shot_id": f"{source}:{r.shot_id}", **conditions})
         for r, g in zip(records, groups, strict=True)
     ]
 
@@ -188,6 +206,48 @@ def players(root: Path) -> SourceData:
                       {str(PLAYERS_PBP): sha256_of(path)}, report)
 
 
+def _round(shot_id: str) -> int:
+    """'060-R2-H15-P29725-S1' -> 2."""
+    return int(shot_id.split("-")[1].removeprefix("R"))
+
+
+def tour_championship(root: Path) -> SourceData:
+    """Rounds 1-2 of the TOUR Championship 2020 (East Lake): radar launch, spin and apex of every tee shot, no spin
+    axis, so no side; the par 3s are the only tour irons with a radar apex we may train on. Validation: every
+    `VAL_EVERY`-th hole."""
+    path = root / TOUR_CHAMPIONSHIP_PBP
+    conversion = load_pbp(path, skip_bad_rows=True)
+    kept = [r for r in conversion.records if _round(r.shot_id) in TOUR_CHAMPIONSHIP_TRAIN_ROUNDS and r.apex_m]
+    check_training_rows(path, shot_ids=[r.shot_id for r in kept])
+    groups = [_tour_group(r.shot_id) for r in kept]
+    val = {g for g in groups if int(g.rsplit("-H", 1)[1]) % VAL_EVERY == 0}
+    report = (f"{conversion.report.summary()}\n  rounds {TOUR_CHAMPIONSHIP_TRAIN_ROUNDS} only (3-4 held out): "
+              f"{len(kept)} tee shots with a radar apex")
+    return SourceData("tour-championship-2020", "measured", _tag(kept, "tour-championship-2020", groups, val),
+                      {str(TOUR_CHAMPIONSHIP_PBP): sha256_of(path)}, report)
+
+
+def _club_record(club: ClubAverage) -> ShotRecord:
+    return ShotRecord(shot_id=club.club, club=club.club, ball_speed_mps=club.ball_speed_mps,
+                      launch_angle_deg=club.launch_angle_deg, launch_direction_deg=0.0, spin_rpm=club.spin_rpm,
+                      spin_axis_deg=0.0, carry_y_m=club.carry_yd * YARD_M, apex_m=club.max_height_yd * YARD_M,
+                      landing_angle_deg=club.land_angle_deg)
+
+
+def pga_table(root: Path) -> SourceData:
+    """TrackMan's PGA TOUR 2023 averages as one shot per club (its average launch, straight, no spin axis) with the
+    average carry, max height and land angle; validation: every `TABLE_VAL_EVERY`-th club from the second on."""
+    path = root / TOUR_AVERAGES_FILE
+    check_training_rows(path, [])
+    clubs = read_tour_averages(path)
+    groups = [f"pga-{c.club}" for c in clubs]
+    val = {g for i, g in enumerate(groups) if i % TABLE_VAL_EVERY == 1}
+    records = _tag([_club_record(c) for c in clubs], "pga-2023-table", groups, val)
+    note = (f"{len(clubs)} clubs, one average shot each; air: {KNOWN_AIR['pga-2023-table'].basis}; validation "
+            f"clubs: {', '.join(r.club for r in records if r.split == 'val')}")
+    return SourceData("pga-2023-table", "table", records, {str(TOUR_AVERAGES_FILE): sha256_of(path)}, note)
+
+
 def driver_like(launch: dict[str, np.ndarray]) -> np.ndarray:
     """Launches where the measured drivers decide (fast and flat)."""
     return (launch["ball_speed_mps"] >= DRIVER_LIKE["min_ball_speed_mps"]) & (
@@ -228,11 +288,14 @@ BUILDERS: dict[str, Callable[[Path], SourceData]] = {
     "sentry-2022": sentry,
     "players-2020": players,
     "trackman-model": trackman_model,
+    "tour-championship-2020": tour_championship,
+    "pga-2023-table": pga_table,
     "synthetic": lambda root: synthetic(),
 }
 """Every source, by name, in the order the merged file lists them."""
 
-DEFAULT_SOURCES = ("trackman-outdoor", "sentry-2022", "players-2020", "synthetic")
+DEFAULT_SOURCES = ("trackman-outdoor", "sentry-2022", "players-2020", "trackman-model", "tour-championship-2020",
+                   "pga-2023-table", "synthetic")
 """What the shipped model is trained on."""
 
 

@@ -31,7 +31,7 @@ if TYPE_CHECKING:
 DATA_FILE = "real_flights.csv"
 CONDITIONS_FILE = "training_conditions.json"
 """The fitted latent conditions of the exported run, beside the bundle's card (read by `golfflight accuracy`)."""
-MEASURED_SOURCES = ("trackman-outdoor", "sentry-2022", "players-2020")
+MEASURED_SOURCES = ("trackman-outdoor", "sentry-2022", "players-2020", "tour-championship-2020")
 SOUP = "soup"
 """The run name (and WORK folder) of the seeds' weight average."""
 
@@ -66,8 +66,11 @@ def latent_description(config: JointConfig, conditions: dict[str, Any]) -> str:
         f"fitted beside the network with Gaussian priors: a uniform wind per conditions group "
         f"({len(conditions['wind'])} groups, prior sd {config.wind_prior_mps:g} m/s per component), an air-density "
         f"factor per air group ({len(conditions['air'])}, prior sd {config.density_prior:g} in log), lift and drag "
-        f"scales per non-Premium ball type ({len(conditions['ball'])}, prior sd {config.ball_prior:g} in log); "
-        f"validation and served shots are flown without them (calm, the air given). Values: {CONDITIONS_FILE}"
+        f"scales per non-Premium ball type ({len(conditions['ball'])}, prior sd {config.ball_prior:g} in log); each "
+        f"source's mean log density held within {config.mean_density_prior:g} of its stated air, or within "
+        f"{config.unknown_mean_density_prior:g} for the sources that recorded none ({', '.join(config.unknown_air_sources)}), "
+        f"so the sources with known air set the level; served shots are flown without them (calm, the air given). "
+        f"Values: {CONDITIONS_FILE}"
     )
 
 
@@ -152,9 +155,11 @@ def export_real(run_dir: Path, data_file: Path, sources: list[SourceData], out: 
         "config": train_config.as_dict(), "epoch": payload["epoch"], "metrics": metrics,
         "data": {**data, "sources": source_cards(sources, config.weights, paths)},
         "split": "validation by conditions group, never a random shuffle: every 4th driver-range block in file "
-                 "order, the Sentry's last round, every 4th hole of THE PLAYERS (one round), the last synthetic "
-                 "sessions; the validation landing and max-height errors are over the measured sources' validation "
-                 f"shots, flown calm ({which})",
+                 "order, the Sentry's last round, every 4th hole of THE PLAYERS (one round) and of the TOUR "
+                 "Championship's rounds 1-2, every 10th modelled indoor row, the 3-wood, 3-iron, 6-iron and 9-iron of "
+                 "the tour-averages table, the last synthetic sessions; the validation landing and max-height errors "
+                 "are over the measured sources' validation shots, flown calm in their air (a range session's in its "
+                 f"source's fitted air) ({which})",
         "loss_description": loss_description(config),
         "latent_conditions": latent_description(config, conditions),
     }, out)

@@ -1,9 +1,10 @@
-"""Calibrate the reference world on recordings that may be trained on, and check it on TrackMan's tour averages.
+"""Calibrate the reference world on recordings that may be trained on, each in its own air.
 
 The fit is a bounded least squares over calibration cells (one source's shots in one ball-speed band, each shot
-flown with its own launch) plus TrackMan's Pro V1x spin losses after 1/3/5 s. A cell contributes the difference
-between the mean of the model's outcomes and the mean of the recorded ones, per observable it has. The PGA TOUR
-2023 averages are held out (NOTES section 9): `evaluate_clubs` flies them as a check only, never inside the fit.
+flown with its own launch and in its source's air; or one club of TrackMan's tour-averages table) plus TrackMan's
+Pro V1x spin losses after 1/3/5 s. A cell contributes the difference between the mean of the model's outcomes and
+the mean of the recorded ones, per observable it has. A source that recorded no air (range sessions) gets a fitted
+density factor with a loose prior (`fit_reference`), so the sources with known air set the level of a carry.
 """
 
 from __future__ import annotations
@@ -52,6 +53,11 @@ fairway woods, drivers (the 2020 pbp files name no club)."""
 
 MIN_CELL_SHOTS = 15
 """A band with fewer recorded values of an observable leaves that observable out (its mean is mostly wind)."""
+TABLE_CELL_WEIGHT = 2.0
+"""A tour-averages club counts as two cells: its residuals are divided by half the scales (1.5 yd, 1 yd, 1 deg)."""
+MAX_CELL_SHOTS = 150
+"""A bigger band is thinned to every k-th shot in file order (k = ceil(n / 150)): the mean of 150 shots is within
+about a yard of all of theirs, and one flight of every cell costs seconds, which a fit repeats hundreds of times."""
 
 BOUNDS: dict[str, tuple[float, float]] = {
     "drag_base": (0.05, 0.30),
@@ -67,23 +73,53 @@ BOUNDS: dict[str, tuple[float, float]] = {
 """Search box of the fit; critical Re kept inside Lyu 2018's crisis (C_D 0.5 at 5e4, 0.2 by 1e5)."""
 
 
+UNKNOWN_AIR_PRIOR_SD = 0.1
+"""Prior sd of the log density factor of a source that recorded no air: range days from cold to hot and from the coast
+to a few hundred metres up differ by up to about 10 %."""
+AIR_FACTOR_LOG_BOUND = 0.3
+"""The search box of each log density factor."""
+
+
 @dataclass(frozen=True)
 class CalibrationCell:
-    """Shots of one source in one ball-speed band: their launches, the air they are flown in, what was recorded."""
+    """Shots of one source in one ball-speed band (or one club's average shot): their launches, the air they are
+    flown in, what was recorded."""
 
     name: str
     launch: dict[str, np.ndarray]
     air: Air
     recorded: np.ndarray
     """[n_shots, len(OBSERVABLES)]; NaN where a shot has no record of an observable."""
+    min_shots: int = MIN_CELL_SHOTS
+    """Recorded values an observable needs to enter the fit: a band's mean of fewer is mostly wind; a table's
+    average needs one."""
+    weight: float = 1.0
+    """Each residual of the cell is multiplied by this: a table's average over thousands of shots in many events'
+    weather is known better than a band's mean of one event or session (`TABLE_CELL_WEIGHT`)."""
 
     @property
     def n_shots(self) -> int:
         return len(self.recorded)
 
+    @property
+    def source(self) -> str:
+        """The source the cell belongs to (its name's first word)."""
+        return self.name.split(" ")[0]
+
     def used(self) -> np.ndarray:
         """Which observables this cell has enough recorded values of to enter the fit [len(OBSERVABLES)]."""
-        return np.sum(np.isfinite(self.recorded), axis=0) >= MIN_CELL_SHOTS
+        return np.sum(np.isfinite(self.recorded), axis=0) >= self.min_shots
+
+    def in_denser_air(self, factor: float) -> CalibrationCell:
+        """The cell flown in air `factor` times as dense at the same temperature (μ unchanged, so ν = μ/ρ divides by
+        the factor)."""
+        air = Air(self.air.density_kg_m3 * factor, self.air.kinematic_viscosity_m2_s / factor)
+        return dataclasses.replace(self, air=air)
+
+
+def with_air_factors(cells: list[CalibrationCell], factors: dict[str, float]) -> list[CalibrationCell]:
+    """Every cell of a source named in `factors` flown in its source's fitted air."""
+    return [c.in_denser_air(factors[c.source]) if c.source in factors else c for c in cells]
 
 
 def cells_from_records(
@@ -96,6 +132,7 @@ def cells_from_records(
         chosen = [r for r, s in zip(records, speed) if low <= s < high]
         if not chosen:
             continue
+        chosen = chosen[::-(-len(chosen) // MAX_CELL_SHOTS)]
         launch = {
             key: np.array([getattr(r, key) for r in chosen])
             for key in ("ball_speed_mps", "launch_angle_deg", "launch_direction_deg", "spin_rpm", "spin_axis_deg")
@@ -106,6 +143,19 @@ def cells_from_records(
                                launch, air, recorded)
         if cell.used().any():
             cells.append(cell)
+    return cells
+
+
+def table_cells(source: str, clubs: list[ClubAverage], air: Air) -> list[CalibrationCell]:
+    """One cell per club of a tour-averages table: its average launch, straight, and its average outcomes."""
+    cells = []
+    for club in clubs:
+        launch = {"ball_speed_mps": np.array([club.ball_speed_mps]), "launch_angle_deg": np.array([club.launch_angle_deg]),
+                  "launch_direction_deg": np.zeros(1), "spin_rpm": np.array([club.spin_rpm]),
+                  "spin_axis_deg": np.zeros(1)}
+        recorded = np.array([[club.carry_yd * YARD_M, club.max_height_yd * YARD_M, club.land_angle_deg]])
+        cells.append(CalibrationCell(f"{source} {club.club}", launch, air, recorded, min_shots=1,
+                                     weight=TABLE_CELL_WEIGHT))
     return cells
 
 
@@ -178,7 +228,7 @@ def spin_loss_pct(flight: Flight, rows: list[int], times_s: tuple[float, ...] = 
 def residuals(params: ReferenceParameters, cells: list[CalibrationCell]) -> np.ndarray:
     """Scaled misfits: every used (cell, observable) mean difference, then the nine spin losses."""
     result = evaluate(cells, params)
-    flight = result.scaled_errors()
+    flight = result.scaled_errors() * np.array([c.weight for c in cells])[:, None]
     flight = flight[np.isfinite(result.recorded_mean)]
     spin = np.concatenate([result.spin_loss_pct[name] - np.array(pct) for name, pct in TRACKMAN_SPIN_LOSS_PCT.items()])
     return np.nan_to_num(np.concatenate([flight, spin / RESIDUAL_SCALES["spin_loss_pct"]]), nan=1e3)
@@ -209,19 +259,44 @@ class FitScaling:
         return dataclasses.replace(self.start, **{n: float(v) for n, v in zip(FREE_PARAMETERS, x * self.typical)})
 
 
+@dataclass(frozen=True)
+class Calibration:
+    """A fit's parameters, the fitted density factor of each source that recorded no air, and the cost."""
+
+    params: ReferenceParameters
+    air_factors: dict[str, float]
+    cost: float
+
+
 def fit_reference(
-    cells: list[CalibrationCell], start: ReferenceParameters = CALIBRATED, max_evaluations: int = 200
-) -> ReferenceParameters:
-    """Least-squares fit of FREE_PARAMETERS (each scaled by its start value) inside BOUNDS; knobs stay as in start."""
+    cells: list[CalibrationCell], start: ReferenceParameters = CALIBRATED, max_evaluations: int = 200,
+    unknown_air: tuple[str, ...] = (), prior_sd: float = UNKNOWN_AIR_PRIOR_SD,
+) -> Calibration:
+    """Least-squares fit of FREE_PARAMETERS (each scaled by its start value) inside BOUNDS, together with a log
+    density factor per `unknown_air` source (Gaussian prior of `prior_sd` about its cells' air); knobs stay as in
+    start."""
     scaling = FitScaling(start)
-    solution = least_squares(lambda x: residuals(scaling.parameters(x), cells), scaling.start_values(),
-                             bounds=scaling.bounds(), diff_step=1e-3, max_nfev=max_evaluations)
-    return scaling.parameters(solution.x)
+    n = len(FREE_PARAMETERS)
+    low, high = scaling.bounds()
+    low = np.append(low, np.full(len(unknown_air), -AIR_FACTOR_LOG_BOUND))
+    high = np.append(high, np.full(len(unknown_air), AIR_FACTOR_LOG_BOUND))
+
+    def unpack(x: np.ndarray) -> tuple[ReferenceParameters, dict[str, float]]:
+        return scaling.parameters(x[:n]), dict(zip(unknown_air, np.exp(x[n:]).tolist()))
+
+    def misfit(x: np.ndarray) -> np.ndarray:
+        params, factors = unpack(x)
+        return np.concatenate([residuals(params, with_air_factors(cells, factors)), x[n:] / prior_sd])
+
+    solution = least_squares(misfit, np.append(scaling.start_values(), np.zeros(len(unknown_air))),
+                             bounds=(low, high), diff_step=1e-3, max_nfev=max_evaluations)
+    params, factors = unpack(solution.x)
+    return Calibration(params, factors, float(solution.cost))
 
 
 @dataclass(frozen=True)
 class ClubCheck:
-    """A model's outcomes for the tour-averages table's clubs (held out: a check, never a fit target)."""
+    """A model's outcomes for the tour-averages table's clubs, beside TrackMan's."""
 
     clubs: list[ClubAverage]
     carry_yd: np.ndarray
@@ -255,7 +330,7 @@ def _club_check(flight: Flight, clubs: list[ClubAverage]) -> ClubCheck:
 def evaluate_clubs(
     clubs: list[ClubAverage], params: ReferenceParameters = CALIBRATED, air: Air = CALIBRATION_AIR
 ) -> ClubCheck:
-    """Fly every club's average launch through the reference world (the held-out check)."""
+    """Fly every club's average launch through the reference world."""
     return _club_check(fly_reference(club_launch_state(clubs), air, params=params), clubs)
 
 
@@ -280,10 +355,13 @@ def _round(value: float) -> float:
 
 
 def render_markdown(evaluation: CellEvaluation, params: ReferenceParameters, check: ClubCheck | None = None,
-                    ferguson: ClubCheck | None = None) -> str:
-    """Markdown: the parameters, the per-cell fit table, the spin-decay table and the held-out tour-averages check."""
+                    ferguson: ClubCheck | None = None, air_factors: dict[str, float] | None = None) -> str:
+    """Markdown: the parameters (and fitted air factors), the per-cell fit table, the spin-decay table and the
+    tour-averages table per club."""
     out = ["### Parameters", "", "| parameter | value |", "|---|---|"]
     out += [f"| `{name}` | {_round(getattr(params, name)):g} |" for name in FREE_PARAMETERS]
+    out += [f"| air density factor of `{source}` (fitted: recorded no air) | {factor:.3f} |"
+            for source, factor in (air_factors or {}).items()]
     out += [
         "",
         "### Calibration cells: mean of the model's flights vs mean of the recordings",
@@ -310,7 +388,7 @@ def render_markdown(evaluation: CellEvaluation, params: ReferenceParameters, che
 def _club_check_markdown(check: ClubCheck, ferguson: ClubCheck | None) -> list[str]:
     out = [
         "",
-        "### Held-out check, never fitted: PGA TOUR 2023 averages, model vs TrackMan",
+        "### PGA TOUR 2023 averages per club, model vs TrackMan (the training clubs are cells of the fit)",
         "",
         "| club | carry model | carry TM | err | max h model | max h TM | err | land model | land TM | err |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",

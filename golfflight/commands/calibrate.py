@@ -1,5 +1,6 @@
-"""`golfflight calibrate-reference`: the reference world's fit to the recordings it is calibrated on, or a new fit,
-with the held-out PGA TOUR 2023 averages flown as a check and the altitude and wind checks nothing is fitted to."""
+"""`golfflight calibrate-reference`: the reference world's fit to the recordings it is calibrated on (every trainable
+source in its own air, the PGA TOUR 2023 table's training clubs among them), or a new fit, with the table per club
+and the altitude and wind checks nothing is fitted to."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import argparse
 from pathlib import Path
 
 from flight.reference_aero import CALIBRATED
-from model_export.reference_targets import calibration_cells
+from model_export.reference_targets import FITTED_AIR_FACTORS, UNKNOWN_AIR, calibration_cells
 from shots.calibrate_reference import (
     evaluate,
     evaluate_clubs,
@@ -15,11 +16,13 @@ from shots.calibrate_reference import (
     fit_reference,
     parameters_literal,
     render_markdown,
+    with_air_factors,
 )
 from shots.markdown import write_generated_section
 from shots.paths import shared_data_dir
 from shots.reference_checks import render_checks_markdown
 from shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
+from shots.source_air import PGA_2023_TABLE
 
 COMMAND = "calibrate-reference"
 
@@ -28,12 +31,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         COMMAND,
         help="render the reference world's calibration tables (or refit it with --fit)",
-        description="Fly the calibration cells (the training split of the measured real sources and TrackMan's "
-        "normalized 7-iron set) through the reference world and compare with the recordings; then fly the held-out "
-        "PGA 2023 tour averages as a check, never a target. Without --fit the committed CALIBRATED parameters are "
-        "used; with --fit they are refitted and the new literal is printed for pasting into flight/reference_aero.py.",
+        description="Fly the calibration cells (the training split of every trainable real source in its own air, "
+        "TrackMan's normalized 7-iron set and the PGA 2023 table's training clubs) through the reference world and "
+        "compare with the recordings. Without --fit the committed CALIBRATED parameters and air factors are used; "
+        "with --fit they are refitted and the new literals are printed for pasting into flight/reference_aero.py "
+        "and model_export/reference_targets.py.",
     )
-    parser.add_argument("--fit", action="store_true", help="run the least-squares fit first (a few minutes)")
+    parser.add_argument("--fit", action="store_true", help="run the least-squares fit first (several minutes)")
     parser.add_argument("--data", type=Path, default=None, help="shared data folder (default: ../shared/data)")
     parser.add_argument("--out", default=None, help="markdown file whose generated section to replace (default: print)")
     parser.set_defaults(run=run)
@@ -42,18 +46,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     root = args.data or shared_data_dir()
     cells = calibration_cells(root)
-    params = CALIBRATED
+    params, factors = CALIBRATED, FITTED_AIR_FACTORS
     if args.fit:
-        params = fit_reference(cells)
+        calibration = fit_reference(cells, unknown_air=UNKNOWN_AIR)
+        params, factors = calibration.params, calibration.air_factors
         print("# Paste into flight/reference_aero.py:")
         print(parameters_literal(params))
-        print()
+        print(f"# and into model_export/reference_targets.py:\nFITTED_AIR_FACTORS = "
+              f"{ {k: round(v, 4) for k, v in factors.items()} }")
+        print(f"# cost {calibration.cost:.2f}\n")
     averages = root / TOUR_AVERAGES_FILE
     check = ferguson = None
     if averages.exists():
         clubs = read_tour_averages(averages)
-        check, ferguson = evaluate_clubs(clubs, params), evaluate_clubs_ferguson(clubs)
-    text = render_markdown(evaluate(cells, params), params, check, ferguson)
+        air = PGA_2023_TABLE.air()
+        check, ferguson = evaluate_clubs(clubs, params, air), evaluate_clubs_ferguson(clubs, air)
+    text = render_markdown(evaluate(with_air_factors(cells, factors), params), params, check, ferguson, factors)
     text += "\n".join(render_checks_markdown(params)) + "\n"
     if args.out:
         write_generated_section(args.out, text, COMMAND)
