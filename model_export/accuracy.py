@@ -1,13 +1,15 @@
-"""`golfflight accuracy`: three models side by side on the real data none of them may be trained on, through the
-flight core the engine's batch path runs (`flight.integrator`: NumPy physics + each bundle's ONNX graph; Ferguson
-2022's quadratics through the same call).
+"""`golfflight accuracy`: three models side by side on the real data none of them may be trained on, and on the
+real training sets, through the flight core the engine's batch path runs (`flight.integrator`: NumPy physics + each
+bundle's ONNX graph; Ferguson 2022's quadratics through the same call).
 
 The models: the real-data model (`--model`), the synthetic model (`--synthetic`) and Ferguson, McNally & McPhee
 2022. The sets (`model_export.accuracy_sets`): the held-out ones of NOTES section 9 (TrackMan outdoor drivers from
-line 2943, the TOUR Championship 2020, the PGA 2023 averages); then the paper's own figures for context, slow shots
-against published amateur launches (`accuracy_slow`), the Sentry 2022 trajectories (a training set of the real-data
-model) with each shot's latent wind (`accuracy_winds`), and a fine-tuning study on the Sony Open 2022
-(`accuracy_finetune`). None of these sets records its weather: every shot is flown calm, each model in its own air.
+line 2943, rounds 3-4 of the TOUR Championship 2020); the paper's own figures for context and slow shots against
+published amateur launches (`accuracy_slow`); then training sets of the real-data model: the PGA 2023 averages
+(a per-club fit), the Sentry 2022 trajectories with each shot's latent wind (`accuracy_winds`), and a fine-tuning
+study on the Sony Open 2022 (`accuracy_finetune`). None of these sets records its weather: every shot is flown calm,
+the TOUR Championship and the PGA table in their source's air (`shots.source_air`), every model alike, the others in
+each model's own air.
 """
 
 from __future__ import annotations
@@ -35,6 +37,8 @@ from model_export.accuracy_sets import (
     PGA_TARGETS,
     PREMIUM,
     SONY_TRAJECTORIES,
+    TEE_GROUPS,
+    TOUR_CHAMPIONSHIP_HELD_OUT,
     TOUR_CHAMPIONSHIP_PBP,
     TOUR_CHAMPIONSHIP_TARGET_FT,
     TOURCAST_PBP,
@@ -48,6 +52,7 @@ from model_export.accuracy_sets import (
     held_out_driver_shots,
     outcome_errors,
     path_errors,
+    tee_groups,
     tour_championship_shots,
 )
 from model_export.accuracy_slow import OUTCOMES as SLOW_OUTCOMES
@@ -67,8 +72,10 @@ from model_export.accuracy_winds import (
 )
 from shots.markdown import table, write_generated_section
 from shots.paths import shared_data_dir
+from shots.pbp import hole_pars
 from shots.records import ShotSet
-from shots.reference_world import CALIBRATION_AIR, TOUR_AVERAGES_FILE, read_tour_averages
+from shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
+from shots.source_air import PGA_2023_TABLE, TOUR_CHAMPIONSHIP_2020
 from shots.tourcast import load_tourcast, read_flights
 from shots.trackman import ConversionReport
 
@@ -224,58 +231,111 @@ def _drivers(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport) ->
     return lines
 
 
+def _tee_group_title(name: str) -> str:
+    """'par4_5' -> 'par 4-5 tee shots'."""
+    return "par " + "-".join(str(par) for par in TEE_GROUPS[name]) + " tee shots"
+
+
+def _tour_championship_verdict(label: str, errors: dict[str, dict[str, np.ndarray]], ferguson: str) -> str:
+    """The target on all tee shots: apex MAE at most TOUR_CHAMPIONSHIP_TARGET_FT and below Ferguson 2022's."""
+    metric = APEX_METRICS[0]
+    mae = metric.of(errors[label])
+    verdict = _verdict("apex MAE", mae, TOUR_CHAMPIONSHIP_TARGET_FT, "ft")
+    if label == ferguson:
+        return f"- {label}: {verdict}"
+    theirs = metric.of(errors[ferguson])
+    below = math.isfinite(mae) and mae < theirs
+    return f"- {label}: {verdict}; below {ferguson}'s {_cell(theirs)} ft: **{'met' if below else 'not met'}**"
+
+
+def _tee_group_rows(errors: dict[str, dict[str, np.ndarray]], labels: Sequence[str],
+                    groups: dict[str, np.ndarray]) -> list[tuple[str, ...]]:
+    """Apex MAE, bias and shot count of each group of tee shots and of them all; the target on all of them."""
+    rows = []
+    for title, mask in [*((_tee_group_title(n), m) for n, m in groups.items()), ("all tee shots", None)]:
+        targets = {APEX_METRICS[0].name: f"<= {TOUR_CHAMPIONSHIP_TARGET_FT:g}"} if mask is None else {}
+        rows += [(f"{title}: {name}", *cells) for name, *cells in _metric_rows(APEX_METRICS, errors, labels, mask,
+                                                                                targets)]
+        rows.append((f"{title}: shots", *(str(_count(errors[label], mask, "apex_m")) for label in labels), ""))
+    return rows
+
+
 def _tour_championship(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
-    lines = ["### TOUR Championship 2020, East Lake (held out)", ""]
+    held = TOUR_CHAMPIONSHIP_HELD_OUT
+    lines = [f"### TOUR Championship 2020, East Lake (held out: {held.rows()})", ""]
     path = data_dir / TOUR_CHAMPIONSHIP_PBP
     if not path.is_file():
         return lines + [_missing(path)]
-    try:
-        shots, note = tour_championship_shots(path)
-    except ImportError:
-        return lines + ["_Skipped: the pbp loader (`shots.pbp.load_pbp`) is not in this checkout yet._"]
+    shots, note = tour_championship_shots(path)
     labels = [f.label for f in flyers]
-    report.tour_championship = per_model(flyers, lambda flyer: outcome_errors(flyer.simulate(shots.launch()), shots))
-    metric = APEX_METRICS[0]
-    rows = _metric_rows(APEX_METRICS, report.tour_championship, labels,
-                        targets={metric.name: f"<= {TOUR_CHAMPIONSHIP_TARGET_FT:g}"})
-    rows.append(("shots", *(str(_count(report.tour_championship[label], key="apex_m")) for label in labels), ""))
-    lines += [f"`{TOUR_CHAMPIONSHIP_PBP.name}`: {note}.", "", *table(("", *labels, "target"), rows), ""]
-    lines += [f"- {label}: " + _verdict("apex MAE", metric.of(report.tour_championship[label]),
-                                        TOUR_CHAMPIONSHIP_TARGET_FT, "ft") for label in labels]
-    return lines
+    air = TOUR_CHAMPIONSHIP_2020.air()
+    report.tour_championship = per_model(
+        flyers, lambda flyer: outcome_errors(flyer.simulate(shots.launch(), air), shots))
+    pars = hole_pars(path)
+    rows = _tee_group_rows(report.tour_championship, labels, tee_groups(shots, pars))
+    par_three = ", ".join(str(hole) for hole, par in pars.items() if par == 3)
+    ferguson = next(f.label for f in flyers if not isinstance(f, ModelFlyer))
+    lines += [
+        (
+            f"`{TOUR_CHAMPIONSHIP_PBP.name}`: {note}. Every model flown in the event's air "
+            f"(`shots.source_air.TOUR_CHAMPIONSHIP_2020`, rho {air.density_kg_m3:.3f} kg/m^3: "
+            f"{TOUR_CHAMPIONSHIP_2020.basis}). Tee shots grouped by the par of their hole, which the file does not "
+            f"name: each player's strokes on the hole less the strokes over par of its score (`textScore`; "
+            f"`shots.pbp.hole_pars`) gives the par 3s, holes {par_three}."
+        ),
+        "",
+        *table(("", *labels, "target"), rows),
+        "",
+        f"Targets on all tee shots (apex MAE, and below {ferguson}'s on the same shots):",
+        "",
+    ]
+    return lines + [_tour_championship_verdict(label, report.tour_championship, ferguson) for label in labels]
+
+
+PGA_OUTCOMES = (("carry", "yd"), ("max height", "yd"), ("land angle", "deg"))
+"""The PGA table's outcomes, in the order of `ClubComparison` columns and PGA_TARGETS."""
+
+
+def _pga_outcome(index: int, comparisons: dict[str, ClubComparison], labels: Sequence[str]) -> list[str]:
+    """One outcome per club for every model, as model (error), and its MAE and bias rows against the target."""
+    name, unit = PGA_OUTCOMES[index]
+    first = comparisons[labels[0]]
+    rows = [(club.club, f"{target:g}", *(f"{comparisons[l].model[k, index]:.1f} "
+                                         f"({comparisons[l].model[k, index] - target:+.1f})" for l in labels), "")
+            for k, (club, target) in enumerate(zip(first.clubs, first.targets[:, index]))]
+    rows.append(("**MAE**", "", *(_cell(float(comparisons[l].mean_absolute_error[index])) for l in labels),
+                 f"<= {PGA_TARGETS[index]:g}"))
+    rows.append(("**bias**", "", *(_cell(float(comparisons[l].bias[index]), signed=True) for l in labels), ""))
+    return [f"{name.capitalize()}, {unit}: each model's value (its error, model - TrackMan):", "",
+            *table(("club", "TrackMan", *labels, "target"), rows), ""]
 
 
 def _pga(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport):
-    lines = ["### PGA TOUR 2023 TrackMan averages per club (held out, a check)", ""]
+    lines = ["### PGA TOUR 2023 TrackMan averages per club (a TRAINING set: a fit, not a check)", ""]
     path = data_dir / TOUR_AVERAGES_FILE
     if not path.is_file():
         return lines + [_missing(path)], None
     clubs = read_tour_averages(path)
     labels = [f.label for f in flyers]
-    report.pga = per_model(flyers, lambda flyer: compare_clubs(flyer, clubs))
-    calibration = per_model(flyers, lambda flyer: compare_clubs(flyer, clubs, CALIBRATION_AIR))
-    names = ("carry MAE (bias), yd", "max height MAE (bias), yd", "land angle MAE (bias), deg")
-    rows = [
-        (name, *(f"{report.pga[l].mean_absolute_error[i]:.2f} ({report.pga[l].bias[i]:+.2f})" for l in labels),
-         f"<= {PGA_TARGETS[i]:g}")
-        for i, name in enumerate(names)
-    ]
-    rows.append((f"carry MAE in TrackMan's normalisation air (rho {CALIBRATION_AIR.density_kg_m3:.3f}), yd",
-                 *(f"{calibration[l].mean_absolute_error[0]:.2f} ({calibration[l].bias[0]:+.2f})" for l in labels), ""))
-    rows.append(("targets", *("met" if report.pga[l].met else "not met" for l in labels), ""))
+    air = PGA_2023_TABLE.air()
+    report.pga = per_model(flyers, lambda flyer: compare_clubs(flyer, clubs, air))
     lines += [
-        f"Each club's average launch (launch direction and spin axis 0) against TrackMan's average carry, max height "
-        f"and land angle, {len(clubs)} clubs, each model in its own air:",
-        "",
-        *table(("", *labels, "target"), rows),
-        "",
-        f"Per club, {labels[0]} (model / TrackMan / error):",
+        (
+            f"Not held out (NOTES section 9): `golfflight train-real` trains the real-data model on this table, so its "
+            f"column is a training fit. Each club's average launch (launch direction and spin axis 0) against "
+            f"TrackMan's average carry, max height and land angle, {len(clubs)} clubs, every model flown in the "
+            f"table's air (`shots.source_air.PGA_2023_TABLE`, rho {air.density_kg_m3:.3f} kg/m^3: "
+            f"{PGA_2023_TABLE.basis})."
+        ),
         "",
     ]
-    first = report.pga[labels[0]]
-    club_rows = [(club.club, *(f"{m:.1f} / {t:g} / {m - t:+.1f}" for m, t in zip(model, target)))
-                 for club, model, target in zip(first.clubs, first.model, first.targets)]
-    lines += table(("club", "carry yd", "max height yd", "land angle deg"), club_rows)
+    for index in range(len(PGA_OUTCOMES)):
+        lines += _pga_outcome(index, report.pga, labels)
+    lines += ["Targets (MAE):", ""]
+    for label in labels:
+        mae = report.pga[label].mean_absolute_error
+        lines.append(f"- {label}: " + "; ".join(
+            _verdict(f"{name} MAE", float(mae[i]), PGA_TARGETS[i], unit) for i, (name, unit) in enumerate(PGA_OUTCOMES)))
     return lines, clubs
 
 
@@ -534,9 +594,10 @@ def _study(data_dir: Path, flyer: ModelFlyer, clubs, epochs: int, report: Accura
         *table(("outcome (rounds 3-4)", "shots", "bias before", "MAE before", "bias after", "MAE after"), rows),
     ]
     if study.pga_after is not None:
-        mae = study.pga_after.mean_absolute_error
-        lines += ["", f"The fine-tuned model on the PGA 2023 table: MAE {mae[0]:.2f} yd carry, {mae[1]:.2f} yd max "
-                      f"height, {mae[2]:.2f} deg land angle."]
+        mae, bias = study.pga_after.mean_absolute_error, study.pga_after.bias
+        lines += ["", (f"The fine-tuned model on the PGA 2023 table, in the table's air: MAE (bias) "
+                       f"{mae[0]:.2f} ({bias[0]:+.2f}) yd carry, {mae[1]:.2f} ({bias[1]:+.2f}) yd max height, "
+                       f"{mae[2]:.2f} ({bias[2]:+.2f}) deg land angle.")]
     return lines
 
 
@@ -559,14 +620,15 @@ def run_accuracy(
         ferguson_flyer(real.dt_s, real.t_sim_s),
     ]
     report = AccuracyReport("", labels=[f.label for f in flyers])
-    lines = _header(flyers, "none of these sets records its weather.")
+    lines = _header(flyers, "none of these sets records its weather; the TOUR Championship and the PGA table are "
+                            "flown in their own air (`shots.source_air`), every model alike.")
     lines += ["", "## Held-out sets (never trained on, never used to choose a model; NOTES section 9)", ""]
     lines += _drivers(data_dir, flyers, report)
     lines += ["", *_tour_championship(data_dir, flyers, report)]
-    pga_lines, clubs = _pga(data_dir, flyers, report)
-    lines += ["", *pga_lines]
     lines += ["", "## Context", "", *_paper(), "", *_slow(flyers, report)]
     lines += ["", "## Training data and studies", ""]
+    pga_lines, clubs = _pga(data_dir, flyers, report)
+    lines += [*pga_lines, ""]
     lines += _sentry(data_dir, flyers, Path(out), Path(figures_dir), report)
     lines += ["", *_study(data_dir, real, clubs, finetune_epochs, report)]
     report.markdown = "\n".join(lines) + "\n"

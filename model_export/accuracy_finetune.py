@@ -17,6 +17,7 @@ from model_export.accuracy_flyers import ModelFlyer
 from model_export.accuracy_sets import ClubComparison, compare_clubs, outcome_errors
 from shots.records import ShotSet, write_shots
 from shots.reference_world import ClubAverage
+from shots.source_air import PGA_2023_TABLE
 
 TRAIN_ROUNDS = (1, 2)
 MEASURED_ROUNDS = (3, 4)
@@ -94,7 +95,7 @@ def finetune_study(
         out, result = results[lr]
         tuned = ModelFlyer(out) if result.improved else flyer
         after = outcome_errors(tuned.simulate(launch), measured)
-        pga_after = compare_clubs(tuned, clubs) if clubs and result.improved else None
+        pga_after = compare_clubs(tuned, clubs, PGA_2023_TABLE.air()) if clubs and result.improved else None
     return FinetuneStudy(
         n_shots=len(shots),
         n_train=result.run.data.n_train,

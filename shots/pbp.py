@@ -7,7 +7,8 @@ A pbp file has one row per stroke; the rows TrackMan measured carry radarData.* 
 No spin axis is recorded (spin_axis_deg = 0). ShotLink adds where each stroke came to rest: tee `from_x, from_y,
 from_z` and rest `x, y, z` in feet on the course's own grid, `distance` (horizontal, "306 yds") and the lie `to`.
 Ids follow `shots.tourcast.shot_id`; a key that holds several radar rows (a provisional ball) numbers them -f1,
--f2, ... in file order, as the TOURCAST loader numbers the flights of a re-teed shot.
+-f2, ... in file order, as the TOURCAST loader numbers the flights of a re-teed shot. No column names a hole's par:
+`hole_pars` reads it from each player's strokes and score on the hole.
 """
 
 from __future__ import annotations
@@ -15,12 +16,13 @@ from __future__ import annotations
 import csv
 import os
 import re
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
 from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from shots.cells import BadRow, MalformedCell, finite_number
-from shots.heldout import held_out_set
+from shots.heldout import held_out_rounds, held_out_set
 from shots.records import RANGES, RecordError, ShotRecord, reading
 from shots.tourcast import shot_id, shot_key
 from shots.trackman import Conversion, ConversionReport
@@ -47,6 +49,10 @@ APEX_NOT_AN_APEX = {
 }
 """(seasonYear, tournamentNumber) of events whose apex fields are not TrackMan's apex: apex_m stays blank."""
 
+SCORE_TO_PAR = {"Eagle": -2, "Birdie": -1, "Par": 0, "Bogey": 1, "Double Bogey": 2}
+"""ShotLink's `textScore` (a player's score on the hole, on each row of it) -> strokes over par; 'Double Bogey+' and
+a blank name no exact number."""
+PAR_COLUMNS = ("roundNumber", "holeNumber", "playerId", "shotNumber", "textScore")
 DISTANCE = re.compile(r"(?:(?P<yds>\d+(?:\.\d+)?) yds|(?:(?P<ft>\d+) ft)? ?(?:(?P<inch>\d+(?:\.\d+)?) in\.)?)")
 """ShotLink's `distance` text: '306 yds', '23 ft 3 in.', '9 in.', '12 ft'."""
 
@@ -203,7 +209,8 @@ def _notes(report: ConversionReport, path: str | os.PathLike, rows: list[RadarRo
                             f"-f2, ... in file order: {several[:5]}")
     held = held_out_set(path)
     if held:
-        report.notes.append(f"held out ({held.name}): for evaluation only, never for training (shots.heldout)")
+        report.notes.append(f"{held.rows()} held out ({held.name}): for evaluation only, never for training "
+                            "(shots.heldout)")
 
 
 def _cells(path: str | os.PathLike, columns: tuple[str, ...]) -> list[RadarRow]:
@@ -256,3 +263,39 @@ def rest_positions(path: str | os.PathLike) -> dict[str, RestPosition]:
             raise RecordError(f"{path} line {row.line} column 'distance': {error}") from None
         positions[row.shot_id] = RestPosition(row.shot_id, dx, dy, dz, distance, (row.cells["to"] or "").strip())
     return positions
+
+
+def _holes_played(path: Path) -> dict[tuple[int, int, str], tuple[int, set[str]]]:
+    """Per player's hole in a round not held out (`shots.heldout`), keyed (round, hole, player): the strokes played
+    (its last `shotNumber`) and the `textScore` cells of its rows."""
+    held_out = held_out_rounds(path)
+    played: dict[tuple[int, int, str], tuple[int, set[str]]] = {}
+    with reading(path), path.open(newline="", encoding="utf-8-sig") as handle:
+        reader = csv.DictReader(handle)
+        missing = [c for c in PAR_COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            raise RecordError(f"{path}: required columns {missing} are missing (columns: {reader.fieldnames})")
+        for line, row in enumerate(reader, start=2):
+            try:
+                round_number, hole, stroke = (int(row[c]) for c in ("roundNumber", "holeNumber", "shotNumber"))
+            except ValueError as error:
+                message = f"{path} line {line}: a round, hole or stroke number is not a number ({error})"
+                raise RecordError(message) from None
+            if round_number in held_out:
+                continue
+            key = (round_number, hole, row["playerId"].strip())
+            strokes, scores = played.get(key, (0, set()))
+            played[key] = (max(strokes, stroke), scores | {row["textScore"].strip()})
+    return played
+
+
+def hole_pars(path: str | os.PathLike) -> dict[int, int]:
+    """The par of each hole of a pbp file's course, which the file does not name: for each player's hole in each
+    round, the strokes played less the strokes over par its `textScore` names; the most common answer per hole, so a
+    hole with a stroke missing from the file cannot move it. Held-out rounds are not read: a hole's par is the same
+    in every round, so nothing built on it depends on them."""
+    answers: dict[int, Counter[int]] = {}
+    for (_, hole, _), (strokes, scores) in _holes_played(Path(path)).items():
+        if len(scores) == 1 and (score := next(iter(scores))) in SCORE_TO_PAR:
+            answers.setdefault(hole, Counter())[strokes - SCORE_TO_PAR[score]] += 1
+    return {hole: counts.most_common(1)[0][0] for hole, counts in sorted(answers.items())}

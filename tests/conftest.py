@@ -1,7 +1,9 @@
-"""Shared tiny data: shots flown through Ferguson et al.'s quadratics (RK4, fine step) and written as canonical CSV."""
+"""Shared tiny data: shots flown through Ferguson et al.'s quadratics (RK4, fine step) and written as canonical CSV;
+and the shared data folder less its held-out rows."""
 
 from __future__ import annotations
 
+import csv
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +12,7 @@ import pytest
 from flight.coefficients import QuadraticSpinRatio
 from flight.integrator import simulate
 from flight.physics import initial_state
+from shots.heldout import ROUND_COLUMN, HeldOutSet, held_out_set
 from shots.records import ShotRecord, write_shots
 
 
@@ -51,3 +54,33 @@ def write_synthetic_shots(path: Path, n: int, seed: int = 0, val_fraction: float
 def tiny_shots(tmp_path_factory) -> Path:
     """About 200 shots (160 train, 40 val)."""
     return write_synthetic_shots(tmp_path_factory.mktemp("data") / "tiny.csv", 200, seed=1)
+
+
+def _write_trainable_rows(source: Path, target: Path, held: HeldOutSet) -> None:
+    """`source` less its held-out rows: the lines before `first_line`, or the rows of the rounds not held out."""
+    with source.open(newline="", encoding="utf-8-sig") as handle:
+        rows = list(csv.reader(handle))
+    if held.rounds:
+        column = rows[0].index(ROUND_COLUMN)
+        rows = rows[:1] + [row for row in rows[1:] if not held.holds_round(int(row[column]))]
+    else:
+        rows = rows[: held.first_line - 1]
+    with target.open("w", newline="", encoding="utf-8") as handle:
+        csv.writer(handle).writerows(rows)
+
+
+def trainable_copy(root: Path, out: Path) -> Path:
+    """The shared data folder `root` rebuilt under `out` without a held-out row (`shots.heldout`): every other file a
+    link to the original, a file split by lines or rounds rewritten with its trainable rows, a file held out whole
+    left out. What is built from it and from `root` must be the same."""
+    for path in root.rglob("*"):
+        held = held_out_set(path) if path.is_file() else None
+        if not path.is_file() or (held is not None and held.whole):
+            continue
+        target = out / path.relative_to(root)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        if held is None:
+            target.symlink_to(path)
+        else:
+            _write_trainable_rows(path, target, held)
+    return out

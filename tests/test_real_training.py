@@ -11,15 +11,32 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
+from conftest import trainable_copy
 
 from flight.physics import initial_state
 from model_export.joint import JointConfig, LatentConditions, cosine_factor, soup_runs, train_joint
 from model_export.observations import load_observed
-from model_export.real_data import DRIVER_FILE, PLAYERS_PBP, build, driver_groups, players, trackman_outdoor
+from model_export.real_data import (
+    BUILDERS,
+    DRIVER_FILE,
+    PLAYERS_PBP,
+    build,
+    driver_groups,
+    players,
+    trackman_outdoor,
+)
 from model_export.torch_physics import euler_rollout, hard_landing, positions_at
 from model_export.training import load_checkpoint
 from model_export.variants import PhysNN, PhysQ
-from shots.heldout import HELD_OUT, HeldOutError, check_training_rows, held_out_set
+from shots.heldout import (
+    HELD_OUT,
+    HeldOutError,
+    HeldOutSet,
+    check_training_rows,
+    held_out_rounds,
+    held_out_set,
+    shot_round,
+)
 from shots.paths import REPO_ROOT, shared_data_dir
 from shots.records import ShotRecord, read_shots, trajectories_path, write_shots, write_trajectories
 from weights_schema.bundle import load_bundle
@@ -45,20 +62,89 @@ def _driver_file(root: Path, measured_lines: list[int], n_lines: int = 2950) -> 
     return path
 
 
-def test_the_registry_names_the_three_held_out_sets():
-    names = {held.path.name for held in HELD_OUT}
-    assert names == {"data.csv", "pbp_2020_060_688.csv", "trackman_tour_averages_pga_2023.csv"}
+TOUR_CHAMPIONSHIP = "real/pga_tourcast_trackman/pbp/pbp_2020_060_688.csv"
+PGA_TABLE = "reference/trackman_tour_averages_pga_2023.csv"
+
+
+def test_the_registry_holds_the_driver_files_second_half_and_tour_championship_rounds_3_4():
+    assert {held.path.name for held in HELD_OUT} == {"data.csv", "pbp_2020_060_688.csv"}
     assert held_out_set("/anywhere/real/trackman_driver_sessions/data.csv").first_line == 2943
+    tour = held_out_set(f"/anywhere/{TOUR_CHAMPIONSHIP}")
+    assert tour.rounds == (3, 4) and tour.rows() == "rounds 3-4" and not tour.whole
+    assert held_out_rounds(f"/anywhere/{TOUR_CHAMPIONSHIP}") == (3, 4)
+    assert held_out_rounds("/anywhere/real/trackman_driver_sessions/data.csv") == ()
+    assert held_out_set(f"/anywhere/{PGA_TABLE}") is None, "the PGA 2023 table may be trained on (NOTES section 9)"
 
 
 def test_a_held_out_line_refuses_the_training_set(tmp_path):
     path = tmp_path / "real" / "trackman_driver_sessions" / "data.csv"
     check_training_rows(path, [3, 2942])
+    check_training_rows(path, shot_ids=["trackman-outdoor:2942", "17"])
     with pytest.raises(HeldOutError, match="lines 2943"):
         check_training_rows(path, [2941, 2943])
-    with pytest.raises(HeldOutError, match="TOUR Championship"):
-        check_training_rows(tmp_path / "real/pga_tourcast_trackman/pbp/pbp_2020_060_688.csv", [2])
+    with pytest.raises(HeldOutError, match="trackman-outdoor:2943"):
+        check_training_rows(path, shot_ids=["trackman-outdoor:2943"])
     check_training_rows(tmp_path / "real/pga_tourcast_trackman/pbp/pbp_2021_016_656.csv", [2])
+    check_training_rows(tmp_path / PGA_TABLE, [])
+
+
+def test_a_shot_of_a_held_out_round_refuses_the_training_set(tmp_path):
+    """Canonical tour ids ('060-R3-H15-P29725-S1', also behind a source prefix) name their round: rounds 3-4 of the
+    TOUR Championship are refused, rounds 1-2 and the file itself pass."""
+    path = tmp_path / TOUR_CHAMPIONSHIP
+    assert shot_round("060-R3-H15-P29725-S1") == 3
+    assert shot_round("tour-championship-2020:060-R1-H2-P11111-S1-f2") == 1
+    with pytest.raises(ValueError):
+        shot_round("tour-championship-2020:2943")
+    check_training_rows(path)
+    check_training_rows(path, [])
+    check_training_rows(path, shot_ids=["060-R1-H2-P11111-S1", "tour-championship-2020:060-R2-H15-P22222-S1-f1"])
+    for leaked in ("060-R3-H15-P29725-S1", "tour-championship-2020:060-R4-H1-P11111-S1", "not-a-tour-id"):
+        with pytest.raises(HeldOutError, match="rounds 3-4"):
+            check_training_rows(path, shot_ids=["060-R1-H1-P11111-S1", leaked])
+
+
+def test_a_held_out_rounds_lines_are_found_through_the_round_column(tmp_path):
+    """Lines of a file split by rounds are refused by the round their row names; unreadable rounds refuse too."""
+    path = tmp_path / TOUR_CHAMPIONSHIP
+    with pytest.raises(HeldOutError, match="cannot be read"):
+        check_training_rows(path, [2])
+    path.parent.mkdir(parents=True)
+    path.write_text("roundNumber,holeNumber\n1,1\n3,1\n2,5\n")
+    check_training_rows(path, [2, 4])
+    with pytest.raises(HeldOutError, match="1 held-out lines .* 3$"):
+        check_training_rows(path, [2, 3, 4])
+    with pytest.raises(HeldOutError, match="5$"):
+        check_training_rows(path, [5])
+
+
+def test_a_file_held_out_whole_refuses_any_use(tmp_path, monkeypatch):
+    import shots.heldout
+
+    whole = HeldOutSet("a whole file", Path("real/whole.csv"))
+    monkeypatch.setattr(shots.heldout, "HELD_OUT", (*HELD_OUT, whole))
+    assert whole.whole and whole.holds(2) and whole.holds_round(1) and whole.rows() == "all"
+    with pytest.raises(HeldOutError, match="whole file"):
+        check_training_rows(tmp_path / "real" / "whole.csv", [])
+
+
+def test_the_trainable_copy_of_a_data_folder_holds_no_held_out_row(tmp_path):
+    """`conftest.trainable_copy` on a hand-made folder: the driver file cut before line 2943, the TOUR Championship
+    less rounds 3-4, every other file as it was."""
+    root = tmp_path / "shared"
+    driver = root / "real" / "trackman_driver_sessions" / "data.csv"
+    driver.parent.mkdir(parents=True)
+    driver.write_text("".join(f"{line},x\n" for line in range(1, 2951)))
+    tour = root / TOUR_CHAMPIONSHIP
+    tour.parent.mkdir(parents=True)
+    tour.write_text("roundNumber,holeNumber\n1,1\n3,2\n2,3\n4,4\n")
+    (root / PGA_TABLE).parent.mkdir(parents=True)
+    (root / PGA_TABLE).write_text("club\nDriver\n")
+    copy = trainable_copy(root, tmp_path / "copy")
+    lines = (copy / driver.relative_to(root)).read_text().splitlines()
+    assert len(lines) == 2942 and lines[-1] == "2942,x"
+    assert (copy / TOUR_CHAMPIONSHIP).read_text().splitlines() == ["roundNumber,holeNumber", "1,1", "2,3"]
+    assert (copy / PGA_TABLE).read_text() == "club\nDriver\n"
 
 
 def test_driver_training_shots_stop_at_line_2942(tmp_path):
@@ -99,20 +185,41 @@ def test_players_shots_train_on_the_carry_their_apex_range_records(tmp_path):
     assert {r.split for r in data.records if not r.group.endswith("-H4")} == {"train"}
 
 
-@pytest.mark.skipif(not (shared_data_dir() / DRIVER_FILE).is_file(), reason="shared data not present")
+REAL_SOURCES = tuple(name for name in BUILDERS if name != "synthetic")
+"""Every source read from the shared data folder."""
+needs_shared_data = pytest.mark.skipif(not (shared_data_dir() / DRIVER_FILE).is_file(),
+                                       reason="shared data not present")
+
+
+@needs_shared_data
 def test_the_merged_real_training_file_holds_no_held_out_row(tmp_path):
-    built = build(shared_data_dir(), tmp_path / "real.csv",
-                  ("trackman-outdoor", "sentry-2022", "players-2020", "trackman-model"))
+    built = build(shared_data_dir(), tmp_path / "real.csv", REAL_SOURCES)
     shots = read_shots(tmp_path / "real.csv")
-    driver_lines = [int(s.split(":")[1]) for s, src in zip(shots.column("shot_id"), shots.column("source"))
-                    if src.startswith("trackman")]
+    ids, sources = list(shots.column("shot_id")), list(shots.column("source"))
+    driver_lines = [int(s.split(":")[1]) for s, src in zip(ids, sources) if src.startswith("trackman")]
     assert driver_lines and max(driver_lines) <= 2942
-    files = {path for data in built for path in data.files}
-    assert not any(held_out_set(path) is not None and held_out_set(path).first_line == 1 for path in files)
+    tour = [shot_round(s) for s in ids if s.startswith("tour-championship-2020:")]
+    assert set(tour) <= {1, 2}, "a TOUR Championship round 3-4 shot reached training or validation"
+    for data in built:
+        for path in data.files:
+            check_training_rows(shared_data_dir() / path, shot_ids=[r.shot_id for r in data.records])
+            assert held_out_set(path) is None or not held_out_set(path).whole
     splits = {}
     for group, split in zip(shots.column("group"), shots.column("split")):
         splits.setdefault(group, set()).add(split)
     assert all(len(s) == 1 for s in splits.values()), "a conditions group spans train and validation"
+
+
+@needs_shared_data
+def test_held_out_rows_change_nothing_in_the_real_training_set(tmp_path):
+    """Built from the shared folder and from a copy without a single held-out row, the merged file (every record,
+    its group and its train or validation split) and its trajectories are the same: no held-out row reaches
+    training, validation or a choice the builders make."""
+    build(shared_data_dir(), tmp_path / "all.csv", REAL_SOURCES)
+    build(trainable_copy(shared_data_dir(), tmp_path / "trainable"), tmp_path / "trainable.csv", REAL_SOURCES)
+    assert (tmp_path / "all.csv").read_text() == (tmp_path / "trainable.csv").read_text()
+    assert trajectories_path(tmp_path / "all.csv").read_text() == trajectories_path(
+        tmp_path / "trainable.csv").read_text()
 
 
 def test_positions_at_interpolates_between_euler_steps():
@@ -222,7 +329,7 @@ def test_the_real_data_card_names_its_sources_with_hashes_and_its_held_out_error
     for source in sources:
         for f in source.files:
             held = held_out_set(f.path)
-            assert held is None or held.first_line > 1, f"{f.path} is held out whole"
+            assert held is None or not held.whole, f"{f.path} is held out whole"
     held_out = {h.name: h for h in card.held_out or []}
     assert {h.name for h in HELD_OUT} <= set(held_out)
     assert all(h.errors for h in held_out.values())

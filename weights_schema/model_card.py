@@ -162,12 +162,12 @@ class Validation(_Strict):
 
 class HeldOutResult(_Strict):
     """The exported model's error on one held-out set (never trained on, never used to select the model), flown
-    through the runtime path, calm, in the card's air."""
+    through the runtime path, calm, in the set's own air where it is known (the note says which), else the card's."""
 
     name: str
     path: str = Field(description="relative to the shared data folder")
     sha256: Sha256
-    rows: str = Field(description="which rows of the file: all, or a line range")
+    rows: str = Field(description="which rows of the file: all, a line range or rounds")
     n_shots: int = Field(ge=1)
     errors: dict[str, NonNegative] = Field(description="mean absolute error per observable (SI units in the key)")
     note: str
