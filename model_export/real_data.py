@@ -245,7 +245,7 @@ def pga_table(root: Path) -> SourceData:
     records = _tag([_club_record(c) for c in clubs], "pga-2023-table", groups, val)
     note = (f"{len(clubs)} clubs, one average shot each; air: {KNOWN_AIR['pga-2023-table'].basis}; validation "
             f"clubs: {', '.join(r.club for r in records if r.split == 'val')}")
-    return SourceData("pga-2023-table", "table", records, {str(TOUR_AVERAGES_FILE): sha256_of(path)}, note)
+    return SourceData("pga-2023-table", "measured", records, {str(TOUR_AVERAGES_FILE): sha256_of(path)}, note)
 
 
 def driver_like(launch: dict[str, np.ndarray]) -> np.ndarray:

@@ -93,6 +93,16 @@ def main() -> int:
             cells.append(f"{sum(values) / len(values):.2f}")
         rows.append([name, ",".join(str(r["seed"]) for r in group), f"{felt:.2f}", *cells])
     print("\n".join(table(["weights", "seeds", "felt error (m), mean of sources", *sources], rows)))
+    print("\nPer run: carry (apex where a source has no carry) MAE / bias, m\n")
+    detail = []
+    for r in sorted(runs, key=lambda r: r["val_loss"]):
+        cells = []
+        for s in sources:
+            row = r["val"].get(s, {})
+            key = "carry_y_m" if "carry_y_m_mae" in row else "apex_m"
+            cells.append(f"{row[key + '_mae']:.2f} / {row[key + '_bias']:+.2f}" if row else "—")
+        detail.append([label(r["weights"], grid), str(r["seed"]), f"{r['val_loss']:.2f}", *cells])
+    print("\n".join(table(["weights", "seed", "felt error (m)", *sources], detail)))
     print(f"\n{len(runs)} runs, {(time.perf_counter() - started) / 60:.1f} min")
     return 0
 

@@ -25,7 +25,7 @@ def _needs(path: str) -> None:
 def test_the_pga_table_is_one_average_shot_per_club_in_its_air():
     _needs("reference/trackman_tour_averages_pga_2023.csv")
     data = pga_table(ROOT)
-    assert len(data.records) == 12 and data.kind == "table"
+    assert len(data.records) == 12 and data.kind == "measured"
     driver = next(r for r in data.records if r.club == "Driver")
     assert driver.carry_y_m == pytest.approx(282 * YARD_M) and driver.apex_m == pytest.approx(35 * YARD_M)
     assert driver.ball_speed_mps == pytest.approx(171 * 0.44704) and driver.spin_axis_deg == 0.0
@@ -65,8 +65,9 @@ class _Data:
 
 
 def test_an_unknown_air_sources_mean_density_is_free_a_known_ones_is_held():
-    """Two air groups of a range source (index 0) and two of a tour source (index 1), every group 5 % thin: the prior
-    on the known source's mean is (log 0.95 / 0.01)^2 / 2 larger than the unknown's (log 0.95 / 0.1)^2 / 2."""
+    """Two air groups of a range source (index 0) and two of a tour source (index 1), every group 5 % thin: the range
+    groups sit on their source's mean and cost only (log 0.95 / 0.1)^2 / 2; the tour groups cost their own distance
+    from the stated air, 2 (log 0.95 / 0.05)^2 / 2, and their mean's (log 0.95 / 0.01)^2 / 2."""
     config = JointConfig(unknown_air_sources=("range",))
     latent = LatentConditions(_Data(0, 4, 0))
     with torch.no_grad():
@@ -76,8 +77,23 @@ def test_an_unknown_air_sources_mean_density_is_free_a_known_ones_is_held():
     wind_source = torch.zeros(0, dtype=torch.long)
     total = float(latent.prior(config, wind_source, air_source, sources).detach())
     x = float(torch.log(torch.tensor(0.95)))
-    groups = 4 * (x / config.density_prior) ** 2
-    expected = 0.5 * (groups + (x / config.unknown_mean_density_prior) ** 2 + (x / config.mean_density_prior) ** 2)
+    tour_groups = 2 * (x / config.density_prior) ** 2
+    expected = 0.5 * (tour_groups + (x / config.unknown_mean_density_prior) ** 2 + (x / config.mean_density_prior) ** 2)
     assert total == pytest.approx(expected, rel=1e-5)
     factors = latent.source_density_factors(config, air_source, sources)
     assert factors.tolist() == pytest.approx([0.95, 1.0])
+
+
+def test_heavy_shots_are_spread_over_batches_at_the_same_total_weight():
+    """Weights 1, 2.5 and 0.2: the 2.5 shot becomes three copies of 2.5/3; the others stay single."""
+    from model_export.joint import spread_heavy_rows
+    from model_export.observations import ObservedShots
+
+    n = 3
+    fields = {name: torch.zeros(n, 3) for name in ObservedShots.__dataclass_fields__}
+    fields["weight"] = torch.tensor([1.0, 2.5, 0.2])
+    fields["source"] = torch.tensor([0, 1, 2])
+    spread = spread_heavy_rows(ObservedShots(**fields))
+    assert spread.source.tolist() == [0, 1, 1, 1, 2]
+    assert spread.weight.tolist() == pytest.approx([1.0, 2.5 / 3, 2.5 / 3, 2.5 / 3, 0.2])
+    assert float(spread.weight.sum()) == pytest.approx(3.7)

@@ -282,9 +282,9 @@ def test_the_latent_prior_pulls_each_sources_mean_wind_to_calm(tmp_path):
     air = torch.zeros(len(data.air_groups), dtype=torch.long)
     with torch.no_grad():
         latent.wind[:] = torch.tensor([[1.0, 0.0], [-1.0, 0.0]])
-        balanced = latent.prior(JointConfig(), source, air)
+        balanced = latent.prior(JointConfig(), source, air, data.sources)
         latent.wind[:] = torch.tensor([[1.0, 0.0], [1.0, 0.0]])
-        shifted = latent.prior(JointConfig(), source, air)
+        shifted = latent.prior(JointConfig(), source, air, data.sources)
     assert float(shifted) > float(balanced) + 5
 
 

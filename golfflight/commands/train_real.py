@@ -33,7 +33,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--data-root", default=None, help="shared data folder (default ../shared/data)")
     parser.add_argument("--sources", default=",".join(DEFAULT_SOURCES),
                         help=f"comma-separated subset of {list(BUILDERS)} (default: {','.join(DEFAULT_SOURCES)})")
-    parser.add_argument("--epochs", type=int, default=20)
+    parser.add_argument("--epochs", type=int, default=14)
     parser.add_argument("--seeds", type=_seeds, default=(0, 1, 2))
     parser.add_argument("--lr", type=float, default=1e-3, help="Adam learning rate of the network")
     parser.add_argument("--threads", type=int, default=2, help="torch CPU threads per seed")
