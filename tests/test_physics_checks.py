@@ -218,6 +218,9 @@ KNOWN_LIFT_MISS = {
     "b8bf638df1808902aa40536d7a8f2ffdbc8c1f0978b16314b0c163c5f413740b":
         "the 3-wood's descent (Re 7-9e4, S 0.23-0.29): lift 0.01 below Acushnet's indoor range and the TopFlite "
         "radar fit (docs/physics_checks.md)",
+    "2b3db399b93aa761898031608ae1fe42c14ddaa754880826dea1a74254a116d4":
+        "the 3-wood's descent (Re 7-8e4, S 0.25): lift up to 0.006 below the band on 49 % of its covered points; "
+        "the issue-22 default (docs/physics_checks.md)",
 }
 """Models known to miss the lift band, by ONNX hash: a retrained model is held to the band again."""
 
