@@ -230,7 +230,7 @@ def shot_losses(predicted: Predicted, shots: ObservedShots, delta: float, scales
 def spread_heavy_rows(shots: ObservedShots) -> ObservedShots:
     """Each shot of weight w > 1 repeated ceil(w) times at weight w / ceil(w): the same total weight, but spread
     over that many minibatches. A few heavy shots (one tour-averages club stands for thousands of shots) would
-    otherwise each land in one batch a epoch, where gradient clipping and Adam's normalisation cap their pull
+    otherwise each land in one batch an epoch, where gradient clipping and Adam's normalisation cap their pull
     whatever their weight (measured: table weights 5 and 150 trained the same network)."""
     copies = torch.ceil(shots.weight.clamp_min(1.0)).long()
     spread = shots.take(torch.repeat_interleave(torch.arange(len(shots)), copies))

@@ -1,6 +1,6 @@
 """`golfflight train-real` end to end: build the merged real-flight file, train jointly from a starting bundle over
-several seeds, keep the seed with the lowest validation loss, and export it as a bundle whose card names every
-source with its SHA-256 and rows, the latent conditions and (added by `golfflight accuracy`) the held-out errors.
+several seeds, keep the run with the lowest validation felt error (`joint.selection_loss`), and export it as a
+bundle whose card names every source with its SHA-256 and rows, the latent conditions and the held-out errors.
 """
 
 from __future__ import annotations
@@ -192,7 +192,7 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
                threads: int = 2) -> RealRun:
     """Build WORK/real_flights.csv from DATA_ROOT, train one joint run per seed from the bundle INIT (WORK/seed-S;
     `jobs` seeds at a time, each with `threads` torch threads), average several seeds' weights into a soup
-    (WORK/soup), and export the run with the lowest validation loss to OUT (if given)."""
+    (WORK/soup), and export the run with the lowest validation felt error to OUT (if given)."""
     from concurrent.futures import ProcessPoolExecutor
 
     from weights_schema.bundle import load_bundle

@@ -21,11 +21,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     parser = subparsers.add_parser(
         "train-real",
-        help="train on the real flights of the shared data (held-out sets never read), export the run with the lowest validation loss",
+        help="train on the real flights of the shared data (held-out sets never read), export the run with the lowest validation felt error (carry MAE + |bias| per source)",
         description="Build WORK/real_flights.csv from every usable real source (docs/training_real.md), fine-tune "
         "the --init bundle on it jointly with a wind per conditions group, an air factor per air group and a scale "
         "per ball type, once per seed, average the seeds' weights into a soup, and export the run (a seed or the "
-        "soup) with the lowest validation loss to --out.",
+        "soup) with the lowest validation felt error (per source the carry MAE plus its absolute bias, averaged) to --out.",
     )
     parser.add_argument("--work", required=True, help="directory for the merged data and each seed's run")
     parser.add_argument("--out", help="bundle directory to export the chosen run to")
@@ -59,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"{data.name}: {len(data.records)} shots ({data.kind})")
     for name, run_result in result.runs.items():
         final = run_result.final
-        print(f"{name}: epoch {final['epoch']}, validation loss {final['val_loss']:.3f}" if final
+        print(f"{name}: epoch {final['epoch']}, validation felt error {final['val_loss']:.2f} m" if final
               else f"{name}: no epoch finished")
     print(f"chosen {result.chosen}; {result.seconds / 60:.1f} min")
     if result.card is not None:
