@@ -41,7 +41,7 @@ import numpy as np
 from flight.air import Air
 from flight.constants import YARD_M
 from flight.physics import initial_state
-from shots.heldout import check_training_rows
+from shots.heldout import check_training_rows, shot_round
 from shots.pbp import load_pbp, recorded_apex
 from shots.records import ShotRecord, trajectories_path, write_shots, write_trajectories
 from shots.reference_world import TOUR_AVERAGES_FILE, ClubAverage, fly_reference, read_tour_averages
@@ -206,18 +206,13 @@ def players(root: Path) -> SourceData:
                       {str(PLAYERS_PBP): sha256_of(path)}, report)
 
 
-def _round(shot_id: str) -> int:
-    """'060-R2-H15-P29725-S1' -> 2."""
-    return int(shot_id.split("-")[1].removeprefix("R"))
-
-
 def tour_championship(root: Path) -> SourceData:
     """Rounds 1-2 of the TOUR Championship 2020 (East Lake): radar launch, spin and apex of every tee shot, no spin
     axis, so no side; the par 3s are the only tour irons with a radar apex we may train on. Validation: every
     `VAL_EVERY`-th hole."""
     path = root / TOUR_CHAMPIONSHIP_PBP
     conversion = load_pbp(path, skip_bad_rows=True)
-    kept = [r for r in conversion.records if _round(r.shot_id) in TOUR_CHAMPIONSHIP_TRAIN_ROUNDS and r.apex_m]
+    kept = [r for r in conversion.records if shot_round(r.shot_id) in TOUR_CHAMPIONSHIP_TRAIN_ROUNDS and r.apex_m]
     check_training_rows(path, shot_ids=[r.shot_id for r in kept])
     groups = [_tour_group(r.shot_id) for r in kept]
     val = {g for g in groups if int(g.rsplit("-H", 1)[1]) % VAL_EVERY == 0}
