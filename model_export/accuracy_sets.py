@@ -19,6 +19,7 @@ from flight.constants import FOOT_M, YARD_M
 from flight.outcomes import Flight
 from model_export.accuracy_flyers import Flyer
 from model_export.data import MIN_APEX_M
+from shots.clubs import straight_launches
 from shots.heldout import HELD_OUT, held_out_rounds, shot_round
 from shots.pbp import load_pbp
 from shots.records import ShotSet
@@ -71,14 +72,7 @@ class ClubComparison:
 
 def compare_clubs(flyer: Flyer, clubs: Sequence[ClubAverage], air: Air | None = None) -> ClubComparison:
     """Fly each club's average launch (launch direction and spin axis 0) and compare with TrackMan's averages."""
-    n = len(clubs)
-    launch = {
-        "ball_speed_mps": np.array([c.ball_speed_mps for c in clubs]),
-        "launch_angle_deg": np.array([c.launch_angle_deg for c in clubs]),
-        "launch_direction_deg": np.zeros(n),
-        "spin_rpm": np.array([c.spin_rpm for c in clubs]),
-        "spin_axis_deg": np.zeros(n),
-    }
+    launch = straight_launches(clubs)
     density = flyer.density_kg_m3 if air is None else float(air.density_kg_m3)
     flight = flyer.simulate(launch, air)
     model = np.stack([flight.carry_m / YARD_M, flight.apex_m / YARD_M, flight.landing_angle_deg], axis=1)

@@ -35,7 +35,7 @@ from flight.air import Air
 from flight.constants import BALL_RADIUS_M
 from flight.physics import spin_ratio
 from model_export.accuracy_flyers import Flyer, ModelFlyer
-from shots.clubs import CLUBS, ClubLaunch
+from shots.clubs import CLUBS, ClubLaunch, straight_launches
 from shots.markdown import table
 
 COMMAND = "physics-check"
@@ -285,18 +285,6 @@ def effective_coefficients(coefficients: np.ndarray) -> dict[str, np.ndarray]:
     return {"C_L": 2.0 * c_q * c_l, "C_D": 2.0 * c_q * c_d, "C_M": 2.0 * c_q * c_m}
 
 
-def launches(clubs: list[ClubLaunch]) -> dict[str, np.ndarray]:
-    """The canonical launch columns of straight shots (no side spin, no launch direction) of these clubs."""
-    n = len(clubs)
-    return {
-        "ball_speed_mps": np.array([c.ball_speed_mps for c in clubs]),
-        "launch_angle_deg": np.array([c.launch_angle_deg for c in clubs]),
-        "launch_direction_deg": np.zeros(n),
-        "spin_rpm": np.array([c.spin_rpm for c in clubs]),
-        "spin_axis_deg": np.zeros(n),
-    }
-
-
 @dataclass(frozen=True)
 class FlightPoints:
     """The states one flight passes through at each Euler step from launch to its last step above the ground: time,
@@ -312,7 +300,7 @@ class FlightPoints:
 def flight_points(flyer: Flyer, clubs: list[ClubLaunch], air: Air) -> list[FlightPoints]:
     """Fly the clubs through `flyer` in `air` (calm) and read back what each flight meets at each step above the
     ground. The coefficients are the model's at those states, the very values the integrator stepped with."""
-    flight = flyer.simulate(launches(clubs), air, keep_states=True)
+    flight = flyer.simulate(straight_launches(clubs), air, keep_states=True)
     model = flyer.coefficients_in(air)
     result = []
     for i, club in enumerate(clubs):
@@ -330,7 +318,7 @@ def spin_lost(flyer: Flyer, clubs: list[ClubLaunch], air: Air, times_s: tuple[fl
     """Share (0-1) of its launch spin each club's ball has lost at each time [clubs, times], flown through `flyer`
     in `air` (the spin magnitude interpolated linearly between steps). A ball is followed past its landing (the
     measurement is of the decay law, not of a flight's length), so the flight is run for the longest time asked."""
-    flight = flyer.simulate(launches(clubs), air, keep_states=True, t_max_s=max(flyer.t_sim_s, max(times_s)),
+    flight = flyer.simulate(straight_launches(clubs), air, keep_states=True, t_max_s=max(flyer.t_sim_s, max(times_s)),
                             ground_height_m=-1e9)
     spin = np.stack([np.linalg.norm(state.spin, axis=-1) for state in flight.states])
     return np.stack([1.0 - np.interp(times_s, flight.times_s, spin[:, i]) / spin[0, i] for i in range(len(clubs))])

@@ -29,7 +29,7 @@ from flight.reference_aero import (
     REFERENCE_T_MAX_S,
     ReferenceParameters,
 )
-from shots.clubs import CLUBS
+from shots.clubs import CLUBS, straight_launches
 from shots.markdown import signed
 from shots.records import ShotRecord
 from shots.reference_world import CALIBRATION_AIR, ClubAverage, fly_reference
@@ -150,9 +150,7 @@ def table_cells(source: str, clubs: list[ClubAverage], air: Air) -> list[Calibra
     """One cell per club of a tour-averages table: its average launch, straight, and its average outcomes."""
     cells = []
     for club in clubs:
-        launch = {"ball_speed_mps": np.array([club.ball_speed_mps]), "launch_angle_deg": np.array([club.launch_angle_deg]),
-                  "launch_direction_deg": np.zeros(1), "spin_rpm": np.array([club.spin_rpm]),
-                  "spin_axis_deg": np.zeros(1)}
+        launch = straight_launches([club])
         recorded = np.array([[club.carry_yd * YARD_M, club.max_height_yd * YARD_M, club.land_angle_deg]])
         cells.append(CalibrationCell(f"{source} {club.club}", launch, air, recorded, min_shots=1,
                                      weight=TABLE_CELL_WEIGHT))
@@ -204,10 +202,7 @@ def evaluate(cells: list[CalibrationCell], params: ReferenceParameters = CALIBRA
 def decay_launch() -> State:
     """The launches of the spin-decay clubs (`shots.clubs.CLUBS`), straight, no spin-axis tilt."""
     clubs = {c.name: c for c in CLUBS}
-    chosen = [clubs[name] for name in TRACKMAN_SPIN_LOSS_PCT]
-    zeros = np.zeros(len(chosen))
-    return initial_state(np.array([c.ball_speed_mps for c in chosen]), np.array([c.launch_angle_deg for c in chosen]),
-                         zeros, np.array([c.spin_rpm for c in chosen]), zeros)
+    return initial_state(**straight_launches([clubs[name] for name in TRACKMAN_SPIN_LOSS_PCT]))
 
 
 def spin_losses(params: ReferenceParameters = CALIBRATED, air: Air = CALIBRATION_AIR) -> dict[str, np.ndarray]:
@@ -318,9 +313,7 @@ class ClubCheck:
 
 def club_launch_state(clubs: list[ClubAverage]) -> State:
     """Initial state of each club's average launch, straight at the target with no spin-axis tilt."""
-    zeros = np.zeros(len(clubs))
-    return initial_state(np.array([c.ball_speed_mps for c in clubs]), np.array([c.launch_angle_deg for c in clubs]),
-                         zeros, np.array([c.spin_rpm for c in clubs]), zeros)
+    return initial_state(**straight_launches(clubs))
 
 
 def _club_check(flight: Flight, clubs: list[ClubAverage]) -> ClubCheck:

@@ -6,7 +6,34 @@ calibration nor any training set (NOTES section 9)."""
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from collections.abc import Sequence
+from typing import NamedTuple, Protocol
+
+import numpy as np
+
+
+class HasLaunch(Protocol):
+    """Anything with a mean launch in SI: a club of CLUBS, a row of a tour-averages table."""
+
+    @property
+    def ball_speed_mps(self) -> float: ...
+    @property
+    def launch_angle_deg(self) -> float: ...
+    @property
+    def spin_rpm(self) -> float: ...
+
+
+def straight_launches(clubs: Sequence[HasLaunch]) -> dict[str, np.ndarray]:
+    """The canonical launch columns of each club's mean launch, straight: launch direction and spin axis 0 (the
+    tables publish neither)."""
+    n = len(clubs)
+    return {
+        "ball_speed_mps": np.array([c.ball_speed_mps for c in clubs], dtype=float),
+        "launch_angle_deg": np.array([c.launch_angle_deg for c in clubs], dtype=float),
+        "launch_direction_deg": np.zeros(n),
+        "spin_rpm": np.array([c.spin_rpm for c in clubs], dtype=float),
+        "spin_axis_deg": np.zeros(n),
+    }
 
 
 class ClubLaunch(NamedTuple):

@@ -13,7 +13,7 @@ from flight.integrator import simulate
 from flight.physics import initial_state
 from flight.reference_aero import CALIBRATED, ReferenceAerodynamics
 from flight.wind import Wind, wind_vector
-from shots.clubs import CLUBS
+from shots.clubs import CLUBS, straight_launches
 
 CARRY_Y, CARRY_X, APEX, TIME, ANGLE = range(5)
 MODEL = reference()
@@ -22,14 +22,7 @@ MODEL = reference()
 def launches() -> dict[str, np.ndarray]:
     """Driver, 7-iron and pitching wedge at their tour launch, straight."""
     clubs = [c for c in CLUBS if c.name in ("Driver", "7-iron", "PW")]
-    n = len(clubs)
-    return {
-        "ball_speed_mps": np.array([c.ball_speed_mps for c in clubs]),
-        "launch_angle_deg": np.array([c.launch_angle_deg for c in clubs]),
-        "launch_direction_deg": np.zeros(n),
-        "spin_rpm": np.array([c.spin_rpm for c in clubs]),
-        "spin_axis_deg": np.zeros(n),
-    }
+    return straight_launches(clubs)
 
 
 def base() -> Setup:
