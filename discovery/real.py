@@ -4,7 +4,12 @@ python -m discovery.real --out runs/discovery-real [--model DIR|reference]
 
 Sets: the outdoor, radar-tracked TrackMan driver shots (all balls, the held-out lines alone, and Premium only), the
 PGA TOUR TrackMan trajectories of the Sentry 2022 (spin from the play-by-play) and the Sony Open 2022 (spin estimated
-from the initial lift), each per event and per round, and TrackMan's PGA TOUR 2023 averages (one row per club).
+from the initial lift), each per event and per round, the TOUR Championship 2020's radar tee shots (launch, spin and
+apex) of its trainable rounds and of its held-out rounds apart, and TrackMan's PGA TOUR 2023 averages (one row per
+club). Each set says whether it is held out (`shots.heldout`, NOTES section 9: only the driver file's lines from 2943
+and the TOUR Championship's rounds 3-4), trained on by `models/default`, or neither. A set whose source's air is known
+(`shots.source_air`: the PGA table, the Sentry, the TOUR Championship) is flown in that air, as training flew it; the
+others (the range sessions, the Sony Open) in the model's air.
 """
 
 from __future__ import annotations
@@ -24,16 +29,28 @@ from discovery.model import FlightModel, load_model
 from discovery.outputs import write_diagnosis
 from discovery.recordings import LABELS, OBSERVABLES, Recordings, from_shot_set
 from shots.files import write_text_atomic
-from shots.heldout import held_out_set
+from shots.heldout import held_out_rounds, held_out_set, shot_round
 from shots.markdown import table
 from shots.paths import shared_data_dir
+from shots.pbp import load_pbp
 from shots.records import ShotRecord, ShotSet
 from shots.reference_world import default_tour_averages_path, read_tour_averages
+from shots.source_air import KNOWN_AIR, SourceAir
 from shots.tourcast import load_tourcast
 from shots.trackman import load_trackman
 
 TOURCAST = Path("real") / "pga_tourcast_trackman"
 TRACKMAN = Path("real") / "trackman_driver_sessions" / "data.csv"
+TOUR_CHAMPIONSHIP = TOURCAST / "pbp" / "pbp_2020_060_688.csv"
+
+HELD_OUT = "held out"
+TRAINED_ON = "trained on"
+"""What a set is to `models/default` (`RealSet.use`); the others say which part was trained on, or 'not trained on'."""
+
+
+def in_air(records: list[ShotRecord], air: SourceAir | None) -> list[ShotRecord]:
+    """The records with their source's air in the condition columns (unchanged where the air is not known)."""
+    return records if air is None else [r.model_copy(update=air.record_conditions()) for r in records]
 
 
 def tour_averages(path: str | Path) -> ShotSet:
@@ -54,7 +71,7 @@ def tour_averages(path: str | Path) -> ShotSet:
         )
         for row in read_tour_averages(path)
     ]
-    return ShotSet(records)
+    return ShotSet(in_air(records, KNOWN_AIR["pga-2023-table"]))
 
 
 @dataclass
@@ -65,30 +82,35 @@ class RealSet:
     title: str
     recordings: Recordings
     caveat: str
+    use: str = ""
+    """What the set is to `models/default`: HELD_OUT (`shots.heldout`), TRAINED_ON, or which part was trained on."""
 
 
 def real_sets(shared: Path) -> list[RealSet]:
     """Every real set, converted in memory by the project's loaders."""
     sets = []
+    held = held_out_set(TRACKMAN)  # shot_id is the line number in the export
+    assert held is not None, "the driver file's second half is held out (shots.heldout)"
+    first = held.first_line
     driver = load_trackman(shared / TRACKMAN, skip_bad_rows=True)
     sets.append(
         RealSet(
             "trackman_driver",
             "TrackMan driver shots, outdoor radar-tracked, all balls",
             from_shot_set(ShotSet(driver.records), source=str(shared / TRACKMAN)),
-            "one session (no dates): held out in blocks of shots; ball types mixed",
+            "one session (no dates): the diagnosis holds out blocks of shots; ball types mixed; no air recorded",
+            f"lines 3 to {first - 1} trained on, {first} on held out",
         )
     )
-    held = held_out_set(TRACKMAN)  # shot_id is the line number in the export
-    assert held is not None, "the driver file's second half is held out (shots.heldout)"
     unseen = [r for r in driver.records if held.holds(int(r.shot_id))]
     sets.append(
         RealSet(
             "trackman_driver_heldout",
-            f"TrackMan driver shots, outdoor radar-tracked, all balls, held-out lines (from {held.first_line})",
-            from_shot_set(ShotSet(unseen), source=f"{shared / TRACKMAN} (lines from {held.first_line})"),
-            "the lines no model was trained on (NOTES section 9; the earlier ones may be): one session, held out in "
-            "blocks of shots; ball types mixed",
+            f"TrackMan driver shots, outdoor radar-tracked, all balls, held-out lines (from {first})",
+            from_shot_set(ShotSet(unseen), source=f"{shared / TRACKMAN} (lines from {first})"),
+            "the lines no model was trained on (NOTES section 9; the earlier ones may be): one session, the diagnosis "
+            "holds out blocks of shots; ball types mixed; no air recorded",
+            HELD_OUT,
         )
     )
     premium = load_trackman(shared / TRACKMAN, balls=["Premium"], skip_bad_rows=True)
@@ -97,7 +119,8 @@ def real_sets(shared: Path) -> list[RealSet]:
             "trackman_driver_premium",
             "TrackMan driver shots, outdoor radar-tracked, Premium balls",
             from_shot_set(ShotSet(premium.records), source=str(shared / TRACKMAN) + " (Premium)"),
-            "one session (no dates): held out in blocks of shots",
+            "one session (no dates): the diagnosis holds out blocks of shots; no air recorded",
+            f"lines 3 to {first - 1} trained on, {first} on held out",
         )
     )
     trajectories = shared / TOURCAST / "shot_trajectory"
@@ -108,6 +131,8 @@ def real_sets(shared: Path) -> list[RealSet]:
             "shot_trajectory_2021_016_656.csv",
             "pbp_2021_016_656.csv",
             "spin from the play-by-play; spin axis derived from the initial lift",
+            KNOWN_AIR["sentry-2022"],
+            TRAINED_ON,
         ),
         (
             "sony",
@@ -115,9 +140,11 @@ def real_sets(shared: Path) -> list[RealSet]:
             "shot_trajectory_2021_006_006.csv",
             None,
             "spin ESTIMATED from the initial lift (Ferguson C_L): spin and lift effects are circular here",
+            None,
+            "not trained on",
         ),
     ]
-    for key, title, file, pbp, caveat in events:
+    for key, title, file, pbp, caveat, air, use in events:
         conversion = load_tourcast(
             trajectories / file,
             None if pbp is None else shared / TOURCAST / "pbp" / pbp,
@@ -125,27 +152,60 @@ def real_sets(shared: Path) -> list[RealSet]:
             sample_interval_s=0.1,
             skip_bad_rows=True,
         )
-        whole = from_shot_set(ShotSet(conversion.records), conversion.trajectories, str(trajectories / file))
+        records = ShotSet(in_air(conversion.records, air))
+        whole = from_shot_set(records, conversion.trajectories, str(trajectories / file))
+        caveat += "; " + (f"in the event's air ({air.basis})" if air else "no air known: the model's air")
         sets.append(
             RealSet(
                 key,
                 f"{title}, all rounds",
                 whole,
                 caveat + "; every hole faces another way, so a round's wind is not one wind in the shot frame",
+                use,
             )
         )
         for session in np.unique(whole.session):
             part = whole.subset(whole.session == session)
-            sets.append(RealSet(f"{key}_{session}", f"{title}, round {session.split('-R')[-1]}", part, caveat))
+            sets.append(RealSet(f"{key}_{session}", f"{title}, round {session.split('-R')[-1]}", part, caveat, use))
+    sets += tour_championship_sets(shared)
     averages = default_tour_averages_path()
     sets.append(
         RealSet(
             "pga_2023_averages",
             "TrackMan PGA TOUR 2023 averages (12 clubs)",
             from_shot_set(tour_averages(averages), source=str(averages)),
-            "averages over players, events and weather; straight shots; leave-one-club-out held-out",
+            "averages over players, events and weather; straight shots; the diagnosis holds out one club at a time; "
+            f"in the table's air ({KNOWN_AIR['pga-2023-table'].basis})",
+            TRAINED_ON,
         )
     )
+    return sets
+
+
+def tour_championship_sets(shared: Path) -> list[RealSet]:
+    """The TOUR Championship 2020's radar tee shots with an apex (launch, spin, apex; no spin axis, so no side), in
+    the event's air: its trainable rounds (trained on) and its held-out rounds (`shots.heldout`) as two sets."""
+    path = shared / TOUR_CHAMPIONSHIP
+    held_rounds = held_out_rounds(path)
+    assert held_rounds, "the TOUR Championship's last rounds are held out (shots.heldout)"
+    air = KNOWN_AIR["tour-championship-2020"]
+    shots = [r for r in load_pbp(path, skip_bad_rows=True).records if r.apex_m is not None]
+    caveat = (f"radar tee shots: launch, spin, apex; no spin axis recorded (0), so no side; clubs not named (par 3s: "
+              f"irons); in the event's air ({air.basis})")
+    sets = []
+    for key, held_out, use in (("trained", False, TRAINED_ON), ("heldout", True, HELD_OUT)):
+        part = [r for r in shots if (shot_round(r.shot_id) in held_rounds) == held_out]
+        numbers = sorted({shot_round(r.shot_id) for r in part})
+        span = f"{numbers[0]}-{numbers[-1]}" if len(numbers) > 1 else f"{numbers[0]}"
+        sets.append(
+            RealSet(
+                f"tour_championship_{key}",
+                f"TOUR Championship 2020 (East Lake), rounds {span}",
+                from_shot_set(ShotSet(in_air(part, air)), source=f"{path} (rounds {span})"),
+                caveat,
+                use,
+            )
+        )
     return sets
 
 
@@ -175,7 +235,7 @@ def summary_row(item: RealSet, diagnosis: Diagnosis) -> list[str]:
     held = report.heldout
     fraction = "-" if held.explained_fraction is None or not report.systematic else f"{held.explained_fraction:.0%}"
     return [
-        item.title,
+        f"{item.title} ({item.use})" if item.use else item.title,
         str(report.n_shots),
         scatter or "-",
         bias,
@@ -233,6 +293,7 @@ def main(argv: list[str] | None = None) -> int:
         rows.append(summary_row(item, diagnosis))
         details[item.key] = {
             "title": item.title,
+            "use": item.use,
             "caveat": item.caveat,
             "statement": diagnosis.report.statement,
             "located": diagnosis.report.located.summary,

@@ -7,9 +7,10 @@ import json
 
 import pytest
 
-from discovery.real import TRACKMAN, main, real_sets
-from shots.heldout import held_out_set
+from discovery.real import HELD_OUT, TOUR_CHAMPIONSHIP, TRACKMAN, TRAINED_ON, main, real_sets
+from shots.heldout import held_out_set, shot_round
 from shots.paths import shared_data_dir
+from shots.source_air import KNOWN_AIR
 
 
 def test_real_run_writes_a_summary_row_and_a_report(tmp_path):
@@ -36,3 +37,22 @@ def test_the_driver_sets_held_out_lines_are_diagnosed_on_their_own():
     lines = [int(s) for s in unseen.shot_id]
     assert min(lines) >= first == 2943
     assert len(unseen) == sum(int(s) >= first for s in every.shot_id) > 0
+
+
+def test_only_what_shots_heldout_holds_out_is_labelled_held_out():
+    """NOTES section 9: the driver lines from 2943 and the TOUR Championship's rounds 3-4 are held out; its rounds
+    1-2 and the PGA 2023 table are trained on, and are flown in their source's air (shots.source_air)."""
+    shared = shared_data_dir()
+    if not (shared / TOUR_CHAMPIONSHIP).is_file() or not (shared / TRACKMAN).is_file():
+        pytest.skip("needs the shared real data")
+    sets = {item.key: item for item in real_sets(shared)}
+    assert {k for k, item in sets.items() if item.use == HELD_OUT} == {"trackman_driver_heldout",
+                                                                        "tour_championship_heldout"}
+    for key, rounds in (("tour_championship_heldout", {3, 4}), ("tour_championship_trained", {1, 2})):
+        recordings = sets[key].recordings
+        assert {shot_round(s) for s in recordings.shot_id} == rounds
+        assert recordings.density_kg_m3 is not None
+        assert recordings.density_kg_m3 == pytest.approx(KNOWN_AIR["tour-championship-2020"].air().density_kg_m3)
+    assert sets["tour_championship_trained"].use == sets["pga_2023_averages"].use == TRAINED_ON
+    table = sets["pga_2023_averages"].recordings.density_kg_m3
+    assert table is not None and table == pytest.approx(KNOWN_AIR["pga-2023-table"].air().density_kg_m3)
