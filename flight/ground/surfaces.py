@@ -58,7 +58,7 @@ class Surface:
 
 
 SURFACES: dict[str, Surface] = {
-    "fairway": Surface(0.7061, 4.181, 0.5, 0.1149, 1.487),
+    "fairway": Surface(0.6627, 0.00067, 0.5, 0.1301, 1.321),
     "firm_fairway": Surface(1.0, 0.0, 0.4, 0.08, 0.8),
     "rough": Surface(0.55, 20.0, 0.62, 0.35, 1.5),
     "green": Surface(0.75, 20.6, 0.58, float(green_rolling_resistance(DEFAULT_STIMP_FT)), 0.0),
