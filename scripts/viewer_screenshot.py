@@ -31,7 +31,7 @@ from servers import free_port
 KEY = "screenshot-key"
 SESSION = [  # club in the page, how it is sent, launch (mph, deg, rpm), shots
     ("PW", "tcp", (102.0, 24.0, 8800.0), 4),
-    ("7 iron", "gspro-http", (120.0, 16.3, 7000.0), 4),
+    ("7-iron", "gspro-http", (120.0, 16.3, 7000.0), 4),
     ("Driver", "http", (167.0, 10.9, 2686.0), 5),
 ]
 

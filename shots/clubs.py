@@ -72,3 +72,49 @@ def club_weights() -> list[float]:
     raw = [CLUB_SHARE.get(club.name, 0.04) for club in CLUBS]
     total = sum(raw)
     return [w / total for w in raw]
+
+
+CLUB_NAMES: tuple[str, ...] = tuple(club.name for club in CLUBS)
+"""The canonical club names, longest to shortest club: what the CLI, the viewer and the API show."""
+
+_NUMBERED = {"wood": (3, 5), "iron": (3, 4, 5, 6, 7, 8, 9)}
+
+CLUB_ALIASES: dict[str, str] = {
+    **{alias: "Driver" for alias in ("driver", "dr", "d", "1w", "1wood", "w1")},
+    **{
+        alias: f"{number}-{kind}"
+        for kind, numbers in _NUMBERED.items()
+        for number in numbers
+        for alias in (f"{number}{kind}", f"{number}{kind[0]}", f"{kind[0]}{number}")
+    },
+    **{alias: "Hybrid" for alias in ("hybrid", "hy", "hyb", "h", "rescue")},
+    **{alias: "PW" for alias in ("pw", "pitchingwedge", "pitching", "p")},
+    **{alias: "GW" for alias in ("gw", "gapwedge", "gap", "aw", "approachwedge", "approach", "uw", "utilitywedge")},
+    **{alias: "SW" for alias in ("sw", "sandwedge", "sand")},
+    **{alias: "LW" for alias in ("lw", "lobwedge", "lob")},
+}
+"""What a golfer types, in `club_key` form -> the canonical name: `dr`, `3w`, `7i`, `7 iron`, `7-Iron`, `pw`, `sand
+wedge`, and the shape of GSPro's club codes (`DR`, `W3`, `I7`, `PW`, ...). Every canonical name is its own alias."""
+
+
+def club_key(text: str) -> str:
+    """A club name as the alias table looks it up: lower case, without spaces, hyphens, underscores or dots."""
+    return "".join(ch for ch in text.strip().lower() if ch not in " \t-_.")
+
+
+def canonical_club_name(text: str) -> str:
+    """The canonical name (`CLUB_NAMES`) of a club as a golfer types it (any case, `7i`, `7 iron`, `7-Iron`, `dr`,
+    `3w`, `pw`, ...); ValueError listing the accepted names if it is none of them."""
+    name = CLUB_ALIASES.get(club_key(text)) if isinstance(text, str) else None
+    if name is None:
+        raise ValueError(
+            f"unknown club {text!r}: give one of {', '.join(CLUB_NAMES)} (any case; also short forms such as dr, 3w, "
+            "7i, 7 iron, hy, pw, gw, sw, lw)"
+        )
+    return name
+
+
+def club_named(text: str) -> ClubLaunch:
+    """The club of CLUBS a golfer's name for it means (`canonical_club_name`); ValueError listing the names if none."""
+    name = canonical_club_name(text)
+    return next(club for club in CLUBS if club.name == name)

@@ -1,71 +1,265 @@
-"""`golfflight fly`: fly one shot through the reference world and print its flight."""
+"""`golfflight fly`: one shot, a club's typical launch or your own, through the served model (the bundle `serve` and
+`simulate` load: `--model DIR`, $GOLFFLIGHT_MODEL, models/default) or, with `--reference`, the reference world.
+
+The shot is checked by the HTTP contract's own request model (`service.api.models.ShotRequest`, ranges from
+`flight.limits`) before anything flies, so a value out of range is refused with the API's message, naming the
+option and the allowed range (exit 2, one line); the result has the fields of POST /v1/shots.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
+import re
 
-import numpy as np
+from pydantic import ValidationError
 
-from flight.air import Air
-from flight.constants import YARD_M
-from flight.physics import initial_state
-from flight.wind import Wind
-from shots.clubs import CLUBS
-from shots.reference_world import fly_reference
+from flight.constants import MPH_TO_MPS, YARD_M
+from flight.limits import WIND_SPEED_MPS, Range
+from shots.clubs import CLUB_NAMES, club_named
+
+WIND_SPEED_MPH = Range(WIND_SPEED_MPS.low, math.floor(WIND_SPEED_MPS.high / MPH_TO_MPS * 10) / 10, "mph")
+"""The request's wind range (`flight.limits.WIND_SPEED_MPS`, 0 to 30 m/s) in mph, for --wind-speed-mph: 0 to 67.1."""
+
+FLAGS = {
+    "ball_speed_mps": "--ball-speed-mps",
+    "ball_speed_mph": "--ball-speed-mph",
+    "launch_angle_deg": "--launch-angle-deg",
+    "launch_direction_deg": "--launch-direction-deg",
+    "spin_rpm": "--spin-rpm",
+    "spin_axis_deg": "--spin-axis-deg",
+    "back_spin_rpm": "--back-spin-rpm",
+    "side_spin_rpm": "--side-spin-rpm",
+    "air.temperature_c": "--temperature-c",
+    "air.altitude_m": "--altitude-m",
+    "air.pressure_hpa": "--pressure-hpa",
+    "air.humidity_pct": "--humidity-pct",
+    "wind.speed_mps": "--wind-speed-mps",
+    "wind.from_deg": "--wind-from-deg",
+    "wind_speed_mph": "--wind-speed-mph",
+}
+"""Request field -> the option that sets it, to name the option in a refusal."""
+
+TABLE = (
+    ("carry", "carry_m", "carry_yd"),
+    ("total", "total_m", "total_yd"),
+    ("apex", "apex_m", "apex_yd"),
+    ("lateral", "lateral_m", None),
+    ("roll", "roll_m", None),
+)
+"""Rows of the printed table with a length: (label, metres field, yards field or None: converted here)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser("fly", help="fly one shot through the reference world (a club's typical launch or your own)")
-    parser.add_argument("--club", choices=[c.name for c in CLUBS], default="Driver", help="start from this club's tour-average launch")
+    parser = subparsers.add_parser(
+        "fly",
+        help="fly one shot (a club's typical launch or your own) through the served model, or the reference world",
+        description="One shot through the model `golfflight serve` flies (or, with --reference, the reference world); "
+        "each launch value left out takes the club's tour-average launch. Values are checked against the API's "
+        "ranges (flight/limits.py).",
+    )
+    parser.add_argument(
+        "--club",
+        default="Driver",
+        help=f"start from this club's tour-average launch: {', '.join(CLUB_NAMES)} (any case), or as typed: dr, 3w, "
+        "7i, 7 iron, pw, ...",
+    )
+    parser.add_argument(
+        "--model", help="model bundle directory (default: as `golfflight serve`: $GOLFFLIGHT_MODEL, models/default)"
+    )
+    parser.add_argument("--reference", action="store_true", help="fly the reference world instead of the model")
     parser.add_argument("--ball-speed-mps", type=float)
+    parser.add_argument("--ball-speed-mph", type=float, help="instead of --ball-speed-mps")
     parser.add_argument("--launch-angle-deg", type=float)
-    parser.add_argument("--launch-direction-deg", type=float, default=0.0, help="+ = right of the target line")
-    parser.add_argument("--spin-rpm", type=float)
-    parser.add_argument("--spin-axis-deg", type=float, default=0.0, help="+ = tilted right, the ball curves right")
-    parser.add_argument("--temperature-c", type=float, default=25.0)
-    parser.add_argument("--altitude-m", type=float, default=0.0)
-    parser.add_argument("--humidity-pct", type=float, default=50.0)
-    parser.add_argument("--wind-speed-mps", type=float, default=0.0)
-    parser.add_argument("--wind-from-deg", type=float, default=0.0, help="0 = headwind, 90 = from the right, 180 = tailwind")
-    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    parser.add_argument("--launch-direction-deg", type=float, help="+ = right of the target line (default 0)")
+    parser.add_argument("--spin-rpm", type=float, help="total spin")
+    parser.add_argument("--spin-axis-deg", type=float, help="with --spin-rpm: + = tilted right, the ball curves right")
+    parser.add_argument("--back-spin-rpm", type=float, help="instead of --spin-rpm")
+    parser.add_argument("--side-spin-rpm", type=float, help="with --back-spin-rpm: + = the ball curves right")
+    parser.add_argument(
+        "--temperature-c", type=float, help="default: ICAO standard air (15 degC, sea level), as the API"
+    )
+    parser.add_argument("--altitude-m", type=float)
+    parser.add_argument("--pressure-hpa", type=float, help="station pressure, instead of --altitude-m")
+    parser.add_argument("--humidity-pct", type=float)
+    parser.add_argument("--wind-speed-mps", type=float)
+    parser.add_argument("--wind-speed-mph", type=float, help="instead of --wind-speed-mps")
+    parser.add_argument("--wind-from-deg", type=float, help="0 = headwind, 90 = from the right, 180 = tailwind")
+    parser.add_argument("--json", action="store_true", help="print JSON (the request and the POST /v1/shots result)")
     parser.set_defaults(run=run)
 
 
-def fly_one(launch: dict[str, float], air: Air, wind: Wind) -> dict[str, float]:
-    """The flight of one shot as a flat dict of SI values with yards alongside."""
-    state = initial_state(**{k: np.array([v]) for k, v in launch.items()})
-    flight = fly_reference(state, air, wind)
-    if not flight.landed[0]:
-        raise ValueError("the shot did not come down within the simulation time cap")
-    return {
-        "carry_m": float(flight.carry_m[0]),
-        "carry_yd": float(flight.carry_m[0] / YARD_M),
-        "lateral_m": float(flight.lateral_m[0]),
-        "apex_m": float(flight.apex_m[0]),
-        "apex_yd": float(flight.apex_m[0] / YARD_M),
-        "flight_time_s": float(flight.flight_time_s[0]),
-        "landing_angle_deg": float(flight.landing_angle_deg[0]),
-        "landing_speed_mps": float(flight.landing_speed_mps[0]),
-        "landing_spin_rpm": float(flight.landing_spin_rpm[0]),
+def _one_of(args: argparse.Namespace, quantity: str, *names: str) -> None:
+    given = [name for name in names if getattr(args, name) is not None]
+    if len(given) > 1:
+        flags = [f"--{name.replace('_', '-')}" for name in names]
+        raise ValueError(f"{quantity}: give {' or '.join(flags)}, not both")
+
+
+def _with_flags(text: str) -> str:
+    """A message with every request field it names replaced by the option that sets it."""
+    by_name = {field.rsplit(".", 1)[-1]: flag for field, flag in FLAGS.items()}
+    names = sorted(by_name, key=len, reverse=True)
+    return re.sub(r"\b(" + "|".join(names) + r")\b", lambda m: by_name[m.group(1)], text)
+
+
+def _refusal(errors: list[dict]) -> str:
+    """The API's 422 messages on one line (` | ` between them), each naming the option instead of the request
+    field."""
+    problems = []
+    for detail in errors:
+        field, message = detail["field"], detail["message"]
+        if field in FLAGS and message.startswith(f"{field}:"):
+            problems.append(FLAGS[field] + message.removeprefix(field))
+        elif field == "body" or detail["msg"].startswith(f"{field}:"):  # the message names what it is about
+            problems.append(_with_flags(detail["msg"]))
+        else:
+            problems.append(_with_flags(message))
+    return " | ".join(problems)
+
+
+def wind_speed_mps(args: argparse.Namespace) -> float | None:
+    """The wind speed in m/s from --wind-speed-mps or --wind-speed-mph (the latter checked as the API checks a
+    field, against WIND_SPEED_MPH), or None when neither was given."""
+    if args.wind_speed_mph is None:
+        return args.wind_speed_mps
+    from pydantic import Field, create_model
+
+    from service.api.models import Strict, describe_errors
+
+    bounds = WIND_SPEED_MPH
+    in_mph = create_model("WindInMph", __base__=Strict, wind_speed_mph=(float, Field(ge=bounds.low, le=bounds.high)))
+    try:
+        in_mph.model_validate({"wind_speed_mph": args.wind_speed_mph})
+    except ValidationError as error:
+        details = describe_errors(error.errors(), {"wind_speed_mph": bounds})
+        raise ValueError(_refusal([{**d, "field": "wind_speed_mph"} for d in details])) from None
+    return args.wind_speed_mph * MPH_TO_MPS
+
+
+def request_of(args: argparse.Namespace) -> tuple[str, dict]:
+    """(the club's canonical name, the POST /v1/shots request of the options): values left out take the club's
+    launch; the air and wind are left out when no option sets them (ICAO standard air, calm, as the API)."""
+    club = club_named(args.club)
+    _one_of(args, "ball speed", "ball_speed_mps", "ball_speed_mph")
+    _one_of(args, "spin", "spin_rpm", "back_spin_rpm")
+    _one_of(args, "wind speed", "wind_speed_mps", "wind_speed_mph")
+    shot: dict = {}
+    if args.ball_speed_mph is not None:
+        shot["ball_speed_mph"] = args.ball_speed_mph
+    else:
+        shot["ball_speed_mps"] = args.ball_speed_mps if args.ball_speed_mps is not None else club.ball_speed_mps
+    shot["launch_angle_deg"] = args.launch_angle_deg if args.launch_angle_deg is not None else club.launch_angle_deg
+    if args.launch_direction_deg is not None:
+        shot["launch_direction_deg"] = args.launch_direction_deg
+    if args.back_spin_rpm is not None or (args.spin_rpm is None and args.side_spin_rpm is not None):
+        shot["back_spin_rpm"] = args.back_spin_rpm if args.back_spin_rpm is not None else club.spin_rpm
+    else:
+        shot["spin_rpm"] = args.spin_rpm if args.spin_rpm is not None else club.spin_rpm
+    for name in ("spin_axis_deg", "side_spin_rpm"):
+        if getattr(args, name) is not None:
+            shot[name] = getattr(args, name)
+    air = {
+        name: getattr(args, name)
+        for name in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct")
+        if getattr(args, name) is not None
     }
+    if air:
+        shot["air"] = air
+    speed = wind_speed_mps(args)
+    if speed is not None or args.wind_from_deg is not None:
+        shot["wind"] = {"speed_mps": 0.0 if speed is None else speed}
+        if args.wind_from_deg is not None:
+            shot["wind"]["from_deg"] = args.wind_from_deg
+    return club.name, shot
+
+
+def checked(shot: dict):
+    """The validated ShotRequest, or ValueError with the API's messages naming the options."""
+    from service.api.models import ShotRequest, describe_errors
+
+    try:
+        return ShotRequest.model_validate(shot)
+    except ValidationError as error:
+        raise ValueError(_refusal(describe_errors(error.errors()))) from None
+
+
+def fly_reference_shot(shot) -> dict:
+    """A checked request flown through the reference world and rolled to rest on the level fairway (the engine's
+    ground phase): the POST /v1/shots result fields."""
+    import numpy as np
+
+    from flight.air import Air
+    from flight.ground import LEVEL_FAIRWAY, ground_phase_one
+    from flight.physics import initial_state
+    from service.api.shots import air_of, conditions_of, flight_fields, launch_of
+    from service.engine import Rest, ShotFlight
+    from shots.reference_world import fly_reference
+
+    air = air_of(shot.air)
+    conditions = conditions_of(shot)
+    state = initial_state(*(np.array([value], dtype=float) for value in launch_of(shot)))
+    flight = fly_reference(state, Air(air.density_kg_m3, air.kinematic_viscosity_m2_s), conditions.wind)
+    if not flight.landed[0]:
+        raise ValueError("the shot did not come down within the reference world's simulation time cap")
+    position, velocity, spin = (tuple(a[0].tolist()) for a in (flight.landing_position, flight.landing_velocity,
+                                                               flight.landing_spin))
+    carry = float(flight.carry_m[0])
+    one = ground_phase_one(position, velocity, spin, LEVEL_FAIRWAY.surface)
+    x, y, _ = one.position
+    total = math.hypot(x, y)
+    result = ShotFlight(
+        landing_x_m=position[0], landing_y_m=position[1], carry_m=carry, lateral_m=position[0],
+        apex_m=float(flight.apex_m[0]), apex_time_s=float(flight.apex_time_s[0]),
+        flight_time_s=float(flight.flight_time_s[0]), landing_angle_deg=float(flight.landing_angle_deg[0]),
+        landing_speed_mps=float(flight.landing_speed_mps[0]), landing_spin_rpm=float(flight.landing_spin_rpm[0]),
+        rest=Rest(x, y, total, total - carry, one.bounces, one.time_s),
+    )
+    fields = flight_fields(result, None)
+    fields["landing"], fields["rest"] = (point.model_dump() for point in (fields["landing"], fields["rest"]))
+    return {key: value for key, value in fields.items() if value is not None}
+
+
+def fly_model_shot(shot, model: str | None) -> tuple[dict, dict]:
+    """A checked request flown by the served model as POST /v1/shots flies it: (the result, the model's identity)."""
+    from service.api.shots import fly_shot
+    from service.engine import FlightEngine, FlightError
+    from service.model_location import model_dir
+
+    engine = FlightEngine(model_dir(model))
+    try:
+        result = fly_shot(engine, shot)
+    except FlightError as error:
+        raise ValueError(str(error)) from None
+    identity = {"bundle": str(engine.bundle_dir), "variant": engine.variant, "sha256": engine.sha256}
+    return result.model_dump(exclude_none=True), identity
 
 
 def run(args: argparse.Namespace) -> int:
-    club = next(c for c in CLUBS if c.name == args.club)
-    launch = {
-        "ball_speed_mps": args.ball_speed_mps if args.ball_speed_mps is not None else club.ball_speed_mps,
-        "launch_angle_deg": args.launch_angle_deg if args.launch_angle_deg is not None else club.launch_angle_deg,
-        "launch_direction_deg": args.launch_direction_deg,
-        "spin_rpm": args.spin_rpm if args.spin_rpm is not None else club.spin_rpm,
-        "spin_axis_deg": args.spin_axis_deg,
-    }
-    air = Air.from_conditions(args.temperature_c, args.altitude_m, args.humidity_pct)
-    result = fly_one(launch, air, Wind(args.wind_speed_mps, args.wind_from_deg))
+    club, request = request_of(args)
+    shot = checked(request)
+    if args.reference:
+        result, source = fly_reference_shot(shot), {"world": "reference"}
+    else:
+        result, source = fly_model_shot(shot, args.model)
     if args.json:
-        print(json.dumps({"launch": launch, "flight": result}, indent=2))
+        print(json.dumps({"club": club, "model": source, "request": request, "flight": result}, indent=2))
         return 0
-    print(f"{args.club}: " + ", ".join(f"{k} {v:g}" for k, v in launch.items()))
-    for key, value in result.items():
-        print(f"  {key:<20} {value:9.2f}")
+    flown_by = "the reference world" if args.reference else f"{source['variant']} model {source['bundle']}"
+    launch = ", ".join(f"{key} {value:g}" for key, value in request.items() if isinstance(value, float))
+    for part, values in request.items():
+        if isinstance(values, dict):
+            launch += f"; {part} " + ", ".join(f"{key} {value:g}" for key, value in values.items())
+    print(f"{club} ({flown_by}): {launch}")
+    for label, metres, yards in TABLE:
+        value = result[metres] + 0.0  # no -0.0
+        in_yards = result[yards] if yards else value / YARD_M
+        print(f"  {label:<18} {value:8.1f} m {in_yards:8.1f} yd")
+    print(f"  {'landing angle':<18} {result['landing_angle_deg']:8.1f} deg")
+    print(f"  {'flight time':<18} {result['flight_time_s']:8.2f} s   apex at {result['apex_time_s']:.2f} s")
+    speed = result["landing_speed_mps"]
+    print(f"  {'landing speed':<18} {speed:8.1f} m/s {speed / MPH_TO_MPS:6.1f} mph")
+    print(f"  {'landing spin':<18} {result['landing_spin_rpm']:8.0f} rpm")
+    print(f"  {'bounces':<18} {result['bounces']:8d}")
     return 0

@@ -1,13 +1,34 @@
-"""The viewer page and its script and style, shipped in `static/` (package data) and read once at import."""
+"""The viewer page and its script and style, shipped in `static/` (package data) and read once at import; the page's
+club menu is filled in from the one club-name table (`shots.clubs.CLUB_NAMES`), so it names the clubs as
+`golfflight fly --club` does."""
 
 from __future__ import annotations
 
+from html import escape
 from importlib.resources import files
+
+from shots.clubs import CLUB_NAMES
 
 PAGE_PATH = "/viewer"
 
+CLUB_OPTIONS_MARKER = b"<!-- club options: shots.clubs.CLUB_NAMES, filled in by service/viewer/page.py -->"
+
+
+def with_club_options(page: bytes) -> bytes:
+    """The page with its club menu's options, one per canonical club name."""
+    if page.count(CLUB_OPTIONS_MARKER) != 1:
+        raise RuntimeError("viewer.html has lost its club options marker")
+    options = "".join(f"<option>{escape(name)}</option>" for name in CLUB_NAMES).encode()
+    return page.replace(CLUB_OPTIONS_MARKER, options)
+
+
+def _read(name: str) -> bytes:
+    content = files(__package__).joinpath("static", name).read_bytes()
+    return with_club_options(content) if name == "viewer.html" else content
+
+
 ASSETS: dict[str, tuple[bytes, str]] = {
-    name: (files(__package__).joinpath("static", name).read_bytes(), media_type)
+    name: (_read(name), media_type)
     for name, media_type in (
         ("viewer.html", "text/html; charset=utf-8"),
         ("viewer.js", "text/javascript; charset=utf-8"),
