@@ -10,8 +10,9 @@ of the routes: a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and
 ($GOLFFLIGHT_CORS_ORIGINS); every refusal is a 4xx whose body names the field, the value and the allowed range
 (`service.api.errors`). Given a connect address, the lifespan also opens GSPro Open Connect over TCP on the same
 loop (`service.open_connect`). Every shot flown, from any input, goes to the live viewer's feed (GET /viewer,
-`service.viewer`). The outermost middleware counts and times every request for GET /metrics (Prometheus) and
-/v1/latency (`service.api.request_metrics`).
+`service.viewer`). /docs loads its script and style from an installed package, not a CDN (`routes.docs`; ReDoc
+is off). The outermost middleware counts and times every request for GET /metrics (Prometheus) and /v1/latency
+(`service.api.request_metrics`).
 """
 
 from __future__ import annotations
@@ -24,12 +25,12 @@ from importlib.metadata import version
 
 from fastapi import FastAPI
 from fastapi.middleware.cors import CORSMiddleware
-from starlette.routing import Route
+from starlette.routing import Mount, Route
 
 from service.api import errors
 from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
 from service.api.request_metrics import RequestMetrics
-from service.api.routes import gspro, metrics, shots, status, viewer
+from service.api.routes import docs, gspro, metrics, shots, status, viewer
 from service.api.state import ServiceState
 from service.model_location import model_dir
 from service.open_connect.server import ConnectAddress, OpenConnectServer
@@ -73,6 +74,8 @@ def create_app(
         version=version("golfflight"),
         summary="Golf ball flights from launch-monitor data: Phys-NN+ (a network inside the equations of motion).",
         lifespan=lifespan,
+        docs_url=None,  # served by service.api.routes.docs from packaged files, not a CDN
+        redoc_url=None,  # ReDoc's bundle fetches its logo from a CDN
     )
     app.state.service = state
     if api_key:
@@ -86,10 +89,13 @@ def create_app(
         )
     app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)
     errors.install(app)
-    routers = (shots.router, gspro.router, status.router, metrics.router, viewer.router)
+    routers = (shots.router, gspro.router, status.router, metrics.router, viewer.router, docs.router)
     for router in routers:
         app.include_router(router)
-    routes = [route for router in routers for route in router.routes] + [r for r in app.routes if isinstance(r, Route)]
+    docs.mount_assets(app)
+    routes = [route for router in routers for route in router.routes] + [
+        r for r in app.routes if isinstance(r, (Route, Mount))
+    ]
     simulation_routes = {"/v1/shots", "/v1/shots/batch", gspro.GSPRO_PATH}
     app.add_middleware(
         RequestMetrics, metrics=state.metrics, routes=routes, rolling=state.requests, timed_routes=simulation_routes

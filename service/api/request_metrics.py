@@ -21,13 +21,16 @@ METHODS = frozenset({"GET", "HEAD", "POST", "PUT", "PATCH", "DELETE", "OPTIONS"}
 """Method labels kept as sent; any other method is labelled `other`."""
 
 
-def route_template(routes: list[BaseRoute], scope: dict) -> str:
+def route_template(routes: list[BaseRoute], scope: dict, path: tuple[str, str] | None = None) -> str:
     """The path template of the route that serves `scope`: the one the router chose, or, for a request answered
-    before routing (a guard's refusal), the first of `routes` (every route of the app, each with its whole path)
-    that matches it."""
+    before routing (a guard's refusal) or by a mount (whose scope the router leaves without a route, its path
+    rebased), the first of `routes` (every route of the app, each with its whole path) that matches `path`, the
+    request's (path, root_path) as it came in."""
     chosen = getattr(scope.get("route"), "path", None)
     if chosen is not None:
         return chosen
+    if path is not None:
+        scope = {**scope, "path": path[0], "root_path": path[1]}
     for route in routes:
         match, _ = route.matches(scope)
         if match is not Match.NONE:
@@ -55,12 +58,13 @@ class RequestMetrics:
                 status = message["status"]
             await send(message)
 
+        path = scope["path"], scope.get("root_path", "")  # a mount rebases the scope's own
         started = time.perf_counter()
         try:
             await self.app(scope, receive, send_and_note_status)
         finally:
             seconds = time.perf_counter() - started
-            route = route_template(self.routes, scope)
+            route = route_template(self.routes, scope, path)
             method = scope["method"] if scope["method"] in METHODS else "other"
             self.metrics.requests.labels(route, method, str(status)).inc()
             self.metrics.request_seconds.labels(route, method).observe(seconds)
