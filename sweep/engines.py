@@ -8,9 +8,13 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import re
+import sys
+import threading
 from collections import deque
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 
 from sweep.flyer import Flyer
 
@@ -56,6 +60,83 @@ def local_tables(source, bundle_dir: str, sha256: str, workers: int) -> Iterator
         pool.shutdown(wait=True, cancel_futures=True)
 
 
+RAY_NOISE = (b"has constructor arguments in the object store and max_restarts > 0",)
+"""Lines Ray's core worker prints in the driver (to its standard error, from C++: no logger to quiet) on every run,
+about Ray Data's own actors, not the sweep's: Ray Data hands each actor of its pool its context and transform as
+object references and lets it restart (ray-project/ray#53727). The sweep drops exactly these lines."""
+
+LOG_HEAD = b"[dddd-dd-dd dd:dd:dd,ddd "
+"""How a line of Ray's C++ log starts (`[2026-11-26 05:44:54,560 E 27196 27196] core_worker.cc:...`), d a digit."""
+
+
+def _noise_lines(noise: tuple[bytes, ...]):
+    head = re.escape(LOG_HEAD).replace(b"d", rb"\d")
+    return re.compile(head + rb"[^\n]*?(?:" + b"|".join(re.escape(n) for n in noise) + rb")[^\n]*\n")
+
+
+def _log_head_at(data: bytes, at: int) -> bool:
+    """Whether a C++ log line starts, or may start (the data ends first), at `at`."""
+    for char, want in zip(data[at : at + len(LOG_HEAD)], LOG_HEAD, strict=False):
+        if not (chr(char).isdigit() if want == ord("d") else char == want):
+            return False
+    return True
+
+
+def _unfinished_log_line(data: bytes) -> int:
+    """Where an unfinished C++ log line begins in `data` (after its last newline), or len(data)."""
+    at = data.rfind(b"\n") + 1
+    while (at := data.find(b"[", at)) >= 0:
+        if _log_head_at(data, at):
+            return at
+        at += 1
+    return len(data)
+
+
+@contextmanager
+def ray_noise_filtered(noise: tuple[bytes, ...] = RAY_NOISE):
+    """Standard error (file descriptor 2, which C++ writes to as well as Python) passed on through a pipe less Ray's
+    log lines that hold one of `noise`; everything else, Ray's real errors included, goes through as it comes. Only
+    the start of a C++ log line waits for the line's end (a progress bar's updates, ended by carriage returns, and
+    Python's lines are passed on at once)."""
+    try:
+        sys.stderr.flush()
+        original = os.dup(2)
+    except (OSError, ValueError):  # no file descriptor 2 to filter
+        yield
+        return
+    dropped = _noise_lines(noise)
+    read_end, write_end = os.pipe()
+    os.dup2(write_end, 2)
+    os.close(write_end)
+
+    def send(data: bytes) -> None:
+        while data:
+            data = data[os.write(original, data) :]
+
+    def forward() -> None:
+        held = b""
+        while chunk := os.read(read_end, 65536):
+            held = dropped.sub(b"", held + chunk)
+            cut = _unfinished_log_line(held)
+            send(held[:cut])
+            held = held[cut:]
+        send(held)
+
+    thread = threading.Thread(target=forward, name="ray-stderr-filter", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        try:
+            sys.stderr.flush()
+        finally:
+            os.dup2(original, 2)  # the pipe's last write end in this process: the thread reads to its end
+            thread.join(timeout=5)  # a process Ray left running that inherited it would hold it open
+            if not thread.is_alive():
+                os.close(read_end)
+            os.close(original)
+
+
 def ray_tables(source, bundle_dir: str, sha256: str, workers: int, address: str | None) -> Iterator:
     """Result tables of `source`'s pieces through Ray Data: `map_batches` with `Flyer` as a callable class on a pool
     of `workers` actors of one CPU each, order preserved. Connects to the cluster at `address` if given (and leaves
@@ -66,11 +147,16 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int, address: str 
     import ray
     import ray.data
 
-    from sweep.ray_input import PiecesDatasource
-
     if "RAY_DATA_LOG_LEVEL" not in os.environ:  # Ray Data's INFO lines and its note that our tqdm replaced its bars
         logging.getLogger("ray.data").setLevel(logging.WARNING)
         logging.getLogger("ray.data._internal.progress").setLevel(logging.ERROR)
+    with ray_noise_filtered():
+        yield from _ray_tables(ray, source, bundle_dir, sha256, workers, address)
+
+
+def _ray_tables(ray, source, bundle_dir: str, sha256: str, workers: int, address: str | None) -> Iterator:
+    from sweep.ray_input import PiecesDatasource
+
     started = not ray.is_initialized()
     if started:
         ray.init(
@@ -84,8 +170,9 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int, address: str 
         context.execution_options.preserve_order = True
         context.enable_progress_bars = False
         # The read task's worker exits when the input has been read (max_calls=1) instead of idling to the end with
-        # Ray Data imported and the pieces it wrote: about 240 MB of RSS less for the rest of the sweep.
-        read = ray.data.read_datasource(PiecesDatasource(source), ray_remote_args={"max_calls": 1})
+        # Ray Data imported and the pieces it wrote: about 240 MB of RSS less for the rest of the sweep. The named
+        # parameter of the Ray the `ray` extra pins (its ray_remote_args is deprecated there and goes away in 2.64).
+        read = ray.data.read_datasource(PiecesDatasource(source), max_calls=1)
         dataset = read.map_batches(
             Flyer,
             fn_constructor_args=(bundle_dir, sha256, source),

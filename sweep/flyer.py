@@ -10,10 +10,19 @@ for the driver to report with the row's place in the input (only the driver know
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property
 
-from service.columns import TEXT_COLUMNS, cell_value, check, is_flag_set, request_of_cells, result_columns
+from service.columns import (
+    REQUEST_COLUMNS,
+    TEXT_COLUMNS,
+    cell_value,
+    check,
+    is_flag_set,
+    request_of_cells,
+    result_columns,
+)
 
 PROBLEM = "problem"
 """Column of a worker's table: why the request model refused the row (lines), null for a row that flew."""
@@ -63,6 +72,24 @@ def _number(value) -> float | None:
     return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
 
 
+NUMERIC_REQUEST_COLUMNS = tuple(c for c in REQUEST_COLUMNS if c not in TEXT_COLUMNS and c != "normalized")
+"""The request's number columns, where a NaN (a Parquet float, or a CSV cell reading NaN) is refused as not a
+number."""
+
+
+def problems_of(cells: dict):
+    """The validated request of one row's cells, or its problems: the request model's, each naming its column, with
+    a NaN cell said to be "not a number" (the model would call it not finite)."""
+    checked = check(request_of_cells(cells))
+    if not isinstance(checked, list):
+        return checked
+    nan = [c for c in NUMERIC_REQUEST_COLUMNS if isinstance(cells.get(c), float) and math.isnan(cells[c])]
+    if not nan:
+        return checked
+    named = tuple(f"column '{c}':" for c in nan)
+    return [f"column '{c}': not a number (got NaN)" for c in nan] + [p for p in checked if not p.startswith(named)]
+
+
 def echo(column: str, value):
     """An input cell as its results column holds it: text, a flag, or a number (None where blank)."""
     if column in TEXT_COLUMNS:
@@ -105,7 +132,7 @@ class Flyer:
         shots, flown = [], []
         for i, values in enumerate(zip(*columns.values(), strict=True)):
             cells = {column: cell_value(value) for column, value in zip(layout.columns, values, strict=True)}
-            checked = check(request_of_cells(cells))
+            checked = problems_of(cells)
             if isinstance(checked, list):
                 problems[i] = "\n".join(checked)
             else:
@@ -117,8 +144,11 @@ class Flyer:
         out = {}
         for name, column in zip(layout.echoed, layout.columns, strict=True):
             out[name] = _echoed(table[column], columns[column], column, flew, schema.field(name).type)
-        flights = fly_columns(self.engine, shots)
+        flights = fly_columns(self.engine, shots) if shots else None  # a chunk of invalid rows only flies nothing
         for name in layout.results:
+            if flights is None:
+                out[name] = pa.nulls(n, schema.field(name).type)
+                continue
             if name == "error":
                 errors: list[str | None] = [None] * n
                 for i, error in zip(flown, flights.errors, strict=True):

@@ -4,7 +4,7 @@ one Parquet file, whole or not at all.
 Memory stays bounded: each result table is written as a row group as soon as it arrives (pyarrow's ParquetWriter)
 and dropped. A row the request model refuses stops the sweep with every problem of that piece, each naming the
 row's place in the input, its column and the allowed range, and nothing is written; with `skip_bad_rows` such rows
-are left out and each is reported. The file is written beside its target and renamed over it at the end
+are left out and each is reported, and a piece of which no row is valid is skipped whole (and counted). The file is written beside its target and renamed over it at the end
 (`shots.files.write_atomic`).
 """
 
@@ -32,6 +32,10 @@ class Summary:
     rows: int
     written: int
     skipped: int
+    chunks: int
+    """Pieces (chunks of rows) read."""
+    chunks_skipped: int
+    """Pieces of which no row was valid, skipped whole (`skip_bad_rows`)."""
     failed: int
     """Shots the engine could not fly to the ground (their `error` column says why)."""
     seconds: float
@@ -82,7 +86,7 @@ def run_sweep(
 
     started = time.perf_counter()
     schema = Layout(tuple(source.columns)).schema()
-    counts = {"rows": 0, "written": 0, "skipped": 0, "failed": 0}
+    counts = {"rows": 0, "written": 0, "skipped": 0, "chunks": 0, "chunks_skipped": 0, "failed": 0}
 
     def write(path: str) -> None:
         tables = _tables(source, engine, workers, model, ray_address)
@@ -92,18 +96,23 @@ def run_sweep(
                 start, count = counts["rows"], table.num_rows
                 table = table.add_column(0, ROW, pa.array(range(start, start + count), pa.int64()))
                 problems = _refused(source, table, start)
+                none_valid = count > 0 and table[PROBLEM].null_count == 0
                 if problems and not skip_bad_rows:
                     shown = "\n  ".join(problems[:SHOWN_PROBLEMS])
                     more = f"\n  ... and {len(problems) - SHOWN_PROBLEMS} more" if len(problems) > SHOWN_PROBLEMS else ""
+                    whole = f"none of the {count} rows is valid; " if none_valid else ""
                     raise ValueError(
-                        f"{len(problems)} invalid values in rows {start} to {start + count - 1} (nothing written; "
-                        f"--skip-bad-rows flies the rest):\n  {shown}{more}"
+                        f"{len(problems)} invalid values in rows {start} to {start + count - 1} ({whole}nothing "
+                        f"written; --skip-bad-rows flies the rest):\n  {shown}{more}"
                     )
                 for problem in problems:
                     skipped(problem)
                 if problems:
                     table = table.filter(pc.is_null(table[PROBLEM]))
-                writer.write_table(table.drop_columns([PROBLEM]))
+                if table.num_rows:
+                    writer.write_table(table.drop_columns([PROBLEM]))
+                counts["chunks"] += 1
+                counts["chunks_skipped"] += int(none_valid)
                 counts["rows"] += count
                 counts["written"] += table.num_rows
                 counts["skipped"] += count - table.num_rows

@@ -214,13 +214,17 @@ def test_a_file_that_cannot_be_swept_gets_one_line(tmp_path, capsys, content, me
     assert "one of the two" in capsys.readouterr().err
 
 
-def test_ray_sweep_with_two_actors_equals_simulate(launches, tmp_path):
+def test_ray_sweep_with_two_actors_equals_simulate(launches, tmp_path, capfd, recwarn):
     """The command starts a local Ray instance (2 actors, a CPU for the read task) and stops it after. Both engines
     read every source through the same `pieces()` and fly it with the same `Flyer`, so one CSV of 300 rows in 5
-    chunks over 2 actors stands for the sources here."""
+    chunks over 2 actors stands for the sources here. No deprecated Ray argument (`ray_remote_args`, gone in Ray
+    2.64) and no `E ... core_worker` line about Ray Data's own actors on standard error."""
     ray = pytest.importorskip("ray")
     source, _, expected = launches
     out = tmp_path / "csv.parquet"
     assert sweep(source, "--out", out, "--engine", "ray", "--workers", 2, "--chunk-rows", 64) == 0
     assert not ray.is_initialized()
+    err = capfd.readouterr().err
+    assert "core_worker" not in err and "max_restarts" not in err, err
+    assert not [w for w in recwarn if "ray_remote_args" in str(w.message)]
     assert_same_as_simulate(pq.read_table(out).to_pylist(), expected)

@@ -10,8 +10,12 @@ Needs the `sweep` extra (pyarrow, tqdm), and the `ray` extra for `--engine ray`.
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
+
+EXTRAS = {"sweep": ("pyarrow", "tqdm"), "ray": ("ray.data",)}
+"""The modules each extra brings: the serving install (`pip install .`, the Docker image) has none of them."""
 
 CHUNK_ROWS = 8192
 """Shots a worker flies in one engine batch: large enough that the per-step ONNX call is spread over many shots."""
@@ -39,12 +43,28 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(run=run)
 
 
+def require_extras(*extras: str) -> None:
+    """Refuse in one line, naming the extra to install, unless every module of `extras` imports (a missing one would
+    otherwise surface as a ModuleNotFoundError's traceback in the middle of the sweep)."""
+    for extra in extras:
+        for module in EXTRAS[extra]:
+            try:
+                importlib.import_module(module)
+            except ImportError as missing:
+                who = "--engine ray needs" if extra == "ray" else "needs"
+                raise ValueError(
+                    f"{who} the {extra} extra, which is not installed (no {missing.name or module}): "
+                    f"pip install 'golfflight[{extra}]'"
+                ) from None
+
+
 def run(args: argparse.Namespace) -> int:
     try:
         from sweep.run import run_sweep
         from sweep.sources import open_source
-    except ImportError as missing:  # the serving install and image carry neither pyarrow nor the sweep package
+    except ImportError as missing:  # an install without the sweep package
         raise ValueError(f"needs the sweep extra: pip install 'golfflight[sweep]' ({missing})") from None
+    require_extras("sweep", *(["ray"] if args.engine == "ray" else []))
 
     if args.workers < 1 or args.chunk_rows < 1:
         raise ValueError("--workers and --chunk-rows take a whole number of at least 1")
@@ -62,8 +82,13 @@ def run(args: argparse.Namespace) -> int:
         progress=not args.no_progress,
         skipped=lambda problem: print(f"golfflight sweep: skipped: {problem}", file=sys.stderr),
     )
+    whole = (
+        f", {summary.chunks_skipped:,} of {summary.chunks:,} chunks skipped whole for want of a valid row"
+        if summary.chunks_skipped
+        else ""
+    )
     print(
-        f"golfflight sweep: {summary.written:,} shots written to {args.out} ({summary.skipped:,} rows skipped, "
+        f"golfflight sweep: {summary.written:,} shots written to {args.out} ({summary.skipped:,} rows skipped{whole}, "
         f"{summary.failed:,} could not be flown) in {summary.seconds:.1f} s: {summary.shots_per_second:,.0f} shots/s "
         f"on {args.engine} with {args.workers} workers"
     )
