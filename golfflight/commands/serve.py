@@ -6,7 +6,9 @@ verified completely before any worker starts; SIGTERM or Ctrl-C lets in-flight r
 GRACEFUL_SHUTDOWN_S) before the workers exit. --connect-port also takes GSPro Open Connect over TCP in the same
 process (`service.open_connect`), on loopback unless --connect-host says otherwise: the protocol has no key.
 Several workers share their Prometheus metrics through files in $PROMETHEUS_MULTIPROC_DIR (a temporary directory
-unless set), so GET /metrics answers for the whole server whichever worker takes the scrape.
+unless set), so GET /metrics answers for the whole server whichever worker takes the scrape. --bay FILE keeps the
+simulator bay's conditions (air, wind, ground, units: GET/PUT /v1/bay, `service.api.bay`) there across restarts;
+a file that is not bay conditions stops the start with one line naming it and the field.
 """
 
 from __future__ import annotations
@@ -47,6 +49,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default="127.0.0.1",
         help="interface for --connect-port (Open Connect has no authentication: keep loopback where you can)",
     )
+    parser.add_argument(
+        "--bay",
+        metavar="FILE",
+        help="the simulator bay's conditions (JSON: air, wind, ground, units as GET /v1/bay shows them): what Open "
+        "Connect shots and shots without conditions of their own fly in; PUT /v1/bay changes them and writes FILE "
+        "(created if missing)",
+    )
     parser.set_defaults(run=run)
 
 
@@ -73,6 +82,7 @@ def run(args: argparse.Namespace) -> int:
     import uvicorn
 
     from flight.bundle_check import verify_bundle
+    from service.api.bay import BAY_FILE_ENV, Bay
     from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
     from service.api.metrics import shared_across_workers
     from service.model_location import MODEL_ENV, model_dir
@@ -85,6 +95,9 @@ def run(args: argparse.Namespace) -> int:
     bundle = model_dir(args.model).resolve()
     card = verify_bundle(bundle)  # refuse a bad bundle here, before any worker starts
     os.environ[MODEL_ENV] = str(bundle)  # the factory in every worker process reads these
+    if args.bay:
+        bay = Bay(args.bay).conditions  # refuse a bad bay file here, before any worker starts
+        os.environ[BAY_FILE_ENV] = os.path.abspath(args.bay)
     if args.cors_origin:
         os.environ[CORS_ORIGINS_ENV] = ",".join(args.cors_origin)
     connect = "off"
@@ -97,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
         f"golfflight serve: {card.variant} model from {bundle} on http://{args.host}:{args.port} (docs at /docs), "
         f"{args.workers} worker(s), API key {'required' if keyed else 'off'}, "
         f"CORS {os.environ.get(CORS_ORIGINS_ENV) or 'off'}, GSPro Open Connect {connect}"
+        + (f", bay {args.bay} ({bay.model_dump_json(exclude_none=True)})" if args.bay else "")
     )
     if not keyed and not _loopback(args.host):
         print(

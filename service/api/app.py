@@ -10,7 +10,8 @@ of the routes: a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and
 ($GOLFFLIGHT_CORS_ORIGINS); every refusal is a 4xx whose body names the field, the value and the allowed range
 (`service.api.errors`). Given a connect address, the lifespan also opens GSPro Open Connect over TCP on the same
 loop (`service.open_connect`). Every shot flown, from any input, goes to the live viewer's feed (GET /viewer,
-`service.viewer`). /docs loads its script and style from an installed package, not a CDN (`routes.docs`; ReDoc
+`service.viewer`). GET/PUT /v1/bay hold the simulator bay's air, wind and ground, which Open Connect shots and shots
+without conditions of their own fly in (`service.api.bay`). /docs loads its script and style from an installed package, not a CDN (`routes.docs`; ReDoc
 is off). The outermost middleware counts and times every request for GET /metrics (Prometheus) and /v1/latency
 (`service.api.request_metrics`).
 """
@@ -28,8 +29,10 @@ from fastapi.middleware.cors import CORSMiddleware
 from starlette.routing import Mount, Route
 
 from service.api import errors
+from service.api.bay import BAY_FILE_ENV, Bay
 from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
 from service.api.request_metrics import RequestMetrics
+from service.api.routes import bay as bay_routes
 from service.api.routes import docs, gspro, metrics, shots, status, viewer
 from service.api.state import ServiceState
 from service.model_location import model_dir
@@ -46,13 +49,17 @@ def create_app(
     api_key: str | None = None,
     cors_origins: list[str] | None = None,
     connect: ConnectAddress | None = None,
+    bay: str | os.PathLike | None = None,
 ) -> FastAPI:
     """The service for a model bundle (default: `service.model_location.model_dir()`).
 
     `api_key` (default $GOLFFLIGHT_API_KEY) makes every route but /healthz require it; `cors_origins` (default the
     comma-separated $GOLFFLIGHT_CORS_ORIGINS) are the browser origins allowed; none means CORS stays off. `connect`
-    (default from $GOLFFLIGHT_CONNECT_PORT and _HOST) also listens for GSPro Open Connect over TCP there."""
-    state = ServiceState(model_dir(model))
+    (default from $GOLFFLIGHT_CONNECT_PORT and _HOST) also listens for GSPro Open Connect over TCP there. `bay`
+    (default $GOLFFLIGHT_BAY_FILE) is the file the bay's conditions are kept in (`service.api.bay`); none keeps them
+    in memory only."""
+    bay = bay if bay is not None else os.environ.get(BAY_FILE_ENV) or None
+    state = ServiceState(model_dir(model), Bay(bay))
     api_key = api_key if api_key is not None else os.environ.get(API_KEY_ENV, "")
     cors_origins = cors_origins if cors_origins is not None else _origins(os.environ.get(CORS_ORIGINS_ENV))
     connect = connect if connect is not None else ConnectAddress.from_env()
@@ -89,7 +96,7 @@ def create_app(
         )
     app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)
     errors.install(app)
-    routers = (shots.router, gspro.router, status.router, metrics.router, viewer.router, docs.router)
+    routers = (shots.router, gspro.router, bay_routes.router, status.router, metrics.router, viewer.router, docs.router)
     for router in routers:
         app.include_router(router)
     docs.mount_assets(app)

@@ -17,10 +17,10 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from flight import limits
 from flight.constants import MPH_TO_MPS
-from flight.ground import LEVEL_FAIRWAY
 from flight.limits import Range
 from service.api.models import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotResult, describe_errors
-from service.api.shots import flight_fields, spin_from_components
+from service.api.bay import BayConditions
+from service.api.shots import conditions_from, flight_fields, ground_of, spin_from_components
 from service.engine import FlightEngine, FlightError, Launch
 
 
@@ -153,11 +153,14 @@ def invalid_message(errors: list) -> str:
     return "; ".join(detail["message"] for detail in describe_errors(errors, GSPRO_RANGES))
 
 
-def fly_message(engine: FlightEngine, message: GSProMessage) -> GSProReply:
-    """The reply to a message with BallData: Code 200 with its flight (standard air) rolled to rest on a level
-    fairway, or Code 500 saying why it could not fly."""
+def fly_message(engine: FlightEngine, message: GSProMessage, bay: BayConditions | None = None) -> GSProReply:
+    """The reply to a message with BallData: Code 200 with its flight in the bay's conditions (`service.api.bay`;
+    without a bay: standard air, calm, rolled to rest on a level fairway), or Code 500 saying why it could not fly.
+    Open Connect carries ball data only: its shots always fly in the bay's air, wind and ground."""
+    bay = bay or BayConditions()
     try:
-        flight = engine.fly(launch_from_ball_data(message.BallData), ground=LEVEL_FAIRWAY)
+        flight = engine.fly(launch_from_ball_data(message.BallData), conditions_from(bay.air, bay.wind),
+                            ground=ground_of(bay.ground))
     except (ValueError, FlightError) as error:
         return GSProReply(Code=500, Message=str(error), ShotNumber=message.ShotNumber)
     result = ShotResult.model_construct(**flight_fields(flight, None))

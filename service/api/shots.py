@@ -61,10 +61,15 @@ def wind_of(wind: WindRequest | None) -> Wind:
     return Wind(wind.speed_mps, wind.from_deg, wind.profile, wind.reference_height_m)
 
 
-def conditions_of(shot: ShotRequest) -> Conditions:
-    if shot.air is None and shot.wind is None:
+def conditions_from(air: AirRequest | None, wind: WindRequest | None) -> Conditions:
+    """Engine conditions from a request's (or a bay's) air and wind; neither = standard air, calm."""
+    if air is None and wind is None:
         return STANDARD
-    return Conditions(air_of(shot.air), wind_of(shot.wind))
+    return Conditions(air_of(air), wind_of(wind))
+
+
+def conditions_of(shot: ShotRequest) -> Conditions:
+    return conditions_from(shot.air, shot.wind)
 
 
 def ground_of(ground: GroundRequest | None) -> GroundSpec:

@@ -12,6 +12,7 @@ from typing import Literal
 
 from fastapi import Depends, Request
 
+from service.api.bay import Bay
 from service.api.batch_process import BatchProcess
 from service.api.gspro import GSProMessage, GSProReply, fly_message
 from service.api.latency import Rolling
@@ -27,10 +28,11 @@ class NotReady(Exception):
 
 class ServiceState:
     """The engine once loaded (or why it failed), the batch process, the rolling latency figures, the Prometheus
-    metrics and the shots the viewer shows."""
+    metrics, the shots the viewer shows and the bay's conditions."""
 
-    def __init__(self, bundle_dir: Path):
+    def __init__(self, bundle_dir: Path, bay: Bay | None = None):
         self.bundle_dir = bundle_dir
+        self.bay = bay or Bay()
         self.engine: FlightEngine | None = None
         self.error: str | None = None
         self.simulation = Rolling()
@@ -65,13 +67,13 @@ class ServiceState:
             self.loaded.set()
 
     def gspro_reply(self, message: GSProMessage, source: Source = "gspro-http") -> GSProReply:
-        """A GSPro shot's reply over HTTP and TCP alike (timed into /v1/latency, shown by the viewer as coming from
-        `source`); Code 503 until the model is ready."""
+        """A GSPro shot's reply over HTTP and TCP alike, flown in the bay's conditions (timed into /v1/latency, shown
+        by the viewer as coming from `source`); Code 503 until the model is ready."""
         if self.engine is None:
             return GSProReply(Code=503, Message=self.error or "the model is still loading")
         started = time.perf_counter()
         try:
-            reply = fly_message(self.engine, message)
+            reply = fly_message(self.engine, message, self.bay.conditions)
         finally:
             self.record_simulation("shot", time.perf_counter() - started)
         self.feed.publish_gspro(source, message, reply)

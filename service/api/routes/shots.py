@@ -1,5 +1,6 @@
 """POST /v1/shots (inline: one shot takes well under a millisecond, less than a hop to a thread would cost) and
-POST /v1/shots/batch (in the batch process, at a lower CPU priority: `service.api.batch_process`)."""
+POST /v1/shots/batch (in the batch process, at a lower CPU priority: `service.api.batch_process`). A shot without
+air, wind or ground of its own flies in the bay's (`service.api.bay`)."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from concurrent.futures.process import BrokenProcessPool
 from fastapi import APIRouter, Depends, Request
 from fastapi.responses import JSONResponse, Response
 
+from service.api.bay import CONDITION_FIELDS, in_bay
 from service.api.models import (
     MAX_BATCH_SHOTS,
     MAX_BATCH_TRAJECTORIES,
@@ -39,7 +41,9 @@ async def shot(
     engine: FlightEngine = Depends(ready_engine),
     state: ServiceState = Depends(service_state),
 ) -> Response:
-    """Fly one shot: launch in SI or launch-monitor units, optional wind, air, normalized and trajectory."""
+    """Fly one shot: launch in SI or launch-monitor units, optional wind, air, ground, normalized and trajectory;
+    the bay's conditions (GET /v1/bay) where the shot gives none."""
+    request = in_bay(request, state.bay.conditions)
     started = time.perf_counter()
     try:
         result = fly_shot(engine, request)
@@ -62,9 +66,16 @@ async def shot(
     dependencies=[Depends(ready_engine)],
 )
 async def batch(request: BatchRequest, http: Request, state: ServiceState = Depends(service_state)) -> Response:
-    """FastAPI has validated `request` (a 422 otherwise); the batch process flies its raw body."""
+    """FastAPI has validated `request` (a 422 otherwise); the batch process flies its raw body, or the shots with the
+    bay's conditions filled in when the bay has any."""
+    bay = state.bay.conditions
+    if any(getattr(bay, name) is not None for name in CONDITION_FIELDS):
+        request = BatchRequest(shots=[in_bay(shot, bay) for shot in request.shots])
+        raw = request.model_dump_json(exclude_none=True).encode()
+    else:
+        raw = await http.body()
     try:
-        body, seconds = await state.batches.submit(await http.body())
+        body, seconds = await state.batches.submit(raw)
     except BrokenProcessPool:
         return JSONResponse({"detail": BATCH_PROCESS_DIED}, 503)
     state.record_simulation("batch", seconds)

@@ -1,0 +1,125 @@
+"""The simulator bay's conditions (service.api.bay): a shot without its own flies in the bay's air, wind and ground
+(over HTTP, in a batch and over GSPro Open Connect's TCP), a shot's own win, PUT /v1/bay validates like a shot and
+is kept in the bay file across restarts, written whole or not at all."""
+
+from __future__ import annotations
+
+import json
+import socket
+
+import pytest
+
+from service.api.app import create_app
+from service.api.bay import Bay, BayConditions, BayFileError, in_bay
+from service.api.models import AirRequest, GroundRequest, ShotRequest, WindRequest
+from service.open_connect.server import ConnectAddress
+from tests.servers import free_port, running, shot
+
+DENVER_HEAT = {"air": {"altitude_m": 1600.0, "temperature_c": 30.0},
+               "wind": {"speed_mps": 4.4704, "from_deg": 0.0},
+               "ground": {"surface": "green", "stimp_ft": 12.0}}
+"""The issue's bay: 1,600 m, 30 degC, a 10 mph headwind, a stimp-12 green."""
+SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}
+OPEN_CONNECT_SHOT = {"DeviceID": "bay test", "Units": "Yards", "ShotNumber": 1, "APIversion": "1",
+                     "BallData": {"Speed": 123.0, "SpinAxis": 0.0, "TotalSpin": 7100.0, "HLA": 0.0, "VLA": 16.0},
+                     "ShotDataOptions": {"ContainsBallData": True, "IsHeartBeat": False}}
+
+
+def test_a_shot_takes_the_bays_conditions_only_where_it_has_none():
+    bay = BayConditions.model_validate(DENVER_HEAT)
+    bare = ShotRequest(**SEVEN_IRON)
+    assert in_bay(bare, bay).air == bay.air and in_bay(bare, bay).ground == bay.ground
+    own = ShotRequest(**SEVEN_IRON, air=AirRequest(temperature_c=10.0))
+    filled = in_bay(own, bay)
+    assert filled.air == AirRequest(temperature_c=10.0) and filled.wind == bay.wind
+    assert in_bay(bare, BayConditions()) is bare
+
+
+def test_the_bay_file_is_kept_whole_and_read_back(tmp_path):
+    path = tmp_path / "bay" / "bay.json"
+    bay = Bay(path)
+    assert bay.conditions == BayConditions() and not path.exists()
+    conditions = BayConditions(wind=WindRequest(speed_mps=3.0, from_deg=90.0), units="metric")
+    bay.set(conditions)
+    assert Bay(path).conditions == conditions
+    assert [p.name for p in path.parent.iterdir()] == ["bay.json"], "no temporary file left behind"
+
+
+def test_another_workers_change_is_read_at_the_next_use(tmp_path):
+    path = tmp_path / "bay.json"
+    mine, other = Bay(path), Bay(path)
+    other.set(BayConditions(ground=GroundRequest(surface="rough")))
+    assert mine.conditions.ground == GroundRequest(surface="rough")
+
+
+def test_a_bad_bay_file_names_itself_and_the_field(tmp_path):
+    path = tmp_path / "bay.json"
+    path.write_text(json.dumps({"air": {"altitude_m": 99999.0}}))
+    with pytest.raises(BayFileError, match=r"bay.json: not bay conditions \(air.altitude_m"):
+        Bay(path)
+
+
+def _open_connect_carry(port: int) -> float:
+    with socket.create_connection(("127.0.0.1", port), timeout=10) as connector:
+        connector.sendall(json.dumps(OPEN_CONNECT_SHOT).encode())
+        reply = json.loads(connector.recv(65536).decode())
+    assert reply["Code"] == 200, reply
+    return reply["Flight"]["carry_m"]
+
+
+def test_http_batch_and_open_connect_shots_fly_in_the_bay_and_it_survives_a_restart(tmp_path):
+    path, port = tmp_path / "bay.json", free_port()
+    with running(create_app(connect=ConnectAddress(port), bay=path)) as http:
+        calm = shot(http, **SEVEN_IRON)
+        tcp_calm = _open_connect_carry(port)
+        answer = http.put("/v1/bay", json=DENVER_HEAT)
+        assert answer.status_code == 200, answer.text
+        assert http.get("/v1/bay").json() == {**DENVER_HEAT, "units": "imperial",
+                                               "wind": {**DENVER_HEAT["wind"], "profile": "uniform",
+                                                        "reference_height_m": 10.0},
+                                               "ground": {**DENVER_HEAT["ground"], "elevation_m": 0.0,
+                                                          "slope_deg": 0.0, "slope_dir_deg": 0.0}}
+        in_bay_shot = shot(http, **SEVEN_IRON)
+        explicit = shot(http, **SEVEN_IRON, **DENVER_HEAT)
+        assert in_bay_shot == explicit and in_bay_shot["carry_m"] != calm["carry_m"]
+        assert in_bay_shot["total_m"] - in_bay_shot["carry_m"] != calm["total_m"] - calm["carry_m"], "the green"
+        own = shot(http, **SEVEN_IRON, air={}, wind={"speed_mps": 0.0}, ground={"surface": "fairway"})
+        assert own == calm, "a shot's own conditions win"
+        batch = http.post("/v1/shots/batch", json={"shots": [SEVEN_IRON]}).json()["results"][0]
+        assert batch["carry_m"] == pytest.approx(explicit["carry_m"], abs=1e-6)
+        tcp = _open_connect_carry(port)
+        assert tcp != tcp_calm
+        assert tcp == pytest.approx(shot(http, ball_speed_mph=123.0, launch_angle_deg=16.0, spin_rpm=7100.0,
+                                         **DENVER_HEAT)["carry_m"], abs=1e-6)
+    with running(create_app(bay=path)) as http:
+        assert shot(http, **SEVEN_IRON) == explicit, "the bay came back from its file"
+
+
+def test_a_bad_bay_is_refused_like_a_bad_shot_and_changes_nothing(tmp_path):
+    path = tmp_path / "bay.json"
+    with running(create_app(bay=path)) as http:
+        http.put("/v1/bay", json={"wind": {"speed_mps": 3.0}})
+        answer = http.put("/v1/bay", json={"air": {"altitude_m": 99999.0}})
+        assert answer.status_code == 422
+        detail = answer.json()["detail"][0]
+        assert detail["field"] == "air.altitude_m" and "allowed -500 to 5000 m" in detail["message"]
+        assert http.get("/v1/bay").json()["wind"]["speed_mps"] == 3.0
+        assert json.loads(path.read_text())["wind"]["speed_mps"] == 3.0
+
+
+def test_the_bay_needs_the_api_key_when_one_is_set(tmp_path):
+    with running(create_app(api_key="k", bay=tmp_path / "bay.json")) as http:
+        assert http.get("/v1/bay").status_code == 401
+        assert http.put("/v1/bay", json={}).status_code == 401
+        assert http.get("/v1/bay", headers={"x-api-key": "k"}).status_code == 200
+
+
+def test_serve_refuses_a_bad_bay_file_in_one_line(tmp_path, capsys):
+    from golfflight.cli import main
+
+    path = tmp_path / "bay.json"
+    path.write_text('{"wind": {"speed_mps": -3}}')
+    assert main(["serve", "--bay", str(path), "--port", str(free_port())]) == 2
+    error = capsys.readouterr().err.strip()
+    assert error.startswith("golfflight serve: error: ") and "bay.json: not bay conditions (wind.speed_mps" in error
+    assert "\n" not in error
