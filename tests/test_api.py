@@ -207,6 +207,26 @@ GSPRO_SHOT = {
 }
 
 
+def test_a_body_without_a_json_content_type_is_refused_saying_so(client):
+    """Issue 23: a body sent with no content type read as "Input should be a valid dictionary"."""
+    shot_body, gspro_body = json.dumps(SEVEN_IRON).encode(), json.dumps(GSPRO_SHOT).encode()
+    for headers, sent in (({}, "none was sent"), ({"content-type": "text/plain"}, "got 'text/plain'")):
+        refused = client.post("/v1/shots", content=shot_body, headers=headers)
+        assert refused.status_code == 415, refused.text
+        detail = refused.json()["detail"][0]
+        assert detail["field"] == "body" and "send content-type: application/json" in detail["message"]
+        assert sent in detail["message"] and "valid dictionary" not in refused.text
+        batch = client.post("/v1/shots/batch", content=json.dumps({"shots": [SEVEN_IRON]}), headers=headers)
+        assert batch.status_code == 415 and "content-type: application/json" in batch.text
+        gspro = client.post("/v1/gspro", content=gspro_body, headers=headers)
+        assert gspro.status_code == 415 and gspro.json() == {
+            "Code": 500,
+            "Message": f"the body must be JSON: send content-type: application/json ({sent})",
+        }
+    assert client.post("/v1/shots", content=shot_body, headers={"content-type": "application/json"}).status_code == 200
+    assert client.post("/v1/gspro", content=gspro_body, headers={"content-type": "application/json"}).json()["Code"] == 200
+
+
 def test_gspro_open_connect_shot_heartbeat_and_error(client):
     reply = client.post("/v1/gspro", json=GSPRO_SHOT)
     assert reply.status_code == 200

@@ -5,7 +5,8 @@ dependency (`service.api.state.ready_engine`, from `app.state`).
 Single shots simulate inline in `async def` routes. Batches fly in a child process at a lower CPU priority
 (`batch_process`), so a fitting studio's thousands of shots neither hold the GIL nor take a core from a simulator
 bay's single shots; more concurrency comes from `golfflight serve --workers N` (one process, one model and one batch
-process each). The model loads in a background thread at startup; /healthz answers 503 until it is ready. In front
+process each). The model loads during the lifespan's startup, before uvicorn opens the port (and before the Open
+Connect port accepts): the first request is served; /healthz answers 503 only if the model failed to load. In front
 of the routes: a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and CORS only for configured origins
 ($GOLFFLIGHT_CORS_ORIGINS); every refusal is a 4xx whose body names the field, the value and the allowed range
 (`service.api.errors`). Given a connect address, the lifespan also opens GSPro Open Connect over TCP on the same
@@ -67,14 +68,21 @@ def create_app(
     @asynccontextmanager
     async def lifespan(app: FastAPI):
         tcp = OpenConnectServer(partial(state.gspro_reply, source="open-connect")) if connect else None
-        if tcp:
-            await tcp.start(connect)  # before the model loads: a port that cannot be had stops the startup cleanly
-        loading = asyncio.get_running_loop().run_in_executor(None, state.load)
-        yield
-        if tcp:
-            await tcp.close()
-        await loading
-        state.batches.stop()
+        if tcp:  # taken before the model loads: a port that cannot be had stops the startup at once
+            await tcp.start(connect, listening=False)
+        loading = asyncio.get_running_loop().run_in_executor(None, state.load)  # in a thread: the event loop stays free
+        try:
+            # Loaded before either port accepts (uvicorn binds HTTP's once this startup returns): the first request
+            # is served, not answered 503. A model that fails to load still lets the service start to say why.
+            await asyncio.shield(loading)
+            if tcp:
+                await tcp.listen()
+            yield
+        finally:
+            if tcp:
+                await tcp.close()
+            await loading
+            state.batches.stop()
 
     app = FastAPI(
         title="golfflight",

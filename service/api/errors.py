@@ -1,5 +1,7 @@
 """How refusals read: every 4xx body names the field, the value and the allowed range, and POST /v1/gspro answers
-in Open Connect's own form (Code 500, a Message); a route called before the model is ready gets 503."""
+in Open Connect's own form (Code 500, a Message); a body sent without a JSON content type gets 415 saying so (FastAPI
+hands a model the raw bytes then, which read as "Input should be a valid dictionary"); a route called before the
+model is ready gets 503."""
 
 from __future__ import annotations
 
@@ -16,15 +18,29 @@ from service.api.state import NotReady
 
 NOT_JSON = "the body is not JSON text in UTF-8"
 """FastAPI's 400 for a body it cannot even decode, said as a 422 like every other refusal of a body."""
+JSON_CONTENT_TYPE = "the body must be JSON: send content-type: application/json"
+"""The refusal (415) of a body sent without a JSON content type, followed by what was sent."""
 
 
-def _gspro_error(message: str) -> JSONResponse:
-    return JSONResponse(GSProReply(Code=500, Message=message).model_dump(exclude_none=True), 422)
+def _gspro_error(message: str, status: int = 422) -> JSONResponse:
+    return JSONResponse(GSProReply(Code=500, Message=message).model_dump(exclude_none=True), status)
+
+
+def _content_type_refusal(request: Request, error: RequestValidationError) -> str | None:
+    """Why a body was not read at all: FastAPI parses a body as JSON only under a JSON content type (application/json
+    or */*+json) and otherwise hands the model the raw bytes; None when the body was read."""
+    if not isinstance(error.body, bytes | bytearray):
+        return None
+    sent = request.headers.get("content-type")
+    return f"{JSON_CONTENT_TYPE} ({f'got {sent!r}' if sent else 'none was sent'})"
 
 
 async def invalid_request(request: Request, error: RequestValidationError) -> JSONResponse:
+    unread = _content_type_refusal(request, error)
     if request.url.path == GSPRO_PATH:
-        return _gspro_error(invalid_message(error.errors()))
+        return _gspro_error(unread, 415) if unread else _gspro_error(invalid_message(error.errors()))
+    if unread:
+        return JSONResponse({"detail": [body_detail(unread, "content_type")]}, 415)
     return JSONResponse({"detail": describe_errors(error.errors(), RANGES)}, 422)
 
 

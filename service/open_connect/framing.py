@@ -5,10 +5,19 @@ growing buffer with `json.JSONDecoder.raw_decode` instead cannot tell an object 
 from a broken one, nor where a broken object ends; counting braces answers both, so one bad object is refused and
 the next one read. Bytes are scanned as they come: `{`, `}`, `"` and `\\` never occur inside a UTF-8 multi-byte
 character, so no decoding is needed to find the ends.
+
+A pause mid-object (`ObjectFramer.stall`, called by the server after a few seconds of silence) ends nothing by
+itself: objects may arrive split across packets (NOTES.md section 8), however late the rest. Only what comes next
+decides: the rest of the object completes it (one object, one reply), while a new object (`{` that does not
+complete the open one as valid JSON) gets the unfinished one refused once and is read from a clean start. Giving up
+at the pause instead refused the piece and then framed its remainder as stray bytes and stray objects: five
+replies for one delayed shot.
 """
 
 from __future__ import annotations
 
+import copy
+import json
 import re
 from dataclasses import dataclass
 
@@ -37,7 +46,8 @@ class Refused:
 class ObjectFramer:
     """Feed it the bytes of one connection as they arrive; it hands back each complete top-level object (bytes, not
     yet parsed) and a `Refused` for whatever is not one, in stream order. Memory stays under `limit` bytes: an
-    object that outgrows it is refused at once and the rest of it skipped."""
+    object that outgrows it is refused at once and the rest of it skipped. `stall` marks a pause mid-object (see the
+    module's notes)."""
 
     def __init__(self, limit: int = MAX_MESSAGE_BYTES):
         self.limit = limit
@@ -49,16 +59,27 @@ class ObjectFramer:
         self._in_string = False
         self._escaped = False
         self._oversized = False
+        self._stalled = False
 
     @property
     def partial(self) -> bool:
         """Whether an object has begun and not yet ended."""
         return self._depth > 0
 
+    @property
+    def stalled(self) -> bool:
+        """Whether the open object's sender paused (`stall`) and nothing has come since."""
+        return self._stalled
+
+    def stall(self) -> None:
+        """The sender went quiet mid-object: the next bytes that come decide whether they are its rest or a new
+        object (`feed`). Nothing is refused yet. No effect between objects."""
+        self._stalled = self.partial
+
     def give_up(self) -> Refused | None:
-        """Drop the object begun and not finished (its sender went quiet), so the next object starts clean; the
-        refusal, or None for an object already refused for its size."""
-        refusal = Refused(f"incomplete JSON object {_quote(self._object)}: nothing more came")
+        """Drop the object begun and not finished, so the next object starts clean; the refusal, or None for an
+        object already refused for its size."""
+        refusal = Refused(f"incomplete JSON object {_quote(self._object)}: a new object began before its end")
         oversized = self._oversized
         self._reset()
         return None if oversized else refusal
@@ -67,12 +88,35 @@ class ObjectFramer:
         """Complete objects and refusals found in `data` (plus what earlier calls left unfinished)."""
         found: list[bytes | Refused] = []
         position = 0
+        first = _NOT_SPACE.search(data) if self._stalled else None
+        if first is not None:  # the first word since a pause mid-object (whitespace alone decides nothing)
+            self._stalled = False
+            if data[first.start()] == ord("{") and not self._completed_by(data):
+                refusal = self.give_up()
+                found += [refusal] if refusal else []
+                position = first.start()
         while position < len(data):
             if self._depth == 0:
                 position = self._top_level(data, position, found)
             else:
                 position = self._inside(data, position, found)
         return found
+
+    def _completed_by(self, data: bytes) -> bool:
+        """Whether `data` (after a pause, opening with `{`) ends the open object as valid JSON: then it is the
+        object's rest (a `{` continues one after a colon, or inside a string), otherwise a new object."""
+        if self._oversized:
+            return False  # refused already; its end cannot be checked
+        probe = copy.copy(self)
+        probe._object = bytearray(self._object)
+        found = probe.feed(data)
+        if not found or not isinstance(found[0], bytes):
+            return False
+        try:
+            json.loads(found[0])
+        except (ValueError, RecursionError):
+            return False
+        return True
 
     def _top_level(self, data: bytes, position: int, found: list[bytes | Refused]) -> int:
         """Skip whitespace; open the next object, or refuse the stray bytes up to it."""

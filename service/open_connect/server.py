@@ -20,10 +20,11 @@ from service.open_connect.replies import Answer, reply_to
 
 CONNECT_HOST_ENV = "GOLFFLIGHT_CONNECT_HOST"
 CONNECT_PORT_ENV = "GOLFFLIGHT_CONNECT_PORT"
-GIVE_UP_S = 2.0
-"""How long a half-received object waits for the rest: a connector writes a message in one go, so its pieces arrive
-within milliseconds; after this the piece is refused and the next object starts clean, before a connector's
-5 s resend arrives."""
+PAUSE_S = 2.0
+"""Silence after which a half-received object counts as paused (`ObjectFramer.stall`): a connector writes a message
+in one go, so its pieces arrive within milliseconds. Nothing is refused at the pause: what comes next is either the
+rest of the object (answered as usual) or a new object, and then the unfinished one gets one refusal before the new
+one is read."""
 READ_BYTES = 64 * 1024
 INTERNAL_ERROR = "internal error while answering this message (the server log has the details)"
 
@@ -54,9 +55,14 @@ class OpenConnectServer:
         self._server: asyncio.Server | None = None
         self._connections: set[asyncio.Task] = set()
 
-    async def start(self, address: ConnectAddress) -> None:
-        """Listen (OSError when the port cannot be had)."""
-        self._server = await asyncio.start_server(self._serve, address.host, address.port)
+    async def start(self, address: ConnectAddress, *, listening: bool = True) -> None:
+        """Take the port (OSError when it cannot be had) and accept connectors on it, or with `listening` False only
+        take it, so that a port that cannot be had stops a startup early, until `listen`."""
+        self._server = await asyncio.start_server(self._serve, address.host, address.port, start_serving=listening)
+
+    async def listen(self) -> None:
+        """Accept connectors on the port `start(..., listening=False)` took."""
+        await self._server.start_serving()
 
     @property
     def port(self) -> int:
@@ -79,16 +85,14 @@ class OpenConnectServer:
         try:
             while True:
                 try:
-                    async with asyncio.timeout(GIVE_UP_S if framer.partial else None):
+                    async with asyncio.timeout(PAUSE_S if framer.partial and not framer.stalled else None):
                         data = await reader.read(READ_BYTES)
                 except TimeoutError:
-                    refusal = framer.give_up()
-                    items = [refusal] if refusal else []
-                else:
-                    if not data:
-                        break
-                    items = framer.feed(data)
-                for item in items:
+                    framer.stall()
+                    continue
+                if not data:
+                    break
+                for item in framer.feed(data):
                     reply = self._reply(item)
                     if reply is not None:
                         writer.write(reply.model_dump_json(exclude_none=True).encode())
