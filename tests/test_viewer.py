@@ -170,7 +170,7 @@ def test_shots_over_http_batch_and_tcp_reach_an_open_stream_in_milliseconds(serv
         assert stream.headers["content-type"].startswith("text/event-stream")
         lines = stream.iter_lines()
         started = time.perf_counter()
-        reply = http.post("/v1/shots", json=DRIVER, headers=KEYED).json()
+        reply = http.post("/v1/shots?viewer=true", json=DRIVER, headers=KEYED).json()
         event = next_event(lines)
         http_s = time.perf_counter() - started
         assert event.source == "http" and event.flight.carry_yd == reply["carry_yd"]
@@ -183,7 +183,7 @@ def test_shots_over_http_batch_and_tcp_reach_an_open_stream_in_milliseconds(serv
         assert event.flight.carry_yd == tcp["Flight"]["carry_yd"] and event.flight.trajectory
 
         batch = http.post(
-            "/v1/shots/batch", json={"shots": [DRIVER, {**DRIVER, "ball_speed_mph": 120.0}]}, headers=KEYED
+            "/v1/shots/batch?viewer=true", json={"shots": [DRIVER, {**DRIVER, "ball_speed_mph": 120.0}]}, headers=KEYED
         ).json()
         firsts = [next_event(lines), next_event(lines)]
         assert [e.source for e in firsts] == ["batch", "batch"]
@@ -206,7 +206,7 @@ def test_a_stalled_viewer_never_delays_a_shot(service, monkeypatch):
         seconds = []
         for _ in range(n):
             started = time.perf_counter()
-            assert http.post("/v1/shots", json=shot, headers=KEYED).status_code == 200
+            assert http.post("/v1/shots?viewer=true", json=shot, headers=KEYED).status_code == 200
             seconds.append(time.perf_counter() - started)
         return seconds
 
@@ -262,7 +262,7 @@ def test_the_page_in_chromium_draws_shots_from_http_and_open_connect(tmp_path):
 
             page.select_option("#club", "Driver")
             started = time.perf_counter()
-            driver = http.post("/v1/shots", json=DRIVER, headers=KEYED).json()
+            driver = http.post("/v1/shots?viewer=1", json=DRIVER, headers=KEYED).json()
             page.wait_for_selector("#shots tbody tr[data-shot='1']", timeout=10_000)
             seen_s = time.perf_counter() - started
             assert page.inner_text("#n-carry").startswith(f"{driver['carry_yd']:.1f}")

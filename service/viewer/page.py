@@ -1,12 +1,14 @@
 """The viewer page and its script and style, shipped in `static/` (package data) and read once at import; the page's
 club menu is filled in from the one club-name table (`shots.clubs.CLUB_NAMES`), so it names the clubs as
-`golfflight fly --club` does."""
+`golfflight fly --club` does, and the bay form's ground menu from the surfaces a request may name
+(`flight.ground.SURFACES`)."""
 
 from __future__ import annotations
 
 from html import escape
 from importlib.resources import files
 
+from flight.ground import SURFACES
 from shots.clubs import CLUB_NAMES
 
 PAGE_PATH = "/viewer"
@@ -22,9 +24,22 @@ def with_club_options(page: bytes) -> bytes:
     return page.replace(CLUB_OPTIONS_MARKER, options)
 
 
+SURFACE_OPTIONS_MARKER = b"<!-- surface options: flight.ground.SURFACES, filled in by service/viewer/page.py -->"
+
+
+def with_surface_options(page: bytes) -> bytes:
+    """The page with the bay form's ground menu: one option per surface a shot (and the bay) can name."""
+    if page.count(SURFACE_OPTIONS_MARKER) != 1:
+        raise RuntimeError("viewer.html has lost its surface options marker")
+    options = "".join(
+        f'<option value="{escape(name)}">{escape(name.replace("_", " "))}</option>' for name in SURFACES
+    ).encode()
+    return page.replace(SURFACE_OPTIONS_MARKER, options)
+
+
 def _read(name: str) -> bytes:
     content = files(__package__).joinpath("static", name).read_bytes()
-    return with_club_options(content) if name == "viewer.html" else content
+    return with_surface_options(with_club_options(content)) if name == "viewer.html" else content
 
 
 ASSETS: dict[str, tuple[bytes, str]] = {

@@ -5,24 +5,33 @@ HTTP GET, so the API key check, CORS and proxies treat it like any other route; 
 with a `websockets` or `wsproto` package, which the serving install does not have. The page reads the stream with
 fetch() rather than EventSource, which cannot send the X-API-Key header.
 
-Each stream ends after LIFETIME_S and the page reconnects at once with Last-Event-ID, losing nothing (the feed
-keeps its last shots): uvicorn's graceful shutdown waits for open responses, so an endless stream would hold a
-SIGTERM up for the whole grace period.
+A stream stays open for as long as its client reads it, and sends a `: keep-alive` comment whenever KEEPALIVE_S
+pass without a shot, so proxies and idle timeouts keep the connection and a client notices a dead service. uvicorn's
+graceful shutdown waits for open responses, so an endless stream would hold up a SIGTERM for the whole grace
+period: each stream watches the uvicorn server that serves it (found through the SIGTERM handler uvicorn installs,
+`serving_server`) and ends within SHUTDOWN_POLL_S once it is told to stop; the page reconnects to the next server
+with Last-Event-ID, losing nothing that is kept.
 """
 
 from __future__ import annotations
 
+import signal
 import time
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Callable
 
 from service.engine import FlightEngine
 from service.viewer.feed import ShotFeed, Viewer
 
-LIFETIME_S = 5.0
-"""How long one stream stays open before the page reconnects."""
+KEEPALIVE_S = 15.0
+"""Longest a stream stays silent: a `: keep-alive` comment is sent after this long without a shot."""
+
+SHUTDOWN_POLL_S = 0.5
+"""How often an idle stream looks whether the server is shutting down."""
 
 RETRY_MS = 500
 """The reconnection delay the stream asks for (EventSource's `retry:` field, also read by our page)."""
+
+KEEPALIVE_FRAME = ": keep-alive\n\n"
 
 
 def last_event_id(header: str | None) -> int | None:
@@ -30,17 +39,47 @@ def last_event_id(header: str | None) -> int | None:
     return int(header) if header is not None and header.strip().isdigit() else None
 
 
+def serving_server() -> Callable[[], bool]:
+    """A test for "the server is shutting down": uvicorn's Server installs its `handle_exit` as the SIGTERM handler
+    while it serves in a process's main thread (`golfflight serve`, each of its workers), and sets `should_exit`
+    there; a server run elsewhere (in a thread, in tests) is never seen as stopping, and its streams end when their
+    clients close them."""
+    server = getattr(signal.getsignal(signal.SIGTERM), "__self__", None)
+    if server is None or not hasattr(server, "should_exit"):
+        return lambda: False
+    return lambda: bool(server.should_exit)
+
+
 async def events(
-    feed: ShotFeed, viewer: Viewer, engine: FlightEngine, lifetime_s: float = LIFETIME_S
+    feed: ShotFeed,
+    viewer: Viewer,
+    engine: FlightEngine,
+    lifetime_s: float | None = None,
+    keepalive_s: float = KEEPALIVE_S,
+    stopping: Callable[[], bool] | None = None,
 ) -> AsyncIterator[str]:
-    """The viewer's shots as server-sent events until `lifetime_s` has passed; unsubscribes it however it ends."""
-    ends = time.monotonic() + lifetime_s
+    """The viewer's shots as server-sent events, with a keep-alive comment after every `keepalive_s` without one,
+    until `lifetime_s` has passed (None: until the client goes or the server shuts down); unsubscribes it however
+    it ends."""
+    stopping = serving_server() if stopping is None else stopping
+    ends = None if lifetime_s is None else time.monotonic() + lifetime_s
     try:
         yield f"retry: {RETRY_MS}\n\n"
-        while (left := ends - time.monotonic()) > 0:
-            entry = await viewer.next(left)
+        quiet_since = time.monotonic()
+        while not stopping():
+            now = time.monotonic()
+            if ends is not None and now >= ends:
+                return
+            if now - quiet_since >= keepalive_s:
+                yield KEEPALIVE_FRAME
+                quiet_since = now = time.monotonic()
+            wait = min(SHUTDOWN_POLL_S, keepalive_s - (now - quiet_since))
+            if ends is not None:
+                wait = min(wait, ends - now)
+            entry = await viewer.next(max(wait, 0.0))
             frame = None if entry is None else feed.frame(entry, engine)
             if frame is not None:
                 yield frame
+                quiet_since = time.monotonic()
     finally:
         feed.unsubscribe(viewer)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import time
 from concurrent.futures.process import BrokenProcessPool
 
-from fastapi import APIRouter, Depends, Request
+from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import JSONResponse, Response
 
 from service.api.bay import CONDITION_FIELDS, in_bay
@@ -29,6 +29,12 @@ BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has 
 
 router = APIRouter(prefix="/v1/shots")
 
+ShowOnViewer = Query(
+    False,
+    description="also show this request's shot (a batch: its last 50 shots) on the bay's live viewer (GET /viewer); "
+    "without it only the bay's own shots (GSPro Open Connect over TCP and POST /v1/gspro) appear there",
+)
+
 
 @router.post(
     "",
@@ -40,6 +46,7 @@ async def shot(
     request: ShotRequest,
     engine: FlightEngine = Depends(ready_engine),
     state: ServiceState = Depends(service_state),
+    viewer: bool = ShowOnViewer,
 ) -> Response:
     """Fly one shot: launch in SI or launch-monitor units, optional wind, air, ground, normalized and trajectory;
     the bay's conditions (GET /v1/bay) where the shot gives none."""
@@ -51,7 +58,8 @@ async def shot(
         return JSONResponse({"detail": [body_detail(str(error), "flight_error")]}, 422)
     finally:
         state.record_simulation("shot", time.perf_counter() - started)
-    state.feed.publish("http", request, result)
+    if viewer:
+        state.feed.publish("http", request, result)
     return json_response(result)
 
 
@@ -65,7 +73,9 @@ async def shot(
     "land gets an error entry of its own.",
     dependencies=[Depends(ready_engine)],
 )
-async def batch(request: BatchRequest, http: Request, state: ServiceState = Depends(service_state)) -> Response:
+async def batch(
+    request: BatchRequest, http: Request, state: ServiceState = Depends(service_state), viewer: bool = ShowOnViewer
+) -> Response:
     """FastAPI has validated `request` (a 422 otherwise); the batch process flies its raw body, or the shots with the
     bay's conditions filled in when the bay has any."""
     bay = state.bay.conditions
@@ -80,5 +90,6 @@ async def batch(request: BatchRequest, http: Request, state: ServiceState = Depe
         return JSONResponse({"detail": BATCH_PROCESS_DIED}, 503)
     state.record_simulation("batch", seconds)
     state.metrics.batch_shots.observe(len(request.shots))
-    state.feed.publish_batch(request.shots)
+    if viewer:
+        state.feed.publish_batch(request.shots)
     return Response(body, media_type="application/json")

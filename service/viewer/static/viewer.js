@@ -11,10 +11,15 @@ const SVG_NS = "http://www.w3.org/2000/svg";
 const KEY_STORE = "golfflight-api-key";
 const SOURCES = { "http": "HTTP", "batch": "batch", "gspro-http": "GSPro (HTTP)", "open-connect": "Open Connect" };
 const CLUB_COLOURS = ["#ffd23f", "#4cd07d", "#5bc0ff", "#ff8a5b", "#c38bff", "#ff5b9a", "#9be15d", "#f2f2f2"];
+const BAY_SOURCES = new Set(["http", "gspro-http", "open-connect"]);  // hit in this bay: tagged with its club
+const STALL_MS = 45_000;          // the service sends a keep-alive comment every 15 s: silence this long is a dead link
+const BAY_POLL_MS = 30_000;       // how often the bay's conditions are read again (another screen may change them)
+const FEET_M = 0.3048;
 
 const state = {
   shots: [],                       // newest last: {event, club}
-  units: localStorage.getItem("golfflight-units") || "imperial",
+  units: localStorage.getItem("golfflight-units") || "imperial",  // the bay's `units` once read (GET /v1/bay)
+  bay: null,                       // the bay's conditions as the service last gave them
   key: initialKey(),
   lastId: null,
   play: null,                      // {id, started, speed, end}
@@ -84,8 +89,9 @@ function setStatus(kind, text) {
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
 /** Reads /v1/events for as long as the page is open. fetch() and not EventSource: EventSource cannot send the
- * X-API-Key header. A stream that ends (the service closes each one after a few seconds) is reopened at once with
- * Last-Event-ID, so no shot is missed; a failure waits a little longer. */
+ * X-API-Key header. The stream stays open (a `: keep-alive` comment every 15 s when no shot comes); one that ends
+ * (a restarting service) or stays silent for STALL_MS is reopened at once with Last-Event-ID, so no kept shot is
+ * missed; a failure waits a little longer. */
 async function follow() {
   for (;;) {
     let pause = 100;
@@ -93,14 +99,15 @@ async function follow() {
       const headers = { "Accept": "text/event-stream" };
       if (state.key) headers["X-API-Key"] = state.key;
       if (state.lastId !== null) headers["Last-Event-ID"] = String(state.lastId);
-      const response = await fetch("v1/events", { headers, cache: "no-store" });
+      const abort = new AbortController();
+      const response = await fetch("v1/events", { headers, cache: "no-store", signal: abort.signal });
       if (response.status === 401) {
         askForKey(state.key ? "wrong API key" : "API key needed");
         return;
       }
       if (response.ok) {
         setStatus("live", "live");
-        await readEvents(response.body);
+        await readEvents(response.body, abort);
       } else {
         const answer = await response.json().catch(() => ({}));
         setStatus("down", `stream refused (${response.status}): ${answer.detail || "retrying"}`);
@@ -114,11 +121,12 @@ async function follow() {
   }
 }
 
-async function readEvents(body) {
+async function readEvents(body, abort) {
   const reader = body.pipeThrough(new TextDecoderStream()).getReader();
   let buffer = "";
   for (;;) {
-    const { value, done } = await reader.read();
+    const stalled = setTimeout(() => abort.abort(), STALL_MS);
+    const { value, done } = await reader.read().finally(() => clearTimeout(stalled));
     if (done) return;
     buffer += value;
     let cut;
@@ -149,7 +157,9 @@ function onBlock(block) {
 function addShot(event) {
   const seen = state.shots.some((s) => s.event.id === event.id && s.event.received_unix_s === event.received_unix_s);
   if (seen) return;
-  state.shots.push({ event, club: document.getElementById("club").value });
+  // the bay's own shots get the club picked now; batches (shown only when their request asked) get none
+  const club = BAY_SOURCES.has(event.source) ? document.getElementById("club").value : "";
+  state.shots.push({ event, club });
   if (state.shots.length > KEEP_SHOTS) state.shots.shift();
   const points = event.flight.trajectory;
   const end = points[points.length - 1].t_s;
@@ -254,16 +264,19 @@ function drawShots(svg, project, scene) {
 
 function unitLabel(metres) { return `${Math.round(metres / (imperial() ? YARD_M : 1))} ${distUnit()}`; }
 
-/** From behind the golfer: a camera 40 m behind the tee, 12 m up and 10 m to the left (a tower behind the range,
- * off the line so a straight shot's arc shows its depth), looking level down the target line; zoomed so that the
- * tee and every path fit. */
+/** From behind the golfer: a camera 40 m behind the tee and 12 m up, on the target line, looking level down it;
+ * zoomed so that every path fits, the tee at the bottom centre and the target line running straight up the middle to
+ * the vanishing point (the horizon). A straight shot (direction 0, spin axis 0, no crosswind) stays on that line.
+ * Every distance line is labelled, the labels alternating right and left of the fairway so that the far ones, which
+ * perspective crowds together, still have room. What was drawn is kept on `window.golfflightViewer.behind`. */
 function drawBehind(svg, box) {
   svg.replaceChildren();
-  const W = 800, H = 800, back = 40, eye = 12, aside = -10, margin = 24;
+  const W = 800, H = 800, back = 40, eye = 12, margin = 24;
   const view = (p) => {
     const depth = Math.max(p.y_m + back, 0.5);
-    return [(p.x_m - aside) / depth, (p.z_m - eye) / depth];
+    return [p.x_m / depth, (p.z_m - eye) / depth];
   };
+  const low = view({ x_m: 0, y_m: 0, z_m: 0 })[1];           // the tee, below the horizon
   let high = 0.05, wide = 0.05;
   for (const shot of state.shots) {
     for (const p of shot.event.flight.trajectory) {
@@ -271,9 +284,9 @@ function drawBehind(svg, box) {
       high = Math.max(high, v); wide = Math.max(wide, Math.abs(u));
     }
   }
-  const low = view({ x_m: 0, y_m: 0, z_m: 0 })[1];
   const scale = Math.min((H - 2 * margin) / (high - low), (W / 2 - margin) / wide);
-  const horizon = margin + high * scale;
+  const bottom = H - margin;
+  const horizon = bottom + low * scale;                        // so that the tee lands on `bottom`
   const project = (p) => {
     const [u, v] = view(p);
     return [W / 2 + u * scale, horizon - v * scale];
@@ -287,20 +300,29 @@ function drawBehind(svg, box) {
   const half = 20;
   const corners = [[-half, 0], [half, 0], [half, box.far], [-half, box.far]];
   el(svg, "polygon", { class: "fairway", points: points(corners.map(([x, y]) => ({ x_m: x, y_m: y, z_m: 0 })), project) });
-  let labelled = H;
-  for (let y = box.step; y <= box.far + 1e-6; y += box.step) {
+  const lines = [];
+  for (let y = box.step; y <= box.far + 1e-6; y += box.step) lines.push(y);
+  const ys = lines.map((y) => project({ x_m: 0, y_m: y, z_m: 0 })[1]);
+  const labels = [];
+  lines.forEach((y, n) => {
     const [x1, y1] = project({ x_m: -half * 1.5, y_m: y, z_m: 0 });
     const [x2] = project({ x_m: half * 1.5, y_m: y, z_m: 0 });
     el(svg, "line", { class: "marker-line", x1, y1, x2, y2: y1 });
-    if (labelled - y1 >= 14) {
-      el(svg, "text", { class: "label", x: project({ x_m: half, y_m: y, z_m: 0 })[0] + 6, y: y1 - 3 }, unitLabel(y));
-      labelled = y1;
-    }
-  }
+    const onLeft = n % 2 === 1;
+    // above its line, as tall as the gap to the next line on the same side allows (that label sits above it)
+    const room = n + 2 < lines.length ? ys[n] - ys[n + 2] - 1 : 20;
+    const size = Math.max(9, Math.min(20, room));
+    const label = el(svg, "text", { class: "label distance", y: y1 - 2, "text-anchor": onLeft ? "end" : "start" }, unitLabel(y));
+    label.style.fontSize = `${size.toFixed(1)}px`;  // CSSOM: the page's CSP allows no inline style attribute
+    const length = label.getComputedTextLength() || 4 * size;  // beside the line's end, always inside the picture
+    label.setAttribute("x", (onLeft ? Math.max(x1 - 6, length + 4) : Math.min(x2 + 6, W - length - 4)).toFixed(1));
+    labels.push({ text: label.textContent, y: y1, size });
+  });
   const [tx, ty] = project({ x_m: 0, y_m: 0, z_m: 0 });
-  const [fx, fy] = project({ x_m: 0, y_m: box.far, z_m: 0 });
-  el(svg, "line", { class: "target-line", x1: tx, y1: ty, x2: fx, y2: fy });
+  el(svg, "line", { class: "target-line", x1: tx, y1: ty, x2: W / 2, y2: horizon });
+  el(svg, "circle", { class: "tee", cx: tx, cy: ty, r: 3 });
   drawShots(svg, project, `${scale} ${horizon}`);
+  (window.golfflightViewer ||= {}).behind = { width: W, height: H, tee: [tx, ty], vanishing: [W / 2, horizon], labels };
 }
 
 /** From the side: downrange to the right, height up, one scale for both. */
@@ -385,7 +407,8 @@ function setNumber(id, text, unit, hand = "") {
   if (unit && text !== "—") {
     const small = document.createElement("small");
     small.textContent = unit;
-    node.append(small, hand ? " " + hand : "");
+    if (unit === "°") small.className = "deg";  // 10.4°, not 10.4 °
+    node.append(small, hand ? "\u00a0" + hand : "");
   }
 }
 
@@ -483,15 +506,166 @@ function tick() {
   requestAnimationFrame(tick);
 }
 
+// ---- the bay's conditions (GET/PUT /v1/bay): shown, changed from the form, its units used for every figure ----
+
+/** The form's fields: the bay's value at `path` in SI, shown in the bay's units (to SI and back). */
+const BAY_FIELDS = [
+  { id: "bay-temperature", path: ["air", "temperature_c"], digits: 1, unit: () => imperial() ? "°F" : "°C",
+    show: (c) => imperial() ? c * 9 / 5 + 32 : c, si: (v) => imperial() ? (v - 32) * 5 / 9 : v },
+  { id: "bay-altitude", path: ["air", "altitude_m"], digits: 0, unit: () => imperial() ? "ft" : "m",
+    show: (m) => imperial() ? m / FEET_M : m, si: (v) => imperial() ? v * FEET_M : v },
+  { id: "bay-humidity", path: ["air", "humidity_pct"], digits: 0, unit: () => "%", show: (v) => v, si: (v) => v },
+  { id: "bay-wind-speed", path: ["wind", "speed_mps"], digits: 1, unit: speedUnit,
+    show: (v) => imperial() ? v / MPH_MPS : v, si: (v) => imperial() ? v * MPH_MPS : v },
+  { id: "bay-wind-from", path: ["wind", "from_deg"], digits: 0, unit: () => "°", show: (v) => v, si: (v) => v },
+  { id: "bay-stimp", path: ["ground", "stimp_ft"], digits: 1, unit: () => "ft", show: (v) => v, si: (v) => v },
+];
+
+function bayValue(bay, [group, name]) { return bay && bay[group] ? bay[group][name] : undefined; }
+
+function bayHeaders() {
+  const headers = { "Accept": "application/json" };
+  if (state.key) headers["X-API-Key"] = state.key;
+  return headers;
+}
+
+function bayMessage(kind, text) {
+  const message = document.getElementById("bay-message");
+  message.dataset.state = kind;
+  message.textContent = text;
+}
+
+/** The service's words for a refused request: each 422 entry's `message` (field, value and range), or `detail`. */
+function refusal(status, answer) {
+  const detail = answer && answer.detail;
+  if (Array.isArray(detail)) return detail.map((d) => d.message || d.msg).join("; ");
+  return typeof detail === "string" ? detail : `refused (${status})`;
+}
+
+/** The bay's conditions in a line, in the bay's units. */
+function baySummary(bay) {
+  const parts = [];
+  const air = bay.air || {};
+  if (air.density_kg_m3 !== undefined) parts.push(`air ${air.density_kg_m3} kg/m³`);
+  else {
+    const t = BAY_FIELDS[0], a = BAY_FIELDS[1];
+    parts.push(air.temperature_c === undefined ? "15 °C standard air" : `${fixed(t.show(air.temperature_c), 1)}${t.unit()}`);
+    if (air.altitude_m !== undefined) parts.push(`${fixed(a.show(air.altitude_m), 0)} ${a.unit()} up`);
+    if (air.pressure_hpa !== undefined) parts.push(`${air.pressure_hpa} hPa`);
+    if (air.humidity_pct !== undefined) parts.push(`${air.humidity_pct}% humidity`);
+  }
+  const wind = bay.wind;
+  parts.push(wind && wind.speed_mps ? `wind ${speedText(wind.speed_mps)} ${speedUnit()} from ${Math.round(wind.from_deg || 0)}°` : "calm");
+  const ground = bay.ground || { surface: "fairway" };
+  parts.push(ground.surface.replace("_", " ") + (ground.stimp_ft !== undefined ? `, stimp ${ground.stimp_ft}` : ""));
+  return parts.join(" · ");
+}
+
+/** The form and the summary from `state.bay`; the fields the operator is editing are left alone unless `all`. */
+function showBay(all = true) {
+  const bay = state.bay;
+  if (!bay) return;
+  document.getElementById("bay-summary").textContent = baySummary(bay);
+  for (const field of BAY_FIELDS) {
+    const input = document.getElementById(field.id);
+    document.querySelector(`label[for=${field.id}] .unit`).textContent = field.unit();
+    if (!all && input.dataset.dirty) continue;
+    const value = bayValue(bay, field.path);
+    input.value = typeof value === "number" ? String(Number(field.show(value).toFixed(field.digits))) : "";
+    delete input.dataset.dirty;
+  }
+  const surface = document.getElementById("bay-surface");
+  if (all || !surface.dataset.dirty) {
+    surface.value = (bay.ground && bay.ground.surface) || "fairway";
+    delete surface.dataset.dirty;
+  }
+  document.getElementById("bay-stimp").disabled = surface.value !== "green";
+}
+
+/** Takes the bay the service answered with: its units become the page's. */
+function takeBay(bay, all = true) {
+  state.bay = bay;
+  if (bay.units && bay.units !== state.units) {
+    state.units = bay.units;
+    localStorage.setItem("golfflight-units", state.units);
+    render();
+  }
+  showBay(all);
+}
+
+async function loadBay() {
+  try {
+    const response = await fetch("v1/bay", { headers: bayHeaders(), cache: "no-store" });
+    if (response.ok) {
+      const editing = document.getElementById("bay-form").contains(document.activeElement);
+      takeBay(await response.json(), !editing);
+    }
+  } catch (error) { /* the stream's status says so */ }
+}
+
+/** PUT /v1/bay with `bay`; the service's answer is shown (its message, on a refused value). */
+async function putBay(bay) {
+  bayMessage("saving", "saving…");
+  try {
+    const response = await fetch("v1/bay", {
+      method: "PUT", headers: { ...bayHeaders(), "Content-Type": "application/json" }, body: JSON.stringify(bay),
+    });
+    const answer = await response.json().catch(() => null);
+    if (!response.ok) {
+      bayMessage("refused", refusal(response.status, answer));
+      return false;
+    }
+    takeBay(answer);
+    bayMessage("saved", "saved");
+    return true;
+  } catch (error) {
+    bayMessage("refused", "service unreachable");
+    return false;
+  }
+}
+
+/** The bay as the form says: the service's last bay with the fields the operator changed (an emptied one
+ * removed), so a value nobody touched goes back exactly as it came, never rounded through the display units. */
+function bayFromForm() {
+  const bay = structuredClone(state.bay || {});
+  for (const field of BAY_FIELDS) {
+    const input = document.getElementById(field.id);
+    if (!input.dataset.dirty) continue;
+    const [group, name] = field.path;
+    const text = input.value.trim();
+    if (text === "") {
+      if (bay[group]) delete bay[group][name];
+      continue;
+    }
+    bay[group] = bay[group] || {};
+    const number = Number(text);
+    bay[group][name] = Number.isFinite(number) ? Number(field.si(number).toPrecision(12)) : text;
+  }
+  const surface = document.getElementById("bay-surface").value;
+  if (surface !== ((bay.ground && bay.ground.surface) || "fairway")) bay.ground = { ...(bay.ground || {}), surface };
+  if (bay.ground && bay.ground.surface !== "green") delete bay.ground.stimp_ft;
+  if (bay.wind && bay.wind.speed_mps === undefined) delete bay.wind;  // no speed: calm
+  for (const group of ["air", "wind", "ground"]) {
+    if (bay[group] && Object.keys(bay[group]).length === 0) delete bay[group];
+  }
+  return bay;
+}
+
+async function setUnits(units) {
+  if (state.bay) {
+    await putBay({ ...state.bay, units });
+    return;
+  }
+  state.units = units;  // no bay read (yet): this screen only
+  localStorage.setItem("golfflight-units", state.units);
+  render();
+}
+
 // ---- start --------------------------------------------------------------------------------------------------
 
 document.addEventListener("DOMContentLoaded", () => {
   for (const button of document.querySelectorAll(".units button")) {
-    button.addEventListener("click", () => {
-      state.units = button.dataset.units;
-      localStorage.setItem("golfflight-units", state.units);
-      render();
-    });
+    button.addEventListener("click", () => setUnits(button.dataset.units));
   }
   document.getElementById("key-form").addEventListener("submit", (event) => {
     event.preventDefault();
@@ -500,7 +674,24 @@ document.addEventListener("DOMContentLoaded", () => {
     event.target.hidden = true;
     setStatus("connecting", "connecting…");
     follow();
+    loadBay();
+  });
+  const bayForm = document.getElementById("bay-form");
+  bayForm.addEventListener("input", (event) => {
+    event.target.dataset.dirty = "1";
+    document.getElementById("bay-stimp").disabled = document.getElementById("bay-surface").value !== "green";
+  });
+  bayForm.addEventListener("submit", async (event) => {
+    event.preventDefault();
+    await putBay(bayFromForm());
+  });
+  bayForm.addEventListener("reset", (event) => {
+    event.preventDefault();
+    showBay(true);
+    bayMessage("", "");
   });
   render();
   follow();
+  loadBay();
+  setInterval(loadBay, BAY_POLL_MS);
 });

@@ -1,0 +1,259 @@
+"""Issue 23 on the viewer: the bay's screen shows the bay's own shots only (Open Connect and /v1/gspro; HTTP shots and
+batches only when their request asks with `?viewer=true`), the event stream stays open with keep-alive comments
+and ends when the server shuts down, and in a real headless Chromium: the behind-the-golfer view puts the tee at the
+bottom centre and keeps a straight shot on the target line, labels every distance line, and the bay form PUTs
+/v1/bay and shows the service's message for a refused value."""
+
+from __future__ import annotations
+
+import asyncio
+import time
+from functools import partial
+
+import browser
+import httpx
+import pytest
+from servers import free_port, running
+from test_viewer import DRIVER, KEY, KEYED, WEDGE_BALL, gspro_over_tcp, next_event
+
+from service.api.app import create_app
+from service.api.models import ShotRequest
+from service.api.routes import viewer as viewer_routes
+from service.api.shots import fly_shot
+from service.engine import FlightEngine
+from service.model_location import model_dir
+from service.open_connect.server import ConnectAddress
+from service.viewer.feed import ShotFeed
+from service.viewer.stream import KEEPALIVE_FRAME, KEEPALIVE_S, events, serving_server
+
+STRAIGHT = {"ball_speed_mph": 160.0, "launch_angle_deg": 11.0, "spin_rpm": 2700.0, "spin_axis_deg": 0.0}
+
+
+@pytest.fixture(scope="module")
+def engine() -> FlightEngine:
+    return FlightEngine(model_dir())
+
+
+@pytest.fixture(scope="module")
+def service():
+    port = free_port()
+    app = create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))
+    with running(app) as http:
+        yield http, port, app
+
+
+def gspro(number: int) -> dict:
+    return {"ShotNumber": number, "APIversion": "1", "BallData": WEDGE_BALL}
+
+
+def test_only_the_bays_own_shots_reach_the_viewer_unless_a_request_asks(service, monkeypatch):
+    http, port, app = service
+    monkeypatch.setattr(viewer_routes, "events", partial(events, lifetime_s=60))
+    with (
+        httpx.Client(base_url=http.base_url, timeout=10) as viewer,
+        viewer.stream("GET", "/v1/events", headers=KEYED) as stream,
+    ):
+        lines = stream.iter_lines()
+        assert http.post("/v1/shots", json=DRIVER, headers=KEYED).status_code == 200
+        big = {"shots": [DRIVER] * 200}
+        assert http.post("/v1/shots/batch", json=big, headers=KEYED).status_code == 200
+        assert http.post("/v1/shots?viewer=false", json=DRIVER, headers=KEYED).status_code == 200
+        # the next event is the bay's own shot: nothing of the traffic before it
+        assert http.post("/v1/gspro", json=gspro(3), headers=KEYED).json()["Code"] == 200
+        event = next_event(lines)
+        assert (event.source, event.shot_number) == ("gspro-http", 3)
+        gspro_over_tcp(port, 4, WEDGE_BALL)
+        assert next_event(lines).source == "open-connect"
+        # asked for: a tagged HTTP shot and a batch's shots are shown
+        assert http.post("/v1/shots?viewer=true", json=DRIVER, headers=KEYED).status_code == 200
+        assert next_event(lines).source == "http"
+        batch = {"shots": [DRIVER, {**DRIVER, "ball_speed_mph": 120.0}]}
+        assert http.post("/v1/shots/batch?viewer=true", json=batch, headers=KEYED).status_code == 200
+        assert [next_event(lines).source, next_event(lines).source] == ["batch", "batch"]
+    kept = [entry.source for entry in app.state.service.feed.subscribe().pending]
+    for viewer in app.state.service.feed.viewers:
+        app.state.service.feed.unsubscribe(viewer)
+    assert "batch" in kept and kept.count("http") <= 2  # earlier tests' tagged shots at most; none untagged
+
+
+def test_the_viewer_flag_leaves_the_batch_contract_as_it_was(service):
+    http, _, _ = service
+    bad = {"shots": [DRIVER, {**DRIVER, "spin_rpm": 99999.0}]}
+    for path in ("/v1/shots/batch", "/v1/shots/batch?viewer=true"):
+        answer = http.post(path, json=bad, headers=KEYED)
+        assert answer.status_code == 422 and answer.json()["detail"][0]["shot"] == 1
+    unknown = http.post("/v1/shots/batch", json={"shots": [DRIVER], "viewer": True}, headers=KEYED)
+    assert unknown.status_code == 422  # the flag is no body field: the body stays strict
+    refused = http.post("/v1/shots?viewer=perhaps", json=DRIVER, headers=KEYED)
+    assert refused.status_code == 422 and "viewer" in refused.text
+    parameters = http.get("/openapi.json", headers=KEYED).json()["paths"]["/v1/shots/batch"]["post"]["parameters"]
+    assert [(p["name"], p["in"], p["schema"]["type"]) for p in parameters] == [("viewer", "query", "boolean")]
+
+
+def test_a_quiet_stream_sends_keep_alive_comments(engine):
+    request = ShotRequest(**DRIVER)
+
+    async def stream() -> list[str]:
+        feed = ShotFeed()
+        viewer = feed.subscribe()
+        feed.publish("http", request, fly_shot(engine, request))
+        return [frame async for frame in events(feed, viewer, engine, lifetime_s=0.55, keepalive_s=0.1)]
+
+    frames = asyncio.run(stream())
+    assert frames[0].startswith("retry: ") and frames[1].startswith("id: 1\n")
+    assert 4 <= frames.count(KEEPALIVE_FRAME) <= 6 and len(frames) == 2 + frames.count(KEEPALIVE_FRAME)
+    assert KEEPALIVE_S <= 15
+
+
+def test_a_stream_ends_promptly_when_the_server_shuts_down(engine):
+    told = []  # the server's should_exit, as the stream sees it
+
+    async def stream() -> tuple[list[str], float, ShotFeed]:
+        feed = ShotFeed()
+        asyncio.get_running_loop().call_later(0.3, told.append, True)
+        started = time.monotonic()
+        frames = [frame async for frame in events(feed, feed.subscribe(), engine, stopping=lambda: bool(told))]
+        return frames, time.monotonic() - started, feed
+
+    frames, seconds, feed = asyncio.run(stream())
+    assert frames == ["retry: 500\n\n"] and 0.3 <= seconds < 1.2 and feed.viewers == ()
+    assert serving_server()() is False  # pytest's main thread runs no uvicorn server: never seen as stopping
+
+
+def test_the_event_stream_stays_open_past_the_old_five_seconds_with_keep_alives(service, monkeypatch):
+    http, _, _ = service
+    monkeypatch.setattr(viewer_routes, "events", partial(events, keepalive_s=0.5))  # endless, as served
+    comments, started = 0, time.monotonic()
+    with (
+        httpx.Client(base_url=http.base_url, timeout=10) as viewer,
+        viewer.stream("GET", "/v1/events", headers=KEYED) as stream,
+    ):
+        for line in stream.iter_lines():
+            comments += line == ": keep-alive"
+            if time.monotonic() - started > 6.0:
+                break
+        else:
+            pytest.fail("the stream ended")
+    assert comments >= 9
+
+
+@pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
+def test_the_page_behind_the_golfer_and_the_bay_form_in_chromium():
+    port = free_port()
+    with running(create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))) as http:
+        base = str(http.base_url).rstrip("/")
+        with browser.headless_page(1400, 1000) as page:
+            errors: list[str] = []
+            page.on("pageerror", lambda error: errors.append(str(error)))
+            page.goto(f"{base}/viewer#key={KEY}")
+            page.wait_for_selector("#status[data-state=live]", timeout=10_000)
+            page.wait_for_function("() => document.querySelector('#bay-summary').textContent !== '—'", timeout=10_000)
+
+            # a batch without the flag never reaches the page; the bay's own shot does
+            page.select_option("#club", "Driver")
+            assert http.post("/v1/shots/batch", json={"shots": [DRIVER] * 60}, headers=KEYED).status_code == 200
+            straight = http.post("/v1/shots?viewer=true", json=STRAIGHT, headers=KEYED).json()
+            assert straight["lateral_m"] == pytest.approx(0.0, abs=1e-6)
+            page.wait_for_selector("#behind polyline.latest[data-done]", state="attached", timeout=10_000)
+            assert page.locator("#shots tbody tr").count() == 1 and "Driver: 1 shot" in page.inner_text("#legend")
+
+            behind = page.evaluate("window.golfflightViewer.behind")
+            width, height = behind["width"], behind["height"]
+            tee_x, tee_y = behind["tee"]
+            assert tee_x == pytest.approx(width / 2) and height - 40 <= tee_y <= height  # bottom centre
+            assert behind["vanishing"][0] == pytest.approx(width / 2) and behind["vanishing"][1] < tee_y
+            target = page.locator("#behind line.target-line")
+            assert [float(target.get_attribute(a)) for a in ("x1", "x2")] == pytest.approx([width / 2] * 2)
+            path = [tuple(map(float, p.split(","))) for p in page.get_attribute("#behind polyline.latest", "points").split()]
+            assert len(path) > 30
+            assert max(abs(x - width / 2) for x, _ in path) <= 0.5, "a straight shot left the centre line"
+            assert path[0] == pytest.approx((tee_x, tee_y), abs=1.0)  # it starts on the tee
+            assert min(y for _, y in path) < tee_y - 200  # and flies up the screen
+
+            gspro_over_tcp(port, 1, {**WEDGE_BALL, "HLA": 4.0, "SpinAxis": 8.0})  # a wedge right of the line
+            page.wait_for_selector("#shots tbody tr[data-shot='2']", timeout=10_000)
+            page.wait_for_selector("#behind polyline.latest[data-done]", state="attached", timeout=10_000)
+            wedge = [tuple(map(float, p.split(","))) for p in page.get_attribute("#behind polyline.latest", "points").split()]
+            assert wedge[0] == pytest.approx((tee_x, tee_y), abs=1.0) and wedge[-1][0] > width / 2 + 5
+
+            markers = page.locator("#behind line.marker-line").count()
+            labels = page.locator("#behind text.distance").all_text_contents()
+            assert markers >= 6 and len(labels) == markers and labels[:2] == ["50 yd", "100 yd"]
+            boxes = page.eval_on_selector_all(
+                "#behind text.distance", "els => els.map(e => { const b = e.getBBox(); return [b.x, b.y, b.width, b.height]; })"
+            )
+            for i, a in enumerate(boxes):  # no two labels overlap, and each is inside the picture
+                assert 0 <= a[0] and a[0] + a[2] <= width and a[1] >= 0
+                for b in boxes[i + 1 :]:
+                    apart = a[0] + a[2] <= b[0] or b[0] + b[2] <= a[0] or a[1] + a[3] <= b[1] or b[1] + b[3] <= a[1]
+                    assert apart, (a, b)
+            assert page.inner_text("#n-launch") == "24.0°"  # the degree sign on its number (the wedge)
+
+            # the bay form: metric units, then the issue's bay, PUT through the page, read back by GET /v1/bay
+            page.click(".units button[data-units=metric]")
+            page.wait_for_selector("#bay-message[data-state=saved]", timeout=10_000)
+            assert http.get("/v1/bay", headers=KEYED).json()["units"] == "metric"
+            assert page.inner_text("#n-carry").endswith("m") and "(m)" in page.inner_text("#shots thead")
+            page.fill("#bay-temperature", "30")
+            page.fill("#bay-altitude", "1600")
+            page.fill("#bay-wind-speed", "4.47")
+            page.fill("#bay-wind-from", "0")
+            page.select_option("#bay-surface", "green")
+            page.fill("#bay-stimp", "12")
+            page.evaluate("document.querySelector('#bay-message').dataset.state = ''")
+            page.click("#bay-form button[type=submit]")
+            page.wait_for_selector("#bay-message[data-state=saved]", timeout=10_000)
+            bay = http.get("/v1/bay", headers=KEYED).json()
+            assert bay["air"] == {"temperature_c": 30.0, "altitude_m": 1600.0}
+            assert bay["wind"]["speed_mps"] == pytest.approx(4.47) and bay["wind"]["from_deg"] == 0.0
+            assert bay["ground"]["surface"] == "green" and bay["ground"]["stimp_ft"] == 12.0
+            assert bay["units"] == "metric"
+            summary = page.inner_text("#bay-summary")
+            assert "30.0°C" in summary and "1600 m" in summary and "stimp 12" in summary
+
+            # imperial: the form shows the same bay in °F, ft and mph; untouched values go back unrounded
+            page.click(".units button[data-units=imperial]")
+            page.wait_for_function("() => document.querySelector('#bay-altitude').value === '5249'", timeout=10_000)
+            assert page.input_value("#bay-temperature") == "86" and page.input_value("#bay-wind-speed") == "10"
+            page.fill("#bay-humidity", "40")
+            page.evaluate("document.querySelector('#bay-message').dataset.state = ''")
+            page.click("#bay-form button[type=submit]")
+            page.wait_for_selector("#bay-message[data-state=saved]", timeout=10_000)
+            bay = http.get("/v1/bay", headers=KEYED).json()
+            assert bay["air"] == {"temperature_c": 30.0, "altitude_m": 1600.0, "humidity_pct": 40.0}
+            assert bay["wind"]["speed_mps"] == pytest.approx(4.47) and bay["units"] == "imperial"
+
+            # a refused value: the service's own message, and the bay unchanged
+            page.fill("#bay-humidity", "150")
+            page.click("#bay-form button[type=submit]")
+            page.wait_for_selector("#bay-message[data-state=refused]", timeout=10_000)
+            message = page.inner_text("#bay-message")
+            assert "humidity_pct" in message and "150" in message, message
+            assert http.get("/v1/bay", headers=KEYED).json()["air"]["humidity_pct"] == 40.0
+            assert errors == []
+
+
+@pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
+def test_the_narrow_layout_keeps_the_lateral_column_and_whole_dots():
+    port = free_port()
+    with running(create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))) as http:
+        base = str(http.base_url).rstrip("/")
+        with browser.headless_page(390, 844) as page:
+            page.goto(f"{base}/viewer#key={KEY}")
+            page.wait_for_selector("#status[data-state=live]", timeout=10_000)
+            for number, (hla, axis) in enumerate(((-6.0, -20.0), (0.0, 0.0), (6.0, 25.0)), start=1):
+                gspro_over_tcp(port, number, {**WEDGE_BALL, "HLA": hla, "SpinAxis": axis})
+            page.wait_for_selector("#shots tbody tr[data-shot='3']", timeout=10_000)
+            assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")  # no sideways scroll
+            scroll = page.locator(".shots .scroll")
+            assert scroll.evaluate("e => e.scrollWidth <= e.clientWidth"), "the shot table is cut"
+            lateral = page.locator("#shots th", has_text="lateral")
+            assert lateral.is_visible() and lateral.bounding_box()["x"] + lateral.bounding_box()["width"] <= 390
+            for view in ("#dispersion",):
+                box = page.locator(view).bounding_box()
+                for dot in page.locator(f"{view} circle.dot").all():
+                    b = dot.bounding_box()  # each dot whole, inside its picture
+                    assert box["x"] <= b["x"] and b["x"] + b["width"] <= box["x"] + box["width"]
+                    assert abs(b["width"] - b["height"]) < 0.5
+            tile = page.locator("#n-landing-angle").bounding_box()
+            assert tile["height"] < 40  # number and degree sign on one line
