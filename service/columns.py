@@ -8,13 +8,16 @@ flat row (`flat_row`). The standard library and the request models only: the ser
 
 from __future__ import annotations
 
+import re
+
 from pydantic import ValidationError
 
-from service.api.models import FlatFlight, FlightResult, ShotRequest, describe_errors
+from service.api.models import FlatFlight, FlightResult, Landing, RestPoint, ShotRequest, describe_errors
 
 AIR_COLUMNS = {name: name for name in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct", "density_kg_m3")}
 WIND_COLUMNS = {
     "wind_speed_mps": "speed_mps",
+    "wind_speed_mph": "speed_mph",
     "wind_from_deg": "from_deg",
     "wind_profile": "profile",
     "wind_reference_height_m": "reference_height_m",
@@ -23,6 +26,7 @@ GROUND_COLUMNS = {
     "ground_surface": "surface",
     "stimp_ft": "stimp_ft",
     "ground_elevation_m": "elevation_m",
+    "ground_elevation_ft": "elevation_ft",
     "slope_deg": "slope_deg",
     "slope_dir_deg": "slope_dir_deg",
 }
@@ -56,6 +60,9 @@ KNOWN_COLUMNS = frozenset({"shot_id", *REQUEST_COLUMNS, *PASSED_OVER})
 
 TEXT_COLUMNS = frozenset({"shot_id", "session", "club", "timestamp", "split", "wind_profile", "ground_surface"})
 """Columns whose cells are words (echoed as text); `normalized` is a flag; every other known column is a number."""
+
+SECTION_COLUMNS = {"air": AIR_COLUMNS, "wind": WIND_COLUMNS, "ground": GROUND_COLUMNS}
+"""The request's condition objects and their columns (column -> field)."""
 
 REQUEST_TO_COLUMN = {
     **{f"air.{field}": column for column, field in AIR_COLUMNS.items()},
@@ -118,14 +125,22 @@ def check(item, csv_columns: bool = True) -> ShotRequest | list[str]:
     except ValidationError as error:
         problems = []
         for detail in describe_errors(error.errors()):
-            field = detail["field"]
+            field, message = detail["field"], detail["message"].split(": ", 1)[-1]
+            if csv_columns and field in SECTION_COLUMNS:  # about several fields (two forms given): name the columns
+                columns = {name: column for column, name in SECTION_COLUMNS[field].items()}
+                message = re.sub(r"\b\w+\b", lambda word, named=columns: named.get(word[0], word[0]), message)
+                problems.append(f"{field} columns: {message}")
+                continue
             where = f"column '{REQUEST_TO_COLUMN.get(field, field)}'" if csv_columns else f"field '{field}'"
-            problems.append(f"{where}: {detail['message'].split(': ', 1)[-1]}")
+            problems.append(f"{where}: {message}")
         return problems
 
 
-NESTED_POINTS = ("landing", "rest")
-"""Result fields that are points, flattened to NAME_x_m and NAME_y_m."""
+NESTED_POINTS = {"landing": Landing, "rest": RestPoint}
+"""Result fields that are points, flattened to NAME_FIELD: NAME_x_m, NAME_y_m, NAME_x_yd, NAME_y_yd."""
+
+ELEVATION_COLUMNS = ("ground_elevation_m", "ground_elevation_ft")
+"""Columns that can put the ground off the tee's elevation, so that flat_* columns come back (`result_columns`)."""
 
 LEFT_OUT = ("trajectory", "normalized", "flat", "conditions")
 """Result fields that are not flat numbers of the flight (the nested flights get prefixed columns instead)."""
@@ -139,7 +154,7 @@ def flat_row(result: dict) -> dict:
             continue
         for key, value in flight.items():
             if key in NESTED_POINTS:
-                row[f"{prefix}{key}_x_m"], row[f"{prefix}{key}_y_m"] = value["x_m"], value["y_m"]
+                row.update({f"{prefix}{key}_{field}": number for field, number in value.items()})
             elif key not in LEFT_OUT:
                 row[prefix + key] = value
     return row
@@ -149,7 +164,7 @@ def _flat_names(fields, prefix: str = "") -> list[str]:
     names = []
     for key in fields:
         if key in NESTED_POINTS:
-            names += [f"{prefix}{key}_x_m", f"{prefix}{key}_y_m"]
+            names += [f"{prefix}{key}_{field}" for field in NESTED_POINTS[key].model_fields]
         elif key not in LEFT_OUT:
             names.append(prefix + key)
     return names

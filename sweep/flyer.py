@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 from service.columns import (
+    ELEVATION_COLUMNS,
     REQUEST_COLUMNS,
     TEXT_COLUMNS,
     cell_value,
@@ -43,7 +44,8 @@ class Layout:
 
     @cached_property
     def results(self) -> list[str]:
-        return result_columns(normalized="normalized" in self.columns, flat="ground_elevation_m" in self.columns)
+        flat = any(column in self.columns for column in ELEVATION_COLUMNS)
+        return result_columns(normalized="normalized" in self.columns, flat=flat)
 
     @cached_property
     def echoed(self) -> list[str]:

@@ -36,19 +36,22 @@ FIELDS = {
     "humidity_pct": (("air",), SEVEN_IRON),
     "density_kg_m3": (("air",), SEVEN_IRON),
     "speed_mps": (("wind",), SEVEN_IRON),
+    "speed_mph": (("wind",), SEVEN_IRON),
     "from_deg": (("wind",), SEVEN_IRON),
     "reference_height_m": (("wind",), SEVEN_IRON),
     "rate_hz": (("trajectory",), SEVEN_IRON),
     "stimp_ft": (("ground",), SEVEN_IRON),
     "elevation_m": (("ground",), SEVEN_IRON),
+    "elevation_ft": (("ground",), SEVEN_IRON),
     "slope_deg": (("ground",), SEVEN_IRON),
     "slope_dir_deg": (("ground",), SEVEN_IRON),
 }
 """Every numeric request field: where it sits in the body and a valid shot to put it in."""
 
-SECTION_BASE = {"wind": {"speed_mps": 3.0}, "stimp_ft": {"surface": "green"}, "slope_deg": {"surface": "rough"}}
+SECTION_BASE = {"wind": {"speed_mps": 3.0}, "speed_mph": {}, "stimp_ft": {"surface": "green"},
+                "slope_deg": {"surface": "rough"}}
 """What a field's section needs besides it to be valid (by section or field name): a stimp reading is a green's,
-and slopes up to 10 degrees are held by the rough, not by the fairway."""
+slopes up to 10 degrees are held by the rough, not by the fairway, and a wind speed in mph is the wind's speed."""
 
 
 @pytest.fixture(scope="module")

@@ -15,7 +15,7 @@ import re
 
 from pydantic import ValidationError
 
-from flight.constants import MPH_TO_MPS, YARD_M
+from flight.constants import MPH_TO_MPS
 from flight.limits import WIND_SPEED_MPS, Range
 from shots.clubs import CLUB_NAMES, club_named
 
@@ -45,10 +45,11 @@ TABLE = (
     ("carry", "carry_m", "carry_yd"),
     ("total", "total_m", "total_yd"),
     ("apex", "apex_m", "apex_yd"),
-    ("lateral", "lateral_m", None),
-    ("roll", "roll_m", None),
+    ("lateral", "lateral_m", "lateral_yd"),
+    ("roll", "roll_m", "roll_yd"),
 )
-"""Rows of the printed table with a length: (label, metres field, yards field or None: converted here)."""
+"""Rows of the printed table with a length: (label, metres field, yards field), both the result's own (POST
+/v1/shots' names; nothing is converted here)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -253,13 +254,11 @@ def run(args: argparse.Namespace) -> int:
             launch += f"; {part} " + ", ".join(f"{key} {value:g}" for key, value in values.items())
     print(f"{club} ({flown_by}): {launch}")
     for label, metres, yards in TABLE:
-        value = result[metres] + 0.0  # no -0.0
-        in_yards = result[yards] if yards else value / YARD_M
+        value, in_yards = result[metres] + 0.0, result[yards] + 0.0  # no -0.0
         print(f"  {label:<18} {value:8.1f} m {in_yards:8.1f} yd")
     print(f"  {'landing angle':<18} {result['landing_angle_deg']:8.1f} deg")
     print(f"  {'flight time':<18} {result['flight_time_s']:8.2f} s   apex at {result['apex_time_s']:.2f} s")
-    speed = result["landing_speed_mps"]
-    print(f"  {'landing speed':<18} {speed:8.1f} m/s {speed / MPH_TO_MPS:6.1f} mph")
+    print(f"  {'landing speed':<18} {result['landing_speed_mps']:8.1f} m/s {result['landing_speed_mph']:6.1f} mph")
     print(f"  {'landing spin':<18} {result['landing_spin_rpm']:8.0f} rpm")
     print(f"  {'bounces':<18} {result['bounces']:8d}")
     return 0

@@ -2,10 +2,12 @@
 
 Input: JSON (one shot, a list of shots, or {"shots": [...]}, in the HTTP request format) or a CSV of launches
 (one row per shot, the request's launch fields as columns plus optional flat conditions: temperature_c,
-altitude_m, pressure_hpa, humidity_pct, density_kg_m3, wind_speed_mps, wind_from_deg, wind_profile,
-wind_reference_height_m, normalized, and the ground: ground_surface, stimp_ft, ground_elevation_m, slope_deg,
-slope_dir_deg). A canonical shot file works as is: its identity and outcome columns are
-passed over, its shot_id echoed. Output: {"results": [...]} as JSON, or a flat CSV when --out ends in .csv.
+altitude_m, pressure_hpa, humidity_pct, density_kg_m3, wind_speed_mps or wind_speed_mph, wind_from_deg, wind_profile,
+wind_reference_height_m, normalized, and the ground: ground_surface, stimp_ft, ground_elevation_m or
+ground_elevation_ft, slope_deg, slope_dir_deg). A canonical shot file works as is: its identity and outcome columns are
+passed over, its shot_id echoed. Output: {"results": [...]} as JSON, or a flat CSV when --out ends in .csv: the
+result's fields as columns (`service.columns.result_columns`), its points flattened (rest_x_m, rest_x_yd, ...), every
+length in metres and yards, the landing speed in m/s and mph.
 
 A bad shot (a value out of range or not a number, an extra cell, a shot_id seen before) refuses the file with its
 line (CSV) or index (JSON) and field; --skip-bad-rows flies the rest and lists each one left out on stderr.

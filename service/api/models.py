@@ -15,7 +15,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from flight import limits
 from flight.conditions import NORMALIZED_REFERENCE
-from flight.constants import MPH_TO_MPS
+from flight.constants import FOOT_M, MPH_TO_MPS
 from flight.ground import SURFACES, holding_slope_deg, surface
 from flight.limits import Range
 
@@ -27,6 +27,8 @@ MAX_BATCH_TRAJECTORIES = 100
 
 BALL_SPEED_MPH = Range(limits.BALL_SPEED_MPS.low / MPH_TO_MPS, limits.BALL_SPEED_MPS.high / MPH_TO_MPS, "mph")
 SIDE_SPIN_RPM = Range(-limits.SPIN_RPM.high, limits.SPIN_RPM.high, "rpm")
+WIND_SPEED_MPH = Range(limits.WIND_SPEED_MPS.low / MPH_TO_MPS, limits.WIND_SPEED_MPS.high / MPH_TO_MPS, "mph")
+GROUND_ELEVATION_FT = Range(limits.GROUND_ELEVATION_M.low / FOOT_M, limits.GROUND_ELEVATION_M.high / FOOT_M, "ft")
 
 RANGES: dict[str, Range] = {
     "ball_speed_mps": limits.BALL_SPEED_MPS,
@@ -43,11 +45,13 @@ RANGES: dict[str, Range] = {
     "humidity_pct": limits.HUMIDITY_PCT,
     "density_kg_m3": limits.AIR_DENSITY_KG_M3,
     "speed_mps": limits.WIND_SPEED_MPS,
+    "speed_mph": WIND_SPEED_MPH,
     "from_deg": limits.WIND_FROM_DEG,
     "reference_height_m": limits.WIND_REFERENCE_HEIGHT_M,
     "rate_hz": limits.TRAJECTORY_RATE_HZ,
     "stimp_ft": limits.STIMP_FT,
     "elevation_m": limits.GROUND_ELEVATION_M,
+    "elevation_ft": GROUND_ELEVATION_FT,
     "slope_deg": limits.SLOPE_DEG,
     "slope_dir_deg": limits.SLOPE_DIR_DEG,
 }
@@ -140,14 +144,25 @@ class ReferenceAir(Strict):
 
 
 class WindRequest(Strict):
-    """A steady wind, by the direction it blows FROM: 0 = headwind, 90 = from the right, 180 = tailwind."""
+    """A steady wind, by the direction it blows FROM: 0 = headwind, 90 = from the right, 180 = tailwind; its speed in
+    exactly one form, speed_mps or speed_mph."""
 
-    speed_mps: _in("speed_mps", "wind speed at the reference height")
+    model_config = ConfigDict(
+        json_schema_extra=_one_of(("speed_mps", ("speed_mph",)), ("speed_mph", ("speed_mps",)))
+    )
+
+    speed_mps: _in("speed_mps", "wind speed at the reference height", True) = None
+    speed_mph: _in("speed_mph", "wind speed at the reference height, instead of speed_mps", True) = None
     from_deg: _in("from_deg", "direction the wind blows from, clockwise seen from behind the golfer") = 0.0
     profile: Literal["uniform", "log"] = Field(
         "uniform", description="uniform: the same at every height; log: V(h) = V_ref ln(h/z0)/ln(h_ref/z0), z0 = 2 cm"
     )
     reference_height_m: _in("reference_height_m", "height the speed is measured at (log profile)") = 10.0
+
+    @model_validator(mode="after")
+    def _one_form(self) -> WindRequest:
+        _exactly_one(self, "wind speed", "speed_mps", "speed_mph")
+        return self
 
 
 class TrajectoryRequest(Strict):
@@ -161,18 +176,37 @@ SurfaceName = Literal[tuple(SURFACES)]
 
 class GroundRequest(Strict):
     """The ground the ball comes down on, bounces and rolls to rest on (flight.ground, docs/ground.md); omitted =
-    level fairway at the tee's elevation. A slope may be no steeper than the surface holds a ball still on."""
+    level fairway at the tee's elevation. Its elevation in at most one form, elevation_m or elevation_ft (neither:
+    elevation_m 0, the tee's; with elevation_ft, elevation_m is None). A slope may be no steeper than the surface
+    holds a ball still on."""
+
+    model_config = ConfigDict(json_schema_extra=_not_together(("elevation_m", "elevation_ft")))
 
     surface: SurfaceName = Field("fairway", description=f"one of {', '.join(SURFACES)}")
     stimp_ft: _in("stimp_ft", "green speed, the stimpmeter reading; green only (default 10)", True) = None
-    elevation_m: _in("elevation_m", "landing ground above (+) or below (-) the tee's ground; the carry is there") = 0.0
+    elevation_m: _in(
+        "elevation_m", "landing ground above (+) or below (-) the tee's ground; the carry is there", True
+    ) = 0.0
+    elevation_ft: _in(
+        "elevation_ft", "landing ground above (+) or below (-) the tee's ground, instead of elevation_m", True
+    ) = None
     slope_deg: _in("slope_deg", "slope of the ground around the landing point") = 0.0
     slope_dir_deg: _in(
         "slope_dir_deg", "direction it falls towards, clockwise from the target line: 0 = away, 90 = to the right"
     ) = 0.0
 
+    @model_validator(mode="before")
+    @classmethod
+    def _feet_replace_the_default(cls, data):
+        """elevation_ft given without elevation_m: elevation_m takes no default (it is not 0, it is not given)."""
+        if isinstance(data, dict) and data.get("elevation_ft") is not None and "elevation_m" not in data:
+            return {**data, "elevation_m": None}
+        return data
+
     @model_validator(mode="after")
     def _holds_a_ball(self) -> GroundRequest:
+        if self.elevation_m is not None and self.elevation_ft is not None:
+            raise ValueError("ground elevation: give elevation_m or elevation_ft, not both")
         if self.stimp_ft is not None and self.surface != "green":
             raise ValueError(f"stimp_ft: a green's reading; surface {self.surface!r} takes none")
         limit = float(holding_slope_deg(surface(self.surface, self.stimp_ft).rolling_resistance))
@@ -251,17 +285,22 @@ class BatchRequest(Strict):
 
 
 class Landing(BaseModel):
-    """Where the ball comes down, on its ground's plane (the tee's elevation unless ground.elevation_m)."""
+    """Where the ball comes down, on its ground's plane (the tee's elevation unless the ground's elevation); metres
+    with yards alongside."""
 
     x_m: float = Field(description="right (+) of the target line")
     y_m: float = Field(description="down the target line")
+    x_yd: float
+    y_yd: float
 
 
 class RestPoint(BaseModel):
-    """Where the ball comes to rest after bouncing and rolling."""
+    """Where the ball comes to rest after bouncing and rolling; metres with yards alongside."""
 
     x_m: float = Field(description="right (+) of the target line")
     y_m: float = Field(description="down the target line")
+    x_yd: float
+    y_yd: float
 
 
 class TrajectoryPoint(BaseModel):
@@ -272,23 +311,27 @@ class TrajectoryPoint(BaseModel):
 
 
 class FlightResult(BaseModel):
-    """One flight to its landing on its ground (at the tee's elevation, "flat", unless ground.elevation_m), then
-    bounced and rolled to rest; metres with yards alongside."""
+    """One flight to its landing on its ground (at the tee's elevation, "flat", unless the ground's elevation), then
+    bounced and rolled to rest; every length in metres with yards alongside (NAME_m, NAME_yd), the landing speed in
+    m/s with mph alongside (`service.api.shots.flight_numbers` derives them all)."""
 
     landing: Landing
     carry_m: float = Field(description="horizontal distance from the tee to the landing point")
     carry_yd: float
     lateral_m: float = Field(description="landing point right (+) or left (-) of the target line")
+    lateral_yd: float
     apex_m: float = Field(description="greatest height")
     apex_yd: float
     apex_time_s: float
     flight_time_s: float
     landing_angle_deg: float = Field(description="descent angle below the horizontal")
     landing_speed_mps: float
+    landing_speed_mph: float
     landing_spin_rpm: float
     total_m: float = Field(description="horizontal distance from the tee to the rest point (carry and roll)")
     total_yd: float
     roll_m: float = Field(description="total minus carry: the run after landing (negative: the ball came back)")
+    roll_yd: float
     rest: RestPoint
     bounces: int = Field(description="hops after the landing before the ball rolls")
     trajectory: list[TrajectoryPoint] | None = Field(
@@ -310,6 +353,7 @@ class FlatFlight(BaseModel):
     carry_m: float
     carry_yd: float
     lateral_m: float
+    lateral_yd: float
     flight_time_s: float
     landing_angle_deg: float
 
@@ -318,7 +362,9 @@ class ShotResult(FlightResult):
     """The flight in the conditions given, and in reference conditions when asked for."""
 
     normalized: NormalizedFlight | None = None
-    flat: FlatFlight | None = Field(None, description="only when ground.elevation_m is not 0: the flight to z = 0")
+    flat: FlatFlight | None = Field(
+        None, description="only when the ground's elevation (elevation_m or elevation_ft) is not 0: the flight to z = 0"
+    )
 
 
 class ShotFailure(BaseModel):

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flight.conditions import STANDARD, AirConditions, Conditions
-from flight.constants import MPH_TO_MPS, YARD_M
+from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from flight.ground import LEVEL_FAIRWAY, GroundSpec, surface
 from flight.wind import CALM, Wind
 from service.api.models import (
@@ -55,10 +55,16 @@ def air_of(air: AirRequest | ReferenceAir | None) -> AirConditions:
     return AirConditions(**given)
 
 
+def wind_speed_mps(wind: WindRequest) -> float:
+    """The SI wind speed of a request's (or a bay's) wind, whichever unit form it used."""
+    return wind.speed_mps if wind.speed_mps is not None else wind.speed_mph * MPH_TO_MPS
+
+
 def wind_of(wind: WindRequest | None) -> Wind:
-    if wind is None or wind.speed_mps == 0.0:
+    speed = 0.0 if wind is None else wind_speed_mps(wind)
+    if speed == 0.0:
         return CALM
-    return Wind(wind.speed_mps, wind.from_deg, wind.profile, wind.reference_height_m)
+    return Wind(speed, wind.from_deg, wind.profile, wind.reference_height_m)
 
 
 def conditions_from(air: AirRequest | None, wind: WindRequest | None) -> Conditions:
@@ -72,12 +78,19 @@ def conditions_of(shot: ShotRequest) -> Conditions:
     return conditions_from(shot.air, shot.wind)
 
 
+def elevation_m(ground: GroundRequest | None) -> float:
+    """The SI elevation of a request's (or a bay's) ground, whichever unit form it used; 0 (the tee's) if none."""
+    if ground is None or (ground.elevation_m is None and ground.elevation_ft is None):
+        return 0.0
+    return ground.elevation_m if ground.elevation_m is not None else ground.elevation_ft * FOOT_M
+
+
 def ground_of(ground: GroundRequest | None) -> GroundSpec:
     """The engine's ground from a request's; omitted = level fairway at the tee's elevation."""
     if ground is None:
         return LEVEL_FAIRWAY
     return GroundSpec(
-        surface(ground.surface, ground.stimp_ft), ground.elevation_m, ground.slope_deg, ground.slope_dir_deg
+        surface(ground.surface, ground.stimp_ft), elevation_m(ground), ground.slope_deg, ground.slope_dir_deg
     )
 
 
@@ -99,51 +112,68 @@ def _trajectory(flight: ShotFlight, request: TrajectoryRequest) -> list[Trajecto
     ]
 
 
+IMPERIAL_TWINS = (("_m", "_yd", YARD_M), ("_mps", "_mph", MPH_TO_MPS))
+"""(SI suffix, imperial suffix, SI units per imperial unit): every result number named NAME_m (a length) gets
+NAME_yd beside it, every NAME_mps (a speed) NAME_mph: the one place the results' imperial fields are defined."""
+
+
+def with_imperial(numbers: dict) -> dict:
+    """`numbers` with each SI length and speed followed by its imperial twin (`IMPERIAL_TWINS`): value / unit."""
+    out = {}
+    for name, value in numbers.items():
+        out[name] = value
+        for si, imperial, unit in IMPERIAL_TWINS:
+            if name.endswith(si):
+                out[name.removesuffix(si) + imperial] = value / unit
+    return out
+
+
 def flight_numbers(flight) -> dict:
-    """The flat numbers of a flight rolled to rest under their column names (yards alongside metres), from one
-    ShotFlight (floats) or a batch's `BatchFlights` (arrays): the one definition of both forms."""
+    """The flat numbers of a flight rolled to rest under their column names (yards alongside metres, mph alongside
+    m/s: `with_imperial`), from one ShotFlight (floats) or a batch's `BatchFlights` (arrays): the one definition of
+    both forms."""
     rest = flight.rest
-    return {
+    return with_imperial({
         "landing_x_m": flight.landing_x_m,
         "landing_y_m": flight.landing_y_m,
         "carry_m": flight.carry_m,
-        "carry_yd": flight.carry_m / YARD_M,
         "lateral_m": flight.lateral_m,
         "apex_m": flight.apex_m,
-        "apex_yd": flight.apex_m / YARD_M,
         "apex_time_s": flight.apex_time_s,
         "flight_time_s": flight.flight_time_s,
         "landing_angle_deg": flight.landing_angle_deg,
         "landing_speed_mps": flight.landing_speed_mps,
         "landing_spin_rpm": flight.landing_spin_rpm,
         "total_m": rest.total_m,
-        "total_yd": rest.total_m / YARD_M,
         "roll_m": rest.roll_m,
         "rest_x_m": rest.x_m,
         "rest_y_m": rest.y_m,
         "bounces": rest.bounces,
-    }
+    })
 
 
 def flat_numbers(flight) -> dict:
     """The flat numbers of a flight flown down to z = 0, from a ShotFlight or a `BatchFlights` (`flight_numbers`)."""
-    return {
+    return with_imperial({
         "landing_x_m": flight.landing_x_m,
         "landing_y_m": flight.landing_y_m,
         "carry_m": flight.carry_m,
-        "carry_yd": flight.carry_m / YARD_M,
         "lateral_m": flight.lateral_m,
         "flight_time_s": flight.flight_time_s,
         "landing_angle_deg": flight.landing_angle_deg,
-    }
+    })
+
+
+POINTS = (("landing", Landing), ("rest", RestPoint))
+"""Result fields that are points; their numbers are NAME_FIELD (landing_x_m, landing_x_yd, ...)."""
 
 
 def _points(numbers: dict) -> dict:
-    """A flight's numbers with NAME_x_m and NAME_y_m as the result's points."""
+    """A flight's numbers with NAME_x_m, NAME_y_m, NAME_x_yd and NAME_y_yd as the result's points."""
     fields = dict(numbers)
-    for name, point in (("landing", Landing), ("rest", RestPoint)):
+    for name, point in POINTS:
         if f"{name}_x_m" in fields:
-            fields[name] = point.model_construct(x_m=fields.pop(f"{name}_x_m"), y_m=fields.pop(f"{name}_y_m"))
+            fields[name] = point.model_construct(**{key: fields.pop(f"{name}_{key}") for key in point.model_fields})
     return fields
 
 
@@ -154,7 +184,7 @@ def flight_fields(flight: ShotFlight, trajectory: TrajectoryRequest | None) -> d
 
 def lands_off_the_flat(shot: ShotRequest) -> bool:
     """Whether the shot's ground lies above or below the tee's, so that its flat flight is returned beside it."""
-    return shot.ground is not None and shot.ground.elevation_m != 0.0
+    return elevation_m(shot.ground) != 0.0
 
 
 def flat_fields(flight: ShotFlight) -> FlatFlight:
