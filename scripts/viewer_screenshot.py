@@ -2,7 +2,7 @@
 to reach the page.
 
 Starts `golfflight serve` with an API key and GSPro Open Connect on free loopback ports, opens /viewer#key=KEY,
-then hits wedges, 7-irons and drivers (seeded scatter) over Open Connect TCP, POST /v1/gspro and POST /v1/shots,
+then hits wedges, 7-irons and drivers (seeded scatter) over Open Connect TCP, POST /v1/gspro and POST /v1/shots?viewer=true,
 picking the club in the page before each group, and screenshots the page once the last drive has played. Prints
 the time from sending each shot to its row appearing in the page (timed in the page by a MutationObserver).
 
@@ -64,7 +64,7 @@ def send(
             "back_spin_rpm": spin,
             "side_spin_rpm": side_spin,
         }
-        http.post("/v1/shots", json=shot).raise_for_status()
+        http.post("/v1/shots?viewer=true", json=shot).raise_for_status()  # shown on the bay's screen
         return
     message = {
         "DeviceID": "screenshot",

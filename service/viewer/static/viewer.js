@@ -376,14 +376,18 @@ function drawDispersion(svg, box) {
     el(svg, "text", { class: "label", x: 2, y: py + 4 }, unitLabel(y));
   }
   el(svg, "line", { class: "target-line", x1: S / 2, y1: pad / 2, x2: S / 2, y2: S - pad });
+  // rest rings first and in the club's colour (CSSOM: a stroke attribute loses to the .dot rule, which drew them
+  // dark over the landing dots as half discs), then the landing dots, whole, on top
+  for (const shot of state.shots) {
+    const flight = shot.event.flight;
+    if (!flight.rest) continue;
+    const [rx, ry] = project(flight.rest.x_m, flight.rest.y_m);
+    el(svg, "circle", { class: "dot rest-dot", cx: rx, cy: ry, r: 5 }).style.stroke = colour(shot.club);
+  }
   for (const shot of state.shots) {
     const flight = shot.event.flight;
     const [x, y] = project(flight.landing.x_m, flight.landing.y_m);
     el(svg, "circle", { class: "dot", cx: x, cy: y, r: 5, fill: colour(shot.club), "data-shot": shot.event.id });
-    if (flight.rest) {
-      const [rx, ry] = project(flight.rest.x_m, flight.rest.y_m);
-      el(svg, "circle", { class: "dot rest-dot", cx: rx, cy: ry, r: 5, stroke: colour(shot.club) });
-    }
   }
   const legend = document.getElementById("legend");
   legend.replaceChildren();
