@@ -230,6 +230,12 @@ def test_the_page_behind_the_golfer_and_the_bay_form_in_chromium():
             message = page.inner_text("#bay-message")
             assert "humidity_pct" in message and "150" in message, message
             assert http.get("/v1/bay", headers=KEYED).json()["air"]["humidity_pct"] == 40.0
+
+            # a bay set over the API in mph: the page reads the wind, not "calm"
+            assert http.put("/v1/bay", json={"wind": {"speed_mph": 10.0, "from_deg": 0.0}}, headers=KEYED).status_code == 200
+            page.evaluate("loadBay()")
+            page.wait_for_function("() => document.querySelector('#bay-summary').textContent.includes('wind 10')",
+                                   timeout=10_000)
             assert errors == []
 
 

@@ -587,7 +587,19 @@ function showBay(all = true) {
 }
 
 /** Takes the bay the service answered with: its units become the page's. */
+/** The bay with its wind speed in m/s, whichever unit it was set in (`speed_mph` over the API): the form and
+ * the summary read `speed_mps`. */
+function windInMps(bay) {
+  const wind = bay.wind;
+  if (wind && wind.speed_mps === undefined && wind.speed_mph !== undefined) {
+    bay.wind = { ...wind, speed_mps: wind.speed_mph * 0.44704 };
+    delete bay.wind.speed_mph;
+  }
+  return bay;
+}
+
 function takeBay(bay, all = true) {
+  bay = windInMps(bay);
   state.bay = bay;
   if (bay.units && bay.units !== state.units) {
     state.units = bay.units;
