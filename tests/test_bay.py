@@ -123,3 +123,46 @@ def test_serve_refuses_a_bad_bay_file_in_one_line(tmp_path, capsys):
     error = capsys.readouterr().err.strip()
     assert error.startswith("golfflight serve: error: ") and "bay.json: not bay conditions (wind.speed_mps" in error
     assert "\n" not in error
+
+
+def test_a_scripted_connector_session_flies_every_shot_in_the_bay():
+    """The issue's session: a connector connects and sends a heartbeat, the operator sets the bay (1,600 m, 30 degC,
+    a 10 mph headwind, a stimp-12 green), then 20 shots of mixed clubs, two of them split across writes; every
+    reply's carry equals POST /v1/shots with the same conditions to the centimetre."""
+    import time
+
+    clubs = [(167.0, 11.0, 2650.0), (150.0, 12.5, 4200.0), (123.0, 16.1, 7124.0), (104.0, 23.7, 9316.0)]
+    port = free_port()
+    with running(create_app(connect=ConnectAddress(port))) as http:
+        with socket.create_connection(("127.0.0.1", port), timeout=10) as connector:
+            heartbeat = {**OPEN_CONNECT_SHOT, "ShotNumber": 0,
+                         "ShotDataOptions": {"ContainsBallData": False, "IsHeartBeat": True}}
+            connector.sendall(json.dumps(heartbeat).encode())
+            bay = {"air": {"altitude_m": 1600.0, "temperature_c": 30.0},
+                   "wind": {"speed_mph": 10.0, "from_deg": 0.0}, "ground": {"surface": "green", "stimp_ft": 12.0}}
+            assert http.put("/v1/bay", json=bay).status_code == 200
+            buffer = b""
+            for number in range(1, 21):
+                speed, vla, spin = clubs[number % len(clubs)]
+                ball = {"Speed": speed, "VLA": vla, "HLA": (number % 5 - 2) * 0.5, "TotalSpin": spin,
+                        "SpinAxis": (number % 7 - 3) * 2.0}
+                message = json.dumps({**OPEN_CONNECT_SHOT, "ShotNumber": number, "BallData": ball}).encode()
+                if number in (7, 13):  # split across two writes
+                    connector.sendall(message[:25])
+                    time.sleep(0.05)
+                    connector.sendall(message[25:])
+                else:
+                    connector.sendall(message)
+                reply = None
+                while reply is None:
+                    buffer += connector.recv(65536)
+                    try:
+                        reply, end = json.JSONDecoder().raw_decode(buffer.decode())
+                    except ValueError:
+                        continue  # the reply is still arriving
+                    buffer = buffer[len(buffer.decode()[:end].encode()):]
+                assert reply["Code"] == 200 and reply["ShotNumber"] == number, reply
+                explicit = shot(http, ball_speed_mph=speed, launch_angle_deg=vla, launch_direction_deg=ball["HLA"],
+                                spin_rpm=spin, spin_axis_deg=ball["SpinAxis"], **bay)
+                assert reply["Flight"]["carry_m"] == pytest.approx(explicit["carry_m"], abs=0.01)
+                assert reply["Flight"]["total_m"] == pytest.approx(explicit["total_m"], abs=0.01)
