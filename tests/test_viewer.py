@@ -287,7 +287,9 @@ def test_the_page_in_chromium_draws_shots_from_http_and_open_connect(tmp_path):
             assert page.locator("#dispersion circle.dot:not(.rest-dot)").count() == 2
             assert "Driver: 1 shot" in page.inner_text("#legend") and "SW: 1 shot" in page.inner_text("#legend")
 
-            page.click(".units button[data-units=metric]")
+            page.click(".units button[data-units=metric]")  # the bay's units: shown once PUT /v1/bay answers
+            page.wait_for_function("() => !document.querySelector('#n-carry').textContent.endsWith('yd')",
+                                   timeout=10_000)
             assert page.inner_text("#n-carry").startswith(f"{wedge['carry_m']:.1f}")
             page.screenshot(path=str(tmp_path / "viewer.png"), full_page=True)
 
