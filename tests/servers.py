@@ -44,6 +44,18 @@ def running(app, ready_path: str = "/healthz", timeout_s: float = 20.0) -> Itera
         thread.join(timeout=10)
 
 
+@contextmanager
+def keyed_service(key: str) -> Iterator[tuple[httpx.Client, int, object]]:
+    """(client, Open Connect port, app) of one service with an API key, listening on HTTP and on Open Connect TCP."""
+    from service.api.app import create_app
+    from service.open_connect.server import ConnectAddress
+
+    port = free_port()
+    app = create_app(api_key=key, cors_origins=[], connect=ConnectAddress(port))
+    with running(app) as http:
+        yield http, port, app
+
+
 def shot(http: httpx.Client, **body) -> dict:
     """POST one shot to /v1/shots, asserting a 200, and return its JSON."""
     response = http.post("/v1/shots", json=body)

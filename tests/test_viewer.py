@@ -14,7 +14,7 @@ from functools import partial
 import browser
 import httpx
 import pytest
-from servers import free_port, running
+from servers import free_port, keyed_service, running
 
 from service.api.app import create_app
 from service.api.models import ShotRequest
@@ -41,10 +41,8 @@ def engine() -> FlightEngine:
 @pytest.fixture(scope="module")
 def service():
     """(client, Open Connect port, app) of one keyed service listening on HTTP and TCP."""
-    port = free_port()
-    app = create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))
-    with running(app) as http:
-        yield http, port, app
+    with keyed_service(KEY) as served:
+        yield served
 
 
 def gspro_over_tcp(port: int, number: int, ball: dict) -> dict:

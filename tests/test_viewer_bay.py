@@ -13,7 +13,7 @@ from functools import partial
 import browser
 import httpx
 import pytest
-from servers import free_port, running
+from servers import free_port, keyed_service, running
 from test_viewer import DRIVER, KEY, KEYED, WEDGE_BALL, gspro_over_tcp, next_event
 
 from service.api.app import create_app
@@ -36,10 +36,8 @@ def engine() -> FlightEngine:
 
 @pytest.fixture(scope="module")
 def service():
-    port = free_port()
-    app = create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))
-    with running(app) as http:
-        yield http, port, app
+    with keyed_service(KEY) as served:
+        yield served
 
 
 def gspro(number: int) -> dict:
