@@ -40,6 +40,7 @@ from model_export.observations import (
 from model_export.torch_physics import DT_S, T_SIM_S, euler_rollout, hard_landing, positions_at
 from model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, load_checkpoint, save_checkpoint
 from shots.files import write_text_atomic
+from shots.source_air import UNKNOWN_AIR_SOURCES
 
 HUBER_DELTA = 2.0
 """Residuals beyond 2 sigma count linearly: mishits and gusts do not dominate the fit."""
@@ -56,8 +57,6 @@ SOURCE_WEIGHTS = {
 """Weight of one shot of each source in the loss: measured flights 1, TrackMan's modelled rows 0.05, the reference
 world 0.2, one club of the tour-averages table 5 (an average over thousands of shots in known air). The modelled rows'
 and the table's weights were chosen on the validation split (`scripts/train_real_weights.py`, docs/training_real.md)."""
-UNKNOWN_AIR_SOURCES = ("trackman-outdoor",)
-"""Sources that recorded no air (range sessions): their mean air is fitted, so they cannot set the level of a carry."""
 
 
 def _typical(effect: str) -> float:

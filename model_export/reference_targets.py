@@ -15,7 +15,7 @@ from model_export.real_data import pga_table, players, sentry, tour_championship
 from shots.calibrate_reference import CalibrationCell, cells_from_records, table_cells
 from shots.heldout import check_training_rows
 from shots.reference_world import CALIBRATION_AIR, read_tour_averages
-from shots.source_air import KNOWN_AIR
+from shots.source_air import KNOWN_AIR, UNKNOWN_AIR_SOURCES
 from shots.trackman import load_trackman
 
 NORMALIZED_7IRON_FILE = Path("real/trackman_normalized_7iron/trackman-csv-export-20230807.Normalized.csv")
@@ -25,8 +25,6 @@ RECORDED_SOURCES = {"trackman-outdoor": trackman_outdoor, "trackman-model": trac
                     "players-2020": players, "tour-championship-2020": tour_championship}
 """Shot-level sources. Of the driver file only the Premium balls: the reference world is a tour ball's, and the
 file's "Limited Distance Soft" range balls fly shorter by design."""
-UNKNOWN_AIR = ("trackman-outdoor",)
-"""Sources that recorded no air: flown in CALIBRATION_AIR times a density factor fitted with them."""
 FITTED_AIR_FACTORS = {"trackman-outdoor": 1.0721}
 """The density factors of the committed calibration (`golfflight calibrate-reference --fit` prints them)."""
 
@@ -38,7 +36,7 @@ def calibration_cells(root: str | os.PathLike) -> list[CalibrationCell]:
     cells: list[CalibrationCell] = []
     for name, build in RECORDED_SOURCES.items():
         records = [r for r in build(root).records if r.split == "train" and r.ball in (None, "Premium")]
-        air = CALIBRATION_AIR if name in UNKNOWN_AIR else KNOWN_AIR[name].air()
+        air = CALIBRATION_AIR if name in UNKNOWN_AIR_SOURCES else KNOWN_AIR[name].air()
         cells += cells_from_records(name, records, air)
     path = root / NORMALIZED_7IRON_FILE
     conversion = load_trackman(path, min_tracked_fraction=None, skip_bad_rows=True)

@@ -88,4 +88,8 @@ KNOWN_AIR: dict[str, SourceAir] = {
     "trackman-model": TRACKMAN_NORMALIZATION,
     "trackman-normalized-7iron": TRACKMAN_NORMALIZED_7IRON,
 }
-"""Every source whose air is known, by source name; a source not named here recorded none."""
+"""Every source whose air is known, by source name."""
+
+UNKNOWN_AIR_SOURCES = ("trackman-outdoor",)
+"""Real sources that recorded no air (range sessions): their air is fitted with them (a density factor in the
+reference world's calibration, a free mean in real-data training), so they cannot set the level of a carry."""

@@ -8,7 +8,7 @@ import argparse
 from pathlib import Path
 
 from flight.reference_aero import CALIBRATED
-from model_export.reference_targets import FITTED_AIR_FACTORS, UNKNOWN_AIR, calibration_cells
+from model_export.reference_targets import FITTED_AIR_FACTORS, calibration_cells
 from shots.calibrate_reference import (
     evaluate,
     evaluate_clubs,
@@ -22,7 +22,7 @@ from shots.markdown import write_generated_section
 from shots.paths import shared_data_dir
 from shots.reference_checks import render_checks_markdown
 from shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
-from shots.source_air import PGA_2023_TABLE
+from shots.source_air import PGA_2023_TABLE, UNKNOWN_AIR_SOURCES
 
 COMMAND = "calibrate-reference"
 
@@ -48,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
     cells = calibration_cells(root)
     params, factors = CALIBRATED, FITTED_AIR_FACTORS
     if args.fit:
-        calibration = fit_reference(cells, unknown_air=UNKNOWN_AIR)
+        calibration = fit_reference(cells, unknown_air=UNKNOWN_AIR_SOURCES)
         params, factors = calibration.params, calibration.air_factors
         print("# Paste into flight/reference_aero.py:")
         print(parameters_literal(params))
