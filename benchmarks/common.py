@@ -16,8 +16,8 @@ REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from service.engine import Launch
-from shots.clubs import CLUBS
+from golfflight.service.engine import Launch
+from golfflight.shots.clubs import CLUBS
 
 RESULTS = REPO / "benchmarks" / "results.json"
 

@@ -13,21 +13,28 @@ from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
+from golfflight.discovery.effects import Context, equivalent_altitude_m
+from golfflight.discovery.model import FlightModel
+from golfflight.discovery.noise import RADAR_NOISE
+from golfflight.discovery.outside import OUTSIDE, air_motion, term_and_weights
+from golfflight.discovery.simulator import Setup
+from golfflight.flight.air import Air
+from golfflight.flight.outcomes import Flight
+from golfflight.flight.physics import initial_state
+from golfflight.flight.reference_aero import CALIBRATED
+from golfflight.flight.wind import Wind, uniform_equivalent_factor, wind_vector
+from golfflight.shots.records import ShotRecord, ShotSet
+from golfflight.shots.reference_world import fly_reference
+from golfflight.shots.synth import (
+    MIN_APEX_M,
+    LaunchTable,
+    MeasurementNoise,
+    SynthConfig,
+    draw_launches,
+    draw_sessions,
+    measure,
+)
 from pydantic import ValidationError
-
-from discovery.effects import Context, equivalent_altitude_m
-from discovery.model import FlightModel
-from discovery.noise import RADAR_NOISE
-from discovery.outside import OUTSIDE, air_motion, term_and_weights
-from discovery.simulator import Setup
-from flight.air import Air
-from flight.outcomes import Flight
-from flight.physics import initial_state
-from flight.reference_aero import CALIBRATED
-from flight.wind import Wind, uniform_equivalent_factor, wind_vector
-from shots.records import ShotRecord, ShotSet
-from shots.reference_world import fly_reference
-from shots.synth import MIN_APEX_M, LaunchTable, MeasurementNoise, SynthConfig, draw_launches, draw_sessions, measure
 
 NOMINAL_AIR = Air.standard()
 """The air of the base sessions and the air the model is told: 15 degC, sea level, dry (1.225 kg/m^3)."""

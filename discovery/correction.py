@@ -18,12 +18,11 @@ import re
 from dataclasses import dataclass
 
 import numpy as np
-
-from discovery.effects import Context, Effect, Parameter, Reported
-from discovery.fit import Fit, Problem, fit, residuals_and_jacobian
-from discovery.recordings import OBSERVABLES
-from discovery.schema import Unlisted
-from discovery.simulator import Setup
+from golfflight.discovery.effects import Context, Effect, Parameter, Reported
+from golfflight.discovery.fit import Fit, Problem, fit, residuals_and_jacobian
+from golfflight.discovery.recordings import OBSERVABLES
+from golfflight.discovery.schema import Unlisted
+from golfflight.discovery.simulator import Setup
 
 NAME = "unlisted"
 MIN_T = 4.0

@@ -21,10 +21,9 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-
-from discovery import correction as learned
-from discovery.effects import LIBRARY, Context
-from discovery.fit import (
+from golfflight.discovery import correction as learned
+from golfflight.discovery.effects import LIBRARY, Context
+from golfflight.discovery.fit import (
     Fit,
     Problem,
     Scored,
@@ -36,9 +35,9 @@ from discovery.fit import (
     linear_starts,
     per_shot,
 )
-from discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
-from discovery.model import FlightModel
-from discovery.noise import (
+from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
+from golfflight.discovery.model import FlightModel
+from golfflight.discovery.noise import (
     RADAR_NOISE,
     ExpectedError,
     Scatter,
@@ -47,11 +46,11 @@ from discovery.noise import (
     recording_scatter,
     with_scatter,
 )
-from discovery.recordings import LABELS, OBSERVABLES, Recordings
-from discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
-from discovery.schema import Candidate, Heldout, ModelInfo, Report, ScatterStat
-from flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
-from shots.synth import MeasurementNoise
+from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
+from golfflight.discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
+from golfflight.discovery.schema import Candidate, Heldout, ModelInfo, Report, ScatterStat
+from golfflight.flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
+from golfflight.shots.synth import MeasurementNoise
 
 OUTLIER_MAD = 8.0
 """A residual further than this many robust SDs from the median is a wild reading, left out of the fits."""

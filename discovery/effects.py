@@ -14,9 +14,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-
-from discovery.simulator import Correction, Setup
-from flight.air import DRY_AIR_GAS_CONSTANT, ZERO_CELSIUS_K, altitude_for_pressure
+from golfflight.discovery.simulator import Correction, Setup
+from golfflight.flight.air import DRY_AIR_GAS_CONSTANT, ZERO_CELSIUS_K, altitude_for_pressure
 
 
 @dataclass(frozen=True)

@@ -11,10 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 import plotly.graph_objects as go
+from golfflight.discovery.locate import binned_means, trajectory_residuals
+from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from plotly.subplots import make_subplots
-
-from discovery.locate import binned_means, trajectory_residuals
-from discovery.recordings import LABELS, OBSERVABLES, Recordings
 
 SHOT_FIELDS = ("shot", "session", "club")
 """What each shot-level point's `customdata` row holds, in this order."""

@@ -12,12 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from golfflight.discovery.effects import Effect, apply_all
+from golfflight.discovery.model import FlightModel
+from golfflight.discovery.recordings import OBSERVABLES, Recordings
+from golfflight.discovery.simulator import Flown, Setup
 from scipy.optimize import least_squares
-
-from discovery.effects import Effect, apply_all
-from discovery.model import FlightModel
-from discovery.recordings import OBSERVABLES, Recordings
-from discovery.simulator import Flown, Setup
 
 MISSED_LANDING_Z = 10.0
 """Standardized residual given to a shot the model does not land (it cannot be compared)."""

@@ -12,8 +12,8 @@ from __future__ import annotations
 import json
 from html import escape
 
-from discovery.recordings import OBSERVABLES
-from discovery.schema import Report
+from golfflight.discovery.recordings import OBSERVABLES
+from golfflight.discovery.schema import Report
 
 STYLE = """body{font-family:sans-serif;max-width:1280px;margin:1em auto;color:#222}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}
@@ -45,9 +45,8 @@ class Plots:
         self.bundle = ""
         if not plots_available():
             return
+        from golfflight.discovery.figures import report_figures
         from plotly.offline import get_plotlyjs
-
-        from discovery.figures import report_figures
 
         self.bundle = get_plotlyjs()
         count = 0

@@ -8,10 +8,9 @@ shots are not independent); every p-value joins one Holm family, so "significant
 from __future__ import annotations
 
 import numpy as np
+from golfflight.discovery.recordings import COVARIATES, OBSERVABLES, Recordings
+from golfflight.discovery.schema import CovariateStat, GroupStat, Located, ObservableStat, TrajectoryStat
 from scipy import stats
-
-from discovery.recordings import COVARIATES, OBSERVABLES, Recordings
-from discovery.schema import CovariateStat, GroupStat, Located, ObservableStat, TrajectoryStat
 
 ALPHA = 0.01
 MIN_CLUSTERS = 5

@@ -15,15 +15,14 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-
-from discovery.recordings import OBSERVABLES
-from discovery.simulator import CoefficientsFor, Correction, Flown, Setup, fly_setup, simulate_setup
-from flight.air import Air
-from flight.limits import FLIGHT_TIME_S
-from flight.onnx_coefficients import OnnxCoefficients
-from flight.outcomes import Flight
-from flight.reference_aero import CALIBRATED, ReferenceAerodynamics, ReferenceParameters
-from flight.wind import Wind
+from golfflight.discovery.recordings import OBSERVABLES
+from golfflight.discovery.simulator import CoefficientsFor, Correction, Flown, Setup, fly_setup, simulate_setup
+from golfflight.flight.air import Air
+from golfflight.flight.limits import FLIGHT_TIME_S
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.outcomes import Flight
+from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics, ReferenceParameters
+from golfflight.flight.wind import Wind
 
 DEFAULT_BUNDLE = Path(__file__).resolve().parents[1] / "models" / "default"
 REFERENCE = "reference"

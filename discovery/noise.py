@@ -11,13 +11,12 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-
-from discovery.fit import cluster_bootstrap
-from discovery.model import FlightModel, reference
-from discovery.recordings import OBSERVABLES, Recordings
-from discovery.simulator import Setup, concatenate
-from shots.records import LAUNCH_COLUMNS
-from shots.synth import MeasurementNoise
+from golfflight.discovery.fit import cluster_bootstrap
+from golfflight.discovery.model import FlightModel, reference
+from golfflight.discovery.recordings import OBSERVABLES, Recordings
+from golfflight.discovery.simulator import Setup, concatenate
+from golfflight.shots.records import LAUNCH_COLUMNS
+from golfflight.shots.synth import MeasurementNoise
 
 RADAR_NOISE = MeasurementNoise()
 """The launch-monitor noise assumed unless told otherwise (the synthetic generator's)."""

@@ -5,8 +5,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from discovery.html import render
-from shots.files import write_text_atomic
+from golfflight.discovery.html import render
+from golfflight.shots.files import write_text_atomic
 
 
 def write_diagnosis(diagnosis, out: str | os.PathLike) -> list[Path]:

@@ -13,10 +13,9 @@ from dataclasses import dataclass, fields
 from functools import cached_property
 
 import numpy as np
-
-from discovery.simulator import Correction
-from flight.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M
-from flight.wind import Wind, wind_vector
+from golfflight.discovery.simulator import Correction
+from golfflight.flight.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M
+from golfflight.flight.wind import Wind, wind_vector
 
 LOW_SPEED_DRAG = "low_speed_drag"
 """{"rise": extra C_D at zero air speed, "speed_mps": the air speed where it has faded to nothing}."""

@@ -14,14 +14,13 @@ import os
 from pathlib import Path
 
 import numpy as np
-
-from discovery.conceal import conceal
-from discovery.model import from_bundle
-from discovery.recordings import OBSERVABLES, from_shot_set
-from shots.files import write_text_atomic
-from shots.synth import MeasurementNoise
-from weights_schema.bundle import CARD_FILE
-from weights_schema.model_card import ModelCard, OwnError
+from golfflight.discovery.conceal import conceal
+from golfflight.discovery.model import from_bundle
+from golfflight.discovery.recordings import OBSERVABLES, from_shot_set
+from golfflight.shots.files import write_text_atomic
+from golfflight.shots.synth import MeasurementNoise
+from golfflight.weights_schema.bundle import CARD_FILE
+from golfflight.weights_schema.model_card import ModelCard, OwnError
 
 NO_NOISE = MeasurementNoise(**{name: 0.0 for name in MeasurementNoise.__dataclass_fields__})
 

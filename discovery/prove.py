@@ -21,17 +21,16 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-
-from discovery.conceal import OUTSIDE_EFFECT, conceal
-from discovery.diagnose import diagnose
-from discovery.effects import EFFECTS, LIBRARY
-from discovery.model import FlightModel
-from discovery.outside import HEIGHT_GUST, HIGH_SPIN_LIFT_LOSS, LOW_SPEED_DRAG, OUTSIDE
-from discovery.recordings import from_shot_set
-from flight.reference_aero import CALIBRATED
-from flight.wind import wind_vector
-from shots.files import write_text_atomic
-from shots.markdown import write_generated_section
+from golfflight.discovery.conceal import OUTSIDE_EFFECT, conceal
+from golfflight.discovery.diagnose import diagnose
+from golfflight.discovery.effects import EFFECTS, LIBRARY
+from golfflight.discovery.model import FlightModel
+from golfflight.discovery.outside import HEIGHT_GUST, HIGH_SPIN_LIFT_LOSS, LOW_SPEED_DRAG, OUTSIDE
+from golfflight.discovery.recordings import from_shot_set
+from golfflight.flight.reference_aero import CALIBRATED
+from golfflight.flight.wind import wind_vector
+from golfflight.shots.files import write_text_atomic
+from golfflight.shots.markdown import write_generated_section
 
 COMBINATION = ("wind", "ball_speed_bias")
 """The two-effect case: a carry-alike pair that only the other observables can separate."""

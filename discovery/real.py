@@ -1,6 +1,6 @@
 """Diagnose the real data sets (read from the shared folder, never copied) and render a summary for the docs.
 
-python -m discovery.real --out runs/discovery-real [--model DIR|reference]
+python -m golfflight.discovery.real --out runs/discovery-real [--model DIR|reference]
 
 Sets: the outdoor, radar-tracked TrackMan driver shots (all balls, the held-out lines alone, and Premium only), the
 PGA TOUR TrackMan trajectories of the Sentry 2022 (spin from the play-by-play) and the Sony Open 2022 (spin estimated
@@ -21,23 +21,22 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
-from discovery import svg
-from discovery.diagnose import Diagnosis, diagnose
-from discovery.locate import binned_means
-from discovery.model import FlightModel, load_model
-from discovery.outputs import write_diagnosis
-from discovery.recordings import LABELS, OBSERVABLES, Recordings, from_shot_set
-from shots.files import write_text_atomic
-from shots.heldout import held_out_rounds, held_out_set, shot_round
-from shots.markdown import table
-from shots.paths import shared_data_dir
-from shots.pbp import load_pbp
-from shots.records import ShotRecord, ShotSet
-from shots.reference_world import default_tour_averages_path, read_tour_averages
-from shots.source_air import KNOWN_AIR, SourceAir
-from shots.tourcast import load_tourcast
-from shots.trackman import load_trackman
+from golfflight.discovery import svg
+from golfflight.discovery.diagnose import Diagnosis, diagnose
+from golfflight.discovery.locate import binned_means
+from golfflight.discovery.model import FlightModel, load_model
+from golfflight.discovery.outputs import write_diagnosis
+from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings, from_shot_set
+from golfflight.shots.files import write_text_atomic
+from golfflight.shots.heldout import held_out_rounds, held_out_set, shot_round
+from golfflight.shots.markdown import table
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.pbp import load_pbp
+from golfflight.shots.records import ShotRecord, ShotSet
+from golfflight.shots.reference_world import default_tour_averages_path, read_tour_averages
+from golfflight.shots.source_air import KNOWN_AIR, SourceAir
+from golfflight.shots.tourcast import load_tourcast
+from golfflight.shots.trackman import load_trackman
 
 TOURCAST = Path("real") / "pga_tourcast_trackman"
 TRACKMAN = Path("real") / "trackman_driver_sessions" / "data.csv"

@@ -7,9 +7,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-
-from flight.wind import wind_vector
-from shots.records import LAUNCH_COLUMNS, ShotSet, read_shots, read_trajectories, trajectories_path
+from golfflight.flight.wind import wind_vector
+from golfflight.shots.records import LAUNCH_COLUMNS, ShotSet, read_shots, read_trajectories, trajectories_path
 
 OBSERVABLES: tuple[str, ...] = ("carry_y_m", "carry_x_m", "apex_m", "flight_time_s", "landing_angle_deg")
 """Outcome columns compared with the model, in report order: carry along and across the line, apex, time, descent."""

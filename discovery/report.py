@@ -4,12 +4,11 @@ ambiguities (explanations the data cannot tell apart, and what measurement would
 from __future__ import annotations
 
 import numpy as np
-
-from discovery.effects import Context
-from discovery.fit import Fit, Problem, Scored, cluster_bootstrap, per_shot
-from discovery.locate import has_structure
-from discovery.recordings import LABELS, OBSERVABLES
-from discovery.schema import (
+from golfflight.discovery.effects import Context
+from golfflight.discovery.fit import Fit, Problem, Scored, cluster_bootstrap, per_shot
+from golfflight.discovery.locate import has_structure
+from golfflight.discovery.recordings import LABELS, OBSERVABLES
+from golfflight.discovery.schema import (
     AirAltitude,
     AirDensity,
     Ambiguity,
@@ -20,7 +19,7 @@ from discovery.schema import (
     Unlisted,
     WindSetting,
 )
-from flight.wind import STATION_HEIGHT_M
+from golfflight.flight.wind import STATION_HEIGHT_M
 
 MATERIAL = 0.05
 """Share above the expected error that counts as a material excess (as in `discovery.diagnose`)."""

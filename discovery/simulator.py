@@ -11,12 +11,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, fields
 
 import numpy as np
-
-from flight.field import BallInAir, ScaledCoefficients, WeightedCorrection
-from flight.integrator import GroundPlane, Method, integrate
-from flight.outcomes import Flight
-from flight.physics import CoefficientModel, initial_state
-from flight.wind import Wind
+from golfflight.flight.field import BallInAir, ScaledCoefficients, WeightedCorrection
+from golfflight.flight.integrator import GroundPlane, Method, integrate
+from golfflight.flight.outcomes import Flight
+from golfflight.flight.physics import CoefficientModel, initial_state
+from golfflight.flight.wind import Wind
 
 CoefficientsFor = Callable[[np.ndarray], CoefficientModel]
 """Builds the model's coefficient function for shots whose air density is `ratio` x the assumed one (per shot)."""

@@ -1,6 +1,6 @@
-"""Tiny static SVG charts (lines, histograms) for the docs' figures of the real sets (`python -m discovery.real
---figures`): files a markdown page shows as images, made without a plotting library. report.html's interactive
-figures are `discovery.figures`."""
+"""Tiny static SVG charts (lines, histograms) for the docs' figures of the real sets
+(`python -m golfflight.discovery.real --figures`): files a markdown page shows as images, made without a plotting
+library. report.html's interactive figures are `discovery.figures`."""
 
 from __future__ import annotations
 

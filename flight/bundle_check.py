@@ -9,11 +9,10 @@ from pathlib import Path
 
 import numpy as np
 import onnxruntime as ort
-
-from flight import limits
-from flight.constants import RPM_TO_RADPS
-from weights_schema.bundle import CARD_FILE, BundleError, load_bundle
-from weights_schema.model_card import ModelCard
+from golfflight.flight import limits
+from golfflight.flight.constants import RPM_TO_RADPS
+from golfflight.weights_schema.bundle import CARD_FILE, BundleError, load_bundle
+from golfflight.weights_schema.model_card import ModelCard
 
 INPUT_SHAPE = ["N", 3]
 OUTPUT_SHAPE = ["N", 4]

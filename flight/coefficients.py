@@ -5,8 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from flight.physics import spin_ratio
+from golfflight.flight.physics import spin_ratio
 
 BASE_DYNAMIC_PRESSURE = 0.5
 """C_Q that makes q = C_Q rho |v|^2 the usual dynamic pressure 1/2 rho |v|^2."""

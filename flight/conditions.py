@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from flight.air import air_density, dynamic_viscosity, pressure_at_altitude
-from flight.wind import CALM, Wind, wind_vector
+from golfflight.flight.air import air_density, dynamic_viscosity, pressure_at_altitude
+from golfflight.flight.wind import CALM, Wind, wind_vector
 
 STANDARD_TEMPERATURE_C = 15.0
 STANDARD_HUMIDITY_PCT = 0.0

@@ -11,9 +11,8 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
-
-from flight.physics import CoefficientModel, ExtraAcceleration, State, derivatives
-from flight.wind import CALM, Wind
+from golfflight.flight.physics import CoefficientModel, ExtraAcceleration, State, derivatives
+from golfflight.flight.wind import CALM, Wind
 
 
 class VectorField(Protocol):

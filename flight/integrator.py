@@ -20,11 +20,10 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-
-from flight.field import BallInAir, VectorField, take
-from flight.outcomes import Flight, parabola_apex
-from flight.physics import CoefficientModel, State
-from flight.wind import CALM, Wind
+from golfflight.flight.field import BallInAir, VectorField, take
+from golfflight.flight.outcomes import Flight, parabola_apex
+from golfflight.flight.physics import CoefficientModel, State
+from golfflight.flight.wind import CALM, Wind
 
 StepRule = Callable[[State, VectorField, float], State]
 

@@ -12,9 +12,8 @@ import copy
 import os
 
 import numpy as np
-
-from flight.bundle_check import open_verified
-from flight.physics import reynolds_scale
+from golfflight.flight.bundle_check import open_verified
+from golfflight.flight.physics import reynolds_scale
 
 
 class OnnxCoefficients:

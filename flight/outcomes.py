@@ -8,9 +8,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-
-from flight.constants import RPM_TO_RADPS
-from flight.physics import State
+from golfflight.flight.constants import RPM_TO_RADPS
+from golfflight.flight.physics import State
 
 
 def landing_angle_deg(vx, vy, vz):

@@ -20,8 +20,7 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
-
-from flight.constants import (
+from golfflight.flight.constants import (
     BALL_AREA_M2,
     BALL_INERTIA_KG_M2,
     BALL_MASS_KG,
@@ -30,7 +29,7 @@ from flight.constants import (
     RPM_TO_RADPS,
     TEE_HEIGHT_M,
 )
-from flight.wind import CALM, Wind
+from golfflight.flight.wind import CALM, Wind
 
 TINY = 1e-12
 """Guards the unit vectors of a ball at rest or with no spin."""

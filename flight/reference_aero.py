@@ -12,8 +12,7 @@ import copy
 from dataclasses import dataclass
 
 import numpy as np
-
-from flight.constants import BALL_RADIUS_M
+from golfflight.flight.constants import BALL_RADIUS_M
 
 BALL_DIAMETER_M = 2.0 * BALL_RADIUS_M
 

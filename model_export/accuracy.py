@@ -23,11 +23,10 @@ from pathlib import Path
 from typing import TypeVar
 
 import numpy as np
-
-from flight.constants import YARD_M
-from model_export.accuracy_finetune import MEASURED_ROUNDS, TRAIN_ROUNDS, FinetuneStudy, finetune_study
-from model_export.accuracy_flyers import CoefficientFlyer, Flyer, ModelFlyer, ferguson_flyer
-from model_export.accuracy_sets import (
+from golfflight.flight.constants import YARD_M
+from golfflight.model_export.accuracy_finetune import MEASURED_ROUNDS, TRAIN_ROUNDS, FinetuneStudy, finetune_study
+from golfflight.model_export.accuracy_flyers import CoefficientFlyer, Flyer, ModelFlyer, ferguson_flyer
+from golfflight.model_export.accuracy_sets import (
     APEX_MAE_YD,
     APEX_METRICS,
     DRIVER_FILE,
@@ -55,9 +54,9 @@ from model_export.accuracy_sets import (
     tee_groups,
     tour_championship_shots,
 )
-from model_export.accuracy_slow import OUTCOMES as SLOW_OUTCOMES
-from model_export.accuracy_slow import SLOW_SHOTS, fly_slow
-from model_export.accuracy_winds import (
+from golfflight.model_export.accuracy_slow import OUTCOMES as SLOW_OUTCOMES
+from golfflight.model_export.accuracy_slow import SLOW_SHOTS, fly_slow
+from golfflight.model_export.accuracy_winds import (
     Anova,
     Consistency,
     GroupWind,
@@ -70,14 +69,14 @@ from model_export.accuracy_winds import (
     measured_paths,
     training_winds,
 )
-from shots.markdown import table, write_generated_section
-from shots.paths import shared_data_dir
-from shots.pbp import hole_pars
-from shots.records import ShotSet
-from shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
-from shots.source_air import PGA_2023_TABLE, TOUR_CHAMPIONSHIP_2020
-from shots.tourcast import load_tourcast, read_flights
-from shots.trackman import ConversionReport
+from golfflight.shots.markdown import table, write_generated_section
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.pbp import hole_pars
+from golfflight.shots.records import ShotSet
+from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
+from golfflight.shots.source_air import PGA_2023_TABLE, TOUR_CHAMPIONSHIP_2020
+from golfflight.shots.tourcast import load_tourcast, read_flights
+from golfflight.shots.trackman import ConversionReport
 
 __all__ = [
     "COMMAND", "DRIVER_FILE", "OUTCOMES", "PATH_FIGURE", "PGA_TARGETS", "TOURCAST_PBP", "TOURCAST_TRAJECTORIES",
@@ -379,7 +378,7 @@ def _slow(flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
 
 
 def _sentry(data_dir: Path, flyers: Sequence[Flyer], out: Path, figures_dir: Path, report: AccuracyReport) -> list[str]:
-    from model_export import figures
+    from golfflight.model_export import figures
 
     lines = ["### PGA TOUR trajectories, 2022 Sentry at Kapalua (a TRAINING set of the real-data model)", ""]
     trajectory_file, pbp_file = data_dir / TOURCAST_TRAJECTORIES, data_dir / TOURCAST_PBP

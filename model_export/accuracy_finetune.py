@@ -12,12 +12,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
-from model_export.accuracy_flyers import ModelFlyer
-from model_export.accuracy_sets import ClubComparison, compare_clubs, outcome_errors
-from shots.records import ShotSet, write_shots
-from shots.reference_world import ClubAverage
-from shots.source_air import PGA_2023_TABLE
+from golfflight.model_export.accuracy_flyers import ModelFlyer
+from golfflight.model_export.accuracy_sets import ClubComparison, compare_clubs, outcome_errors
+from golfflight.shots.records import ShotSet, write_shots
+from golfflight.shots.reference_world import ClubAverage
+from golfflight.shots.source_air import PGA_2023_TABLE
 
 TRAIN_ROUNDS = (1, 2)
 MEASURED_ROUNDS = (3, 4)
@@ -73,7 +72,7 @@ def finetune_study(
     picks its validation shots by its own rule: the latest sessions, i.e. rounds), keep the rate whose best epoch has
     the lowest validation landing error (the measured rounds play no part in any choice), and compare
     `measured_rounds` before and after. Everything is written to a temporary directory, then deleted."""
-    from model_export.finetune import finetune
+    from golfflight.model_export.finetune import finetune
 
     train, measured = by_rounds(shots, train_rounds), by_rounds(shots, measured_rounds)
     if not len(train) or not len(measured):

@@ -9,14 +9,13 @@ import os
 from pathlib import Path
 
 import numpy as np
-
-from flight.air import Air
-from flight.coefficients import FERGUSON_2022, QuadraticSpinRatio
-from flight.integrator import simulate
-from flight.onnx_coefficients import OnnxCoefficients
-from flight.outcomes import Flight
-from flight.physics import CoefficientModel, initial_state
-from flight.wind import CALM, Wind
+from golfflight.flight.air import Air
+from golfflight.flight.coefficients import FERGUSON_2022, QuadraticSpinRatio
+from golfflight.flight.integrator import simulate
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.outcomes import Flight
+from golfflight.flight.physics import CoefficientModel, initial_state
+from golfflight.flight.wind import CALM, Wind
 
 STANDARD_DENSITY_KG_M3 = 1.225
 """ICAO standard air: the air a closed-form model is flown in (it has no Reynolds-number input)."""

@@ -13,18 +13,17 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
-from flight.air import Air
-from flight.constants import FOOT_M, YARD_M
-from flight.outcomes import Flight
-from model_export.accuracy_flyers import Flyer
-from model_export.data import MIN_APEX_M
-from shots.clubs import straight_launches
-from shots.heldout import HELD_OUT, held_out_rounds, shot_round
-from shots.pbp import load_pbp
-from shots.records import ShotSet
-from shots.reference_world import ClubAverage
-from shots.trackman import load_trackman, read_table
+from golfflight.flight.air import Air
+from golfflight.flight.constants import FOOT_M, YARD_M
+from golfflight.flight.outcomes import Flight
+from golfflight.model_export.accuracy_flyers import Flyer
+from golfflight.model_export.data import MIN_APEX_M
+from golfflight.shots.clubs import straight_launches
+from golfflight.shots.heldout import HELD_OUT, held_out_rounds, shot_round
+from golfflight.shots.pbp import load_pbp
+from golfflight.shots.records import ShotSet
+from golfflight.shots.reference_world import ClubAverage
+from golfflight.shots.trackman import load_trackman, read_table
 
 TRACKMAN_HELD_OUT, TOUR_CHAMPIONSHIP_HELD_OUT = HELD_OUT
 DRIVER_FILE = TRACKMAN_HELD_OUT.path

@@ -10,9 +10,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-
-from flight.constants import MPH_TO_MPS, YARD_M
-from model_export.accuracy_flyers import Flyer
+from golfflight.flight.constants import MPH_TO_MPS, YARD_M
+from golfflight.model_export.accuracy_flyers import Flyer
 
 
 @dataclass(frozen=True)

@@ -16,13 +16,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from golfflight.discovery.effects import wind_from_components
+from golfflight.flight.wind import Wind
+from golfflight.model_export.accuracy_flyers import Flyer
 from scipy import sparse
 from scipy.optimize import least_squares
 from scipy.stats import f as f_distribution
-
-from discovery.effects import wind_from_components
-from flight.wind import Wind
-from model_export.accuracy_flyers import Flyer
 
 TRAINING_CONDITIONS_FILE = "training_conditions.json"
 """Written beside a bundle by the real-data training pipeline: the per-group winds (and air, ball) it learned."""

@@ -13,19 +13,18 @@ import os
 
 import onnx
 import torch
-from onnx import numpy_helper
-from torch import nn
-
-from flight.bundle_check import OUTPUT_COLUMNS
-from model_export.export import (
+from golfflight.flight.bundle_check import OUTPUT_COLUMNS
+from golfflight.model_export.export import (
     PARITY_TOLERANCE,
     onnx_torch_difference,
     probe_inputs,
 )
-from model_export.training import TrainConfig
-from model_export.variants import SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, PhysNN, build_model
-from weights_schema.bundle import load_bundle
-from weights_schema.model_card import ModelCard
+from golfflight.model_export.training import TrainConfig
+from golfflight.model_export.variants import SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, PhysNN, build_model
+from golfflight.weights_schema.bundle import load_bundle
+from golfflight.weights_schema.model_card import ModelCard
+from onnx import numpy_helper
+from torch import nn
 
 
 def _mlp_state(model: PhysNN, weights: dict[str, torch.Tensor], card: ModelCard) -> dict[str, torch.Tensor]:

@@ -16,20 +16,25 @@ from typing import Any, NamedTuple
 
 import numpy as np
 import torch
+from golfflight.flight.air import Air
+from golfflight.flight.integrator import simulate
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.physics import initial_state
+from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics
+from golfflight.model_export.noise_floor import Floor, noise_floors, nominal_conditions
+from golfflight.model_export.report import metres_yards
+from golfflight.model_export.torch_physics import euler_rollout, hard_landing, spin_ratio
+from golfflight.model_export.training import (
+    VALIDATION_BATCH,
+    TrainConfig,
+    load_checkpoint,
+    model_from_checkpoint,
+    predict,
+)
+from golfflight.model_export.validation import Errors, Prediction, ValidationSet, errors_of, gap, load_validation
+from golfflight.model_export.variants import PhysNN, PhysQ
+from golfflight.shots.markdown import table, write_generated_section
 from torch import nn
-
-from flight.air import Air
-from flight.integrator import simulate
-from flight.onnx_coefficients import OnnxCoefficients
-from flight.physics import initial_state
-from flight.reference_aero import CALIBRATED, ReferenceAerodynamics
-from model_export.noise_floor import Floor, noise_floors, nominal_conditions
-from model_export.report import metres_yards
-from model_export.torch_physics import euler_rollout, hard_landing, spin_ratio
-from model_export.training import VALIDATION_BATCH, TrainConfig, load_checkpoint, model_from_checkpoint, predict
-from model_export.validation import Errors, Prediction, ValidationSet, errors_of, gap, load_validation
-from model_export.variants import PhysNN, PhysQ
-from shots.markdown import table, write_generated_section
 
 COMMAND = "evaluate"
 FIGURES = ("fig6_errors.png", "fig7_coefficients.png")
@@ -145,7 +150,7 @@ class BundleCheck:
 def check_bundle(bundle_dir: str | os.PathLike, val: ValidationSet) -> BundleCheck:
     """Validation errors of a bundle through `flight.integrator.simulate` + `OnnxCoefficients` (the runtime path) and
     the largest per-shot difference from the torch float64 evaluation of the same weights."""
-    from model_export.bundle_model import config_from_card, model_from_bundle
+    from golfflight.model_export.bundle_model import config_from_card, model_from_bundle
 
     coefficients = OnnxCoefficients(bundle_dir)
     physics = coefficients.card.physics
@@ -253,8 +258,8 @@ def write_figures(
     with Phys-Q's curves), for the variants among `runs`, and Figure 7's summary line (empty without a network
     variant). Figure 7's effective coefficients are C x 2 C_Q x rho_trained / rho_air: the force the model applies,
     expressed in the reference world's (nominal) air."""
-    from flight.coefficients import FERGUSON_2022
-    from model_export import figures
+    from golfflight.flight.coefficients import FERGUSON_2022
+    from golfflight.model_export import figures
 
     directory = Path(directory)
     by_variant = {run.variant: run for run in runs}

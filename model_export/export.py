@@ -22,19 +22,25 @@ import numpy as np
 import onnx
 import onnxruntime as ort
 import torch
+from golfflight.flight.air import Air
+from golfflight.flight.bundle_check import OUTPUT_COLUMNS
+from golfflight.flight.coefficients import BASE_DYNAMIC_PRESSURE
+from golfflight.flight.constants import (
+    BALL_AREA_M2,
+    BALL_INERTIA_KG_M2,
+    BALL_MASS_KG,
+    BALL_RADIUS_M,
+    GRAVITY_MPS2,
+    TEE_HEIGHT_M,
+)
+from golfflight.model_export import PHYSICS_VARIANTS
+from golfflight.model_export.torch_physics import LANDING_SEARCH_START_S, TINY
+from golfflight.model_export.training import TrainConfig, load_checkpoint, model_from_checkpoint
+from golfflight.model_export.variants import SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, PhysNN, PhysQ
+from golfflight.shots.files import write_atomic
+from golfflight.weights_schema.bundle import CARD_FILE, sha256_of
+from golfflight.weights_schema.model_card import SCHEMA_VERSION, Architecture, ModelCard, TensorSpec
 from torch import nn
-
-from flight.air import Air
-from flight.bundle_check import OUTPUT_COLUMNS
-from flight.coefficients import BASE_DYNAMIC_PRESSURE
-from flight.constants import BALL_AREA_M2, BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, TEE_HEIGHT_M
-from model_export import PHYSICS_VARIANTS
-from model_export.torch_physics import LANDING_SEARCH_START_S, TINY
-from model_export.training import TrainConfig, load_checkpoint, model_from_checkpoint
-from model_export.variants import SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, PhysNN, PhysQ
-from shots.files import write_atomic
-from weights_schema.bundle import CARD_FILE, sha256_of
-from weights_schema.model_card import SCHEMA_VERSION, Architecture, ModelCard, TensorSpec
 
 OPSET = 17
 ONNX_FILE = "model.onnx"

@@ -15,9 +15,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from golfflight.flight.constants import YARD_M
 from PIL import Image
-
-from flight.constants import YARD_M
 
 DPI = 110
 MAX_SCATTER_POINTS = 50_000

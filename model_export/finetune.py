@@ -15,14 +15,20 @@ from typing import Any
 
 import numpy as np
 import torch
+from golfflight.model_export.data import load_training_data
+from golfflight.model_export.export import export_checkpoint
+from golfflight.model_export.training import (
+    RunResult,
+    TrainConfig,
+    load_checkpoint,
+    model_from_checkpoint,
+    train,
+    validate,
+)
+from golfflight.shots.records import ShotSet, read_shots, write_shots
+from golfflight.weights_schema.bundle import CARD_FILE
+from golfflight.weights_schema.model_card import ModelCard
 from torch import nn
-
-from model_export.data import load_training_data
-from model_export.export import export_checkpoint
-from model_export.training import RunResult, TrainConfig, load_checkpoint, model_from_checkpoint, train, validate
-from shots.records import ShotSet, read_shots, write_shots
-from weights_schema.bundle import CARD_FILE
-from weights_schema.model_card import ModelCard
 
 RUN_DIR = "finetune-run"
 """Subdirectory of the output bundle that holds the fine-tuning run (checkpoints, history, the split data)."""
@@ -43,7 +49,7 @@ def load_base(model: str | os.PathLike) -> BaseModel:
     """Weights and settings of a bundle directory, a run directory (its best.pt) or a checkpoint file."""
     path = Path(model)
     if (path / CARD_FILE).is_file():
-        from model_export.bundle_model import config_from_card, model_from_bundle
+        from golfflight.model_export.bundle_model import config_from_card, model_from_bundle
 
         module, card = model_from_bundle(path)
         return BaseModel(module.state_dict(), config_from_card(card), f"bundle {path} ({card.variant})")

@@ -9,9 +9,8 @@ import os
 from pathlib import Path
 
 import numpy as np
-
-from model_export.accuracy_flyers import ModelFlyer
-from model_export.accuracy_sets import (
+from golfflight.model_export.accuracy_flyers import ModelFlyer
+from golfflight.model_export.accuracy_sets import (
     TOUR_CHAMPIONSHIP_HELD_OUT,
     TRACKMAN_HELD_OUT,
     held_out_driver_shots,
@@ -19,12 +18,12 @@ from model_export.accuracy_sets import (
     tee_groups,
     tour_championship_shots,
 )
-from shots.files import write_text_atomic
-from shots.heldout import HeldOutSet
-from shots.pbp import hole_pars
-from shots.source_air import TOUR_CHAMPIONSHIP_2020
-from weights_schema.bundle import CARD_FILE, load_bundle, sha256_of
-from weights_schema.model_card import HeldOutResult, ModelCard
+from golfflight.shots.files import write_text_atomic
+from golfflight.shots.heldout import HeldOutSet
+from golfflight.shots.pbp import hole_pars
+from golfflight.shots.source_air import TOUR_CHAMPIONSHIP_2020
+from golfflight.weights_schema.bundle import CARD_FILE, load_bundle, sha256_of
+from golfflight.weights_schema.model_card import HeldOutResult, ModelCard
 
 FLIGHT_ERRORS = {"landing_m": "landing_point_m", "carry_m": "carry_m", "side_m": "side_m", "apex_m": "apex_m",
                  "landing_angle_deg": "landing_angle_deg", "flight_time_s": "flight_time_s"}

@@ -25,11 +25,8 @@ from pathlib import Path
 from typing import Any
 
 import torch
-from torch import nn
-from tqdm import tqdm
-
-from discovery.effects import EFFECTS, wind_from_components
-from model_export.observations import (
+from golfflight.discovery.effects import EFFECTS, wind_from_components
+from golfflight.model_export.observations import (
     OBSERVABLES,
     PATH_OBSERVATIONS,
     PATH_SIGMA_M,
@@ -37,10 +34,12 @@ from model_export.observations import (
     ObservedShots,
     load_observed,
 )
-from model_export.torch_physics import DT_S, T_SIM_S, euler_rollout, hard_landing, positions_at
-from model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, load_checkpoint, save_checkpoint
-from shots.files import write_text_atomic
-from shots.source_air import UNKNOWN_AIR_SOURCES
+from golfflight.model_export.torch_physics import DT_S, T_SIM_S, euler_rollout, hard_landing, positions_at
+from golfflight.model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, load_checkpoint, save_checkpoint
+from golfflight.shots.files import write_text_atomic
+from golfflight.shots.source_air import UNKNOWN_AIR_SOURCES
+from torch import nn
+from tqdm import tqdm
 
 HUBER_DELTA = 2.0
 """Residuals beyond 2 sigma count linearly: mishits and gusts do not dominate the fit."""

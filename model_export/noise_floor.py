@@ -13,14 +13,13 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-
-from flight.air import Air
-from flight.physics import initial_state
-from flight.wind import CALM, Wind
-from model_export.validation import Errors, Prediction, ValidationSet, errors_of
-from shots.records import ShotSet
-from shots.reference_world import fly_reference
-from shots.synth import MeasurementNoise, sessions_path
+from golfflight.flight.air import Air
+from golfflight.flight.physics import initial_state
+from golfflight.flight.wind import CALM, Wind
+from golfflight.model_export.validation import Errors, Prediction, ValidationSet, errors_of
+from golfflight.shots.records import ShotSet
+from golfflight.shots.reference_world import fly_reference
+from golfflight.shots.synth import MeasurementNoise, sessions_path
 
 
 class SessionTruth(NamedTuple):

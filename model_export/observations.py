@@ -15,11 +15,10 @@ from pathlib import Path
 
 import numpy as np
 import torch
-
-from flight.air import Air
-from flight.physics import initial_state, reynolds_scale
-from shots.records import ShotSet, read_shots, read_trajectories, trajectories_path
-from shots.synth import MeasurementNoise
+from golfflight.flight.air import Air
+from golfflight.flight.physics import initial_state, reynolds_scale
+from golfflight.shots.records import ShotSet, read_shots, read_trajectories, trajectories_path
+from golfflight.shots.synth import MeasurementNoise
 
 NOISE = MeasurementNoise()
 PATH_SIGMA_M = 0.3

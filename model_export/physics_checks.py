@@ -30,13 +30,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
-from flight.air import Air
-from flight.constants import BALL_RADIUS_M
-from flight.physics import spin_ratio
-from model_export.accuracy_flyers import Flyer, ModelFlyer
-from shots.clubs import CLUBS, ClubLaunch, straight_launches
-from shots.markdown import table
+from golfflight.flight.air import Air
+from golfflight.flight.constants import BALL_RADIUS_M
+from golfflight.flight.physics import spin_ratio
+from golfflight.model_export.accuracy_flyers import Flyer, ModelFlyer
+from golfflight.shots.clubs import CLUBS, ClubLaunch, straight_launches
+from golfflight.shots.markdown import table
 
 COMMAND = "physics-check"
 LITERATURE_DIR = Path("literature")

@@ -37,19 +37,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-
-from flight.air import Air
-from flight.constants import YARD_M
-from flight.physics import initial_state
-from shots.heldout import check_training_rows, shot_round
-from shots.pbp import load_pbp, recorded_apex
-from shots.records import ShotRecord, trajectories_path, write_shots, write_trajectories
-from shots.reference_world import TOUR_AVERAGES_FILE, ClubAverage, fly_reference, read_tour_averages
-from shots.source_air import KNOWN_AIR
-from shots.synth import MIN_APEX_M, SynthConfig, draw_launches, draw_sessions
-from shots.tourcast import load_tourcast, read_flights
-from shots.trackman import ConversionReport, load_trackman
-from weights_schema.bundle import sha256_of
+from golfflight.flight.air import Air
+from golfflight.flight.constants import YARD_M
+from golfflight.flight.physics import initial_state
+from golfflight.shots.heldout import check_training_rows, shot_round
+from golfflight.shots.pbp import load_pbp, recorded_apex
+from golfflight.shots.records import ShotRecord, trajectories_path, write_shots, write_trajectories
+from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, ClubAverage, fly_reference, read_tour_averages
+from golfflight.shots.source_air import KNOWN_AIR
+from golfflight.shots.synth import MIN_APEX_M, SynthConfig, draw_launches, draw_sessions
+from golfflight.shots.tourcast import load_tourcast, read_flights
+from golfflight.shots.trackman import ConversionReport, load_trackman
+from golfflight.weights_schema.bundle import sha256_of
 
 DRIVER_FILE = Path("real/trackman_driver_sessions/data.csv")
 DRIVER_TRAIN_LINES = (3, 2942)

@@ -14,16 +14,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-
-from flight.constants import YARD_M
-from model_export.export import export_bundle
-from model_export.joint import JointConfig, JointResult, soup_runs, train_joint
-from model_export.observations import NOISE, OBSERVABLES, PATH_OBSERVATIONS, PATH_SIGMA_M
-from model_export.real_data import SourceData, build
-from model_export.training import TrainConfig, load_checkpoint
-from shots.records import read_shots
-from weights_schema.bundle import sha256_of
-from weights_schema.model_card import ModelCard
+from golfflight.flight.constants import YARD_M
+from golfflight.model_export.export import export_bundle
+from golfflight.model_export.joint import JointConfig, JointResult, soup_runs, train_joint
+from golfflight.model_export.observations import NOISE, OBSERVABLES, PATH_OBSERVATIONS, PATH_SIGMA_M
+from golfflight.model_export.real_data import SourceData, build
+from golfflight.model_export.training import TrainConfig, load_checkpoint
+from golfflight.shots.records import read_shots
+from golfflight.weights_schema.bundle import sha256_of
+from golfflight.weights_schema.model_card import ModelCard
 
 if TYPE_CHECKING:
     from torch import nn
@@ -131,7 +130,7 @@ def _validation_metrics(final: dict[str, Any]) -> dict[str, Any]:
 def export_real(run_dir: Path, data_file: Path, sources: list[SourceData], out: Path, variant: str,
                 hidden: tuple[int, ...]) -> ModelCard:
     """Export a joint run's final epoch with a card that records its sources and latent conditions."""
-    from model_export.variants import build_model
+    from golfflight.model_export.variants import build_model
 
     payload = load_checkpoint(run_dir / "last.pt")
     config = JointConfig(**payload["config"])
@@ -169,7 +168,7 @@ def export_real(run_dir: Path, data_file: Path, sources: list[SourceData], out: 
 
 def _network(init: str | os.PathLike) -> nn.Module:
     """A fresh copy of the network of the bundle INIT (a seed's start, or the module the soup's weights go into)."""
-    from model_export.bundle_model import model_from_bundle
+    from golfflight.model_export.bundle_model import model_from_bundle
 
     model, _ = model_from_bundle(init)
     return model
@@ -195,7 +194,7 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     (WORK/soup), and export the run with the lowest validation felt error to OUT (if given)."""
     from concurrent.futures import ProcessPoolExecutor
 
-    from weights_schema.bundle import load_bundle
+    from golfflight.weights_schema.bundle import load_bundle
 
     started = time.perf_counter()
     work = Path(work)
@@ -216,7 +215,7 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     chosen = min(runs, key=lambda s: runs[s].final["val_loss"] if runs[s].final else float("inf"))
     exported = None
     if out is not None:
-        from model_export.held_out import record_held_out
+        from golfflight.model_export.held_out import record_held_out
 
         card, _ = load_bundle(init)
         export_real(runs[chosen].out_dir, data_file, sources, Path(out), card.variant,

@@ -11,12 +11,19 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from model_export.real_data import pga_table, players, sentry, tour_championship, trackman_model, trackman_outdoor
-from shots.calibrate_reference import CalibrationCell, cells_from_records, table_cells
-from shots.heldout import check_training_rows
-from shots.reference_world import CALIBRATION_AIR, read_tour_averages
-from shots.source_air import KNOWN_AIR, UNKNOWN_AIR_SOURCES
-from shots.trackman import load_trackman
+from golfflight.model_export.real_data import (
+    pga_table,
+    players,
+    sentry,
+    tour_championship,
+    trackman_model,
+    trackman_outdoor,
+)
+from golfflight.shots.calibrate_reference import CalibrationCell, cells_from_records, table_cells
+from golfflight.shots.heldout import check_training_rows
+from golfflight.shots.reference_world import CALIBRATION_AIR, read_tour_averages
+from golfflight.shots.source_air import KNOWN_AIR, UNKNOWN_AIR_SOURCES
+from golfflight.shots.trackman import load_trackman
 
 NORMALIZED_7IRON_FILE = Path("real/trackman_normalized_7iron/trackman-csv-export-20230807.Normalized.csv")
 NORMALIZED_7IRON_AIR = KNOWN_AIR["trackman-normalized-7iron"].air()

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from flight.constants import YARD_M
+from golfflight.flight.constants import YARD_M
 
 
 def metres_yards(value_m: float | None, digits: int = 2) -> tuple[str, str]:

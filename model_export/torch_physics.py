@@ -12,9 +12,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import torch
-
-from flight.constants import BALL_AREA_M2, BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2
-from flight.physics import TINY
+from golfflight.flight.constants import BALL_AREA_M2, BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2
+from golfflight.flight.physics import TINY
 
 DT_S = 0.1
 """Euler step of the paper (section 2.3.2): the step the models are trained and served with."""

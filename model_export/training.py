@@ -16,13 +16,10 @@ from pathlib import Path
 from typing import Any, Literal
 
 import torch
-from torch import nn
-from tqdm import tqdm
-
-from flight.constants import YARD_M
-from model_export import DEFAULT_HIDDEN, VARIANTS
-from model_export.data import MIN_APEX_M, DataSummary, ShotTensors, load_training_data
-from model_export.torch_physics import (
+from golfflight.flight.constants import YARD_M
+from golfflight.model_export import DEFAULT_HIDDEN, VARIANTS
+from golfflight.model_export.data import MIN_APEX_M, DataSummary, ShotTensors, load_training_data
+from golfflight.model_export.torch_physics import (
     DT_S,
     SOFT_ARGMAX_TEMPERATURE_M,
     T_SIM_S,
@@ -30,8 +27,10 @@ from model_export.torch_physics import (
     hard_landing,
     soft_landing,
 )
-from model_export.variants import build_model
-from shots.files import write_atomic, write_text_atomic
+from golfflight.model_export.variants import build_model
+from golfflight.shots.files import write_atomic, write_text_atomic
+from torch import nn
+from tqdm import tqdm
 
 CHECKPOINT_FORMAT = 1
 VALIDATION_BATCH = 4096

@@ -12,9 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import torch
-
-from model_export.data import MIN_APEX_M, ShotTensors, to_tensors
-from shots.records import ShotSet, read_shots
+from golfflight.model_export.data import MIN_APEX_M, ShotTensors, to_tensors
+from golfflight.shots.records import ShotSet, read_shots
 
 
 @dataclass

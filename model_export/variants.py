@@ -10,11 +10,10 @@ import math
 from collections.abc import Sequence
 
 import torch
+from golfflight.flight.coefficients import BASE_DYNAMIC_PRESSURE, FERGUSON_2022
+from golfflight.model_export import DEFAULT_HIDDEN, PHYS_NN_VARIANTS, VARIANTS
+from golfflight.model_export.torch_physics import spin_ratio, spin_ratio_of
 from torch import nn
-
-from flight.coefficients import BASE_DYNAMIC_PRESSURE, FERGUSON_2022
-from model_export import DEFAULT_HIDDEN, PHYS_NN_VARIANTS, VARIANTS
-from model_export.torch_physics import spin_ratio, spin_ratio_of
 
 VELOCITY_SCALE_MPS = 89.4
 """MLP input normalisation (paper section 2.2): 200 mph."""

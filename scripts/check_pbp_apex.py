@@ -19,19 +19,19 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from flight.air import Air  # noqa: E402
-from flight.coefficients import FERGUSON_2022, QuadraticSpinRatio  # noqa: E402
-from flight.constants import FOOT_M  # noqa: E402
-from flight.integrator import simulate  # noqa: E402
-from flight.outcomes import Flight  # noqa: E402
-from flight.physics import initial_state  # noqa: E402
-from flight.reference_aero import REFERENCE_DT_S, REFERENCE_T_MAX_S  # noqa: E402
-from shots.markdown import table  # noqa: E402
-from shots.paths import shared_data_dir  # noqa: E402
-from shots.pbp import load_pbp, recorded_apex, rest_positions  # noqa: E402
-from shots.records import ShotSet  # noqa: E402
-from shots.reference_world import fly_reference  # noqa: E402
-from shots.tourcast import load_tourcast  # noqa: E402
+from golfflight.flight.air import Air  # noqa: E402
+from golfflight.flight.coefficients import FERGUSON_2022, QuadraticSpinRatio  # noqa: E402
+from golfflight.flight.constants import FOOT_M  # noqa: E402
+from golfflight.flight.integrator import simulate  # noqa: E402
+from golfflight.flight.outcomes import Flight  # noqa: E402
+from golfflight.flight.physics import initial_state  # noqa: E402
+from golfflight.flight.reference_aero import REFERENCE_DT_S, REFERENCE_T_MAX_S  # noqa: E402
+from golfflight.shots.markdown import table  # noqa: E402
+from golfflight.shots.paths import shared_data_dir  # noqa: E402
+from golfflight.shots.pbp import load_pbp, recorded_apex, rest_positions  # noqa: E402
+from golfflight.shots.records import ShotSet  # noqa: E402
+from golfflight.shots.reference_world import fly_reference  # noqa: E402
+from golfflight.shots.tourcast import load_tourcast  # noqa: E402
 
 TOURCAST = Path("real/pga_tourcast_trackman")
 EVENTS = {

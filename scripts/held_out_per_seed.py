@@ -14,14 +14,14 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from flight.constants import FOOT_M, YARD_M
-from model_export.held_out import record_held_out
-from model_export.real_data import DEFAULT_SOURCES, build
-from model_export.real_training import DATA_FILE, SOUP, export_real
-from shots.markdown import table
-from shots.paths import shared_data_dir
-from weights_schema.bundle import load_bundle
-from weights_schema.model_card import ModelCard
+from golfflight.flight.constants import FOOT_M, YARD_M
+from golfflight.model_export.held_out import record_held_out
+from golfflight.model_export.real_data import DEFAULT_SOURCES, build
+from golfflight.model_export.real_training import DATA_FILE, SOUP, export_real
+from golfflight.shots.markdown import table
+from golfflight.shots.paths import shared_data_dir
+from golfflight.weights_schema.bundle import load_bundle
+from golfflight.weights_schema.model_card import ModelCard
 
 
 def cells(card: ModelCard) -> list[str]:

@@ -18,14 +18,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from flight.air import Air
-from flight.constants import YARD_M
-from model_export.accuracy_flyers import ModelFlyer
-from model_export.real_data import trackman_outdoor
-from model_export.real_training import CONDITIONS_FILE
-from shots.markdown import table
-from shots.paths import shared_data_dir
-from shots.records import ShotSet
+from golfflight.flight.air import Air
+from golfflight.flight.constants import YARD_M
+from golfflight.model_export.accuracy_flyers import ModelFlyer
+from golfflight.model_export.real_data import trackman_outdoor
+from golfflight.model_export.real_training import CONDITIONS_FILE
+from golfflight.shots.markdown import table
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.records import ShotSet
 
 RANGE_SOURCE = "trackman-outdoor"
 

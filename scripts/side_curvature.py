@@ -17,15 +17,15 @@ from scipy.optimize import least_squares
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from flight.field import ScaledCoefficients
-from flight.integrator import simulate
-from flight.physics import CoefficientModel, initial_state
-from model_export.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
-from model_export.accuracy_sets import outcome_errors
-from model_export.real_data import trackman_outdoor
-from shots.markdown import table
-from shots.paths import shared_data_dir
-from shots.records import ShotSet
+from golfflight.flight.field import ScaledCoefficients
+from golfflight.flight.integrator import simulate
+from golfflight.flight.physics import CoefficientModel, initial_state
+from golfflight.model_export.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
+from golfflight.model_export.accuracy_sets import outcome_errors
+from golfflight.model_export.real_data import trackman_outdoor
+from golfflight.shots.markdown import table
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.records import ShotSet
 
 AXIS_STEP_DEG = 1.0
 """The axis step of each model's own side sensitivity (a central difference)."""

@@ -23,11 +23,11 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from model_export.joint import JointConfig, felt_error_m
-from model_export.real_data import DEFAULT_SOURCES, build
-from model_export.real_training import DATA_FILE, train_seed
-from shots.markdown import table
-from shots.paths import shared_data_dir
+from golfflight.model_export.joint import JointConfig, felt_error_m
+from golfflight.model_export.real_data import DEFAULT_SOURCES, build
+from golfflight.model_export.real_training import DATA_FILE, train_seed
+from golfflight.shots.markdown import table
+from golfflight.shots.paths import shared_data_dir
 
 
 def parse_grid(items: list[str]) -> dict[str, list[float]]:

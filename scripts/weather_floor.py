@@ -18,12 +18,12 @@ from scipy.optimize import least_squares
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from flight.wind import Wind
-from model_export.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
-from model_export.real_data import trackman_outdoor
-from shots.markdown import table
-from shots.paths import shared_data_dir
-from shots.records import ShotSet
+from golfflight.flight.wind import Wind
+from golfflight.model_export.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
+from golfflight.model_export.real_data import trackman_outdoor
+from golfflight.shots.markdown import table
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.records import ShotSet
 
 MIN_OTHERS = 3
 """A shot counts only where its block has at least this many other Premium shots to fit the wind on."""

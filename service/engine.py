@@ -24,19 +24,18 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-
-from flight.bundle_check import open_session, session_options
-from flight.conditions import STANDARD, Conditions
-from flight.constants import RPM_TO_RADPS
-from flight.field import BallInAir
-from flight.ground import GroundPhase, GroundSpec, Surface, ground_phase, ground_phase_one
-from flight.integrator import GroundPlane, integrate
-from flight.limits import FLIGHT_TIME_S
-from flight.onnx_coefficients import OnnxCoefficients
-from flight.outcomes import Flight, landing_angle_deg, parabola_apex
-from flight.physics import euler_step, initial_state, reynolds_scale
-from flight.wind import Wind, log_profile_factor
-from weights_schema.model_card import ModelCard
+from golfflight.flight.bundle_check import open_session, session_options
+from golfflight.flight.conditions import STANDARD, Conditions
+from golfflight.flight.constants import RPM_TO_RADPS
+from golfflight.flight.field import BallInAir
+from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, ground_phase, ground_phase_one
+from golfflight.flight.integrator import GroundPlane, integrate
+from golfflight.flight.limits import FLIGHT_TIME_S
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.outcomes import Flight, landing_angle_deg, parabola_apex
+from golfflight.flight.physics import euler_step, initial_state, reynolds_scale
+from golfflight.flight.wind import Wind, log_profile_factor
+from golfflight.weights_schema.model_card import ModelCard
 
 MAX_FLIGHT_TIME_S = FLIGHT_TIME_S.high
 """Longest flight simulated (20 s, the shot records' limit); a shot still in the air then gets a FlightError."""

@@ -14,25 +14,24 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
-
-from flight.air import Air
-from flight.coefficients import QuadraticSpinRatio
-from flight.constants import YARD_M
-from flight.integrator import simulate
-from flight.outcomes import Flight
-from flight.physics import State, initial_state
-from flight.reference_aero import (
+from golfflight.flight.air import Air
+from golfflight.flight.coefficients import QuadraticSpinRatio
+from golfflight.flight.constants import YARD_M
+from golfflight.flight.integrator import simulate
+from golfflight.flight.outcomes import Flight
+from golfflight.flight.physics import State, initial_state
+from golfflight.flight.reference_aero import (
     CALIBRATED,
     FREE_PARAMETERS,
     REFERENCE_DT_S,
     REFERENCE_T_MAX_S,
     ReferenceParameters,
 )
-from shots.clubs import CLUBS, straight_launches
-from shots.markdown import signed
-from shots.records import ShotRecord
-from shots.reference_world import CALIBRATION_AIR, ClubAverage, fly_reference
+from golfflight.shots.clubs import CLUBS, straight_launches
+from golfflight.shots.markdown import signed
+from golfflight.shots.records import ShotRecord
+from golfflight.shots.reference_world import CALIBRATION_AIR, ClubAverage, fly_reference
+from scipy.optimize import least_squares
 
 DECAY_TIMES_S = (1.0, 3.0, 5.0)
 TRACKMAN_SPIN_LOSS_PCT = {"Driver": (3.1, 8.8, 12.8), "5-iron": (3.4, 9.7, 15.5), "8-iron": (3.6, 9.0, 13.3)}

@@ -17,16 +17,15 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
+from golfflight.flight.constants import YARD_M
+from golfflight.flight.ground import SURFACES, Surface, ground_phase
+from golfflight.flight.integrator import simulate
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.outcomes import Flight
+from golfflight.flight.physics import initial_state
+from golfflight.shots.markdown import table
+from golfflight.shots.pbp import load_pbp, recorded_apex, rest_positions
 from scipy.optimize import minimize
-
-from flight.constants import YARD_M
-from flight.ground import SURFACES, Surface, ground_phase
-from flight.integrator import simulate
-from flight.onnx_coefficients import OnnxCoefficients
-from flight.outcomes import Flight
-from flight.physics import initial_state
-from shots.markdown import table
-from shots.pbp import load_pbp, recorded_apex, rest_positions
 
 PBP_DIR = Path("real/pga_tourcast_trackman/pbp")
 FIT_EVENT = ("THE PLAYERS 2020", PBP_DIR / "pbp_2020_011_011.csv")

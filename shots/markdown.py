@@ -9,7 +9,7 @@ import os
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
-from shots.files import write_text_atomic
+from golfflight.shots.files import write_text_atomic
 
 END_MARKER = "<!-- END generated -->"
 

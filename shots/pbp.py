@@ -20,12 +20,12 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
-from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from shots.cells import BadRow, MalformedCell, finite_number
-from shots.heldout import held_out_rounds, held_out_set
-from shots.records import RANGES, RecordError, ShotRecord, reading
-from shots.tourcast import shot_id, shot_key
-from shots.trackman import Conversion, ConversionReport
+from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from golfflight.shots.cells import BadRow, MalformedCell, finite_number
+from golfflight.shots.heldout import held_out_rounds, held_out_set
+from golfflight.shots.records import RANGES, RecordError, ShotRecord, reading
+from golfflight.shots.tourcast import shot_id, shot_key
+from golfflight.shots.trackman import Conversion, ConversionReport
 
 KEY_COLUMNS = ("tournamentNumber", "seasonYear", "roundNumber", "holeNumber", "playerId", "shotNumber")
 RADAR_FLAG = "radarData.ballSpeed"

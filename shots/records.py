@@ -24,12 +24,11 @@ from pathlib import Path
 from typing import Annotated, Iterable, Iterator, Literal
 
 import numpy as np
+from golfflight.flight import limits
+from golfflight.flight.air import Air, pressure_at_altitude
+from golfflight.flight.limits import Range
+from golfflight.shots.files import write_atomic
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
-
-from flight import limits
-from flight.air import Air, pressure_at_altitude
-from flight.limits import Range
-from shots.files import write_atomic
 
 RANGES: dict[str, Range] = {
     "ball_speed_mps": limits.BALL_SPEED_MPS,

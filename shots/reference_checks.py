@@ -7,15 +7,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from flight.air import Air
-from flight.constants import MPH_TO_MPS, YARD_M
-from flight.physics import initial_state
-from flight.reference_aero import CALIBRATED, ReferenceParameters
-from flight.wind import CALM, Wind
-from shots.clubs import CLUBS
-from shots.markdown import signed, table
-from shots.reference_world import CALIBRATION_AIR, fly_reference
+from golfflight.flight.air import Air
+from golfflight.flight.constants import MPH_TO_MPS, YARD_M
+from golfflight.flight.physics import initial_state
+from golfflight.flight.reference_aero import CALIBRATED, ReferenceParameters
+from golfflight.flight.wind import CALM, Wind
+from golfflight.shots.clubs import CLUBS
+from golfflight.shots.markdown import signed, table
+from golfflight.shots.reference_world import CALIBRATION_AIR, fly_reference
 
 HIGH_ALTITUDE_M = 2377.0
 """7,800 ft, the altitude of NOTES §2's rule: a 282 yd drive at sea level flies about 306 yd there (apex −6 yd,

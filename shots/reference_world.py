@@ -12,22 +12,21 @@ import os
 from pathlib import Path
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict
-
-from flight.air import Air
-from flight.constants import MPH_TO_MPS, YARD_M
-from flight.integrator import simulate
-from flight.outcomes import Flight
-from flight.physics import State
-from flight.reference_aero import (
+from golfflight.flight.air import Air
+from golfflight.flight.constants import MPH_TO_MPS, YARD_M
+from golfflight.flight.integrator import simulate
+from golfflight.flight.outcomes import Flight
+from golfflight.flight.physics import State
+from golfflight.flight.reference_aero import (
     CALIBRATED,
     REFERENCE_DT_S,
     REFERENCE_T_MAX_S,
     ReferenceAerodynamics,
     ReferenceParameters,
 )
-from flight.wind import CALM, Wind
-from shots.paths import shared_data_dir
+from golfflight.flight.wind import CALM, Wind
+from golfflight.shots.paths import shared_data_dir
+from pydantic import BaseModel, ConfigDict
 
 CALIBRATION_AIR = Air.from_conditions(temperature_c=25.0, altitude_m=0.0, humidity_pct=50.0)
 """The air the unrecorded-air sources are calibrated and the tour-average table checked in: TrackMan's normalize

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from flight.air import Air, pressure_at_altitude
-from flight.constants import FOOT_M
+from golfflight.flight.air import Air, pressure_at_altitude
+from golfflight.flight.constants import FOOT_M
 
 
 @dataclass(frozen=True)

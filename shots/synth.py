@@ -14,16 +14,15 @@ from datetime import datetime, timedelta
 from pathlib import Path
 
 import numpy as np
-
-from flight.air import Air
-from flight.constants import YARD_M
-from flight.outcomes import Flight
-from flight.physics import initial_state
-from flight.reference_aero import CALIBRATED, ReferenceParameters
-from flight.wind import Wind
-from shots.clubs import CLUBS, club_weights
-from shots.records import LAUNCH_COLUMNS, RANGES, ShotRecord, write_csv_atomic, write_shots
-from shots.reference_world import fly_reference
+from golfflight.flight.air import Air
+from golfflight.flight.constants import YARD_M
+from golfflight.flight.outcomes import Flight
+from golfflight.flight.physics import initial_state
+from golfflight.flight.reference_aero import CALIBRATED, ReferenceParameters
+from golfflight.flight.wind import Wind
+from golfflight.shots.clubs import CLUBS, club_weights
+from golfflight.shots.records import LAUNCH_COLUMNS, RANGES, ShotRecord, write_csv_atomic, write_shots
+from golfflight.shots.reference_world import fly_reference
 
 MIN_APEX_M = 8 * YARD_M
 """The paper drops shots that peak under 8 yd (tops and duffs)."""

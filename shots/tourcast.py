@@ -26,12 +26,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from golfflight.flight.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
+from golfflight.shots.records import RANGES, RecordError, ShotRecord, reading
+from golfflight.shots.trackman import Conversion, ConversionReport
 from numpy.polynomial import Polynomial
 from pydantic import ValidationError
-
-from flight.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
-from shots.records import RANGES, RecordError, ShotRecord, reading
-from shots.trackman import Conversion, ConversionReport
 
 FULL_COEFFICIENTS = 7
 """Coefficients of a complete TOURCAST polynomial (degree 6); fewer means the scraper truncated it."""

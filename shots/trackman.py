@@ -23,10 +23,9 @@ from datetime import datetime
 from pathlib import Path
 
 import numpy as np
-
-from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from shots.cells import BadRow, MalformedCell, finite_number
-from shots.records import RANGES, RecordError, ShotRecord, reading
+from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from golfflight.shots.cells import BadRow, MalformedCell, finite_number
+from golfflight.shots.records import RANGES, RecordError, ShotRecord, reading
 
 SPEED = {"mph": MPH_TO_MPS, "m/s": 1.0, "km/h": 1.0 / 3.6}
 ANGLE = {"deg": 1.0}

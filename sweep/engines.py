@@ -16,12 +16,12 @@ from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 
-from sweep.flyer import Flyer
+from golfflight.sweep.flyer import Flyer
 
 PIECES_PER_WORKER = 2
 """Pieces queued per local worker: one flying and one waiting, so a worker never idles while the driver writes."""
 
-WORKER_IMPORTS = ["service.engine", "service.api.shots", "sweep.flyer"]
+WORKER_IMPORTS = ["golfflight.service.engine", "golfflight.service.api.shots", "golfflight.sweep.flyer"]
 """Modules the local pool's fork server imports before it forks the workers."""
 
 _flyer: Flyer | None = None
@@ -155,7 +155,7 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int, address: str 
 
 
 def _ray_tables(ray, source, bundle_dir: str, sha256: str, workers: int, address: str | None) -> Iterator:
-    from sweep.ray_input import PiecesDatasource
+    from golfflight.sweep.ray_input import PiecesDatasource
 
     started = not ray.is_initialized()
     if started:

@@ -16,10 +16,10 @@ from contextlib import closing
 from dataclasses import dataclass
 from typing import Literal
 
-from service.model_location import model_dir
-from shots.files import write_atomic
-from sweep.flyer import PROBLEM, ROW, Layout
-from sweep.sources import Source
+from golfflight.service.model_location import model_dir
+from golfflight.shots.files import write_atomic
+from golfflight.sweep.flyer import PROBLEM, ROW, Layout
+from golfflight.sweep.sources import Source
 
 SHOWN_PROBLEMS = 20
 """Problems listed when a sweep is refused (the rest are counted)."""
@@ -47,8 +47,8 @@ class Summary:
 
 def _tables(source: Source, engine: Engine, workers: int, model: str | None, ray_address: str | None) -> Iterator:
     """Result tables from the chosen engine, its workers loading the bundle the driver verified here."""
-    from flight.bundle_check import verify_bundle
-    from sweep.engines import local_tables, ray_tables
+    from golfflight.flight.bundle_check import verify_bundle
+    from golfflight.sweep.engines import local_tables, ray_tables
 
     bundle = model_dir(model).resolve()
     sha256 = verify_bundle(bundle).onnx.sha256

@@ -16,9 +16,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from service.columns import columns_message
-from shots.records import reading
-from sweep.grid import Grid
+from golfflight.service.columns import columns_message
+from golfflight.shots.records import reading
+from golfflight.sweep.grid import Grid
 
 REQUIRED_COLUMNS = (("ball_speed_mps", "ball_speed_mph"), ("launch_angle_deg",), ("spin_rpm", "back_spin_rpm"))
 """What every row needs, as columns: a ball speed, a launch angle and a spin, each in one of its forms (a column's

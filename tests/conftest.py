@@ -8,12 +8,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from flight.coefficients import QuadraticSpinRatio
-from flight.integrator import simulate
-from flight.physics import initial_state
-from shots.heldout import ROUND_COLUMN, HeldOutSet, held_out_set
-from shots.records import ShotRecord, write_shots
+from golfflight.flight.coefficients import QuadraticSpinRatio
+from golfflight.flight.integrator import simulate
+from golfflight.flight.physics import initial_state
+from golfflight.shots.heldout import ROUND_COLUMN, HeldOutSet, held_out_set
+from golfflight.shots.records import ShotRecord, write_shots
 
 
 def random_launches(n: int, seed: int = 0) -> dict[str, np.ndarray]:

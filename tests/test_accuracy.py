@@ -12,17 +12,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from scipy.stats import f_oneway
-
-from flight.air import Air
-from flight.coefficients import FERGUSON_2022, QuadraticSpinRatio
-from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from flight.integrator import simulate
-from flight.outcomes import Flight
-from flight.physics import State, initial_state
-from flight.wind import Wind, wind_vector
-from golfflight.cli import main
-from model_export.accuracy import (
+from golfflight.flight.air import Air
+from golfflight.flight.coefficients import FERGUSON_2022, QuadraticSpinRatio
+from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from golfflight.flight.integrator import simulate
+from golfflight.flight.outcomes import Flight
+from golfflight.flight.physics import State, initial_state
+from golfflight.flight.wind import Wind, wind_vector
+from golfflight.model_export.accuracy import (
     DRIVER_FILE,
     PATH_FIGURE,
     TOURCAST_PBP,
@@ -36,16 +33,16 @@ from model_export.accuracy import (
     per_model,
     run_accuracy,
 )
-from model_export.accuracy_finetune import finetune_study, round_number
-from model_export.accuracy_sets import (
+from golfflight.model_export.accuracy_finetune import finetune_study, round_number
+from golfflight.model_export.accuracy_sets import (
     SONY_TRAJECTORIES,
     TOUR_CHAMPIONSHIP_PBP,
     held_out_driver_shots,
     tee_groups,
     tour_championship_shots,
 )
-from model_export.accuracy_slow import SLOW_SHOTS, fly_slow
-from model_export.accuracy_winds import (
+from golfflight.model_export.accuracy_slow import SLOW_SHOTS, fly_slow
+from golfflight.model_export.accuracy_winds import (
     TRAINING_CONDITIONS_FILE,
     anova,
     compare_training_winds,
@@ -55,16 +52,19 @@ from model_export.accuracy_winds import (
     measured_paths,
     training_winds,
 )
-from model_export.export import export_checkpoint
-from model_export.held_out import held_out_results
-from model_export.training import TrainConfig, train
-from shots.heldout import HELD_OUT, shot_round
-from shots.paths import shared_data_dir
-from shots.pbp import SCORE_TO_PAR, hole_pars
-from shots.records import ShotRecord, ShotSet
-from shots.reference_world import TOUR_AVERAGES_FILE, ClubAverage, fly_reference
-from shots.source_air import PGA_2023_TABLE, TOUR_CHAMPIONSHIP_2020
-from weights_schema.bundle import load_bundle
+from golfflight.model_export.export import export_checkpoint
+from golfflight.model_export.held_out import held_out_results
+from golfflight.model_export.training import TrainConfig, train
+from golfflight.shots.heldout import HELD_OUT, shot_round
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.pbp import SCORE_TO_PAR, hole_pars
+from golfflight.shots.records import ShotRecord, ShotSet
+from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, ClubAverage, fly_reference
+from golfflight.shots.source_air import PGA_2023_TABLE, TOUR_CHAMPIONSHIP_2020
+from golfflight.weights_schema.bundle import load_bundle
+from scipy.stats import f_oneway
+
+from golfflight.cli import main
 
 torch.set_num_threads(1)
 FIXTURES = Path(__file__).parent / "fixtures"
@@ -381,7 +381,7 @@ def test_the_wind_fit_recovers_a_known_wind(bundle, which):
 
 def test_wind_components_round_trip_through_the_wind_object():
     """x right, y down the line (m/s) -> speed and from-direction -> the same air velocity, as discovery reads it."""
-    from discovery.effects import wind_from_components
+    from golfflight.discovery.effects import wind_from_components
 
     x, y = np.array([2.0, -1.0, 0.0]), np.array([-3.0, 0.0, 4.0])
     wind = Wind.from_components(x, y)
@@ -408,7 +408,7 @@ def test_groups_and_the_anova_of_fitted_winds():
 
 
 def test_training_winds_are_compared_with_the_fitted_group_means(tmp_path):
-    from model_export.accuracy_winds import WindFit
+    from golfflight.model_export.accuracy_winds import WindFit
 
     ids = [f"016-R1-H{h}-P{p}-S1" for h in (1, 2, 3) for p in (1, 2)]
     x = np.array([1.0, 1.2, -2.0, -2.2, 0.4, 0.6])
@@ -435,7 +435,7 @@ def test_slow_shots_have_a_source_and_fly():
 
 
 def test_the_finetune_study_tunes_early_rounds_and_measures_later_ones(bundle, tiny_shots):
-    from shots.records import read_shots
+    from golfflight.shots.records import read_shots
 
     records = read_shots(tiny_shots).records[:120]
     shots = ShotSet([r.model_copy(update={"split": None, "session": f"901-R{1 + i * 4 // len(records)}",
@@ -530,7 +530,7 @@ def test_default_models_card_tells_its_held_out_errors_as_the_runtime_flies_them
 def test_ball_types_are_keyed_like_the_loaders_shot_ids(tmp_path, first_line):
     """Each shot's ball, by the shot_id the TrackMan loader gives it (its file line), also after Excel's optional
     'sep=,' line (which once hid the header, so every ball read as blank)."""
-    from shots.trackman import load_trackman
+    from golfflight.shots.trackman import load_trackman
 
     export = tmp_path / "export.csv"
     export.write_text(first_line + (FIXTURES / "trackman_export.csv").read_text())

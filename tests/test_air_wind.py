@@ -2,9 +2,8 @@
 
 import numpy as np
 import pytest
-
-from flight.air import Air, air_density, altitude_for_pressure, dynamic_viscosity, pressure_at_altitude
-from flight.wind import Wind, log_profile_factor, uniform_equivalent_factor, wind_vector
+from golfflight.flight.air import Air, air_density, altitude_for_pressure, dynamic_viscosity, pressure_at_altitude
+from golfflight.flight.wind import Wind, log_profile_factor, uniform_equivalent_factor, wind_vector
 
 
 def test_standard_sea_level_density():

@@ -7,17 +7,16 @@ import subprocess
 import sys
 
 import pytest
+from golfflight.flight.constants import MPH_TO_MPS, YARD_M
+from golfflight.model_export.accuracy_flyers import ModelFlyer
+from golfflight.model_export.accuracy_sets import compare_clubs
+from golfflight.service.api.app import create_app
+from golfflight.service.api.models import MAX_BATCH_SHOTS
+from golfflight.service.model_location import model_dir
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
+from golfflight.weights_schema.bundle import load_bundle
 from servers import running, shot
-
-from flight.constants import MPH_TO_MPS, YARD_M
-from model_export.accuracy_flyers import ModelFlyer
-from model_export.accuracy_sets import compare_clubs
-from service.api.app import create_app
-from service.api.models import MAX_BATCH_SHOTS
-from service.model_location import model_dir
-from shots.paths import shared_data_dir
-from shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
-from weights_schema.bundle import load_bundle
 
 DRIVER_MPH = {"ball_speed_mph": 171.0, "launch_angle_deg": 10.4, "back_spin_rpm": 2545.0}
 SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}
@@ -272,8 +271,9 @@ def test_latency_reports_rolling_percentiles_and_a_probe(client):
 
 def test_the_service_imports_no_torch():
     code = (
-        "import sys, service.api.app, service.engine, golfflight.commands.serve, golfflight.commands.simulate\n"
-        "service.api.app.create_app()\n"
+        "import sys, golfflight.service.api.app, golfflight.service.engine\n"
+        "import golfflight.commands.serve, golfflight.commands.simulate\n"
+        "golfflight.service.api.app.create_app()\n"
         "assert 'torch' not in sys.modules, 'torch imported on the serving path'"
     )
     subprocess.run([sys.executable, "-c", code], check=True)

@@ -8,11 +8,11 @@ import json
 import socket
 
 import pytest
+from golfflight.service.api.app import create_app
+from golfflight.service.api.bay import Bay, BayConditions, BayFileError, in_bay
+from golfflight.service.api.models import AirRequest, GroundRequest, ShotRequest, WindRequest
+from golfflight.service.open_connect.server import ConnectAddress
 
-from service.api.app import create_app
-from service.api.bay import Bay, BayConditions, BayFileError, in_bay
-from service.api.models import AirRequest, GroundRequest, ShotRequest, WindRequest
-from service.open_connect.server import ConnectAddress
 from tests.servers import free_port, running, shot
 
 DENVER_HEAT = {"air": {"altitude_m": 1600.0, "temperature_c": 30.0},

@@ -11,15 +11,15 @@ from pathlib import Path
 import numpy as np
 import onnx
 import pytest
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.service.api.app import create_app
+from golfflight.service.engine import FlightEngine
+from golfflight.service.model_location import model_dir
+from golfflight.weights_schema.bundle import BundleError, sha256_of
 from onnx import numpy_helper
 from servers import running
 
-from flight.onnx_coefficients import OnnxCoefficients
 from golfflight.cli import main
-from service.api.app import create_app
-from service.engine import FlightEngine
-from service.model_location import model_dir
-from weights_schema.bundle import BundleError, sha256_of
 
 REPO = Path(__file__).resolve().parents[1]
 

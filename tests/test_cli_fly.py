@@ -10,18 +10,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from golfflight.flight.air import Air
+from golfflight.flight.constants import MPH_TO_MPS
+from golfflight.flight.physics import initial_state
+from golfflight.service.api.app import create_app
+from golfflight.service.api.shots import air_of
+from golfflight.service.engine import FlightEngine, Launch
+from golfflight.service.model_location import model_dir
+from golfflight.service.viewer.page import ASSETS
+from golfflight.shots.clubs import CLUB_ALIASES, CLUB_NAMES, CLUBS, canonical_club_name, club_key, club_named
+from golfflight.shots.reference_world import fly_reference
 
-from flight.air import Air
-from flight.constants import MPH_TO_MPS
-from flight.physics import initial_state
 from golfflight.cli import main
-from service.api.app import create_app
-from service.api.shots import air_of
-from service.engine import FlightEngine, Launch
-from service.model_location import model_dir
-from service.viewer.page import ASSETS
-from shots.clubs import CLUB_ALIASES, CLUB_NAMES, CLUBS, canonical_club_name, club_key, club_named
-from shots.reference_world import fly_reference
 from tests.servers import running
 
 REPO = Path(__file__).resolve().parents[1]

@@ -10,13 +10,12 @@ from concurrent.futures import ThreadPoolExecutor
 
 import psutil
 import pytest
+from golfflight.flight import limits
+from golfflight.service.api.app import create_app
+from golfflight.service.api.guards import MAX_BODY_BYTES
+from golfflight.service.api.models import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, RANGES, ShotRequest
+from golfflight.service.api.shots import fly_shots
 from servers import running
-
-from flight import limits
-from service.api.app import create_app
-from service.api.guards import MAX_BODY_BYTES
-from service.api.models import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, RANGES, ShotRequest
-from service.api.shots import fly_shots
 
 SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}
 MONITOR = {"ball_speed_mph": 120.0, "launch_angle_deg": 16.0, "back_spin_rpm": 7000.0}

@@ -6,15 +6,15 @@ import json
 
 import numpy as np
 import pytest
+from golfflight.discovery.conceal import conceal
+from golfflight.discovery.diagnose import diagnose
+from golfflight.discovery.model import reference
+from golfflight.discovery.recordings import from_shot_set
+from golfflight.discovery.schema import SCHEMA_PATH, Report, schema_text
+from golfflight.shots.paths import REPO_ROOT
+from golfflight.shots.records import ShotSet, trajectories_path, write_shots, write_trajectories
 
-from discovery.conceal import conceal
-from discovery.diagnose import diagnose
-from discovery.model import reference
-from discovery.recordings import from_shot_set
-from discovery.schema import SCHEMA_PATH, Report, schema_text
 from golfflight.cli import main
-from shots.paths import REPO_ROOT
-from shots.records import ShotSet, trajectories_path, write_shots, write_trajectories
 
 SYNTHETIC_BUNDLE = REPO_ROOT / "models" / "synthetic"
 """The bundle trained on the reference world's flights: what the controlled diagnosis assumes (the real-data default
@@ -62,8 +62,8 @@ def test_clean_recordings_raise_no_alarm():
 def test_the_reference_control_takes_the_bundles_difference_out(windy):
     """With the reference control, the bundle's difference from the reference world on these launches is reported
     and subtracted, so a wind concealed in reference-world flights is still the one thing named."""
-    from discovery.model import from_bundle
-    from discovery.recordings import read_recordings
+    from golfflight.discovery.model import from_bundle
+    from golfflight.discovery.recordings import read_recordings
 
     model = from_bundle(SYNTHETIC_BUNDLE, control=True)
     assert model.control is not None and set(model.model_error.values()) == {0.0}
@@ -87,7 +87,7 @@ def test_diagnose_flies_the_bundle_as_the_service_does(windy, tmp_path):
 
 
 def test_report_schema_is_fresh():
-    assert SCHEMA_PATH.read_text() == schema_text(), "regenerate with: python -m discovery.schema"
+    assert SCHEMA_PATH.read_text() == schema_text(), "regenerate with: python -m golfflight.discovery.schema"
 
 
 def test_thin_air_is_told_from_headwind():
@@ -120,8 +120,8 @@ def test_the_bundle_names_thin_air_alone_despite_its_own_air_response():
     out its error at the assumed air only, so after air_density is fitted that difference is left; a pair or a
     learned term that removes no more than it must not be claimed (it once named `unlisted` here). That difference
     also moves the fitted ratio: 0.866 for 0.843 with the bundle retrained on the recalibrated world."""
-    from discovery.diagnose import Diagnoser
-    from discovery.model import from_bundle
+    from golfflight.discovery.diagnose import Diagnoser
+    from golfflight.discovery.model import from_bundle
 
     recordings = from_shot_set(conceal({"air_density": {"ratio": 0.843}}, 300, seed=1).shots)
     diagnoser = Diagnoser(recordings, from_bundle(SYNTHETIC_BUNDLE, control=True), seed=1)
@@ -138,7 +138,7 @@ def test_a_model_is_its_own_perfect_control():
     same physics, and zero for a model without a control."""
     from dataclasses import replace
 
-    from discovery.diagnose import Diagnoser
+    from golfflight.discovery.diagnose import Diagnoser
 
     recordings = from_shot_set(conceal({"air_density": {"ratio": 0.85}}, 60, seed=9).shots)
     for model in (reference(), replace(reference(), control=reference())):

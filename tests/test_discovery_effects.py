@@ -4,16 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from discovery.effects import EFFECTS, LIBRARY, apply_all, wind_from_components
-from discovery.model import reference
-from discovery.simulator import Setup, simulate_setup
-from flight.air import Air
-from flight.integrator import simulate
-from flight.physics import initial_state
-from flight.reference_aero import CALIBRATED, ReferenceAerodynamics
-from flight.wind import Wind, wind_vector
-from shots.clubs import CLUBS, straight_launches
+from golfflight.discovery.effects import EFFECTS, LIBRARY, apply_all, wind_from_components
+from golfflight.discovery.model import reference
+from golfflight.discovery.simulator import Setup, simulate_setup
+from golfflight.flight.air import Air
+from golfflight.flight.integrator import simulate
+from golfflight.flight.physics import initial_state
+from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics
+from golfflight.flight.wind import Wind, wind_vector
+from golfflight.shots.clubs import CLUBS, straight_launches
 
 CARRY_Y, CARRY_X, APEX, TIME, ANGLE = range(5)
 MODEL = reference()

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
-
-from discovery.fit import cluster_bootstrap, folds
-from discovery.locate import group_test, holm, locate, mean_test, slope_test
-from discovery.recordings import OBSERVABLES, Recordings
+from golfflight.discovery.fit import cluster_bootstrap, folds
+from golfflight.discovery.locate import group_test, holm, locate, mean_test, slope_test
+from golfflight.discovery.recordings import OBSERVABLES, Recordings
 
 
 def crafted(n: int = 600, seed: int = 0) -> tuple[Recordings, np.ndarray, np.ndarray]:

@@ -7,15 +7,15 @@ import dataclasses
 
 import numpy as np
 import pytest
+from golfflight.discovery.conceal import conceal
+from golfflight.discovery.diagnose import diagnose
+from golfflight.discovery.model import reference
+from golfflight.discovery.noise import RADAR_NOISE, recording_scatter
+from golfflight.discovery.recordings import OBSERVABLES, from_shot_set
+from golfflight.discovery.schema import Report
+from golfflight.shots.records import write_shots
 
-from discovery.conceal import conceal
-from discovery.diagnose import diagnose
-from discovery.model import reference
-from discovery.noise import RADAR_NOISE, recording_scatter
-from discovery.recordings import OBSERVABLES, from_shot_set
-from discovery.schema import Report
 from golfflight.cli import main
-from shots.records import write_shots
 
 
 @pytest.fixture(scope="module")

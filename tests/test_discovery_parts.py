@@ -5,18 +5,25 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from discovery.conceal import conceal
-from discovery.correction import TERMS, correction_effect, features, knots_for, select_terms, term_named, terms_for
-from discovery.effects import EFFECTS, Context, equivalent_altitude_m
-from discovery.model import reference
-from discovery.outside import HEIGHT_GUST, OUTSIDE, HeightGust, air_motion
-from discovery.prove import Run, cases, draw_effect, expected_label, relative_error, tables
-from discovery.report import plus_minus, service_settings, share_interval
-from discovery.schema import EffectResult
-from flight.air import pressure_at_altitude
-from flight.wind import Wind, wind_vector
-from shots.markdown import replace_section
+from golfflight.discovery.conceal import conceal
+from golfflight.discovery.correction import (
+    TERMS,
+    correction_effect,
+    features,
+    knots_for,
+    select_terms,
+    term_named,
+    terms_for,
+)
+from golfflight.discovery.effects import EFFECTS, Context, equivalent_altitude_m
+from golfflight.discovery.model import reference
+from golfflight.discovery.outside import HEIGHT_GUST, OUTSIDE, HeightGust, air_motion
+from golfflight.discovery.prove import Run, cases, draw_effect, expected_label, relative_error, tables
+from golfflight.discovery.report import plus_minus, service_settings, share_interval
+from golfflight.discovery.schema import EffectResult
+from golfflight.flight.air import pressure_at_altitude
+from golfflight.flight.wind import Wind, wind_vector
+from golfflight.shots.markdown import replace_section
 
 ICAO = Context(1.225, 15.0)
 
@@ -121,7 +128,7 @@ def test_service_settings_from_effects():
 def test_a_fitted_wind_as_a_station_reading_is_a_wind_the_service_accepts():
     """With the log profile's mean factor along the flights (1.2 here), the uniform 4.8 m/s is a 4.0 m/s 10 m
     reading; both validate as the service's wind option."""
-    from service.api.models import WindRequest
+    from golfflight.service.api.models import WindRequest
 
     wind = EffectResult(name="wind", parameters={"speed_mps": 4.8, "from_deg": 5.0}, uncertainty={})
     settings = service_settings([wind], ICAO, wind_factor=1.2)

@@ -1,16 +1,15 @@
-"""`python -m discovery.real` on a real set: the shared data are read in place, and the summary row says how the
-recordings scatter and what was found (skipped where ../shared/data is absent)."""
+"""`python -m golfflight.discovery.real` on a real set: the shared data are read in place, and the summary row says
+how the recordings scatter and what was found (skipped where ../shared/data is absent)."""
 
 from __future__ import annotations
 
 import json
 
 import pytest
-
-from discovery.real import HELD_OUT, TOUR_CHAMPIONSHIP, TRACKMAN, TRAINED_ON, main, real_sets
-from shots.heldout import held_out_set, shot_round
-from shots.paths import shared_data_dir
-from shots.source_air import KNOWN_AIR
+from golfflight.discovery.real import HELD_OUT, TOUR_CHAMPIONSHIP, TRACKMAN, TRAINED_ON, main, real_sets
+from golfflight.shots.heldout import held_out_set, shot_round
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.source_air import KNOWN_AIR
 
 
 def test_real_run_writes_a_summary_row_and_a_report(tmp_path):

@@ -11,17 +11,16 @@ import sys
 import browser
 import numpy as np
 import pytest
-
-from discovery.conceal import conceal
-from discovery.diagnose import Diagnosis, diagnose
-from discovery.html import PLOTS_MISSING, render
-from discovery.model import reference
-from discovery.outputs import write_diagnosis
-from discovery.recordings import from_shot_set
+from golfflight.discovery.conceal import conceal
+from golfflight.discovery.diagnose import Diagnosis, diagnose
+from golfflight.discovery.html import PLOTS_MISSING, render
+from golfflight.discovery.model import reference
+from golfflight.discovery.outputs import write_diagnosis
+from golfflight.discovery.recordings import from_shot_set
 
 plotly = pytest.importorskip("plotly", reason="report.html's figures need the extra 'report'")
 
-from discovery.figures import SHOT_FIELDS, report_figures  # after the skip: it imports plotly
+from golfflight.discovery.figures import SHOT_FIELDS, report_figures  # after the skip: it imports plotly
 
 
 @pytest.fixture(scope="module")

@@ -7,15 +7,15 @@ import json
 
 import numpy as np
 import pytest
+from golfflight.discovery.conceal import conceal
+from golfflight.discovery.model import DEFAULT_BUNDLE, load_model
+from golfflight.discovery.schema import Report
+from golfflight.service.api.models import ShotRequest
+from golfflight.service.api.shots import conditions_of
+from golfflight.service.engine import FlightEngine, Launch
+from golfflight.shots.records import LAUNCH_COLUMNS, write_shots
 
-from discovery.conceal import conceal
-from discovery.model import DEFAULT_BUNDLE, load_model
-from discovery.schema import Report
 from golfflight.cli import main
-from service.api.models import ShotRequest
-from service.api.shots import conditions_of
-from service.engine import FlightEngine, Launch
-from shots.records import LAUNCH_COLUMNS, write_shots
 
 WIND = {"wind": {"speed_mps": 4.0, "from_deg": 230.0}}
 

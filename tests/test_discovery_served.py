@@ -11,17 +11,16 @@ import shutil
 
 import numpy as np
 import pytest
-
-from discovery.conceal import conceal
-from discovery.diagnose import diagnose
-from discovery.model import DEFAULT_BUNDLE, from_bundle, load_model
-from discovery.noise import RADAR_NOISE
-from discovery.own_error import measure_own_error, write_own_error
-from discovery.recordings import from_shot_set
-from discovery.simulator import Setup
-from service.engine import FlightEngine, Launch
-from shots.paths import REPO_ROOT
-from weights_schema.bundle import load_bundle
+from golfflight.discovery.conceal import conceal
+from golfflight.discovery.diagnose import diagnose
+from golfflight.discovery.model import DEFAULT_BUNDLE, from_bundle, load_model
+from golfflight.discovery.noise import RADAR_NOISE
+from golfflight.discovery.own_error import measure_own_error, write_own_error
+from golfflight.discovery.recordings import from_shot_set
+from golfflight.discovery.simulator import Setup
+from golfflight.service.engine import FlightEngine, Launch
+from golfflight.shots.paths import REPO_ROOT
+from golfflight.weights_schema.bundle import load_bundle
 
 SHOTS = 200
 

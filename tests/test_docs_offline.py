@@ -10,10 +10,9 @@ from urllib.parse import urljoin, urlsplit
 
 import browser
 import pytest
+from golfflight.service.api.app import create_app
+from golfflight.service.api.routes.docs import ASSETS_DIR
 from servers import running
-
-from service.api.app import create_app
-from service.api.routes.docs import ASSETS_DIR
 
 KEY = "docs-test-key"
 CONTENT_TYPES = {".js": "text/javascript", ".css": "text/css", ".png": "image/png"}

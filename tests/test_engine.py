@@ -8,15 +8,14 @@ import numpy as np
 import onnxruntime as ort
 import pytest
 from conftest import random_launches
-
-from flight.conditions import STANDARD, AirConditions, Conditions
-from flight.integrator import simulate
-from flight.onnx_coefficients import OnnxCoefficients
-from flight.physics import initial_state, reynolds_scale
-from flight.wind import Wind
-from service.engine import FlightEngine, FlightError, Launch, ShotFlight
-from service.model_location import model_dir
-from service.trajectory import resample
+from golfflight.flight.conditions import STANDARD, AirConditions, Conditions
+from golfflight.flight.integrator import simulate
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.physics import initial_state, reynolds_scale
+from golfflight.flight.wind import Wind
+from golfflight.service.engine import FlightEngine, FlightError, Launch, ShotFlight
+from golfflight.service.model_location import model_dir
+from golfflight.service.trajectory import resample
 
 PAPER_SINGLE_SHOT_MS = 34.9
 """Phys-NN+ one shot on a CPU, the paper's Table 2."""
@@ -39,7 +38,7 @@ SEVEN_IRON = Launch(55.0, 16.0, 0.0, 7100.0, 0.0)
 def test_flights_match_the_torch_simulator_within_a_centimetre(engine, air):
     """In the card's air and in hot, high air (density and Reynolds scale of the inputs both differ)."""
     torch = pytest.importorskip("torch")
-    from model_export.torch_physics import euler_rollout, hard_landing
+    from golfflight.model_export.torch_physics import euler_rollout, hard_landing
 
     shots = launches(64, seed=21)
     session = ort.InferenceSession(str(engine.bundle_dir / engine.card.onnx.file), providers=["CPUExecutionProvider"])

@@ -8,28 +8,28 @@ import math
 import numpy as np
 import pytest
 import torch
-
-from flight.air import Air
-from flight.physics import initial_state
-from flight.wind import Wind
-from golfflight.cli import main
-from model_export.data import load_training_data
-from model_export.evaluate import COMMAND, FIGURES, CoefficientSamples, coefficient_summary, run_evaluation
-from model_export.export import export_checkpoint
-from model_export.noise_floor import (
+from golfflight.flight.air import Air
+from golfflight.flight.physics import initial_state
+from golfflight.flight.wind import Wind
+from golfflight.model_export.data import load_training_data
+from golfflight.model_export.evaluate import COMMAND, FIGURES, CoefficientSamples, coefficient_summary, run_evaluation
+from golfflight.model_export.export import export_checkpoint
+from golfflight.model_export.noise_floor import (
     expected_outcome_noise,
     noise_floors,
     nominal_conditions,
     population_air,
     read_session_truth,
 )
-from model_export.training import TrainConfig, load_checkpoint, train
-from model_export.validation import load_validation
-from model_export.variants import PhysNN
-from shots.markdown import begin_marker
-from shots.records import ShotRecord, read_shots, write_csv_atomic, write_shots
-from shots.reference_world import fly_reference
-from shots.synth import sessions_path
+from golfflight.model_export.training import TrainConfig, load_checkpoint, train
+from golfflight.model_export.validation import load_validation
+from golfflight.model_export.variants import PhysNN
+from golfflight.shots.markdown import begin_marker
+from golfflight.shots.records import ShotRecord, read_shots, write_csv_atomic, write_shots
+from golfflight.shots.reference_world import fly_reference
+from golfflight.shots.synth import sessions_path
+
+from golfflight.cli import main
 
 torch.set_num_threads(1)
 

@@ -12,17 +12,17 @@ import onnxruntime as ort
 import pytest
 import torch
 from conftest import random_launches
+from golfflight.flight import constants
+from golfflight.flight.integrator import simulate
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.physics import initial_state
+from golfflight.model_export.export import OPSET, export_bundle, export_checkpoint, probe_inputs
+from golfflight.model_export.torch_physics import euler_rollout, hard_landing
+from golfflight.model_export.training import TrainConfig, load_checkpoint, model_from_checkpoint, train
+from golfflight.weights_schema import BundleError, load_bundle
+from golfflight.weights_schema.model_card import SCHEMA_PATH, schema_text
 
-from flight import constants
-from flight.integrator import simulate
-from flight.onnx_coefficients import OnnxCoefficients
-from flight.physics import initial_state
 from golfflight.cli import main
-from model_export.export import OPSET, export_bundle, export_checkpoint, probe_inputs
-from model_export.torch_physics import euler_rollout, hard_landing
-from model_export.training import TrainConfig, load_checkpoint, model_from_checkpoint, train
-from weights_schema import BundleError, load_bundle
-from weights_schema.model_card import SCHEMA_PATH, schema_text
 
 torch.set_num_threads(1)  # tiny models: one thread is as fast, and immune to other jobs on the 2 cores
 
@@ -135,7 +135,9 @@ def test_unreadable_or_missing_card_is_refused(trained, tmp_path):
 
 
 def test_committed_schema_is_current():
-    assert SCHEMA_PATH.read_text() == schema_text(), "model_card.schema.json is stale: run `python -m weights_schema`"
+    assert SCHEMA_PATH.read_text() == schema_text(), (
+        "model_card.schema.json is stale: run `python -m golfflight.weights_schema`"
+    )
 
 
 def test_phys_q_exports_and_nn_does_not(tiny_shots, tmp_path):
@@ -174,7 +176,8 @@ def test_command_line_train_and_export(tiny_shots, tmp_path, capsys):
 
 def test_runtime_path_imports_no_torch():
     code = (
-        "import sys, flight.onnx_coefficients, flight.integrator, weights_schema, golfflight.cli\n"
+        "import sys, golfflight.flight.onnx_coefficients, golfflight.flight.integrator\n"
+        "import golfflight.weights_schema, golfflight.cli\n"
         "golfflight.cli.build_parser()\n"
         "assert 'torch' not in sys.modules, 'torch imported on the serving path'"
     )

@@ -12,11 +12,11 @@ import time
 
 import httpx
 import pytest
+from golfflight.service.api.app import create_app
+from golfflight.service.api.guards import API_KEY_ENV
 from servers import free_port, running
 
 from golfflight.commands import serve
-from service.api.app import create_app
-from service.api.guards import API_KEY_ENV
 
 KEY = "test-key-0d5f8c1e9a7b4c2d"
 SHOT = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}

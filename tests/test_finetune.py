@@ -8,14 +8,14 @@ import json
 import numpy as np
 import pytest
 import torch
+from golfflight.model_export.bundle_model import config_from_card, model_from_bundle
+from golfflight.model_export.export import export_checkpoint
+from golfflight.model_export.finetune import RUN_DIR, assign_split, finetune, load_base
+from golfflight.model_export.training import TrainConfig, load_checkpoint, train
+from golfflight.shots.records import ShotRecord, ShotSet, read_shots, write_shots
+from golfflight.weights_schema import load_bundle
 
 from golfflight.cli import main
-from model_export.bundle_model import config_from_card, model_from_bundle
-from model_export.export import export_checkpoint
-from model_export.finetune import RUN_DIR, assign_split, finetune, load_base
-from model_export.training import TrainConfig, load_checkpoint, train
-from shots.records import ShotRecord, ShotSet, read_shots, write_shots
-from weights_schema import load_bundle
 
 torch.set_num_threads(1)
 

@@ -8,12 +8,11 @@ import sys
 
 import pytest
 import schemathesis
+from golfflight.service.api.app import create_app
 from hypothesis import HealthCheck, given, settings
 from schemathesis import GenerationMode
 from schemathesis.checks import negative_data_rejection, positive_data_acceptance
 from servers import running
-
-from service.api.app import create_app
 
 CASES_PER_ROUTE = 25
 """Hypothesis examples per operation and mode (valid, invalid): about 300 requests in all, a few seconds."""

@@ -7,14 +7,20 @@ import math
 
 import numpy as np
 import pytest
+from golfflight.flight.constants import (
+    BALL_INERTIA_KG_M2,
+    BALL_MASS_KG,
+    BALL_RADIUS_M,
+    FOOT_M,
+    GRAVITY_MPS2,
+    RPM_TO_RADPS,
+)
+from golfflight.flight.ground import SURFACES, Surface, ground_phase, ground_phase_one, holding_slope_deg, surface
+from golfflight.flight.ground.impact import impact
+from golfflight.flight.ground.phase import plane_normals
+from golfflight.flight.ground.surfaces import STIMPMETER_EXIT_SPEED_MPS, green_rolling_resistance
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
-from flight.constants import BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, FOOT_M, GRAVITY_MPS2, RPM_TO_RADPS
-from flight.ground import SURFACES, Surface, ground_phase, ground_phase_one, holding_slope_deg, surface
-from flight.ground.impact import impact
-from flight.ground.phase import plane_normals
-from flight.ground.surfaces import STIMPMETER_EXIT_SPEED_MPS, green_rolling_resistance
 
 ORIGIN = np.zeros((1, 3))
 

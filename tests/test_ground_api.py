@@ -9,18 +9,18 @@ import json
 import math
 
 import pytest
+from golfflight.flight.constants import YARD_M
+from golfflight.flight.ground import SURFACES, GroundSpec, holding_slope_deg
+from golfflight.flight.limits import SLOPE_DEG
+from golfflight.service.api.app import create_app
+from golfflight.service.api.gspro import GSProMessage, fly_message
+from golfflight.service.engine import FlightEngine, Launch
+from golfflight.service.model_location import model_dir
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from servers import running, shot
 
-from flight.constants import YARD_M
-from flight.ground import SURFACES, GroundSpec, holding_slope_deg
-from flight.limits import SLOPE_DEG
 from golfflight.cli import main
-from service.api.app import create_app
-from service.api.gspro import GSProMessage, fly_message
-from service.engine import FlightEngine, Launch
-from service.model_location import model_dir
 
 DRIVER = {"ball_speed_mph": 171.0, "launch_angle_deg": 10.4, "back_spin_rpm": 2545.0}
 WEDGE = {"ball_speed_mps": 40.0, "launch_angle_deg": 30.0, "spin_rpm": 10000.0}

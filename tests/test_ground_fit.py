@@ -9,11 +9,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from flight.ground import SURFACES
-from flight.onnx_coefficients import OnnxCoefficients
-from shots.ground_fit import FAIRWAY_LIES, FIT_EVENT, FITTED, fairway_shots, landings, score, totals
-from shots.paths import REPO_ROOT, shared_data_dir
+from golfflight.flight.ground import SURFACES
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.shots.ground_fit import FAIRWAY_LIES, FIT_EVENT, FITTED, fairway_shots, landings, score, totals
+from golfflight.shots.paths import REPO_ROOT, shared_data_dir
 
 RESULTS = REPO_ROOT / "docs" / "ground_fit.json"
 FIXTURE = Path(__file__).parent / "fixtures" / "pbp.csv"

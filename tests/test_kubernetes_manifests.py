@@ -12,10 +12,10 @@ from pathlib import Path
 import kubernetes_validate
 import pytest
 import yaml
+from golfflight.service.api.guards import API_KEY_ENV, OPEN_PATHS
+from golfflight.service.api.routes.metrics import METRICS_PATH
 
 from golfflight.commands import serve
-from service.api.guards import API_KEY_ENV, OPEN_PATHS
-from service.api.routes.metrics import METRICS_PATH
 
 ROOT = Path(__file__).resolve().parents[1]
 MANIFESTS = ROOT / "deploy" / "kubernetes"

@@ -10,13 +10,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.pbp import distance_m, load_pbp, recorded_apex, rest_positions
+from golfflight.shots.records import RecordError, read_shots
+from golfflight.shots.tourcast import load_tourcast
 
-from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.commands import convert
-from shots.paths import shared_data_dir
-from shots.pbp import distance_m, load_pbp, recorded_apex, rest_positions
-from shots.records import RecordError, read_shots
-from shots.tourcast import load_tourcast
 
 PBP = Path(__file__).parent / "fixtures" / "pbp.csv"
 REAL = shared_data_dir() / "real" / "pga_tourcast_trackman"

@@ -9,9 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from flight.air import Air
-from flight.constants import (
+from golfflight.flight.air import Air
+from golfflight.flight.constants import (
     BALL_AREA_M2,
     BALL_INERTIA_KG_M2,
     BALL_MASS_KG,
@@ -19,10 +18,9 @@ from flight.constants import (
     GRAVITY_MPS2,
     RPM_TO_RADPS,
 )
-from flight.physics import aerodynamics
-from golfflight.cli import main
-from model_export.accuracy_flyers import CoefficientFlyer
-from model_export.physics_checks import (
+from golfflight.flight.physics import aerodynamics
+from golfflight.model_export.accuracy_flyers import CoefficientFlyer
+from golfflight.model_export.physics_checks import (
     AERO_FILE,
     COEFFICIENTS,
     INSIDE_REQUIRED,
@@ -43,8 +41,10 @@ from model_export.physics_checks import (
     run_physics_checks,
     spin_lost,
 )
-from shots.clubs import ClubLaunch
-from shots.paths import shared_data_dir
+from golfflight.shots.clubs import ClubLaunch
+from golfflight.shots.paths import shared_data_dir
+
+from golfflight.cli import main
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_MODEL = REPO / "models" / "default"

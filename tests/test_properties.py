@@ -10,15 +10,14 @@ import math
 import numpy as np
 import pytest
 import torch
+from golfflight.flight import limits
+from golfflight.flight.conditions import AirConditions, Conditions
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.wind import CALM, Wind
+from golfflight.service.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
+from golfflight.service.model_location import model_dir
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
-from flight import limits
-from flight.conditions import AirConditions, Conditions
-from flight.wind import CALM, Wind
-from flight.onnx_coefficients import OnnxCoefficients
-from service.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
-from service.model_location import model_dir
 
 torch.set_num_threads(1)
 

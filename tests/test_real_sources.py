@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import pytest
 import torch
-
-from flight.constants import YARD_M
-from model_export.joint import JointConfig, LatentConditions, felt_error_m, selection_loss
-from model_export.real_data import TABLE_VAL_EVERY, pga_table, tour_championship
-from shots.paths import shared_data_dir
-from shots.records import ShotSet
-from shots.source_air import KNOWN_AIR
+from golfflight.flight.constants import YARD_M
+from golfflight.model_export.joint import JointConfig, LatentConditions, felt_error_m, selection_loss
+from golfflight.model_export.real_data import TABLE_VAL_EVERY, pga_table, tour_championship
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.records import ShotSet
+from golfflight.shots.source_air import KNOWN_AIR
 
 ROOT = shared_data_dir()
 
@@ -86,8 +85,8 @@ def test_an_unknown_air_sources_mean_density_is_free_a_known_ones_is_held():
 
 def test_heavy_shots_are_spread_over_batches_at_the_same_total_weight():
     """Weights 1, 2.5 and 0.2: the 2.5 shot becomes three copies of 2.5/3; the others stay single."""
-    from model_export.joint import spread_heavy_rows
-    from model_export.observations import ObservedShots
+    from golfflight.model_export.joint import spread_heavy_rows
+    from golfflight.model_export.observations import ObservedShots
 
     n = 3
     fields = {name: torch.zeros(n, 3) for name in ObservedShots.__dataclass_fields__}

@@ -12,11 +12,10 @@ import numpy as np
 import pytest
 import torch
 from conftest import trainable_copy
-
-from flight.physics import initial_state
-from model_export.joint import JointConfig, LatentConditions, cosine_factor, soup_runs, train_joint
-from model_export.observations import load_observed
-from model_export.real_data import (
+from golfflight.flight.physics import initial_state
+from golfflight.model_export.joint import JointConfig, LatentConditions, cosine_factor, soup_runs, train_joint
+from golfflight.model_export.observations import load_observed
+from golfflight.model_export.real_data import (
     BUILDERS,
     DRIVER_FILE,
     PLAYERS_PBP,
@@ -25,10 +24,10 @@ from model_export.real_data import (
     players,
     trackman_outdoor,
 )
-from model_export.torch_physics import euler_rollout, hard_landing, positions_at
-from model_export.training import load_checkpoint
-from model_export.variants import PhysNN, PhysQ
-from shots.heldout import (
+from golfflight.model_export.torch_physics import euler_rollout, hard_landing, positions_at
+from golfflight.model_export.training import load_checkpoint
+from golfflight.model_export.variants import PhysNN, PhysQ
+from golfflight.shots.heldout import (
     HELD_OUT,
     HeldOutError,
     HeldOutSet,
@@ -37,9 +36,9 @@ from shots.heldout import (
     held_out_set,
     shot_round,
 )
-from shots.paths import REPO_ROOT, shared_data_dir
-from shots.records import ShotRecord, read_shots, trajectories_path, write_shots, write_trajectories
-from weights_schema.bundle import load_bundle
+from golfflight.shots.paths import REPO_ROOT, shared_data_dir
+from golfflight.shots.records import ShotRecord, read_shots, trajectories_path, write_shots, write_trajectories
+from golfflight.weights_schema.bundle import load_bundle
 
 torch.set_num_threads(1)
 FIXTURE = Path(__file__).parent / "fixtures" / "trackman_export.csv"
@@ -119,10 +118,10 @@ def test_a_held_out_rounds_lines_are_found_through_the_round_column(tmp_path):
 
 
 def test_a_file_held_out_whole_refuses_any_use(tmp_path, monkeypatch):
-    import shots.heldout
+    import golfflight.shots.heldout
 
     whole = HeldOutSet("a whole file", Path("real/whole.csv"))
-    monkeypatch.setattr(shots.heldout, "HELD_OUT", (*HELD_OUT, whole))
+    monkeypatch.setattr(golfflight.shots.heldout, "HELD_OUT", (*HELD_OUT, whole))
     assert whole.whole and whole.holds(2) and whole.holds_round(1) and whole.rows() == "all"
     with pytest.raises(HeldOutError, match="whole file"):
         check_training_rows(tmp_path / "real" / "whole.csv", [])

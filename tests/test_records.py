@@ -2,8 +2,7 @@
 
 import numpy as np
 import pytest
-
-from shots.records import (
+from golfflight.shots.records import (
     COLUMNS,
     RecordError,
     ShotRecord,

@@ -2,8 +2,7 @@
 sizes NOTES §2-3 publish, within what docs/reference_world.md reports."""
 
 import pytest
-
-from shots.reference_checks import altitude_check, render_checks_markdown, wind_check
+from golfflight.shots.reference_checks import altitude_check, render_checks_markdown, wind_check
 
 
 def test_thin_air_carries_farther_flies_lower_and_lands_shallower():

@@ -8,14 +8,13 @@ import dataclasses
 import numpy as np
 import pytest
 from conftest import trainable_copy
-
-from flight.air import Air
-from flight.constants import BALL_RADIUS_M, MPH_TO_MPS, YARD_M
-from flight.integrator import simulate
-from flight.physics import initial_state
-from flight.reference_aero import CALIBRATED, REFERENCE_DT_S, REFERENCE_T_MAX_S, ReferenceAerodynamics
-from model_export.reference_targets import FITTED_AIR_FACTORS, NORMALIZED_7IRON_FILE, calibration_cells
-from shots.calibrate_reference import (
+from golfflight.flight.air import Air
+from golfflight.flight.constants import BALL_RADIUS_M, MPH_TO_MPS, YARD_M
+from golfflight.flight.integrator import simulate
+from golfflight.flight.physics import initial_state
+from golfflight.flight.reference_aero import CALIBRATED, REFERENCE_DT_S, REFERENCE_T_MAX_S, ReferenceAerodynamics
+from golfflight.model_export.reference_targets import FITTED_AIR_FACTORS, NORMALIZED_7IRON_FILE, calibration_cells
+from golfflight.shots.calibrate_reference import (
     BOUNDS,
     FREE_PARAMETERS,
     MIN_CELL_SHOTS,
@@ -31,16 +30,16 @@ from shots.calibrate_reference import (
     table_cells,
     with_air_factors,
 )
-from shots.paths import shared_data_dir
-from shots.records import ShotRecord
-from shots.reference_world import (
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.records import ShotRecord
+from golfflight.shots.reference_world import (
     CALIBRATION_AIR,
     ClubAverage,
     default_tour_averages_path,
     fly_reference,
     read_tour_averages,
 )
-from shots.source_air import PGA_2023_TABLE
+from golfflight.shots.source_air import PGA_2023_TABLE
 
 NU = float(CALIBRATION_AIR.kinematic_viscosity_m2_s)
 LIFT, DRAG, MOMENT, Q = range(4)

@@ -5,11 +5,10 @@ import math
 
 import numpy as np
 import pytest
-
-from flight.air import Air
-from shots.calibrate_reference import CalibrationCell, with_air_factors
-from shots.reference_world import CALIBRATION_AIR
-from shots.source_air import KNOWN_AIR, PGA_2023_TABLE, TOUR_CHAMPIONSHIP_2020, SourceAir
+from golfflight.flight.air import Air
+from golfflight.shots.calibrate_reference import CalibrationCell, with_air_factors
+from golfflight.shots.reference_world import CALIBRATION_AIR
+from golfflight.shots.source_air import KNOWN_AIR, PGA_2023_TABLE, TOUR_CHAMPIONSHIP_2020, SourceAir
 
 RHO_0 = 1.2250  # ICAO standard density, kg/m^3
 

@@ -13,10 +13,9 @@ from pathlib import Path
 
 import httpx
 import uvicorn
+from golfflight.service.api.app import create_app
+from golfflight.service.open_connect.server import ConnectAddress
 from servers import free_port
-
-from service.api.app import create_app
-from service.open_connect.server import ConnectAddress
 
 SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}
 SHOT = {

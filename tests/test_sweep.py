@@ -9,9 +9,9 @@ import math
 
 import numpy as np
 import pytest
+from golfflight.sweep.grid import Grid, GridError, parse_axis
 
 from golfflight.cli import main
-from sweep.grid import Grid, GridError, parse_axis
 
 pa = pytest.importorskip("pyarrow")
 pq = pytest.importorskip("pyarrow.parquet")
@@ -148,10 +148,10 @@ def test_the_column_path_gives_fly_shots_numbers_bit_for_bit():
     object a shot, as simulate and the HTTP batch route) fly the same batch: every number equal, not just close,
     each column present exactly where the shot's flat row has it, the same errors (a ground the ball never reaches
     fails its shot alone)."""
-    from service.api.shots import fly_columns, fly_shots
-    from service.columns import cell_value, check, flat_row, request_of_cells
-    from service.engine import FlightEngine
-    from service.model_location import model_dir
+    from golfflight.service.api.shots import fly_columns, fly_shots
+    from golfflight.service.columns import cell_value, check, flat_row, request_of_cells
+    from golfflight.service.engine import FlightEngine
+    from golfflight.service.model_location import model_dir
 
     rows = launch_rows(200, seed=3)
     rows[5].update(ground_elevation_m=90.0)  # never rises that high: a FlightError for this shot only

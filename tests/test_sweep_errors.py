@@ -77,7 +77,7 @@ def test_nan_is_not_a_number_at_its_line_and_column(tmp_path, capsys):
     assert "launches.csv line 2 column 'launch_angle_deg': not a number (got NaN)" in err
     assert "launches.csv line 3 column 'spin_rpm': not a number (got NaN)" in err
     assert "Field required" not in err and "spin: give exactly one" not in err
-    from sweep.flyer import problems_of
+    from golfflight.sweep.flyer import problems_of
 
     assert problems_of({"ball_speed_mps": float("nan"), "launch_angle_deg": 12.0, "spin_rpm": 99999.0}) == [
         "column 'ball_speed_mps': not a number (got NaN)",
@@ -112,7 +112,7 @@ def test_the_ray_noise_filter_drops_only_its_line(capfd):
     """Written to file descriptor 2 (as Ray's C++ core worker writes, in pieces): the noise line goes, a real
     core_worker error, other lines and a progress bar's carriage-return updates (brackets and all) come through, in
     order, and standard error is itself again after."""
-    from sweep.engines import RAY_NOISE, ray_noise_filtered
+    from golfflight.sweep.engines import RAY_NOISE, ray_noise_filtered
 
     noise = (
         f"[2026-11-26 05:44:54,560 E 27196 27196] core_worker.cc:2465: Actor with class name: 'MapWorker' and "

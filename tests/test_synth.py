@@ -2,11 +2,11 @@
 
 import numpy as np
 import pytest
+from golfflight.flight.air import Air
+from golfflight.shots.records import read_shots
+from golfflight.shots.synth import MIN_APEX_M, SynthConfig, draw_sessions, generate, sessions_path, validation_sessions
 
-from flight.air import Air
 from golfflight.cli import main
-from shots.records import read_shots
-from shots.synth import MIN_APEX_M, SynthConfig, draw_sessions, generate, sessions_path, validation_sessions
 
 N = 400
 

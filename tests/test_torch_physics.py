@@ -6,14 +6,13 @@ import numpy as np
 import pytest
 import torch
 from conftest import random_launches
-
-from flight.air import Air
-from flight.coefficients import ConstantCoefficients, QuadraticSpinRatio
-from flight.integrator import simulate
-from flight.physics import State, initial_state
-from flight.physics import derivatives as np_derivatives
-from model_export.torch_physics import Trajectory, derivatives, euler_rollout, hard_landing, soft_landing
-from model_export.variants import PhysQ
+from golfflight.flight.air import Air
+from golfflight.flight.coefficients import ConstantCoefficients, QuadraticSpinRatio
+from golfflight.flight.integrator import simulate
+from golfflight.flight.physics import State, initial_state
+from golfflight.flight.physics import derivatives as np_derivatives
+from golfflight.model_export.torch_physics import Trajectory, derivatives, euler_rollout, hard_landing, soft_landing
+from golfflight.model_export.variants import PhysQ
 
 torch.set_num_threads(1)  # tiny models: one thread is as fast, and immune to other jobs on the 2 cores
 

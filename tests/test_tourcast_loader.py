@@ -9,12 +9,20 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from golfflight.flight.constants import (
+    BALL_AREA_M2,
+    BALL_MASS_KG,
+    BALL_RADIUS_M,
+    FOOT_M,
+    GRAVITY_MPS2,
+    MPH_TO_MPS,
+    RPM_TO_RADPS,
+)
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.records import RecordError, read_shots, read_trajectories, trajectories_path
+from golfflight.shots.tourcast import load_tourcast, spin_axis_deg
 
-from flight.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M, FOOT_M, GRAVITY_MPS2, MPH_TO_MPS, RPM_TO_RADPS
 from golfflight.commands import convert
-from shots.paths import shared_data_dir
-from shots.records import RecordError, read_shots, read_trajectories, trajectories_path
-from shots.tourcast import load_tourcast, spin_axis_deg
 
 FIXTURES = Path(__file__).parent / "fixtures"
 TRAJECTORY = FIXTURES / "tourcast_shot_trajectory.csv"

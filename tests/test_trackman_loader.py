@@ -8,12 +8,12 @@ import math
 from pathlib import Path
 
 import pytest
+from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.records import RecordError, read_shots
+from golfflight.shots.trackman import load_trackman
 
-from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.commands import convert
-from shots.paths import shared_data_dir
-from shots.records import RecordError, read_shots
-from shots.trackman import load_trackman
 
 FIXTURES = Path(__file__).parent / "fixtures"
 EXPORT = FIXTURES / "trackman_export.csv"

@@ -5,13 +5,12 @@ from __future__ import annotations
 import json
 import math
 
+import golfflight.model_export.training as training
 import pytest
 import torch
-
-import model_export.training as training
-from model_export.data import load_training_data
-from model_export.training import TrainConfig, load_checkpoint, train
-from shots.records import read_shots
+from golfflight.model_export.data import load_training_data
+from golfflight.model_export.training import TrainConfig, load_checkpoint, train
+from golfflight.shots.records import read_shots
 
 torch.set_num_threads(1)  # tiny models: one thread is as fast, and immune to other jobs on the 2 cores
 

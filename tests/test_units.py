@@ -11,13 +11,13 @@ import json
 import socket
 
 import pytest
+from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from golfflight.service.api.app import create_app
+from golfflight.service.api.models import FlatFlight, FlightResult, Landing, RestPoint
+from golfflight.service.columns import result_columns
+from golfflight.service.open_connect.server import ConnectAddress
 
-from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.cli import main
-from service.api.app import create_app
-from service.api.models import FlatFlight, FlightResult, Landing, RestPoint
-from service.columns import result_columns
-from service.open_connect.server import ConnectAddress
 from tests.servers import free_port, running, shot
 
 SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0, "spin_axis_deg": 4.0}

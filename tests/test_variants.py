@@ -7,12 +7,11 @@ from typing import get_args
 import numpy as np
 import pytest
 import torch
-
-from flight.coefficients import QuadraticSpinRatio
-from model_export import PHYSICS_VARIANTS, VARIANTS
-from model_export.torch_physics import spin_ratio
-from model_export.variants import P_M_INIT, LandingNN, PhysNN, PhysQ, build_model
-from weights_schema.model_card import ExportableVariant
+from golfflight.flight.coefficients import QuadraticSpinRatio
+from golfflight.model_export import PHYSICS_VARIANTS, VARIANTS
+from golfflight.model_export.torch_physics import spin_ratio
+from golfflight.model_export.variants import P_M_INIT, LandingNN, PhysNN, PhysQ, build_model
+from golfflight.weights_schema.model_card import ExportableVariant
 
 torch.set_num_threads(1)  # tiny models: one thread is as fast, and immune to other jobs on the 2 cores
 

@@ -14,18 +14,17 @@ from functools import partial
 import browser
 import httpx
 import pytest
+from golfflight.service.api.app import create_app
+from golfflight.service.api.models import ShotRequest
+from golfflight.service.api.routes import viewer as viewer_routes
+from golfflight.service.api.shots import fly_shot
+from golfflight.service.engine import FlightEngine
+from golfflight.service.model_location import model_dir
+from golfflight.service.open_connect.server import ConnectAddress
+from golfflight.service.viewer.event import SCHEMA_PATH, ShotEvent, schema_text
+from golfflight.service.viewer.feed import HISTORY, MAX_POINTS, ShotFeed, TooManyViewers, thin
+from golfflight.service.viewer.stream import events
 from servers import free_port, keyed_service, running
-
-from service.api.app import create_app
-from service.api.models import ShotRequest
-from service.api.routes import viewer as viewer_routes
-from service.api.shots import fly_shot
-from service.engine import FlightEngine
-from service.model_location import model_dir
-from service.open_connect.server import ConnectAddress
-from service.viewer.event import SCHEMA_PATH, ShotEvent, schema_text
-from service.viewer.feed import HISTORY, MAX_POINTS, ShotFeed, TooManyViewers, thin
-from service.viewer.stream import events
 
 KEY = "viewer-test-key"
 KEYED = {"x-api-key": KEY}
@@ -69,7 +68,9 @@ def next_event(lines, deadline_s: float = 5.0) -> ShotEvent:
 
 
 def test_the_event_schema_is_current():
-    assert SCHEMA_PATH.read_text() == schema_text(), "event.schema.json is stale: run `python -m service.viewer`"
+    assert SCHEMA_PATH.read_text() == schema_text(), (
+        "event.schema.json is stale: run `python -m golfflight.service.viewer`"
+    )
 
 
 def test_thin_keeps_both_ends_and_at_most_the_limit():

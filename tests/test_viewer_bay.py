@@ -13,18 +13,17 @@ from functools import partial
 import browser
 import httpx
 import pytest
+from golfflight.service.api.app import create_app
+from golfflight.service.api.models import ShotRequest
+from golfflight.service.api.routes import viewer as viewer_routes
+from golfflight.service.api.shots import fly_shot
+from golfflight.service.engine import FlightEngine
+from golfflight.service.model_location import model_dir
+from golfflight.service.open_connect.server import ConnectAddress
+from golfflight.service.viewer.feed import ShotFeed
+from golfflight.service.viewer.stream import KEEPALIVE_FRAME, KEEPALIVE_S, events, serving_server
 from servers import free_port, keyed_service, running
 from test_viewer import DRIVER, KEY, KEYED, WEDGE_BALL, gspro_over_tcp, next_event
-
-from service.api.app import create_app
-from service.api.models import ShotRequest
-from service.api.routes import viewer as viewer_routes
-from service.api.shots import fly_shot
-from service.engine import FlightEngine
-from service.model_location import model_dir
-from service.open_connect.server import ConnectAddress
-from service.viewer.feed import ShotFeed
-from service.viewer.stream import KEEPALIVE_FRAME, KEEPALIVE_S, events, serving_server
 
 STRAIGHT = {"ball_speed_mph": 160.0, "launch_angle_deg": 11.0, "spin_rpm": 2700.0, "spin_axis_deg": 0.0}
 

@@ -3,7 +3,7 @@
 Pure pydantic + hashlib: the serving install imports this without torch.
 """
 
-from weights_schema.bundle import BundleError, load_bundle
-from weights_schema.model_card import SCHEMA_VERSION, ModelCard
+from golfflight.weights_schema.bundle import BundleError, load_bundle
+from golfflight.weights_schema.model_card import SCHEMA_VERSION, ModelCard
 
 __all__ = ["SCHEMA_VERSION", "BundleError", "ModelCard", "load_bundle"]

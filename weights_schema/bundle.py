@@ -7,9 +7,8 @@ import json
 import os
 from pathlib import Path
 
+from golfflight.weights_schema.model_card import SUPPORTED_SCHEMA_VERSIONS, ModelCard
 from pydantic import ValidationError
-
-from weights_schema.model_card import SUPPORTED_SCHEMA_VERSIONS, ModelCard
 
 CARD_FILE = "model_card.json"
 

@@ -1,7 +1,7 @@
 """model_card.json: everything a third party needs to re-run a shipped model without reading our code.
 
 The JSON Schema beside this file (model_card.schema.json) is generated from these models by
-`python -m weights_schema`; a test fails when the committed copy is stale.
+`python -m golfflight.weights_schema`; a test fails when the committed copy is stale.
 """
 
 from __future__ import annotations

@@ -2,9 +2,9 @@
 point, level or sloped. Pure NumPy, batch-first; `ground_phase` is the entry point, `SURFACES` the one table of
 surface parameters."""
 
-from flight.ground.phase import GroundPath, GroundPhase, OneRest, ground_phase, ground_phase_one
-from flight.ground.spec import LEVEL_FAIRWAY, GroundSpec
-from flight.ground.surfaces import SURFACES, Surface, green_rolling_resistance, holding_slope_deg, surface
+from golfflight.flight.ground.phase import GroundPath, GroundPhase, OneRest, ground_phase, ground_phase_one
+from golfflight.flight.ground.spec import LEVEL_FAIRWAY, GroundSpec
+from golfflight.flight.ground.surfaces import SURFACES, Surface, green_rolling_resistance, holding_slope_deg, surface
 
 __all__ = [
     "LEVEL_FAIRWAY",

@@ -27,11 +27,10 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-
-from flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
-from flight.ground.impact import impact, impact_components
-from flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, holding_slope_deg
-from flight.ground.vectors import TINY, add, cross, dot, expm1, log1p, maximum, norm, times, where
+from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
+from golfflight.flight.ground.impact import impact, impact_components
+from golfflight.flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, holding_slope_deg
+from golfflight.flight.ground.vectors import TINY, add, cross, dot, expm1, log1p, maximum, norm, times, where
 
 MIN_HOP_SPEED_MPS = 0.5
 """Rebounds slower than this off the plane (a hop under 13 mm high: a skip the turf soaks up) end the bounces: the

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from flight.ground.surfaces import SURFACES, Surface, holding_slope_deg
-from flight.limits import SLOPE_DEG
+from golfflight.flight.ground.surfaces import SURFACES, Surface, holding_slope_deg
+from golfflight.flight.limits import SLOPE_DEG
 
 
 @dataclass(frozen=True)

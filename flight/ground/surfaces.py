@@ -17,8 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-
-from flight.constants import FOOT_M, GRAVITY_MPS2
+from golfflight.flight.constants import FOOT_M, GRAVITY_MPS2
 
 STIMPMETER_EXIT_SPEED_MPS = 6.00 * FOOT_M
 """Speed a ball leaves the stimpmeter's ramp at, rolling: 6.00 ft/s = 1.83 m/s (the USGA device: released from the

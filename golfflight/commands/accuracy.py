@@ -31,7 +31,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from model_export.accuracy import run_accuracy
+    from golfflight.model_export.accuracy import run_accuracy
 
     if args.finetune_epochs < 0:
         raise ValueError(f"--finetune-epochs must be 0 or more, got {args.finetune_epochs}")

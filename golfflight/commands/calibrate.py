@@ -7,9 +7,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from flight.reference_aero import CALIBRATED
-from model_export.reference_targets import FITTED_AIR_FACTORS, calibration_cells
-from shots.calibrate_reference import (
+from golfflight.flight.reference_aero import CALIBRATED
+from golfflight.model_export.reference_targets import FITTED_AIR_FACTORS, calibration_cells
+from golfflight.shots.calibrate_reference import (
     evaluate,
     evaluate_clubs,
     evaluate_clubs_ferguson,
@@ -18,11 +18,11 @@ from shots.calibrate_reference import (
     render_markdown,
     with_air_factors,
 )
-from shots.markdown import write_generated_section
-from shots.paths import shared_data_dir
-from shots.reference_checks import render_checks_markdown
-from shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
-from shots.source_air import PGA_2023_TABLE, UNKNOWN_AIR_SOURCES
+from golfflight.shots.markdown import write_generated_section
+from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.reference_checks import render_checks_markdown
+from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
+from golfflight.shots.source_air import PGA_2023_TABLE, UNKNOWN_AIR_SOURCES
 
 COMMAND = "calibrate-reference"
 

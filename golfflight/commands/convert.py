@@ -5,11 +5,10 @@ from __future__ import annotations
 import argparse
 import sys
 
-from shots.pbp import load_pbp
-from shots.records import trajectories_path, write_shots, write_trajectories
-from shots.tourcast import load_tourcast
-from shots.trackman import Conversion, load_trackman
-
+from golfflight.shots.pbp import load_pbp
+from golfflight.shots.records import trajectories_path, write_shots, write_trajectories
+from golfflight.shots.tourcast import load_tourcast
+from golfflight.shots.trackman import Conversion, load_trackman
 
 SKIP_HELP = "leave out malformed rows (each listed in the report) instead of refusing the file"
 

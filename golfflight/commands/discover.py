@@ -6,13 +6,13 @@ import argparse
 import re
 from pathlib import Path
 
-from discovery.diagnose import diagnose
-from discovery.html import PLOTS_MISSING, plots_available
-from discovery.model import REFERENCE, load_model
-from discovery.outputs import write_diagnosis
-from discovery.own_error import measure_own_error, write_own_error
-from discovery.prove import CLEAN_SETS, cases, command, prove, read_runs, write_tables
-from discovery.recordings import read_recordings
+from golfflight.discovery.diagnose import diagnose
+from golfflight.discovery.html import PLOTS_MISSING, plots_available
+from golfflight.discovery.model import REFERENCE, load_model
+from golfflight.discovery.outputs import write_diagnosis
+from golfflight.discovery.own_error import measure_own_error, write_own_error
+from golfflight.discovery.prove import CLEAN_SETS, cases, command, prove, read_runs, write_tables
+from golfflight.discovery.recordings import read_recordings
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

@@ -25,7 +25,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import torch
 
-    from model_export.evaluate import run_evaluation
+    from golfflight.model_export.evaluate import run_evaluation
 
     torch.set_num_threads(2)
     report = run_evaluation(args.data, args.runs, args.out, bundle=args.bundle)

@@ -13,7 +13,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from model_export.export import export_checkpoint
+    from golfflight.model_export.export import export_checkpoint
 
     card = export_checkpoint(args.checkpoint, args.out)
     print(

@@ -35,7 +35,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import torch
 
-    from model_export.finetune import RUN_DIR, finetune
+    from golfflight.model_export.finetune import RUN_DIR, finetune
 
     torch.set_num_threads(1)  # fine-tuning batches are small: a second thread only adds synchronisation
     result = finetune(

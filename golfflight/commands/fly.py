@@ -15,9 +15,9 @@ import re
 
 from pydantic import ValidationError
 
-from flight.constants import MPH_TO_MPS
-from flight.limits import WIND_SPEED_MPS, Range
-from shots.clubs import CLUB_NAMES, club_named
+from golfflight.flight.constants import MPH_TO_MPS
+from golfflight.flight.limits import WIND_SPEED_MPS, Range
+from golfflight.shots.clubs import CLUB_NAMES, club_named
 
 WIND_SPEED_MPH = Range(WIND_SPEED_MPS.low, math.floor(WIND_SPEED_MPS.high / MPH_TO_MPS * 10) / 10, "mph")
 """The request's wind range (`flight.limits.WIND_SPEED_MPS`, 0 to 30 m/s) in mph, for --wind-speed-mph: 0 to 67.1."""
@@ -127,7 +127,7 @@ def wind_speed_mps(args: argparse.Namespace) -> float | None:
         return args.wind_speed_mps
     from pydantic import Field, create_model
 
-    from service.api.models import Strict, describe_errors
+    from golfflight.service.api.models import Strict, describe_errors
 
     bounds = WIND_SPEED_MPH
     in_mph = create_model("WindInMph", __base__=Strict, wind_speed_mph=(float, Field(ge=bounds.low, le=bounds.high)))
@@ -178,7 +178,7 @@ def request_of(args: argparse.Namespace) -> tuple[str, dict]:
 
 def checked(shot: dict):
     """The validated ShotRequest, or ValueError with the API's messages naming the options."""
-    from service.api.models import ShotRequest, describe_errors
+    from golfflight.service.api.models import ShotRequest, describe_errors
 
     try:
         return ShotRequest.model_validate(shot)
@@ -191,12 +191,12 @@ def fly_reference_shot(shot) -> dict:
     ground phase): the POST /v1/shots result fields."""
     import numpy as np
 
-    from flight.air import Air
-    from flight.ground import LEVEL_FAIRWAY, ground_phase_one
-    from flight.physics import initial_state
-    from service.api.shots import air_of, conditions_of, flight_fields, launch_of
-    from service.engine import Rest, ShotFlight
-    from shots.reference_world import fly_reference
+    from golfflight.flight.air import Air
+    from golfflight.flight.ground import LEVEL_FAIRWAY, ground_phase_one
+    from golfflight.flight.physics import initial_state
+    from golfflight.service.api.shots import air_of, conditions_of, flight_fields, launch_of
+    from golfflight.service.engine import Rest, ShotFlight
+    from golfflight.shots.reference_world import fly_reference
 
     air = air_of(shot.air)
     conditions = conditions_of(shot)
@@ -224,9 +224,9 @@ def fly_reference_shot(shot) -> dict:
 
 def fly_model_shot(shot, model: str | None) -> tuple[dict, dict]:
     """A checked request flown by the served model as POST /v1/shots flies it: (the result, the model's identity)."""
-    from service.api.shots import fly_shot
-    from service.engine import FlightEngine, FlightError
-    from service.model_location import model_dir
+    from golfflight.service.api.shots import fly_shot
+    from golfflight.service.engine import FlightEngine, FlightError
+    from golfflight.service.model_location import model_dir
 
     engine = FlightEngine(model_dir(model))
     try:

@@ -26,10 +26,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from shots.files import write_text_atomic
-    from shots.ground_fit import markdown, run_fit
-    from shots.markdown import write_generated_section
-    from shots.paths import shared_data_dir
+    from golfflight.shots.files import write_text_atomic
+    from golfflight.shots.ground_fit import markdown, run_fit
+    from golfflight.shots.markdown import write_generated_section
+    from golfflight.shots.paths import shared_data_dir
 
     data_dir = Path(args.data_dir) if args.data_dir else shared_data_dir()
     fit = run_fit(args.model, data_dir)

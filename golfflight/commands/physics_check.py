@@ -25,9 +25,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from model_export.physics_checks import COMMAND, markdown, run_physics_checks
-    from shots.markdown import write_generated_section
-    from shots.paths import shared_data_dir
+    from golfflight.model_export.physics_checks import COMMAND, markdown, run_physics_checks
+    from golfflight.shots.markdown import write_generated_section
+    from golfflight.shots.paths import shared_data_dir
 
     data_dir = Path(args.data_dir) if args.data_dir else shared_data_dir()
     section = markdown(run_physics_checks(args.model, data_dir))

@@ -21,8 +21,8 @@ import json
 import sys
 from pathlib import Path
 
-from service.columns import cell_value, check, columns_message, flat_row, request_of_cells
-from shots.records import reading
+from golfflight.service.columns import cell_value, check, columns_message, flat_row, request_of_cells
+from golfflight.shots.records import reading
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -86,9 +86,9 @@ def shots_from_json(text: str, source: str) -> list[dict]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from service.api.shots import fly_shots
-    from service.engine import FlightEngine
-    from service.model_location import model_dir
+    from golfflight.service.api.shots import fly_shots
+    from golfflight.service.engine import FlightEngine
+    from golfflight.service.model_location import model_dir
 
     ids: list[str | None] = []
     problems: list[str] = []

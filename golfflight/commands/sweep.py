@@ -60,8 +60,8 @@ def require_extras(*extras: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        from sweep.run import run_sweep
-        from sweep.sources import open_source
+        from golfflight.sweep.run import run_sweep
+        from golfflight.sweep.sources import open_source
     except ImportError as missing:  # an install without the sweep package
         raise ValueError(f"needs the sweep extra: pip install 'golfflight[sweep]' ({missing})") from None
     require_extras("sweep", *(["ray"] if args.engine == "ray" else []))

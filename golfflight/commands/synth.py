@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from shots.synth import SynthConfig, generate, sessions_path, write_synthetic
+from golfflight.shots.synth import SynthConfig, generate, sessions_path, write_synthetic
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from model_export import DEFAULT_HIDDEN, VARIANTS
+from golfflight.model_export import DEFAULT_HIDDEN, VARIANTS
 
 
 def _hidden(text: str) -> tuple[int, ...]:
@@ -50,7 +50,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import torch
 
-    from model_export.training import TrainConfig, train
+    from golfflight.model_export.training import TrainConfig, train
 
     torch.set_num_threads(args.threads)
     config = TrainConfig(

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from shots.paths import shared_data_dir
+from golfflight.shots.paths import shared_data_dir
 
 
 def _seeds(text: str) -> tuple[int, ...]:
@@ -17,7 +17,7 @@ def _seeds(text: str) -> tuple[int, ...]:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from model_export.real_data import BUILDERS, DEFAULT_SOURCES
+    from golfflight.model_export.real_data import BUILDERS, DEFAULT_SOURCES
 
     parser = subparsers.add_parser(
         "train-real",
@@ -42,9 +42,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from model_export.joint import JointConfig
-    from model_export.real_data import BUILDERS
-    from model_export.real_training import train_real
+    from golfflight.model_export.joint import JointConfig
+    from golfflight.model_export.real_data import BUILDERS
+    from golfflight.model_export.real_training import train_real
 
     names = tuple(n.strip() for n in args.sources.split(","))
     unknown = [n for n in names if n not in BUILDERS]

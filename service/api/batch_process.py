@@ -18,9 +18,9 @@ from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
-from service.api.models import BatchRequest, BatchResult
-from service.api.shots import fly_shots
-from service.engine import FlightEngine
+from golfflight.service.api.models import BatchRequest, BatchResult
+from golfflight.service.api.shots import fly_shots
+from golfflight.service.engine import FlightEngine
 
 BATCH_NICE = 19
 """How much lower the batch process's CPU priority is (Linux nice increment): a single shot waiting for a core

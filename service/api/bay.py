@@ -13,10 +13,9 @@ import threading
 from pathlib import Path
 from typing import Literal
 
+from golfflight.service.api.models import AirRequest, GroundRequest, ShotRequest, Strict, WindRequest
+from golfflight.shots.files import write_text_atomic
 from pydantic import Field, ValidationError
-
-from service.api.models import AirRequest, GroundRequest, ShotRequest, Strict, WindRequest
-from shots.files import write_text_atomic
 
 CONDITION_FIELDS = ("air", "wind", "ground")
 BAY_FILE_ENV = "GOLFFLIGHT_BAY_FILE"

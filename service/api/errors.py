@@ -9,12 +9,11 @@ from fastapi import FastAPI, Request
 from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
+from golfflight.service.api.gspro import GSProReply, invalid_message
+from golfflight.service.api.models import RANGES, body_detail, describe_errors
+from golfflight.service.api.routes.gspro import GSPRO_PATH
+from golfflight.service.api.state import NotReady
 from starlette.exceptions import HTTPException as StarletteHTTPException
-
-from service.api.gspro import GSProReply, invalid_message
-from service.api.models import RANGES, body_detail, describe_errors
-from service.api.routes.gspro import GSPRO_PATH
-from service.api.state import NotReady
 
 NOT_JSON = "the body is not JSON text in UTF-8"
 """FastAPI's 400 for a body it cannot even decode, said as a 422 like every other refusal of a body."""

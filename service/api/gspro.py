@@ -13,15 +13,14 @@ from __future__ import annotations
 
 from typing import Annotated
 
+from golfflight.flight import limits
+from golfflight.flight.constants import MPH_TO_MPS
+from golfflight.flight.limits import Range
+from golfflight.service.api.bay import BayConditions
+from golfflight.service.api.models import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotResult, describe_errors
+from golfflight.service.api.shots import conditions_from, flight_fields, ground_of, spin_from_components
+from golfflight.service.engine import FlightEngine, FlightError, Launch
 from pydantic import BaseModel, ConfigDict, Field, model_validator
-
-from flight import limits
-from flight.constants import MPH_TO_MPS
-from flight.limits import Range
-from service.api.models import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotResult, describe_errors
-from service.api.bay import BayConditions
-from service.api.shots import conditions_from, flight_fields, ground_of, spin_from_components
-from service.engine import FlightEngine, FlightError, Launch
 
 
 def _spelled_as_fields(data, fields) -> dict:

@@ -9,8 +9,8 @@ from __future__ import annotations
 import hmac
 import json
 
-from service.api.models import body_detail
-from service.viewer.page import PUBLIC_PATHS
+from golfflight.service.api.models import body_detail
+from golfflight.service.viewer.page import PUBLIC_PATHS
 
 API_KEY_ENV = "GOLFFLIGHT_API_KEY"
 """Environment variable holding the API key; when set (non-empty) every route but /healthz requires it."""

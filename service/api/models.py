@@ -11,13 +11,12 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
+from golfflight.flight import limits
+from golfflight.flight.conditions import NORMALIZED_REFERENCE
+from golfflight.flight.constants import FOOT_M, MPH_TO_MPS
+from golfflight.flight.ground import SURFACES, holding_slope_deg, surface
+from golfflight.flight.limits import Range
 from pydantic import BaseModel, ConfigDict, Field, model_validator
-
-from flight import limits
-from flight.conditions import NORMALIZED_REFERENCE
-from flight.constants import FOOT_M, MPH_TO_MPS
-from flight.ground import SURFACES, holding_slope_deg, surface
-from flight.limits import Range
 
 MAX_BATCH_SHOTS = 10_000
 """Most shots one POST /v1/shots/batch may carry."""

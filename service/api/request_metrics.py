@@ -9,10 +9,9 @@ from __future__ import annotations
 
 import time
 
+from golfflight.service.api.latency import Rolling
+from golfflight.service.api.metrics import ServiceMetrics
 from starlette.routing import BaseRoute, Match
-
-from service.api.latency import Rolling
-from service.api.metrics import ServiceMetrics
 
 UNMATCHED = "<unmatched>"
 """Route label of a request whose path no route serves (a 404)."""

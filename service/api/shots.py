@@ -6,12 +6,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-
-from flight.conditions import STANDARD, AirConditions, Conditions
-from flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from flight.ground import LEVEL_FAIRWAY, GroundSpec, surface
-from flight.wind import CALM, Wind
-from service.api.models import (
+from golfflight.flight.conditions import STANDARD, AirConditions, Conditions
+from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from golfflight.flight.ground import LEVEL_FAIRWAY, GroundSpec, surface
+from golfflight.flight.wind import CALM, Wind
+from golfflight.service.api.models import (
     AirRequest,
     FlatFlight,
     GroundRequest,
@@ -26,8 +25,8 @@ from service.api.models import (
     TrajectoryRequest,
     WindRequest,
 )
-from service.engine import FlightEngine, FlightError, Launch, ShotFlight
-from service.trajectory import resample
+from golfflight.service.engine import FlightEngine, FlightError, Launch, ShotFlight
+from golfflight.service.trajectory import resample
 
 
 def spin_from_components(back_spin_rpm: float, side_spin_rpm: float) -> tuple[float, float]:

@@ -14,9 +14,9 @@ import logging
 import os
 from dataclasses import dataclass
 
-from service.api.gspro import GSProReply
-from service.open_connect.framing import ObjectFramer, Refused
-from service.open_connect.replies import Answer, reply_to
+from golfflight.service.api.gspro import GSProReply
+from golfflight.service.open_connect.framing import ObjectFramer, Refused
+from golfflight.service.open_connect.replies import Answer, reply_to
 
 CONNECT_HOST_ENV = "GOLFFLIGHT_CONNECT_HOST"
 CONNECT_PORT_ENV = "GOLFFLIGHT_CONNECT_PORT"

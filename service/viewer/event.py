@@ -1,8 +1,8 @@
 """The payload of the viewer's event stream (`GET /v1/events`): one `ShotEvent` per shot, as JSON.
 
-The JSON Schema beside this file (event.schema.json) is generated from these models by `python -m service.viewer`;
-a test keeps it current. The stream is left out of the OpenAPI document (an endless response is no operation a
-client or a fuzzer can call and validate), so this schema is its contract.
+The JSON Schema beside this file (event.schema.json) is generated from these models by
+`python -m golfflight.service.viewer`; a test keeps it current. The stream is left out of the OpenAPI document (an
+endless response is no operation a client or a fuzzer can call and validate), so this schema is its contract.
 """
 
 from __future__ import annotations
@@ -11,9 +11,8 @@ import json
 from pathlib import Path
 from typing import Literal
 
+from golfflight.service.api.models import ShotResult
 from pydantic import BaseModel, Field
-
-from service.api.models import ShotResult
 
 SCHEMA_PATH = Path(__file__).with_name("event.schema.json")
 

@@ -16,11 +16,11 @@ import time
 from collections import deque
 from dataclasses import dataclass
 
-from service.api.gspro import GSProMessage, GSProReply, launch_from_ball_data
-from service.api.models import ShotRequest, ShotResult, TrajectoryPoint, TrajectoryRequest
-from service.api.shots import fly_shot, launch_of
-from service.engine import FlightEngine, FlightError
-from service.viewer.event import LaunchNumbers, ShotEvent, Source
+from golfflight.service.api.gspro import GSProMessage, GSProReply, launch_from_ball_data
+from golfflight.service.api.models import ShotRequest, ShotResult, TrajectoryPoint, TrajectoryRequest
+from golfflight.service.api.shots import fly_shot, launch_of
+from golfflight.service.engine import FlightEngine, FlightError
+from golfflight.service.viewer.event import LaunchNumbers, ShotEvent, Source
 
 HISTORY = 50
 """Shots kept for viewers that open (or reconnect) later, and the length of each viewer's queue."""

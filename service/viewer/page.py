@@ -8,8 +8,8 @@ from __future__ import annotations
 from html import escape
 from importlib.resources import files
 
-from flight.ground import SURFACES
-from shots.clubs import CLUB_NAMES
+from golfflight.flight.ground import SURFACES
+from golfflight.shots.clubs import CLUB_NAMES
 
 PAGE_PATH = "/viewer"
 

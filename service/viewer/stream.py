@@ -19,8 +19,8 @@ import signal
 import time
 from collections.abc import AsyncIterator, Callable
 
-from service.engine import FlightEngine
-from service.viewer.feed import ShotFeed, Viewer
+from golfflight.service.engine import FlightEngine
+from golfflight.service.viewer.feed import ShotFeed, Viewer
 
 KEEPALIVE_S = 15.0
 """Longest a stream stays silent: a `: keep-alive` comment is sent after this long without a shot."""

@@ -6,11 +6,10 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Depends
 from fastapi.responses import JSONResponse, Response
-
-from service.api.bay import BayConditions
-from service.api.models import body_detail
-from service.api.routes.responses import ERROR_RESPONSES, json_response
-from service.api.state import ServiceState, service_state
+from golfflight.service.api.bay import BayConditions
+from golfflight.service.api.models import body_detail
+from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
+from golfflight.service.api.state import ServiceState, service_state
 
 BAY_PATH = "/v1/bay"
 

@@ -6,10 +6,9 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Depends
 from fastapi.responses import PlainTextResponse, Response
-
-from service.api.metrics import CONTENT_TYPE
-from service.api.routes.responses import ERROR_RESPONSES
-from service.api.state import ServiceState, service_state
+from golfflight.service.api.metrics import CONTENT_TYPE
+from golfflight.service.api.routes.responses import ERROR_RESPONSES
+from golfflight.service.api.state import ServiceState, service_state
 
 METRICS_PATH = "/metrics"
 

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
+from golfflight.service.api.guards import MAX_BODY_BYTES
 from pydantic import BaseModel
 from starlette.responses import Response
-
-from service.api.guards import MAX_BODY_BYTES
 
 
 def json_response(model: BaseModel, status_code: int = 200) -> Response:

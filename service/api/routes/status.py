@@ -7,13 +7,12 @@ from importlib.metadata import version
 
 from fastapi import APIRouter, Depends
 from fastapi.responses import JSONResponse, Response
-
-from service.api.models import ShotRequest
-from service.api.routes.responses import ERROR_RESPONSES
-from service.api.shots import fly_shot
-from service.api.state import ServiceState, ready_engine, service_state
-from service.engine import FlightEngine
-from weights_schema.model_card import ModelCard
+from golfflight.service.api.models import ShotRequest
+from golfflight.service.api.routes.responses import ERROR_RESPONSES
+from golfflight.service.api.shots import fly_shot
+from golfflight.service.api.state import ServiceState, ready_engine, service_state
+from golfflight.service.engine import FlightEngine
+from golfflight.weights_schema.model_card import ModelCard
 
 PROBE_SHOT = ShotRequest(ball_speed_mps=55.0, launch_angle_deg=16.0, spin_rpm=7100.0)
 """The shot /v1/latency times on demand: a tour-average 7-iron in standard air."""

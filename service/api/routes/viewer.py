@@ -8,12 +8,11 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Depends, Header
 from fastapi.responses import JSONResponse, Response, StreamingResponse
-
-from service.api.state import ServiceState, ready_engine, service_state
-from service.engine import FlightEngine
-from service.viewer.feed import TooManyViewers
-from service.viewer.page import ASSETS, PAGE_PATH, SECURITY_HEADERS
-from service.viewer.stream import events, last_event_id
+from golfflight.service.api.state import ServiceState, ready_engine, service_state
+from golfflight.service.engine import FlightEngine
+from golfflight.service.viewer.feed import TooManyViewers
+from golfflight.service.viewer.page import ASSETS, PAGE_PATH, SECURITY_HEADERS
+from golfflight.service.viewer.stream import events, last_event_id
 
 EVENTS_PATH = "/v1/events"
 
