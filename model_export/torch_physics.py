@@ -4,6 +4,8 @@ The one place the equations of motion exist in torch. Same axes, signs, constant
 core (errata applied: lift along omega x v, spin only decays, q = C_Q rho |v|^2), batched over shots and
 dtype-agnostic (float64 for the parity tests, float32 for training). Wind is uniform (one air velocity per shot):
 real-data training fits it as a per-group nuisance, where a uniform wind is the simplest stand-in for the profile.
+The landing and the apex are measured as `flight.integrator` measures them (`hard_landing`, `apex`), so training
+fits the figures the runtime reports.
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ T_SIM_S = 10.0
 """Simulated time (section 2.3.2): longer than any flight in the data, so 100 network calls."""
 
 LANDING_SEARCH_START_S = 1.0
-"""The landing search starts at i_s = floor(1 s / dt) so the tee (r_z = 1 cm) is never taken for the landing."""
+"""The soft-argmax landing (`soft_landing`, training's L_p) searches from i_s = floor(1 s / dt) on, so the tee
+(r_z = 1 cm) is never taken for the landing."""
 
 SOFT_ARGMAX_TEMPERATURE_M = 0.5
 """Default soft-argmax temperature (m of |r_z|). The weights then share out between the steps around the ground
@@ -44,8 +47,16 @@ class Trajectory:
 
     @property
     def apex_m(self) -> torch.Tensor:
-        """Highest simulated r_z per shot [N] (the max-height loss compares it with apex_m)."""
-        return self.positions[:, :, 2].amax(dim=0)
+        """Apex height per shot [N], measured as the runtime measures it (`apex`)."""
+        return apex(self).height_m
+
+
+@dataclass
+class Apex:
+    """Apex per shot: height [N] (m) and time [N] (s) of the vertex of the parabola through the highest state."""
+
+    height_m: torch.Tensor
+    time_s: torch.Tensor
 
 
 @dataclass
@@ -156,35 +167,56 @@ def soft_landing(
     return (weights[:, :, None] * tail[:, :, :2]).sum(dim=0)
 
 
-def hard_landing(trajectory: Trajectory, start_s: float = LANDING_SEARCH_START_S) -> Landing:
-    """Landing used at validation and inference: hard argmax of -|r_z| from i_s on, then the state interpolated
-    linearly to r_z = 0 between the two steps that bracket the crossing (as `flight.integrator.simulate` does).
-    Where that step has no downward crossing beside it (no landing within t_sim), the state of the step itself."""
-    positions = trajectory.positions
-    last = positions.shape[0] - 1
-    start = _search_start(trajectory, start_s)
-    z = positions[:, :, 2]
-    nearest = start + torch.argmax(-z[start:].abs(), dim=0)
+def _first_crossing(z: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """Per shot of heights z [T+1, N]: the step before the first downward crossing of r_z = 0 (z_i > 0 >= z_{i+1})
+    and whether there is one; where there is none, the step before the last."""
+    crossed = (z[:-1] > 0) & (z[1:] <= 0)
+    landed = crossed.any(dim=0)
+    first = torch.argmax(crossed.to(torch.int8), dim=0)
+    return torch.where(landed, first, z.shape[0] - 2), landed
+
+
+def hard_landing(trajectory: Trajectory) -> Landing:
+    """Landing as `flight.integrator` measures it: the state interpolated linearly to r_z = 0 between the two steps
+    around the first downward crossing (differentiable in the states, the fraction included). Where no step crosses
+    within t_sim, the last state, with `landed` False."""
+    z = trajectory.positions[:, :, 2]
+    before, landed = _first_crossing(z)
     shots = torch.arange(z.shape[1], device=z.device)
-    above = z[nearest, shots] > 0
-    before = torch.where(above, nearest, nearest - 1).clamp(0, last - 1)
-    after = before + 1
-    z_before, z_after = z[before, shots], z[after, shots]
-    landed = (z_before > 0) & (z_after <= 0)
+    z_before, z_after = z[before, shots], z[before + 1, shots]
     drop = torch.where(landed, z_before - z_after, torch.ones_like(z_before))
-    frac = torch.where(landed, z_before / drop, (nearest - before).to(z.dtype))
+    frac = torch.where(landed, z_before / drop, torch.ones_like(z_before))
 
     def interpolate(states: torch.Tensor) -> torch.Tensor:
-        old, new = states[before, shots], states[after, shots]
+        old, new = states[before, shots], states[before + 1, shots]
         return old + frac[:, None] * (new - old)
 
     return Landing(
-        interpolate(positions),
+        interpolate(trajectory.positions),
         interpolate(trajectory.velocities),
         interpolate(trajectory.spins),
         (before + frac) * trajectory.dt,
         landed,
     )
+
+
+def apex(trajectory: Trajectory) -> Apex:
+    """Apex as `flight.integrator` measures it (`flight.outcomes.parabola_apex`): the highest state up to the first
+    downward crossing and the vertex of the parabola through it and its two neighbours; the highest state itself
+    where it is the first or last state or the three do not bend down. Differentiable in the three heights."""
+    z = trajectory.positions[:, :, 2]
+    last = z.shape[0] - 1
+    before, landed = _first_crossing(z)
+    in_flight = torch.arange(last + 1, device=z.device)[:, None] <= torch.where(landed, before + 1, last)
+    peak_step = torch.argmax(torch.where(in_flight, z, torch.full_like(z, -torch.inf)), dim=0)
+    shots = torch.arange(z.shape[1], device=z.device)
+    peak = z[peak_step, shots]
+    below, above = z[(peak_step - 1).clamp_min(0), shots], z[(peak_step + 1).clamp_max(last), shots]
+    bend = below - 2.0 * peak + above
+    down = (bend < 0.0) & (peak_step > 0) & (peak_step < last)
+    shift = torch.where(down, (below - above) / (2.0 * torch.where(down, bend, -torch.ones_like(bend))), 0.0)
+    height = torch.where(down, peak - (below - above) * shift / 4.0, peak)
+    return Apex(height, (peak_step + shift) * trajectory.dt)
 
 
 def positions_at(trajectory: Trajectory, times_s: torch.Tensor) -> torch.Tensor:

@@ -11,7 +11,14 @@ from golfflight.flight.coefficients import ConstantCoefficients, QuadraticSpinRa
 from golfflight.flight.integrator import simulate
 from golfflight.flight.physics import State, initial_state
 from golfflight.flight.physics import derivatives as np_derivatives
-from golfflight.model_export.torch_physics import Trajectory, derivatives, euler_rollout, hard_landing, soft_landing
+from golfflight.model_export.torch_physics import (
+    Trajectory,
+    apex,
+    derivatives,
+    euler_rollout,
+    hard_landing,
+    soft_landing,
+)
 from golfflight.model_export.variants import PhysQ
 
 torch.set_num_threads(1)  # tiny models: one thread is as fast, and immune to other jobs on the 2 cores
@@ -67,10 +74,46 @@ def test_euler_flights_and_landing_match_numpy(launch_state, name, numpy_model, 
     np.testing.assert_allclose(landing.velocity.numpy(), flight.landing_velocity, rtol=0, atol=1e-6)
     np.testing.assert_allclose(landing.spin.numpy(), flight.landing_spin, rtol=0, atol=1e-6)
     np.testing.assert_allclose(landing.time_s.numpy(), flight.flight_time_s, rtol=0, atol=1e-9)
+    measured = apex(trajectory)
+    np.testing.assert_allclose(measured.height_m.numpy(), flight.apex_m, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(measured.time_s.numpy(), flight.apex_time_s, rtol=0, atol=1e-9)
     highest_step = np.stack([s.position[:, 2] for s in flight.states]).max(axis=0)
-    np.testing.assert_allclose(trajectory.apex_m.numpy(), highest_step, rtol=0, atol=1e-6)
-    # the core's apex lies between the steps: on the parabola through the highest one and its neighbours
-    assert (highest_step <= flight.apex_m).all() and (flight.apex_m <= highest_step + 0.02).all()
+    assert (flight.apex_m - highest_step > 1e-4).any(), "the apex lies between the steps, not on the highest one"
+
+
+def _low_and_high_launches() -> State:
+    """Topped shots that land within 1 s (one launched downward from the tee), a flat one and full shots."""
+    return initial_state(
+        np.array([30.0, 20.0, 40.0, 25.0, 70.0, 60.0]),
+        np.array([-5.0, 1.0, 2.0, 0.0, 12.0, 30.0]),
+        np.array([0.0, 3.0, -2.0, 0.0, 1.0, -4.0]),
+        np.array([500.0, 800.0, 1500.0, 0.0, 2500.0, 6000.0]),
+        np.array([0.0, 10.0, -20.0, 0.0, 5.0, 0.0]),
+    )
+
+
+@pytest.mark.parametrize("name, numpy_model, torch_model", MODELS, ids=[m[0] for m in MODELS])
+@pytest.mark.parametrize("t_max", [10.0, 2.5])
+@torch.no_grad()
+def test_landing_and_apex_are_measured_as_the_runtime_measures_them(name, numpy_model, torch_model, t_max):
+    """Short flights (landing within 1 s, or on the first step) and, at 2.5 s, flights still in the air at the end:
+    the same landing x/y, time and apex as `flight.integrator.simulate` within 1e-6 m."""
+    state = _low_and_high_launches()
+    flight = simulate(state, numpy_model, DENSITY, dt=0.1, t_max=t_max)
+    trajectory = euler_rollout(
+        _torch(state.position), _torch(state.velocity), _torch(state.spin), torch_model(), DENSITY, t_sim=t_max
+    )
+    landing, measured = hard_landing(trajectory), apex(trajectory)
+    np.testing.assert_array_equal(landing.landed.numpy(), flight.landed)
+    assert flight.landed[:4].all() and (flight.flight_time_s[:4] < 1.0).all()
+    assert t_max == 10.0 or not flight.landed.all()
+    np.testing.assert_allclose(landing.position.numpy()[flight.landed], flight.landing_position[flight.landed],
+                               rtol=0, atol=1e-6)
+    np.testing.assert_allclose(landing.time_s.numpy()[flight.landed], flight.flight_time_s[flight.landed],
+                               rtol=0, atol=1e-9)
+    np.testing.assert_allclose(measured.height_m.numpy(), flight.apex_m, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(trajectory.apex_m.numpy(), flight.apex_m, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(measured.time_s.numpy(), flight.apex_time_s, rtol=0, atol=1e-9)
 
 
 @torch.no_grad()
@@ -124,7 +167,11 @@ def test_soft_landing_has_gradients_and_no_landing_is_flagged():
         return torch.stack([fixed[0], drag, fixed[2], fixed[3]]).expand(v.shape[0], 4)
 
     trajectory = euler_rollout(position, velocity, spin, coefficients, DENSITY)
-    soft_landing(trajectory)[0, 1].backward()
+    soft_landing(trajectory)[0, 1].backward(retain_graph=True)
     assert drag.grad is not None and drag.grad < 0
+    for measure in (lambda: hard_landing(trajectory).position[0, 1], lambda: apex(trajectory).height_m[0]):
+        drag.grad = None
+        measure().backward(retain_graph=True)
+        assert drag.grad is not None and torch.isfinite(drag.grad) and drag.grad < 0
     short = Trajectory(trajectory.positions[:15], trajectory.velocities[:15], trajectory.spins[:15], 0.1)
     assert not hard_landing(short).landed.any()
