@@ -74,12 +74,13 @@ EQUATIONS = [
     "forward Euler: r, v, omega at step i+1 = value at step i + dt * derivative at step i, from t = 0 to t_sim",
 ]
 LANDING = (
-    "i_s = floor(landing_search_start_s / dt); i_g = i_s + argmax over i >= i_s of -|r_z,i|; the state is interpolated "
-    "linearly to r_z = 0 between the two steps around i_g that bracket the downward crossing (z_a > 0 >= z_b, "
-    "fraction z_a / (z_a - z_b)). Landing point = (x, y) there. Max height: training took the largest r_z over the "
-    "steps; the runtime (flight.outcomes.parabola_apex) reports the vertex of the parabola through the highest step "
-    "and its two neighbours, z_k - (z_{k-1} - z_{k+1})^2 / (8 (z_{k-1} - 2 z_k + z_{k+1})) at t_k + dt (z_{k-1} - "
-    "z_{k+1}) / (2 (z_{k-1} - 2 z_k + z_{k+1})): about g dt^2 / 8 (1.2 cm at 0.1 s) above the highest step at most."
+    "Landing: the first step i with r_z,i > 0 >= r_z,i+1 (z_a > 0 >= z_b); the state is interpolated linearly to r_z = "
+    "0 between the two (fraction z_a / (z_a - z_b)); landing point = (x, y) there. Max height: the vertex of the "
+    "parabola through the highest step k up to the landing and its two neighbours, z_k - (z_{k-1} - z_{k+1})^2 / (8 "
+    "(z_{k-1} - 2 z_k + z_{k+1})) at t_k + dt (z_{k-1} - z_{k+1}) / (2 (z_{k-1} - 2 z_k + z_{k+1})) (the highest step "
+    "itself where it is the first or last or the three do not bend down): about g dt^2 / 8 (1.2 cm at 0.1 s) above it "
+    "at most. Training (model_export.torch_physics) and the runtime (flight.integrator, flight.outcomes.parabola_apex) "
+    "measure both the same way. The soft-argmax landing of the L_p loss searches from landing_search_start_s on."
 )
 
 
@@ -303,7 +304,7 @@ def build_card(
                 "loss_description": payload.get(
                     "loss_description",
                     "L_p = mean |soft-argmax landing (x, y) - target|"
-                    + (" + L_h = mean |max r_z - apex|" if config.loss == "lp+lh" else "")
+                    + (" + L_h = mean |parabola apex - apex|" if config.loss == "lp+lh" else "")
                     + " over the shots that have each target, in metres",
                 ),
                 "latent_conditions": payload.get("latent_conditions"),

@@ -55,8 +55,9 @@ def loss_description(config: JointConfig) -> str:
         f"noise: landing point {NOISE.carry_m:g} m + {NOISE.carry_fraction:.1%} of the carry per axis, apex "
         f"{NOISE.apex_m:g} m, flight time {NOISE.flight_time_s:g} s, landing angle {NOISE.landing_angle_deg:g} deg; "
         f"plus path positions every 0.5 s up to the radar's last point (3-D distance / {PATH_SIGMA_M:g} m, a path "
-        f"counting as {PATH_OBSERVATIONS:g} observations); weighted per source {config.weights}; hard landing "
-        "(Euler states interpolated to r_z = 0), apex = highest Euler state, as the runtime flies them"
+        f"counting as {PATH_OBSERVATIONS:g} observations); weighted per source {config.weights}; landing = the Euler "
+        "states interpolated to r_z = 0 at the first downward crossing, apex = the vertex of the parabola through the "
+        "highest state and its neighbours: measured as the runtime measures them"
     )
 
 

@@ -86,8 +86,8 @@ class RunResult:
 def predict(
     model: nn.Module, shots: ShotTensors, config: TrainConfig, soft: bool
 ) -> tuple[torch.Tensor, torch.Tensor | None]:
-    """Landing point [N,2] and apex [N] (None for the NN baseline): soft-argmax for training, hard argmax +
-    interpolation to r_z = 0 for validation."""
+    """Landing point [N,2] and apex [N] (None for the NN baseline): soft-argmax landing for training, the runtime's
+    landing (first crossing interpolated to r_z = 0) for validation; the apex as the runtime measures it."""
     if config.variant == "nn":
         return model(shots.velocity, shots.spin), None
     trajectory = euler_rollout(
@@ -122,7 +122,7 @@ def errors(landing: torch.Tensor, apex: torch.Tensor | None, shots: ShotTensors)
 
 @torch.no_grad()
 def validate(model: nn.Module, shots: ShotTensors, config: TrainConfig) -> dict[str, float]:
-    """Validation metrics with the inference landing (hard argmax + interpolation), in m and yd."""
+    """Validation metrics with the runtime's landing and apex (`torch_physics.hard_landing`, `apex`), in m and yd."""
     model.eval()
     sums = {"landing": 0.0, "apex": 0.0}
     for start in range(0, len(shots), VALIDATION_BATCH):

@@ -82,7 +82,10 @@ class Physics(_Strict):
     integrator: Literal["forward-euler"]
     dt_s: Positive
     t_sim_s: Positive
-    landing_search_start_s: NonNegative
+    landing_search_start_s: NonNegative = Field(
+        description="where the soft-argmax landing of training's L_p loss starts its search (s); the reported landing "
+        "is the first downward crossing of r_z = 0, in training as at runtime"
+    )
     axes: str
     launch_state: str
     equations: list[str]
