@@ -13,6 +13,7 @@ COPY service ./service
 COPY shots ./shots
 COPY weights_schema ./weights_schema
 COPY model_export ./model_export
+COPY evaluation ./evaluation
 COPY discovery ./discovery
 COPY sweep ./sweep
 COPY models/default ./models/default

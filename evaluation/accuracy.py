@@ -3,7 +3,7 @@ real training sets, through the flight core the engine's batch path runs (`fligh
 bundle's ONNX graph; Ferguson 2022's quadratics through the same call).
 
 The models: the real-data model (`--model`), the synthetic model (`--synthetic`) and Ferguson, McNally & McPhee
-2022. The sets (`model_export.accuracy_sets`): the held-out ones of NOTES section 9 (TrackMan outdoor drivers from
+2022. The sets (`evaluation.accuracy_sets`): the held-out ones of NOTES section 9 (TrackMan outdoor drivers from
 line 2943, rounds 3-4 of the TOUR Championship 2020); the paper's own figures for context and slow shots against
 published amateur launches (`accuracy_slow`); then training sets of the real-data model: the PGA 2023 averages
 (a per-club fit), the Sentry 2022 trajectories with each shot's latent wind (`accuracy_winds`), and a fine-tuning
@@ -23,10 +23,15 @@ from pathlib import Path
 from typing import TypeVar
 
 import numpy as np
-from golfflight.flight.constants import YARD_M
-from golfflight.model_export.accuracy_finetune import MEASURED_ROUNDS, TRAIN_ROUNDS, FinetuneStudy, finetune_study
-from golfflight.model_export.accuracy_flyers import CoefficientFlyer, Flyer, ModelFlyer, ferguson_flyer
-from golfflight.model_export.accuracy_sets import (
+from golfflight.evaluation.accuracy_finetune import (
+    MEASURED_ROUNDS,
+    TRAIN_ROUNDS,
+    Finetune,
+    FinetuneStudy,
+    finetune_study,
+)
+from golfflight.evaluation.accuracy_flyers import CoefficientFlyer, Flyer, ModelFlyer, ferguson_flyer
+from golfflight.evaluation.accuracy_sets import (
     APEX_MAE_YD,
     APEX_METRICS,
     DRIVER_FILE,
@@ -54,9 +59,9 @@ from golfflight.model_export.accuracy_sets import (
     tee_groups,
     tour_championship_shots,
 )
-from golfflight.model_export.accuracy_slow import OUTCOMES as SLOW_OUTCOMES
-from golfflight.model_export.accuracy_slow import SLOW_SHOTS, fly_slow
-from golfflight.model_export.accuracy_winds import (
+from golfflight.evaluation.accuracy_slow import OUTCOMES as SLOW_OUTCOMES
+from golfflight.evaluation.accuracy_slow import SLOW_SHOTS, fly_slow
+from golfflight.evaluation.accuracy_winds import (
     Anova,
     Consistency,
     GroupWind,
@@ -69,6 +74,7 @@ from golfflight.model_export.accuracy_winds import (
     measured_paths,
     training_winds,
 )
+from golfflight.flight.constants import YARD_M
 from golfflight.shots.markdown import table, write_generated_section
 from golfflight.shots.paths import shared_data_dir
 from golfflight.shots.pbp import hole_pars
@@ -378,7 +384,7 @@ def _slow(flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
 
 
 def _sentry(data_dir: Path, flyers: Sequence[Flyer], out: Path, figures_dir: Path, report: AccuracyReport) -> list[str]:
-    from golfflight.model_export import figures
+    from golfflight.evaluation import figures
 
     lines = ["### PGA TOUR trajectories, 2022 Sentry at Kapalua (a TRAINING set of the real-data model)", ""]
     trajectory_file, pbp_file = data_dir / TOURCAST_TRAJECTORIES, data_dir / TOURCAST_PBP
@@ -487,7 +493,7 @@ def _winds(trajectory_file: Path, conversion, shots: ShotSet, flyers: Sequence[F
     lines += [
         "",
         f"Holes with at least {MIN_HOLE_SHOTS} fitted shots: mean wind (speed and the direction it blows from, "
-        "0 = headwind, 90 = from the right; `discovery.effects.wind_from_components`) and the within-hole SD of x, y:",
+        "0 = headwind, 90 = from the right; `flight.wind.Wind.from_components`) and the within-hole SD of x, y:",
         "",
         *(table(("round-hole", "shots", *labels),
                 [(g.group, str(g.n), *(describe(groups[l].get(g.group)) for l in labels)) for g in listed])
@@ -555,17 +561,20 @@ def _summary_rows(errors: dict[str, np.ndarray]) -> list[tuple[str, ...]]:
     return rows
 
 
-def _study(data_dir: Path, flyer: ModelFlyer, clubs, epochs: int, report: AccuracyReport) -> list[str]:
+def _study(data_dir: Path, flyer: ModelFlyer, clubs, epochs: int, finetune: Finetune | None,
+           report: AccuracyReport) -> list[str]:
     lines = ["### Fine-tuning on a tour event's early rounds (Sony Open 2022)", ""]
     path = data_dir / SONY_TRAJECTORIES
     if not path.is_file():
         return lines + [_missing(path)]
     if epochs <= 0:
         return lines + ["_Skipped (no epochs asked for)._"]
+    if finetune is None:
+        return lines + ["_Skipped (no fine-tuning given: it needs the training side, `model_export.finetune`)._"]
     conversion = load_tourcast(path, None, estimate_spin=True)
     shots = ShotSet(conversion.records)
     try:
-        study = finetune_study(flyer, shots, clubs, epochs=epochs)
+        study = finetune_study(flyer, shots, clubs, finetune, epochs=epochs)
     except ValueError as error:
         return lines + [f"_Skipped: {error}._"]
     report.study = study
@@ -607,10 +616,12 @@ def run_accuracy(
     data_dir: str | os.PathLike | None = None,
     finetune_epochs: int = 30,
     synthetic: str | os.PathLike | None = None,
+    finetune: Finetune | None = None,
 ) -> AccuracyReport:
     """Compare the real-data model `bundle`, the `synthetic` one (default: the same bundle) and Ferguson 2022 on every
-    real set found under `data_dir` (default: the shared data folder), run the fine-tuning study, and write OUT's
-    generated section and the path-error figure; missing sets are announced."""
+    real set found under `data_dir` (default: the shared data folder), run the fine-tuning study with `finetune`
+    (`model_export.finetune.finetune`; None skips it), and write OUT's generated section and the path-error figure;
+    missing sets are announced."""
     data_dir = Path(data_dir) if data_dir is not None else shared_data_dir()
     real = ModelFlyer(bundle, "real-data model")
     flyers: list[Flyer] = [
@@ -629,7 +640,7 @@ def run_accuracy(
     pga_lines, clubs = _pga(data_dir, flyers, report)
     lines += [*pga_lines, ""]
     lines += _sentry(data_dir, flyers, Path(out), Path(figures_dir), report)
-    lines += ["", *_study(data_dir, real, clubs, finetune_epochs, report)]
+    lines += ["", *_study(data_dir, real, clubs, finetune_epochs, finetune, report)]
     report.markdown = "\n".join(lines) + "\n"
     write_generated_section(out, report.markdown, COMMAND)
     return report

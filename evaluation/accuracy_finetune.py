@@ -1,19 +1,22 @@
 """The fine-tuning study of `golfflight accuracy`: `golfflight finetune` on some rounds of a tour event, measured on
 the event's later rounds before and after. It never touches a held-out set (NOTES section 9): the event is the Sony
-Open 2022 (trajectories only, so its spin is the loader's estimate from the initial lift).
+Open 2022 (trajectories only, so its spin is the loader's estimate from the initial lift). The fine-tuning itself
+(`model_export.finetune.finetune`, torch) is passed in by the caller, so this package needs no torch.
 """
 
 from __future__ import annotations
 
+import os
 import re
 import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
-from golfflight.model_export.accuracy_flyers import ModelFlyer
-from golfflight.model_export.accuracy_sets import ClubComparison, compare_clubs, outcome_errors
+from golfflight.evaluation.accuracy_flyers import ModelFlyer
+from golfflight.evaluation.accuracy_sets import ClubComparison, compare_clubs, outcome_errors
 from golfflight.shots.records import ShotSet, write_shots
 from golfflight.shots.reference_world import ClubAverage
 from golfflight.shots.source_air import PGA_2023_TABLE
@@ -34,6 +37,14 @@ def round_number(session: str | None, shot_id: str | None) -> int | None:
 
 def by_rounds(shots: ShotSet, rounds: Sequence[int]) -> ShotSet:
     return ShotSet([r for r in shots.records if round_number(r.session, r.shot_id) in rounds])
+
+
+class Finetune(Protocol):
+    """`model_export.finetune.finetune` as the study calls it: fine-tune a bundle on a canonical file and export the
+    best epoch to `out` if it beats the base model; the result has `run` (best, data), `improved`, `base_metrics`."""
+
+    def __call__(self, model: str | os.PathLike, data: str | os.PathLike, out: str | os.PathLike, epochs: int,
+                 lr: float, batch_size: int, *, val_fraction: float, progress: bool) -> Any: ...
 
 
 @dataclass
@@ -61,6 +72,7 @@ def finetune_study(
     flyer: ModelFlyer,
     shots: ShotSet,
     clubs: Sequence[ClubAverage] | None,
+    finetune: Finetune,
     epochs: int = 30,
     lrs: Sequence[float] = (3e-4, 1e-3),
     batch_size: int = 64,
@@ -72,8 +84,6 @@ def finetune_study(
     picks its validation shots by its own rule: the latest sessions, i.e. rounds), keep the rate whose best epoch has
     the lowest validation landing error (the measured rounds play no part in any choice), and compare
     `measured_rounds` before and after. Everything is written to a temporary directory, then deleted."""
-    from golfflight.model_export.finetune import finetune
-
     train, measured = by_rounds(shots, train_rounds), by_rounds(shots, measured_rounds)
     if not len(train) or not len(measured):
         raise ValueError(f"needs shots in rounds {list(train_rounds)} and {list(measured_rounds)}; "

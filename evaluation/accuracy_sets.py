@@ -13,16 +13,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from golfflight.evaluation.accuracy_flyers import Flyer
 from golfflight.flight.air import Air
 from golfflight.flight.constants import FOOT_M, YARD_M
 from golfflight.flight.outcomes import Flight
-from golfflight.model_export.accuracy_flyers import Flyer
-from golfflight.model_export.data import MIN_APEX_M
 from golfflight.shots.clubs import straight_launches
 from golfflight.shots.heldout import HELD_OUT, held_out_rounds, shot_round
 from golfflight.shots.pbp import load_pbp
 from golfflight.shots.records import ShotSet
 from golfflight.shots.reference_world import ClubAverage
+from golfflight.shots.synth import MIN_APEX_M
 from golfflight.shots.trackman import load_trackman, read_table
 
 TRACKMAN_HELD_OUT, TOUR_CHAMPIONSHIP_HELD_OUT = HELD_OUT

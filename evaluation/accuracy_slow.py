@@ -10,8 +10,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from golfflight.evaluation.accuracy_flyers import Flyer
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
-from golfflight.model_export.accuracy_flyers import Flyer
 
 
 @dataclass(frozen=True)

@@ -16,9 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from golfflight.discovery.effects import wind_from_components
+from golfflight.evaluation.accuracy_flyers import Flyer
 from golfflight.flight.wind import Wind
-from golfflight.model_export.accuracy_flyers import Flyer
 from scipy import sparse
 from scipy.optimize import least_squares
 from scipy.stats import f as f_distribution
@@ -208,11 +207,11 @@ class GroupWind:
 
     @property
     def speed_mps(self) -> float:
-        return wind_from_components(self.x_mps, self.y_mps)[0]
+        return float(Wind.from_components(self.x_mps, self.y_mps).speed_mps)
 
     @property
     def from_deg(self) -> float:
-        return wind_from_components(self.x_mps, self.y_mps)[1]
+        return float(Wind.from_components(self.x_mps, self.y_mps).from_deg)
 
 
 def group_winds(fit: WindFit) -> list[GroupWind]:

@@ -9,8 +9,8 @@ import os
 from pathlib import Path
 
 import numpy as np
-from golfflight.model_export.accuracy_flyers import ModelFlyer
-from golfflight.model_export.accuracy_sets import (
+from golfflight.evaluation.accuracy_flyers import ModelFlyer
+from golfflight.evaluation.accuracy_sets import (
     TOUR_CHAMPIONSHIP_HELD_OUT,
     TRACKMAN_HELD_OUT,
     held_out_driver_shots,

@@ -13,10 +13,10 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
+from golfflight.evaluation.validation import Errors, Prediction, ValidationShots, errors_of
 from golfflight.flight.air import Air
 from golfflight.flight.physics import initial_state
 from golfflight.flight.wind import CALM, Wind
-from golfflight.model_export.validation import Errors, Prediction, ValidationSet, errors_of
 from golfflight.shots.records import ShotSet
 from golfflight.shots.reference_world import fly_reference
 from golfflight.shots.synth import MeasurementNoise, sessions_path
@@ -75,7 +75,7 @@ DEFAULT_NOISE = MeasurementNoise()
 """The measurement noise `golfflight synth` records with."""
 
 
-def expected_outcome_noise(val: ValidationSet, noise: MeasurementNoise = DEFAULT_NOISE) -> tuple[float, float]:
+def expected_outcome_noise(val: ValidationShots, noise: MeasurementNoise = DEFAULT_NOISE) -> tuple[float, float]:
     """Mean landing and max-height error that the recorded outcomes' own noise alone gives (the generator's default
     `MeasurementNoise`): E|2-D normal| = sigma sqrt(pi/2) with sigma = carry_m + carry_fraction x carry, and
     E|normal| = sigma sqrt(2/pi)."""
@@ -96,13 +96,13 @@ class Floor:
     prediction: Prediction | None = None
 
 
-def hidden_truth(val: ValidationSet) -> dict[str, SessionTruth] | None:
+def hidden_truth(val: ValidationShots) -> dict[str, SessionTruth] | None:
     """The per-session hidden conditions of a synthetic file (NAME.sessions.csv beside it), None for other data."""
     truth_file = sessions_path(val.path)
     return read_session_truth(truth_file) if truth_file.is_file() else None
 
 
-def nominal_conditions(val: ValidationSet) -> tuple[Air, str]:
+def nominal_conditions(val: ValidationShots) -> tuple[Air, str]:
     """The air of the nominal floor and its description: the training sessions' mean air where the hidden truth
     is known (the best single air a model trained without conditions can learn), else ICAO standard air."""
     truth = hidden_truth(val)
@@ -114,7 +114,7 @@ def nominal_conditions(val: ValidationSet) -> tuple[Air, str]:
     return air, f"{described} (rho {float(air.density_kg_m3):.3f} kg/m^3)"
 
 
-def noise_floors(val: ValidationSet, nominal_air: Air, described: str) -> list[Floor]:
+def noise_floors(val: ValidationShots, nominal_air: Air, described: str) -> list[Floor]:
     """The nominal floor (calm, `nominal_air`) and, with a synthetic file's hidden truth, the true-conditions floor
     and the expected outcome-noise part of it."""
     truth = hidden_truth(val)

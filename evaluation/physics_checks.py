@@ -1,7 +1,7 @@
 """`golfflight physics-check`: a model bundle's aerodynamics along real flights, held against the literature.
 
 Torch-free (NumPy and ONNX Runtime only), so it runs in the serving install. Each club of `shots.clubs.CLUBS` is
-flown through the runtime path (`model_export.accuracy_flyers.ModelFlyer`: the bundle's ONNX graph in
+flown through the runtime path (`evaluation.accuracy_flyers.ModelFlyer`: the bundle's ONNX graph in
 `flight.integrator.simulate`, forward Euler at the card's step) in ICAO standard air, calm. At every step above the
 ground it records the Reynolds number Re = |v_rel| d / nu and spin ratio S = R |omega| / |v_rel| the ball meets, and
 the coefficients the graph gives there, converted to the literature's convention (below). Two checks:
@@ -30,10 +30,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from golfflight.evaluation.accuracy_flyers import Flyer, ModelFlyer
 from golfflight.flight.air import Air
 from golfflight.flight.constants import BALL_RADIUS_M
 from golfflight.flight.physics import spin_ratio
-from golfflight.model_export.accuracy_flyers import Flyer, ModelFlyer
 from golfflight.shots.clubs import CLUBS, ClubLaunch, straight_launches
 from golfflight.shots.markdown import table
 
@@ -496,7 +496,7 @@ def _literature_lines(report: PhysicsReport) -> list[str]:
         f"+-{near.s_half_width:g} in S (an ellipse in ln Re and S); covered where at least {near.min_points} points "
         f"from at least {near.min_publications} publications lie inside; the band is their min to max widened by "
         + " and ".join(f"{m:g} ({name})" for name, m in near.margin)
-        + ", one measurement standard deviation (`model_export.physics_checks.Neighbourhood` says why).",
+        + ", one measurement standard deviation (`evaluation.physics_checks.Neighbourhood` says why).",
     ]
 
 

@@ -1,7 +1,8 @@
-"""The validation split of a canonical file, model predictions on it and their errors (the paper's L_p and L_h).
+"""The validation split of a canonical file as records, model predictions on it and their errors (the paper's L_p and
+L_h).
 
-The shots are exactly those `model_export.data.load_training_data` validates on, kept both as records (for the
-NumPy reference world and the runtime path) and as float64 tensors (for the torch rollout).
+The shots are exactly those `model_export.data.load_training_data` validates on; `model_export.validation` adds
+their float64 tensors for the torch rollout. Torch-free: the reference world and the runtime path need only these.
 """
 
 from __future__ import annotations
@@ -11,18 +12,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import torch
-from golfflight.model_export.data import MIN_APEX_M, ShotTensors, to_tensors
 from golfflight.shots.records import ShotSet, read_shots
+from golfflight.shots.synth import MIN_APEX_M
 
 
 @dataclass
-class ValidationSet:
-    """The validation shots (the file's 'val' rows after the training filters) as records and float64 tensors."""
+class ValidationShots:
+    """The validation shots (the file's 'val' rows after the training filters) as records, and all the file's rows."""
 
     path: Path
     shots: ShotSet
-    tensors: ShotTensors
     all_shots: ShotSet
 
     def __len__(self) -> int:
@@ -47,14 +46,14 @@ def validation_mask(shots: ShotSet, min_apex_m: float = MIN_APEX_M) -> np.ndarra
         return (shots.column("split") == "val") & (landing_known | ~np.isnan(apex)) & ~(apex < min_apex_m)
 
 
-def load_validation(path: str | os.PathLike, min_apex_m: float = MIN_APEX_M) -> ValidationSet:
+def load_validation_shots(path: str | os.PathLike, min_apex_m: float = MIN_APEX_M) -> ValidationShots:
     """Read a canonical CSV and keep its validation shots."""
     path = Path(path)
     shots = read_shots(path)
     val = shots.subset(validation_mask(shots, min_apex_m))
     if not len(val):
         raise ValueError(f"{path}: no validation shots (rows marked 'val' that pass the training filters)")
-    return ValidationSet(path, val, to_tensors(val, torch.float64), shots)
+    return ValidationShots(path, val, shots)
 
 
 @dataclass
@@ -85,7 +84,7 @@ class Errors:
         return None if self.apex_m is None else float(np.nanmean(np.abs(self.apex_m)))
 
 
-def errors_of(prediction: Prediction, val: ValidationSet) -> Errors:
+def errors_of(prediction: Prediction, val: ValidationShots) -> Errors:
     """Landing distance, length (y) and side (x) errors, and max-height error against the recorded outcomes."""
     difference = prediction.landing_m - val.landing_m
     apex = None if prediction.apex_m is None else prediction.apex_m - val.apex_m

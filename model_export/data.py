@@ -13,13 +13,10 @@ from pathlib import Path
 import numpy as np
 import torch
 from golfflight.flight.air import Air
-from golfflight.flight.constants import YARD_M
 from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.shots.records import ShotSet, read_shots
+from golfflight.shots.synth import MIN_APEX_M
 from golfflight.weights_schema.bundle import sha256_of
-
-MIN_APEX_M = 8 * YARD_M
-"""The paper drops shots whose max height is under 8 yd (tops, duffs and other mishits)."""
 
 
 @dataclass

@@ -16,13 +16,14 @@ from typing import Any, NamedTuple
 
 import numpy as np
 import torch
+from golfflight.evaluation.noise_floor import Floor, noise_floors, nominal_conditions
+from golfflight.evaluation.report import metres_yards
+from golfflight.evaluation.validation import Errors, Prediction, errors_of, gap
 from golfflight.flight.air import Air
 from golfflight.flight.integrator import simulate
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state
 from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics
-from golfflight.model_export.noise_floor import Floor, noise_floors, nominal_conditions
-from golfflight.model_export.report import metres_yards
 from golfflight.model_export.torch_physics import euler_rollout, hard_landing, spin_ratio
 from golfflight.model_export.training import (
     VALIDATION_BATCH,
@@ -31,7 +32,7 @@ from golfflight.model_export.training import (
     model_from_checkpoint,
     predict,
 )
-from golfflight.model_export.validation import Errors, Prediction, ValidationSet, errors_of, gap, load_validation
+from golfflight.model_export.validation import ValidationSet, load_validation
 from golfflight.model_export.variants import PhysNN, PhysQ
 from golfflight.shots.markdown import table, write_generated_section
 from torch import nn
@@ -258,8 +259,8 @@ def write_figures(
     with Phys-Q's curves), for the variants among `runs`, and Figure 7's summary line (empty without a network
     variant). Figure 7's effective coefficients are C x 2 C_Q x rho_trained / rho_air: the force the model applies,
     expressed in the reference world's (nominal) air."""
+    from golfflight.evaluation import figures
     from golfflight.flight.coefficients import FERGUSON_2022
-    from golfflight.model_export import figures
 
     directory = Path(directory)
     by_variant = {run.variant: run for run in runs}

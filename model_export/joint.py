@@ -25,7 +25,8 @@ from pathlib import Path
 from typing import Any
 
 import torch
-from golfflight.discovery.effects import EFFECTS, wind_from_components
+from golfflight.discovery.effects import EFFECTS
+from golfflight.flight.wind import Wind
 from golfflight.model_export.observations import (
     OBSERVABLES,
     PATH_OBSERVATIONS,
@@ -289,7 +290,8 @@ def conditions_report(latent: LatentConditions, data: ObservedData, train: Obser
     wind = []
     for i, group in enumerate(data.wind_groups.names):
         x, y = (float(v) for v in latent.wind[i].detach())
-        speed, from_deg = wind_from_components(x, y)
+        fitted = Wind.from_components(x, y)
+        speed, from_deg = float(fitted.speed_mps), float(fitted.from_deg)
         source = data.sources[int(train.source[train.wind_group == i][0])]
         wind.append({"group": group, "source": source, "n_shots": count(train.wind_group, i), "x_mps": x,
                      "y_mps": y, "speed_mps": speed, "from_deg": from_deg})

@@ -216,7 +216,7 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     chosen = min(runs, key=lambda s: runs[s].final["val_loss"] if runs[s].final else float("inf"))
     exported = None
     if out is not None:
-        from golfflight.model_export.held_out import record_held_out
+        from golfflight.evaluation.held_out import record_held_out
 
         card, _ = load_bundle(init)
         export_real(runs[chosen].out_dir, data_file, sources, Path(out), card.variant,

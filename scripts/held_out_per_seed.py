@@ -14,8 +14,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from golfflight.evaluation.held_out import record_held_out
 from golfflight.flight.constants import FOOT_M, YARD_M
-from golfflight.model_export.held_out import record_held_out
 from golfflight.model_export.real_data import DEFAULT_SOURCES, build
 from golfflight.model_export.real_training import DATA_FILE, SOUP, export_real
 from golfflight.shots.markdown import table

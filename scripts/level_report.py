@@ -18,9 +18,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.flight.air import Air
 from golfflight.flight.constants import YARD_M
-from golfflight.model_export.accuracy_flyers import ModelFlyer
 from golfflight.model_export.real_data import trackman_outdoor
 from golfflight.model_export.real_training import CONDITIONS_FILE
 from golfflight.shots.markdown import table

@@ -17,11 +17,11 @@ from scipy.optimize import least_squares
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from golfflight.evaluation.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
+from golfflight.evaluation.accuracy_sets import outcome_errors
 from golfflight.flight.field import ScaledCoefficients
 from golfflight.flight.integrator import simulate
 from golfflight.flight.physics import CoefficientModel, initial_state
-from golfflight.model_export.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
-from golfflight.model_export.accuracy_sets import outcome_errors
 from golfflight.model_export.real_data import trackman_outdoor
 from golfflight.shots.markdown import table
 from golfflight.shots.paths import shared_data_dir

@@ -18,8 +18,8 @@ from scipy.optimize import least_squares
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from golfflight.evaluation.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
 from golfflight.flight.wind import Wind
-from golfflight.model_export.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
 from golfflight.model_export.real_data import trackman_outdoor
 from golfflight.shots.markdown import table
 from golfflight.shots.paths import shared_data_dir

@@ -12,14 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from golfflight.flight.air import Air
-from golfflight.flight.coefficients import FERGUSON_2022, QuadraticSpinRatio
-from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from golfflight.flight.integrator import simulate
-from golfflight.flight.outcomes import Flight
-from golfflight.flight.physics import State, initial_state
-from golfflight.flight.wind import Wind, wind_vector
-from golfflight.model_export.accuracy import (
+from golfflight.evaluation.accuracy import (
     DRIVER_FILE,
     PATH_FIGURE,
     TOURCAST_PBP,
@@ -33,16 +26,16 @@ from golfflight.model_export.accuracy import (
     per_model,
     run_accuracy,
 )
-from golfflight.model_export.accuracy_finetune import finetune_study, round_number
-from golfflight.model_export.accuracy_sets import (
+from golfflight.evaluation.accuracy_finetune import finetune_study, round_number
+from golfflight.evaluation.accuracy_sets import (
     SONY_TRAJECTORIES,
     TOUR_CHAMPIONSHIP_PBP,
     held_out_driver_shots,
     tee_groups,
     tour_championship_shots,
 )
-from golfflight.model_export.accuracy_slow import SLOW_SHOTS, fly_slow
-from golfflight.model_export.accuracy_winds import (
+from golfflight.evaluation.accuracy_slow import SLOW_SHOTS, fly_slow
+from golfflight.evaluation.accuracy_winds import (
     TRAINING_CONDITIONS_FILE,
     anova,
     compare_training_winds,
@@ -52,8 +45,16 @@ from golfflight.model_export.accuracy_winds import (
     measured_paths,
     training_winds,
 )
+from golfflight.evaluation.held_out import held_out_results
+from golfflight.flight.air import Air
+from golfflight.flight.coefficients import FERGUSON_2022, QuadraticSpinRatio
+from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from golfflight.flight.integrator import simulate
+from golfflight.flight.outcomes import Flight
+from golfflight.flight.physics import State, initial_state
+from golfflight.flight.wind import Wind, wind_vector
 from golfflight.model_export.export import export_checkpoint
-from golfflight.model_export.held_out import held_out_results
+from golfflight.model_export.finetune import finetune
 from golfflight.model_export.training import TrainConfig, train
 from golfflight.shots.heldout import HELD_OUT, shot_round
 from golfflight.shots.paths import shared_data_dir
@@ -408,7 +409,7 @@ def test_groups_and_the_anova_of_fitted_winds():
 
 
 def test_training_winds_are_compared_with_the_fitted_group_means(tmp_path):
-    from golfflight.model_export.accuracy_winds import WindFit
+    from golfflight.evaluation.accuracy_winds import WindFit
 
     ids = [f"016-R1-H{h}-P{p}-S1" for h in (1, 2, 3) for p in (1, 2)]
     x = np.array([1.0, 1.2, -2.0, -2.2, 0.4, 0.6])
@@ -442,7 +443,7 @@ def test_the_finetune_study_tunes_early_rounds_and_measures_later_ones(bundle, t
                                           "shot_id": f"901-R{1 + i * 4 // len(records)}-H1-P{i}-S1"})
                      for i, r in enumerate(records)])
     assert round_number("006-R3", None) == 3 and round_number(None, "006-R12-H1-P1-S1") == 12
-    study = finetune_study(ModelFlyer(bundle), shots, CLUBS, epochs=2, lrs=(3e-3,), batch_size=32)
+    study = finetune_study(ModelFlyer(bundle), shots, CLUBS, finetune, epochs=2, lrs=(3e-3,), batch_size=32)
     assert study.n_measured == 60 and study.n_train + study.n_val <= 60
     assert len(study.before["carry_m"]) == 60 and set(study.validation) == {3e-3}
     assert study.improved == (study.validation[3e-3][0] < study.base_validation_m)
@@ -469,7 +470,8 @@ def _data_dir(root: Path) -> Path:
 def test_accuracy_report_on_hand_made_data(bundle, tmp_path):
     data = _data_dir(tmp_path / "shared")
     out = tmp_path / "docs" / "accuracy.md"
-    report = run_accuracy(bundle, out, tmp_path / "docs" / "figures", data, finetune_epochs=2, synthetic=bundle)
+    report = run_accuracy(bundle, out, tmp_path / "docs" / "figures", data, finetune_epochs=2, synthetic=bundle,
+                          finetune=finetune)
     labels = ["real-data model", "synthetic model", "Ferguson 2022"]
     assert report.labels == labels and set(report.driver) == set(labels)
     assert len(report.driver_shots) == 24 and min(int(s) for s in report.driver_shots.column("shot_id")) >= 2943

@@ -7,9 +7,9 @@ import subprocess
 import sys
 
 import pytest
+from golfflight.evaluation.accuracy_flyers import ModelFlyer
+from golfflight.evaluation.accuracy_sets import compare_clubs
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
-from golfflight.model_export.accuracy_flyers import ModelFlyer
-from golfflight.model_export.accuracy_sets import compare_clubs
 from golfflight.service.api.app import create_app
 from golfflight.service.api.models import MAX_BATCH_SHOTS
 from golfflight.service.model_location import model_dir

@@ -8,19 +8,19 @@ import math
 import numpy as np
 import pytest
 import torch
-from golfflight.flight.air import Air
-from golfflight.flight.physics import initial_state
-from golfflight.flight.wind import Wind
-from golfflight.model_export.data import load_training_data
-from golfflight.model_export.evaluate import COMMAND, FIGURES, CoefficientSamples, coefficient_summary, run_evaluation
-from golfflight.model_export.export import export_checkpoint
-from golfflight.model_export.noise_floor import (
+from golfflight.evaluation.noise_floor import (
     expected_outcome_noise,
     noise_floors,
     nominal_conditions,
     population_air,
     read_session_truth,
 )
+from golfflight.flight.air import Air
+from golfflight.flight.physics import initial_state
+from golfflight.flight.wind import Wind
+from golfflight.model_export.data import load_training_data
+from golfflight.model_export.evaluate import COMMAND, FIGURES, CoefficientSamples, coefficient_summary, run_evaluation
+from golfflight.model_export.export import export_checkpoint
 from golfflight.model_export.training import TrainConfig, load_checkpoint, train
 from golfflight.model_export.validation import load_validation
 from golfflight.model_export.variants import PhysNN

@@ -9,18 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from golfflight.flight.air import Air
-from golfflight.flight.constants import (
-    BALL_AREA_M2,
-    BALL_INERTIA_KG_M2,
-    BALL_MASS_KG,
-    BALL_RADIUS_M,
-    GRAVITY_MPS2,
-    RPM_TO_RADPS,
-)
-from golfflight.flight.physics import aerodynamics
-from golfflight.model_export.accuracy_flyers import CoefficientFlyer
-from golfflight.model_export.physics_checks import (
+from golfflight.evaluation.accuracy_flyers import CoefficientFlyer
+from golfflight.evaluation.physics_checks import (
     AERO_FILE,
     COEFFICIENTS,
     INSIDE_REQUIRED,
@@ -41,6 +31,16 @@ from golfflight.model_export.physics_checks import (
     run_physics_checks,
     spin_lost,
 )
+from golfflight.flight.air import Air
+from golfflight.flight.constants import (
+    BALL_AREA_M2,
+    BALL_INERTIA_KG_M2,
+    BALL_MASS_KG,
+    BALL_RADIUS_M,
+    GRAVITY_MPS2,
+    RPM_TO_RADPS,
+)
+from golfflight.flight.physics import aerodynamics
 from golfflight.shots.clubs import ClubLaunch
 from golfflight.shots.paths import shared_data_dir
 

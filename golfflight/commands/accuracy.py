@@ -31,19 +31,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from golfflight.model_export.accuracy import run_accuracy
+    from golfflight.evaluation.accuracy import run_accuracy
 
     if args.finetune_epochs < 0:
         raise ValueError(f"--finetune-epochs must be 0 or more, got {args.finetune_epochs}")
+    finetune = None
     if args.finetune_epochs:
         import torch
 
+        from golfflight.model_export import finetune as training
+
         torch.set_num_threads(1)  # batches of 64 shots: a second thread only adds synchronisation
+        finetune = training.finetune
     synthetic = args.synthetic
     if synthetic is None:
         synthetic = DEFAULT_SYNTHETIC if Path(DEFAULT_SYNTHETIC, "model_card.json").is_file() else args.model
     figures = args.figures or Path(args.out).parent / "figures"
-    report = run_accuracy(args.model, args.out, figures, args.data_dir, args.finetune_epochs, synthetic=synthetic)
+    report = run_accuracy(args.model, args.out, figures, args.data_dir, args.finetune_epochs, synthetic=synthetic,
+                          finetune=finetune)
     print(report.markdown, end="")
     print(f"wrote {args.out}" + "".join(f", {path}" for path in report.figures))
     return 0

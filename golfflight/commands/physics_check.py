@@ -25,7 +25,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from golfflight.model_export.physics_checks import COMMAND, markdown, run_physics_checks
+    from golfflight.evaluation.physics_checks import COMMAND, markdown, run_physics_checks
     from golfflight.shots.markdown import write_generated_section
     from golfflight.shots.paths import shared_data_dir
 
