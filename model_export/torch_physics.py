@@ -211,11 +211,11 @@ def apex(trajectory: Trajectory) -> Apex:
     peak_step = torch.argmax(torch.where(in_flight, z, torch.full_like(z, -torch.inf)), dim=0)
     shots = torch.arange(z.shape[1], device=z.device)
     peak = z[peak_step, shots]
-    below, above = z[(peak_step - 1).clamp_min(0), shots], z[(peak_step + 1).clamp_max(last), shots]
-    bend = below - 2.0 * peak + above
+    earlier, later = z[(peak_step - 1).clamp_min(0), shots], z[(peak_step + 1).clamp_max(last), shots]
+    bend, rise = earlier - 2.0 * peak + later, earlier - later
     down = (bend < 0.0) & (peak_step > 0) & (peak_step < last)
-    shift = torch.where(down, (below - above) / (2.0 * torch.where(down, bend, -torch.ones_like(bend))), 0.0)
-    height = torch.where(down, peak - (below - above) * shift / 4.0, peak)
+    shift = torch.where(down, rise / (2.0 * torch.where(down, bend, -torch.ones_like(bend))), 0.0)
+    height = torch.where(down, peak - rise * shift / 4.0, peak)
     return Apex(height, (peak_step + shift) * trajectory.dt)
 
 
