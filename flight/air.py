@@ -1,4 +1,4 @@
-"""Air: pressure at altitude, moist-air density and viscosity (NOTES.md section 3).
+"""Air: pressure at altitude (US Standard Atmosphere 1976), moist-air density (Tetens 1930) and viscosity (Sutherland).
 
 Every function works on floats or NumPy arrays alike, so a batch of shots can each have their own air.
 """

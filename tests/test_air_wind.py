@@ -1,4 +1,4 @@
-"""Air density, viscosity and wind against published values (NOTES.md section 3)."""
+"""Air density, viscosity and wind against published values (US Standard Atmosphere, Tetens, Sutherland)."""
 
 import numpy as np
 import pytest

@@ -181,7 +181,7 @@ def test_thin_warm_air_lowers_the_reynolds_number_the_network_sees(engine):
 
 
 def test_a_drive_at_7800_ft_gains_about_what_is_published(engine):
-    """NOTES.md section 2: a 282 yd drive at sea level flies about 306 yd at 7,800 ft (+8.5 %), with a lower apex
+    """The rule of thumb: a 282 yd drive at sea level flies about 306 yd at 7,800 ft (+8.5 %), with a lower apex
     and a land angle 9 degrees shallower. The default model: +9.0 %, apex -7 yd, land -10 deg (the reference world:
     +14.8 %, docs/reference_world.md)."""
     drive = Launch(76.4, 10.4, 0.0, 2545.0, 0.0)
