@@ -1,7 +1,7 @@
 """Where a single-shot step's time goes: ONNX Runtime's fixed cost per call, the cost per graph node, the physics.
 
 For one row every graph node costs a fixed dispatch overhead, so the node count matters more than the network's
-arithmetic (NOTES.md section 6). This script times, one row through IOBinding as the engine calls them: a one-node
+arithmetic (docs/benchmarks.md). This script times, one row through IOBinding as the engine calls them: a one-node
 graph (the per-call floor), the bundle's network alone (its Gemms and sigmoid), the bundle's whole graph, and the
 plain-float Euler step; then a whole 7-iron, to compare the parts with the sum.
 

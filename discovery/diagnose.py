@@ -48,7 +48,8 @@ from golfflight.discovery.noise import (
 )
 from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from golfflight.discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
-from golfflight.discovery.schema import Candidate, Heldout, ModelInfo, Report, ScatterStat
+from golfflight.discovery.schema import Candidate, Heldout, Located, ModelInfo, Report, ScatterStat, Unlisted
+from golfflight.discovery.simulator import Flown, Setup
 from golfflight.flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
 from golfflight.shots.synth import MeasurementNoise
 
@@ -91,6 +92,46 @@ class Diagnosis:
     chosen: Scored | None
 
 
+@dataclass(frozen=True)
+class Baseline:
+    """The model as is on the recordings: its predictions (the control's known error taken out), the residuals, the
+    wild readings left out of the fits, the error each shot is expected to miss by and the recordings' own scatter."""
+
+    base: Setup
+    flown: Flown
+    predicted: np.ndarray
+    offset: np.ndarray
+    residual: np.ndarray
+    wild: np.ndarray
+    use: np.ndarray
+    expected: ExpectedError
+    scatter: Scatter
+
+
+@dataclass(frozen=True)
+class Selection:
+    """What the candidates decided: the null, every candidate fitted, the choice (the null unless the mismatch is
+    systematic), the systematic test's numbers, the learned correction if chosen, and structure the choice leaves."""
+
+    null: Scored
+    scored: list[Scored]
+    chosen: Scored
+    systematic: bool
+    test: dict
+    unlisted: Unlisted | None
+    unexplained: list[str]
+
+
+@dataclass(frozen=True)
+class Corrected:
+    """The recordings as the chosen explanation predicts them (the model as is when none is chosen), with the flights'
+    positions and, for a wind, the log profile's uniform-equivalent factor along them."""
+
+    outcomes: np.ndarray
+    positions: np.ndarray | None
+    wind_factor: float | None
+
+
 def _mean_sq(z: np.ndarray) -> float:
     return float(np.nanmean(z**2)) if np.isfinite(z).any() else float("nan")
 
@@ -113,8 +154,95 @@ def outlier_mask(residual: np.ndarray) -> np.ndarray:
     return out
 
 
+def baseline(
+    recordings: Recordings, model: FlightModel, noise: MeasurementNoise, seed: int, estimate_scatter: bool
+) -> Baseline:
+    """Fly the recorded launches through the model (and its control), and measure how far off it is expected to be."""
+    base = base_conditions(recordings, model)
+    flown = model.simulate(base, keep_positions=bool(recordings.trajectories))
+    predicted = flown.outcomes()
+    expected = expected_error(model, recordings, base, predicted, noise)
+    offset = np.zeros_like(predicted)
+    if model.control is not None:  # the model's known error on these launches, taken out of every prediction
+        offset = np.nan_to_num(model.control.simulate(base).outcomes() - predicted)
+        predicted = predicted + offset
+    residual = recordings.observed - predicted
+    wild = outlier_mask(residual)
+    use = np.isfinite(recordings.observed) & ~wild
+    own_rng = np.random.default_rng([seed, 1])  # its own stream: the fits' draws stay as they were
+    scatter = recording_scatter(recordings, np.where(use, residual / expected.sigma, np.nan), own_rng)
+    if estimate_scatter:
+        expected = with_scatter(expected, scatter)
+    return Baseline(base, flown, predicted, offset, residual, wild, use, expected, scatter)
+
+
+def located_mismatch(recordings: Recordings, start: Baseline) -> Located:
+    """The systematic test on the model's residuals, along the recorded trajectories too."""
+    flown = start.flown
+    along = (
+        trajectory_stats(list(trajectory_residuals(recordings, flown.positions, flown.dt_s).values()))
+        if flown.positions is not None
+        else []
+    )
+    outliers = {name: int(start.wild[:, j].sum()) for j, name in enumerate(OBSERVABLES) if start.wild[:, j].any()}
+    return locate(recordings, start.residual, start.expected.sigma, start.use, along, outliers, start.expected.dilution)
+
+
+def corrected(problem: Problem, chosen: Fit, predicted: np.ndarray, keep_trajectories: bool) -> Corrected:
+    """Fly every recorded shot with the chosen effects (the model's own `predicted` when none)."""
+    if not chosen.k:
+        return Corrected(predicted, None, None)
+    has_wind = any(e.name == "wind" for e in chosen.effects)
+    everyone = np.arange(len(problem.recordings))
+    theta_rows = np.repeat(chosen.theta[None], len(everyone), 0)
+    flown = problem.outcomes(chosen.effects, theta_rows, everyone, keep_positions=keep_trajectories or has_wind)
+    factor = (
+        uniform_equivalent_factor(flown.positions[..., 2], STATION_HEIGHT_M, FAIRWAY_ROUGHNESS_M) if has_wind else None
+    )
+    return Corrected(flown.outcomes() + problem.offset, flown.positions, factor)
+
+
+def model_info(model: FlightModel, context: Context, start: Baseline, estimate_scatter: bool) -> ModelInfo:
+    """The report's account of the model: its settings, the error it is expected to make and its known error."""
+    expected, scatter = start.expected, start.scatter
+    return ModelInfo(
+        name=model.name,
+        dt_s=model.dt_s,
+        integrator=model.method,
+        density_kg_m3=context.density_kg_m3,
+        model_error=expected.model,
+        model_error_source=expected.model_source,
+        outcome_noise=expected.outcome_noise,
+        launch_noise=expected.launch_noise,
+        scatter={
+            name: ScatterStat(ratio=ratio, low=scatter.low[name], applied=estimate_scatter and name in scatter.applied)
+            for name, ratio in scatter.ratio.items()
+        },
+        control=None if model.control is None else model.control.name,
+        known_model_error=None
+        if model.control is None
+        else {name: float(-np.mean(start.offset[:, j])) for j, name in enumerate(OBSERVABLES)},
+    )
+
+
+def candidates(selection: Selection, context: Context) -> list[Candidate]:
+    """Every candidate tried, the null among them, best score first."""
+    return [
+        Candidate(
+            name=s.fit.name,
+            effects=effect_results(s.fit, context),
+            n_parameters=s.fit.k,
+            heldout_error=s.error,
+            penalty=s.penalty,
+            score=s.score,
+        )
+        for s in sorted([selection.null] + selection.scored, key=lambda s: s.score)
+    ]
+
+
 class Diagnoser:
-    """Fits and scores candidates on one problem; `run` returns the full diagnosis."""
+    """One diagnosis. Making it flies the model on the recordings (`baseline`) and sets up the problem, folds and fit
+    rows every candidate shares; its methods read only those, and `run` fits, chooses and reports."""
 
     def __init__(
         self,
@@ -125,11 +253,114 @@ class Diagnoser:
         with_correction: bool = True,
         estimate_scatter: bool = True,
     ):
+        self.started = time.perf_counter()
         self.recordings, self.model, self.library = recordings, model, LIBRARY
         self.with_correction, self.estimate_scatter = with_correction, estimate_scatter
-        self.seed, self.rng = seed, np.random.default_rng(seed)
+        self.rng = np.random.default_rng(seed)
+        self.baseline = baseline(recordings, model, noise, seed, estimate_scatter)
+        start = self.baseline
+        self.problem = Problem(model, recordings, start.base, start.expected.sigma, start.use, start.offset)
+        self.fold, self.grouping = folds(recordings.session)
+        self.rows = fit_rows(recordings, self.rng)
         self._response_errors: dict[tuple[str, bytes], float] = {}  # memo: asked up to three times
-        self.noise = noise
+
+    def run(self) -> Diagnosis:
+        """Locate the mismatch, choose its explanation, and report it with the arrays the plots need."""
+        start = self.baseline
+        located = located_mismatch(self.recordings, start)
+        selection = self.select(has_structure(located))
+        chosen = selection.chosen
+        after = corrected(self.problem, chosen.fit, start.predicted, bool(self.recordings.trajectories))
+        heldout_block = self.heldout_summary(selection.null, chosen)
+        ambiguities = (
+            ambiguity(self.problem, chosen, after.outcomes, selection.scored, self.rng) if selection.systematic else []
+        )
+        report = self.report(located, selection, after, heldout_block, ambiguities)
+        sigma = start.expected.sigma
+        return Diagnosis(
+            report,
+            self.recordings,
+            start.predicted,
+            after.outcomes,
+            selection.null.heldout_z * sigma,
+            chosen.heldout_z * sigma,
+            start.flown.positions,
+            after.positions,
+            chosen if selection.systematic else None,
+        )
+
+    def report(
+        self, located: Located, selection: Selection, after: Corrected, heldout_block: Heldout, ambiguities: list
+    ) -> Report:
+        """The report of a finished selection."""
+        recordings, model, chosen = self.recordings, self.model, selection.chosen
+        context = Context(float(np.median(self.baseline.base.density_kg_m3)), model.temperature_c)
+        effects = effect_results(chosen.fit, context)
+        words = statement(
+            selection.systematic,
+            located,
+            effects,
+            selection.unlisted,
+            heldout_block,
+            ambiguities,
+            selection.scored,
+            chosen,
+        )
+        return Report(
+            recordings=recordings.source,
+            n_shots=len(recordings),
+            n_sessions=recordings.n_sessions,
+            observables=list(recordings.observed_names),
+            trajectories=len(recordings.trajectories),
+            model=model_info(model, context, self.baseline, self.estimate_scatter),
+            systematic=selection.systematic,
+            systematic_test=selection.test,
+            located=located,
+            effects=effects,
+            unlisted=selection.unlisted,
+            candidates=candidates(selection, context),
+            ambiguities=ambiguities,
+            heldout=heldout_block,
+            statement=words
+            + left_sentence(selection.unexplained)
+            + control_sentence(model, self.baseline.offset, self.response_error(chosen))
+            + (scatter_sentence(self.baseline.scatter) if self.estimate_scatter else ""),
+            service_settings=service_settings(effects, context, after.wind_factor),
+            seconds=time.perf_counter() - self.started,
+        )
+
+    def null_candidate(self) -> Scored:
+        """The model as is, scored like any candidate (no parameters, no penalty)."""
+        null_z = self.problem.standardize(self.baseline.predicted, np.arange(len(self.recordings)))
+        empty = Fit((), np.zeros(0), null_z, np.zeros(null_z.shape + (0,)), np.zeros((0, 0)))
+        return Scored(empty, null_z, _mean_sq(null_z), 0.0)
+
+    def select(self, structure: bool) -> Selection:
+        """Fit the singles and pairs, choose among them, try the learned correction where structure is left, and
+        call the mismatch systematic only if the test found `structure` and something beat the null."""
+        null = self.null_candidate()
+        singles = self.fit_singles()
+        pairs = self.fit_pairs(singles)
+        scored = singles + pairs
+        chosen, test = self.choose(null, singles, pairs)
+        unlisted, left = None, self.structure_left(chosen) if structure and self.with_correction else []
+        if left:
+            library_best = chosen
+            chosen, tried, entries = self.try_correction(null, chosen)
+            scored += tried
+            test.update(entries)
+            if chosen is not library_best:
+                unlisted = learned.summary(chosen.fit, chosen.error, library_best.error)
+        unexplained = left if chosen.fit.k and unlisted is None else []
+        systematic = structure and chosen is not null
+        test.update(
+            before_error=null.error,
+            structure_found=structure,
+            decision="systematic" if systematic else "consistent with noise and the model's own error",
+        )
+        if not systematic:
+            return Selection(null, scored, null, False, test, None, [])
+        return Selection(null, scored, chosen, True, test, unlisted, unexplained)
 
     def score(self, result: Fit) -> Scored:
         z = heldout(self.problem, result, self.fold)
@@ -174,24 +405,24 @@ class Diagnoser:
             self._response_errors[key] = _mean_sq(z)
         return self._response_errors[key]
 
-    def fit_singles(self, rows: np.ndarray) -> list[Scored]:
+    def fit_singles(self) -> list[Scored]:
         """Every library effect alone, from Gauss-Newton starts out of one Jacobian; best score first."""
-        starts = linear_starts(self.problem, None, self.library, rows)
-        singles = [self.score(fit(self.problem, (e,), start, rows)) for e, (start, _) in zip(self.library, starts)]
+        starts = linear_starts(self.problem, None, self.library, self.rows)
+        singles = [self.score(fit(self.problem, (e,), start, self.rows)) for e, (start, _) in zip(self.library, starts)]
         return sorted(singles, key=lambda s: s.score)
 
-    def fit_pairs(self, singles: list[Scored], rows: np.ndarray) -> list[Scored]:
+    def fit_pairs(self, singles: list[Scored]) -> list[Scored]:
         """Each of the best singles with the effects that most reduce its linearised cost; best score first."""
         pairs, tried = [], set()
         for anchor in singles[:PAIR_ANCHORS]:
             others = tuple(e for e in self.library if e not in anchor.fit.effects)
             screened = sorted(
-                zip(others, linear_starts(self.problem, anchor.fit, others, rows)), key=lambda item: item[1][1]
+                zip(others, linear_starts(self.problem, anchor.fit, others, self.rows)), key=lambda item: item[1][1]
             )
             fresh = [(o, start) for o, (start, _) in screened if frozenset((anchor.fit.name, o.name)) not in tried]
             for other, start in fresh[:PAIR_FITS]:
                 tried.add(frozenset((anchor.fit.name, other.name)))
-                pairs.append(self.score(fit(self.problem, anchor.fit.effects + (other,), start, rows)))
+                pairs.append(self.score(fit(self.problem, anchor.fit.effects + (other,), start, self.rows)))
         return sorted(pairs, key=lambda s: s.score)
 
     def choose(self, null: Scored, singles: list[Scored], pairs: list[Scored]) -> tuple[Scored, dict]:
@@ -215,22 +446,21 @@ class Diagnoser:
                     chosen = pairs[0]
         return chosen, test
 
-    def try_correction(
-        self, null: Scored, chosen: Scored, rows: np.ndarray, scored: list[Scored], test: dict
-    ) -> Scored:
+    def try_correction(self, null: Scored, chosen: Scored) -> tuple[Scored, list[Scored], dict]:
         """The learned correction on top of the chosen explanation and alone; it replaces the choice if better. A
         library effect is kept beside it only if that beats the correction alone beyond doubt: an effect that
-        explains the size of the mismatch but not its structure is not named."""
-        tolerance = self.response_error(chosen)
+        explains the size of the mismatch but not its structure is not named. (choice, corrections tried, the
+        systematic test's entries)."""
+        tolerance, tried, test = self.response_error(chosen), [], {}
         if tolerance:
             test[f"model_response_error_of_{chosen.fit.name}"] = tolerance
         library, alone = chosen, None
         for foundation in {id(chosen): chosen, id(null): null}.values():
-            term = learned.fit_correction(self.problem, rows, foundation.fit)
+            term = learned.fit_correction(self.problem, self.rows, foundation.fit)
             if term is None:
                 continue
             candidate = self.score(term)
-            scored.append(candidate)
+            tried.append(candidate)
             level = SINGLE_LEVEL if library is null else COMBINATION_LEVEL
             against = max(null.error - 1.0, 0.0) if library is null else None
             flag, gain, low, _ = self.better(candidate, library, level, tolerance, against)
@@ -245,7 +475,7 @@ class Diagnoser:
             test["library_beside_correction_gain"], test["library_beside_correction_gain_low"] = gain, low
             if not flag:
                 chosen = alone
-        return chosen
+        return chosen, tried, test
 
     def structure_left(self, explanation: Scored) -> list[str]:
         """What the systematic test still finds in the residuals that `explanation` leaves (its summary lines; empty
@@ -256,151 +486,13 @@ class Diagnoser:
         after = self.problem.predict(explanation.fit.effects, explanation.fit.theta, everyone)[0]
         residual = self.recordings.observed - after
         use = self.problem.use & np.isfinite(after)
-        left = locate(self.recordings, residual, self.problem.sigma, use, [], {}, self.dilution)
+        left = locate(self.recordings, residual, self.problem.sigma, use, [], {}, self.baseline.expected.dilution)
         return left.summary if has_structure(left) else []
 
-    def run(self) -> Diagnosis:
-        started = time.perf_counter()
-        recordings, model = self.recordings, self.model
-        base = base_conditions(recordings, model)
-        everyone = np.arange(len(recordings))
-        flown = model.simulate(base, keep_positions=bool(recordings.trajectories))
-        predicted = flown.outcomes()
-        expected: ExpectedError = expected_error(model, recordings, base, predicted, self.noise)
-        offset = np.zeros_like(predicted)
-        if model.control is not None:  # the model's known error on these launches, taken out of every prediction
-            offset = np.nan_to_num(model.control.simulate(base).outcomes() - predicted)
-            predicted = predicted + offset
-        residual = recordings.observed - predicted
-        wild = outlier_mask(residual)
-        use = np.isfinite(recordings.observed) & ~wild
-        own_rng = np.random.default_rng([self.seed, 1])  # its own stream: the fits' draws stay as they were
-        scatter = recording_scatter(recordings, np.where(use, residual / expected.sigma, np.nan), own_rng)
-        if self.estimate_scatter:
-            expected = with_scatter(expected, scatter)
-        self.problem = Problem(model, recordings, base, expected.sigma, use, offset)
-        self.fold, grouping = folds(recordings.session)
-        rows = fit_rows(recordings, self.rng)
-
-        along = (
-            trajectory_stats(list(trajectory_residuals(recordings, flown.positions, flown.dt_s).values()))
-            if flown.positions is not None
-            else []
-        )
-        outliers = {name: int(wild[:, j].sum()) for j, name in enumerate(OBSERVABLES) if wild[:, j].any()}
-        self.dilution = expected.dilution
-        located = locate(recordings, residual, expected.sigma, use, along, outliers, self.dilution)
-
-        null_z = self.problem.standardize(predicted, everyone)
-        null = Scored(
-            Fit((), np.zeros(0), null_z, np.zeros(null_z.shape + (0,)), np.zeros((0, 0))),
-            null_z,
-            _mean_sq(null_z),
-            0.0,
-        )
-        singles = self.fit_singles(rows)
-        pairs = self.fit_pairs(singles, rows)
-        scored = singles + pairs
-        chosen, test = self.choose(null, singles, pairs)
-        structure = has_structure(located)
-        unlisted, left = None, self.structure_left(chosen) if structure and self.with_correction else []
-        if left:
-            library_best = chosen
-            chosen = self.try_correction(null, chosen, rows, scored, test)
-            if chosen is not library_best:
-                unlisted = learned.summary(chosen.fit, chosen.error, library_best.error)
-        unexplained = left if chosen.fit.k and unlisted is None else []
-
-        systematic = structure and chosen is not null
-        test.update(
-            before_error=null.error,
-            structure_found=structure,
-            decision="systematic" if systematic else "consistent with noise and the model's own error",
-        )
-        if not systematic:
-            chosen, unlisted = null, None
-
-        after_fit = chosen.fit
-        after, positions_after, wind_factor = predicted, None, None
-        has_wind = any(e.name == "wind" for e in after_fit.effects)
-        if after_fit.k:
-            theta_rows = np.repeat(after_fit.theta[None], len(everyone), 0)
-            keep = bool(recordings.trajectories) or has_wind
-            flown_after = self.problem.outcomes(after_fit.effects, theta_rows, everyone, keep_positions=keep)
-            after, positions_after = flown_after.outcomes() + self.problem.offset, flown_after.positions
-            if has_wind:
-                wind_factor = uniform_equivalent_factor(positions_after[..., 2], STATION_HEIGHT_M, FAIRWAY_ROUGHNESS_M)
-        heldout_block = self.heldout_summary(null, chosen, grouping, expected)
-        context = Context(float(np.median(base.density_kg_m3)), model.temperature_c)
-        effects = effect_results(after_fit, context)
-        ambiguities = ambiguity(self.problem, chosen, after, scored, self.rng) if systematic else []
-        candidates = [
-            Candidate(
-                name=s.fit.name,
-                effects=effect_results(s.fit, context),
-                n_parameters=s.fit.k,
-                heldout_error=s.error,
-                penalty=s.penalty,
-                score=s.score,
-            )
-            for s in sorted([null] + scored, key=lambda s: s.score)
-        ]
-        report = Report(
-            recordings=recordings.source,
-            n_shots=len(recordings),
-            n_sessions=recordings.n_sessions,
-            observables=list(recordings.observed_names),
-            trajectories=len(recordings.trajectories),
-            model=ModelInfo(
-                name=model.name,
-                dt_s=model.dt_s,
-                integrator=model.method,
-                density_kg_m3=context.density_kg_m3,
-                model_error=expected.model,
-                model_error_source=expected.model_source,
-                outcome_noise=expected.outcome_noise,
-                launch_noise=expected.launch_noise,
-                scatter={
-                    name: ScatterStat(
-                        ratio=ratio,
-                        low=scatter.low[name],
-                        applied=self.estimate_scatter and name in scatter.applied,
-                    )
-                    for name, ratio in scatter.ratio.items()
-                },
-                control=None if model.control is None else model.control.name,
-                known_model_error=None
-                if model.control is None
-                else {name: float(-np.mean(offset[:, j])) for j, name in enumerate(OBSERVABLES)},
-            ),
-            systematic=systematic,
-            systematic_test=test,
-            located=located,
-            effects=effects,
-            unlisted=unlisted,
-            candidates=candidates,
-            ambiguities=ambiguities,
-            heldout=heldout_block,
-            statement=statement(systematic, located, effects, unlisted, heldout_block, ambiguities, scored, chosen)
-            + left_sentence(unexplained if systematic else [])
-            + control_sentence(model, offset, self.response_error(chosen))
-            + (scatter_sentence(scatter) if self.estimate_scatter else ""),
-            service_settings=service_settings(effects, context, wind_factor),
-            seconds=time.perf_counter() - started,
-        )
-        return Diagnosis(
-            report,
-            recordings,
-            predicted,
-            after,
-            null.heldout_z * expected.sigma,
-            chosen.heldout_z * expected.sigma,
-            flown.positions,
-            positions_after,
-            chosen if systematic else None,
-        )
-
-    def heldout_summary(self, null: Scored, chosen: Scored, grouping: str, expected: ExpectedError) -> Heldout:
+    def heldout_summary(self, null: Scored, chosen: Scored) -> Heldout:
+        """Held-out errors before and after the choice, its improvement with bootstrap intervals, and how much of
+        the excess over the noise floor it explains."""
+        expected = self.baseline.expected
         sigma = expected.sigma
         before_r, after_r = null.heldout_z * sigma, chosen.heldout_z * sigma
         names = [(j, n) for j, n in enumerate(OBSERVABLES) if np.isfinite(null.heldout_z[:, j]).any()]
@@ -430,7 +522,7 @@ class Diagnoser:
             fraction_ci = tuple(float(q) for q in np.quantile(ratio, [0.025, 0.975]))
             absorbs = fraction_ci[0] > 1.0 and chosen.error < (1.0 - NOISE_SPREAD) * noise_floor
         return Heldout(
-            grouping=grouping,
+            grouping=self.grouping,
             n_folds=int(self.fold.max()) + 1,
             before={n: _rms(before_r[:, j]) for j, n in names},
             after={n: _rms(after_r[:, j]) for j, n in names},

@@ -81,13 +81,11 @@ def _table(header: list[str], rows: list[list[object]]) -> str:
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def render(diagnosis) -> str:
-    """The whole HTML page of a diagnosis."""
-    report: Report = diagnosis.report
+def _mismatch_table(report: Report) -> str:
+    """Per observable: the located bias and scatter against the expected, and the held-out RMS before and after."""
     held = report.heldout
-    observed = [n for n in OBSERVABLES if n in held.before]
     stats = {o.name: o for o in report.located.observables}
-    mismatch_rows = [
+    rows = [
         [
             n,
             stats[n].bias,
@@ -100,10 +98,44 @@ def render(diagnosis) -> str:
             held.after[n],
             "{:.3g} [{:.3g}, {:.3g}]".format(*held.improvement_by_observable[n]),
         ]
-        for n in observed
-        if n in stats
+        for n in OBSERVABLES
+        if n in held.before and n in stats
     ]
-    candidates = [
+    header = ["observable", "bias", "bias SE", "RMS", "expected", "RMS/expected", "significant"]
+    return _table(header + ["held-out RMS before", "held-out RMS after", "improvement of mean z² [95 %]"], rows)
+
+
+def _heldout_line(report: Report) -> str:
+    """The held-out errors before and after in one sentence, with the explained share where there is one."""
+    held = report.heldout
+    fraction = (
+        ""
+        if held.explained_fraction is None
+        else f"; explained share of the excess error {100 * held.explained_fraction:.0f} % "
+        f"(95 % interval {100 * held.explained_fraction_ci[0]:.0f}–{100 * held.explained_fraction_ci[1]:.0f} %)"
+    )
+    return (
+        f"<p>Held-out ({escape(held.grouping)}): mean squared standardized error {held.before_error:.3g} → "
+        f"{held.after_error:.3g}, improvement {held.improvement:.3g} (95 % interval {held.improvement_ci[0]:.3g} to "
+        f"{held.improvement_ci[1]:.3g}){fraction}.</p>"
+    )
+
+
+def _trajectory_section(report: Report, plots: Plots) -> list[str]:
+    """The mismatch along the recorded flights (none without trajectories)."""
+    rows = [
+        [t.phase, t.height_band, t.n_samples, t.n_shots, t.across_m, t.along_m, t.height_m, t.rms_m]
+        for t in report.located.trajectory
+    ]
+    if not rows and not plots.div("along"):
+        return []
+    header = ["phase", "height band", "samples", "shots", "across (m)", "along (m)", "height (m)", "RMS (m)"]
+    return ["<h2>Along the flight</h2>" + _table(header, rows) + plots.div("along")]
+
+
+def _candidates_table(report: Report) -> str:
+    """Every candidate with its fitted parameters (± 1 sigma) and its held-out score."""
+    rows = [
         [
             c.name,
             "; ".join(
@@ -118,7 +150,26 @@ def render(diagnosis) -> str:
         ]
         for c in report.candidates
     ]
-    group_rows = [
+    return _table(["candidate", "fitted parameters", "k", "held-out error", "penalty", "score"], rows)
+
+
+def _named_sections(report: Report) -> list[str]:
+    """The ambiguities and the unlisted effect, where the report has them."""
+    sections = []
+    if report.ambiguities:
+        items = "".join(
+            f"<li>{escape(a.effects[0])} vs {escape(a.effects[1])}: {escape(a.note)}</li>" for a in report.ambiguities
+        )
+        sections.append(f"<h2>What the data cannot separate</h2><ul>{items}</ul>")
+    if report.unlisted is not None:
+        items = "".join(f"<li>{escape(k)}: {escape(v)}</li>" for k, v in report.unlisted.meaning.items())
+        sections.append(f"<h2>Unlisted effect</h2><p>{escape(report.unlisted.expression)}</p><ul>{items}</ul>")
+    return sections
+
+
+def _groups_table(report: Report) -> str:
+    """The differences between clubs and sessions the systematic test measured."""
+    rows = [
         [
             g.observable,
             g.grouping,
@@ -130,18 +181,31 @@ def render(diagnosis) -> str:
         ]
         for g in report.located.groups
     ]
-    trajectory_rows = [
-        [t.phase, t.height_band, t.n_samples, t.n_shots, t.across_m, t.along_m, t.height_m, t.rms_m]
-        for t in report.located.trajectory
+    return _table(["observable", "grouping", "groups", "F", "p", "significant", "extreme groups (mean residual)"], rows)
+
+
+def _expected_table(report: Report) -> str:
+    """The error each observable was expected to have, by part, and where the recordings' own scatter replaced it."""
+    model = report.model
+    rows = [
+        [
+            n,
+            model.model_error[n],
+            model.model_error_source.get(n, ""),
+            model.outcome_noise[n],
+            model.launch_noise[n],
+            model.scatter[n].ratio if n in model.scatter else "",
+            model.scatter[n].applied if n in model.scatter else "",
+        ]
+        for n in OBSERVABLES
     ]
-    fraction = (
-        ""
-        if held.explained_fraction is None
-        else f"; explained share of the excess error {100 * held.explained_fraction:.0f} % "
-        f"(95 % interval {100 * held.explained_fraction_ci[0]:.0f}–{100 * held.explained_fraction_ci[1]:.0f} %)"
-    )
-    plots = Plots(diagnosis)
-    sections = [
+    header = ["observable", "model error", "source", "outcome noise", "launch noise"]
+    return _table(header + ["recordings' scatter (x expected)", "scatter used"], rows)
+
+
+def _opening(report: Report, plots: Plots) -> list[str]:
+    """What was diagnosed against what, the statement, the systematic test and where the mismatch is."""
+    return [
         (
             f"<h1>Mismatch diagnosis</h1><p>{escape(report.recordings)}: {report.n_shots} shots, {report.n_sessions} "
             f"sessions, observed {', '.join(report.observables)}, {report.trajectories} trajectories. Model: "
@@ -149,93 +213,33 @@ def render(diagnosis) -> str:
         ),
         plots.notice(),
         f"<p class='statement'>{escape(report.statement)}</p>",
-        f"<p><b>Systematic:</b> {report.systematic}. Test: {escape(json.dumps(report.systematic_test, default=str))}</p>",
+        f"<p><b>Systematic:</b> {report.systematic}. Test: "
+        f"{escape(json.dumps(report.systematic_test, default=str))}</p>",
         "<h2>Where the mismatch is</h2><ul>"
         + "".join(f"<li>{escape(s)}</li>" for s in report.located.summary)
         + "</ul>",
-        _table(
-            [
-                "observable",
-                "bias",
-                "bias SE",
-                "RMS",
-                "expected",
-                "RMS/expected",
-                "significant",
-                "held-out RMS before",
-                "held-out RMS after",
-                "improvement of mean z² [95 %]",
-            ],
-            mismatch_rows,
-        ),
-        (
-            f"<p>Held-out ({escape(held.grouping)}): mean squared standardized error {held.before_error:.3g} → "
-            f"{held.after_error:.3g}, improvement {held.improvement:.3g} (95 % interval {held.improvement_ci[0]:.3g} to "
-            f"{held.improvement_ci[1]:.3g}){fraction}.</p>"
-        ),
+    ]
+
+
+def render(diagnosis) -> str:
+    """The whole HTML page of a diagnosis."""
+    report: Report = diagnosis.report
+    plots = Plots(diagnosis)
+    sections = [
+        *_opening(report, plots),
+        _mismatch_table(report),
+        _heldout_line(report),
         plots.div("residuals"),
         "<h2>Before and after, held-out shots</h2>" + plots.div("heldout"),
-    ]
-    if trajectory_rows or plots.div("along"):
-        sections.append(
-            "<h2>Along the flight</h2>"
-            + _table(
-                ["phase", "height band", "samples", "shots", "across (m)", "along (m)", "height (m)", "RMS (m)"],
-                trajectory_rows,
-            )
-            + plots.div("along")
-        )
-    sections += [
+        *_trajectory_section(report, plots),
         "<h2>Candidates</h2>" + plots.div("candidates"),
-        _table(["candidate", "fitted parameters", "k", "held-out error", "penalty", "score"], candidates),
-    ]
-    if report.ambiguities:
-        sections.append(
-            "<h2>What the data cannot separate</h2><ul>"
-            + "".join(
-                f"<li>{escape(a.effects[0])} vs {escape(a.effects[1])}: {escape(a.note)}</li>"
-                for a in report.ambiguities
-            )
-            + "</ul>"
-        )
-    if report.unlisted is not None:
-        sections.append(
-            f"<h2>Unlisted effect</h2><p>{escape(report.unlisted.expression)}</p><ul>"
-            + "".join(f"<li>{escape(k)}: {escape(v)}</li>" for k, v in report.unlisted.meaning.items())
-            + "</ul>"
-        )
-    sections += [
-        "<h2>Differences between groups</h2>"
-        + _table(
-            ["observable", "grouping", "groups", "F", "p", "significant", "extreme groups (mean residual)"], group_rows
-        ),
+        _candidates_table(report),
+        *_named_sections(report),
+        "<h2>Differences between groups</h2>" + _groups_table(report),
         "<h2>Service settings</h2><pre>"
         + escape(report.service_settings.model_dump_json(indent=2, exclude_none=True))
         + "</pre>",
-        "<h2>Expected error</h2>"
-        + _table(
-            [
-                "observable",
-                "model error",
-                "source",
-                "outcome noise",
-                "launch noise",
-                "recordings' scatter (x expected)",
-                "scatter used",
-            ],
-            [
-                [
-                    n,
-                    report.model.model_error[n],
-                    report.model.model_error_source.get(n, ""),
-                    report.model.outcome_noise[n],
-                    report.model.launch_noise[n],
-                    report.model.scatter[n].ratio if n in report.model.scatter else "",
-                    report.model.scatter[n].applied if n in report.model.scatter else "",
-                ]
-                for n in OBSERVABLES
-            ],
-        ),
+        "<h2>Expected error</h2>" + _expected_table(report),
     ]
     return (
         f"<!doctype html><html><head><meta charset='utf-8'><title>golfflight diagnose</title><style>{STYLE}</style>"

@@ -256,22 +256,12 @@ def _share(flags: list[bool]) -> str:
     return f"{sum(flags)} of {len(flags)} ({np.mean(flags):.0%})"
 
 
-def tables(runs: list[Run], model_name: str, truth: Truth = "model") -> str:
-    """The markdown tables of a prove run."""
-    flown = "the diagnosed model's own flights" if truth == "model" else "the reference world's flights"
-    lines = [
-        (
-            f"Model diagnosed: {model_name}; effects hidden in {flown}. {len(runs)} concealed sets, "
-            f"{int(np.mean([r.n_shots for r in runs]))} shots and {np.mean([r.n_sessions for r in runs]):.1f} sessions "
-            f"each on average; diagnose took {np.median([r.seconds for r in runs]):.1f} s per set (median)."
-        ),
-        "",
-    ]
+def _measure_rows(runs: list[Run], truth: Truth) -> list[str]:
+    """The headline table's rows: false alarms, detection, naming, parameter error and the error removed."""
     clean = [r for r in runs if r.case == "clean"]
     hidden = [r for r in runs if r.case != "clean"]
     library = [r for r in hidden if r.case in EFFECTS]
     outside = [r for r in hidden if _outside(r.hidden)]
-    absorbing = sum(r.absorbs_noise for r in hidden)
     errors = [e for r in hidden for e in r.parameter_error.values()]
     fractions = [r.explained_fraction for r in hidden if r.explained_fraction is not None]
     rows = []
@@ -301,7 +291,7 @@ def tables(runs: list[Run], model_name: str, truth: Truth = "model") -> str:
     if hidden:
         rows.append(
             "| fits flagged as absorbing noise (over 100 % beyond doubt, error 25 % below the noise floor) | "
-            f"{absorbing} | - |"
+            f"{sum(r.absorbs_noise for r in hidden)} | - |"
         )
     if errors:
         rows.append(
@@ -313,10 +303,13 @@ def tables(runs: list[Run], model_name: str, truth: Truth = "model") -> str:
             f"| excess held-out error removed (median; min) | {np.median(fractions):.1%}; {min(fractions):.1%} "
             "| ≥ 70 % |"
         )
-    lines += ["| measure | reached | target |", "|---|---:|---:|", *rows, ""]
-    present = [(case, effects) for case, effects in cases(truth) if any(r.case == case for r in runs)]
+    return rows
+
+
+def _confusion(runs: list[Run], present: list[tuple[str, tuple[str, ...]]]) -> list[str]:
+    """Hidden case (rows) against the named explanation (columns), the right cell in bold."""
     labels = sorted({r.named for r in runs} | {expected_label(e) for _, e in present}, key=lambda s: (s != "none", s))
-    lines += [
+    lines = [
         "### Confusion: hidden case (rows) vs named explanation (columns)",
         "",
         "| hidden \\ named | " + " | ".join(labels) + " |",
@@ -330,8 +323,12 @@ def tables(runs: list[Run], model_name: str, truth: Truth = "model") -> str:
             for label, c in zip(labels, counts)
         ]
         lines.append(f"| {case} | " + " | ".join(cells) + " |")
-    lines += [
-        "",
+    return lines
+
+
+def _per_case(runs: list[Run], present: list[tuple[str, tuple[str, ...]]]) -> list[str]:
+    """Per case: named right, detected, parameter error, error removed and held-out error before and after."""
+    lines = [
         "### Per case",
         "",
         (
@@ -352,8 +349,12 @@ def tables(runs: list[Run], model_name: str, truth: Truth = "model") -> str:
             + " | "
             + f"{np.median([r.before_error for r in row]):.2f} → {np.median([r.after_error for r in row]):.2f} |"
         )
-    lines += [
-        "",
+    return lines
+
+
+def _every_run(runs: list[Run]) -> list[str]:
+    """One row a run: what was hidden, what was named and fitted, and how far off."""
+    lines = [
         "### Every run",
         "",
         "| case | seed | hidden | named | fitted | parameter error | removed |",
@@ -370,6 +371,20 @@ def tables(runs: list[Run], model_name: str, truth: Truth = "model") -> str:
         errs = ", ".join(f"{v:.1%}" for v in r.parameter_error.values()) or "-"
         removed = "-" if r.explained_fraction is None or not r.systematic else f"{r.explained_fraction:.0%}"
         lines.append(f"| {r.case} | {r.seed} | {_fmt_hidden(r.hidden)} | {r.named} | {fitted} | {errs} | {removed} |")
+    return lines
+
+
+def tables(runs: list[Run], model_name: str, truth: Truth = "model") -> str:
+    """The markdown tables of a prove run."""
+    flown = "the diagnosed model's own flights" if truth == "model" else "the reference world's flights"
+    opening = (
+        f"Model diagnosed: {model_name}; effects hidden in {flown}. {len(runs)} concealed sets, "
+        f"{int(np.mean([r.n_shots for r in runs]))} shots and {np.mean([r.n_sessions for r in runs]):.1f} sessions "
+        f"each on average; diagnose took {np.median([r.seconds for r in runs]):.1f} s per set (median)."
+    )
+    present = [(case, effects) for case, effects in cases(truth) if any(r.case == case for r in runs)]
+    lines = [opening, "", "| measure | reached | target |", "|---|---:|---:|", *_measure_rows(runs, truth), ""]
+    lines += [*_confusion(runs, present), "", *_per_case(runs, present), "", *_every_run(runs)]
     return "\n".join(lines) + "\n"
 
 

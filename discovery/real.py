@@ -6,7 +6,7 @@ Sets: the outdoor, radar-tracked TrackMan driver shots (all balls, the held-out 
 PGA TOUR TrackMan trajectories of the Sentry 2022 (spin from the play-by-play) and the Sony Open 2022 (spin estimated
 from the initial lift), each per event and per round, the TOUR Championship 2020's radar tee shots (launch, spin and
 apex) of its trainable rounds and of its held-out rounds apart, and TrackMan's PGA TOUR 2023 averages (one row per
-club). Each set says whether it is held out (`shots.heldout`, NOTES section 9: only the driver file's lines from 2943
+club). Each set says whether it is held out (`shots.heldout`: only the driver file's lines from 2943
 and the TOUR Championship's rounds 3-4), trained on by `models/default`, or neither. A set whose source's air is known
 (`shots.source_air`: the PGA table, the Sentry, the TOUR Championship) is flown in that air, as training flew it; the
 others (the range sessions, the Sony Open) in the model's air.
@@ -87,98 +87,116 @@ class RealSet:
 
 def real_sets(shared: Path) -> list[RealSet]:
     """Every real set, converted in memory by the project's loaders."""
-    sets = []
+    return driver_sets(shared) + tourcast_sets(shared) + tour_championship_sets(shared) + [averages_set()]
+
+
+def driver_sets(shared: Path) -> list[RealSet]:
+    """The TrackMan driver sessions: all balls, the held-out lines alone, and the Premium balls."""
     held = held_out_set(TRACKMAN)  # shot_id is the line number in the export
     assert held is not None, "the driver file's second half is held out (shots.heldout)"
     first = held.first_line
+    split = f"lines 3 to {first - 1} trained on, {first} on held out"
     driver = load_trackman(shared / TRACKMAN, skip_bad_rows=True)
-    sets.append(
+    premium = load_trackman(shared / TRACKMAN, balls=["Premium"], skip_bad_rows=True)
+    unseen = [r for r in driver.records if held.holds(int(r.shot_id))]
+    return [
         RealSet(
             "trackman_driver",
             "TrackMan driver shots, outdoor radar-tracked, all balls",
             from_shot_set(ShotSet(driver.records), source=str(shared / TRACKMAN)),
             "one session (no dates): the diagnosis holds out blocks of shots; ball types mixed; no air recorded",
-            f"lines 3 to {first - 1} trained on, {first} on held out",
-        )
-    )
-    unseen = [r for r in driver.records if held.holds(int(r.shot_id))]
-    sets.append(
+            split,
+        ),
         RealSet(
             "trackman_driver_heldout",
             f"TrackMan driver shots, outdoor radar-tracked, all balls, held-out lines (from {first})",
             from_shot_set(ShotSet(unseen), source=f"{shared / TRACKMAN} (lines from {first})"),
-            "the lines no model was trained on (NOTES section 9; the earlier ones may be): one session, the diagnosis "
+            "the lines no model was trained on (shots.heldout; the earlier ones may be): one session, the diagnosis "
             "holds out blocks of shots; ball types mixed; no air recorded",
             HELD_OUT,
-        )
-    )
-    premium = load_trackman(shared / TRACKMAN, balls=["Premium"], skip_bad_rows=True)
-    sets.append(
+        ),
         RealSet(
             "trackman_driver_premium",
             "TrackMan driver shots, outdoor radar-tracked, Premium balls",
             from_shot_set(ShotSet(premium.records), source=str(shared / TRACKMAN) + " (Premium)"),
             "one session (no dates): the diagnosis holds out blocks of shots; no air recorded",
-            f"lines 3 to {first - 1} trained on, {first} on held out",
-        )
-    )
-    trajectories = shared / TOURCAST / "shot_trajectory"
-    events = [
-        (
-            "sentry",
-            "PGA TOUR Sentry 2022 (Kapalua)",
-            "shot_trajectory_2021_016_656.csv",
-            "pbp_2021_016_656.csv",
-            "spin from the play-by-play; spin axis derived from the initial lift",
-            KNOWN_AIR["sentry-2022"],
-            TRAINED_ON,
-        ),
-        (
-            "sony",
-            "PGA TOUR Sony Open 2022 (Waialae)",
-            "shot_trajectory_2021_006_006.csv",
-            None,
-            "spin ESTIMATED from the initial lift (Ferguson C_L): spin and lift effects are circular here",
-            None,
-            "not trained on",
+            split,
         ),
     ]
-    for key, title, file, pbp, caveat, air, use in events:
+
+
+@dataclass(frozen=True)
+class TourcastEvent:
+    """A PGA TOUR event's TrackMan trajectories: where they are, where the spin comes from, and the event's air."""
+
+    key: str
+    title: str
+    trajectories: str
+    pbp: str | None
+    """The play-by-play file with the measured spin; None: the spin is estimated from the initial lift."""
+    caveat: str
+    air: SourceAir | None
+    use: str
+
+
+TOURCAST_EVENTS = (
+    TourcastEvent(
+        "sentry",
+        "PGA TOUR Sentry 2022 (Kapalua)",
+        "shot_trajectory_2021_016_656.csv",
+        "pbp_2021_016_656.csv",
+        "spin from the play-by-play; spin axis derived from the initial lift",
+        KNOWN_AIR["sentry-2022"],
+        TRAINED_ON,
+    ),
+    TourcastEvent(
+        "sony",
+        "PGA TOUR Sony Open 2022 (Waialae)",
+        "shot_trajectory_2021_006_006.csv",
+        None,
+        "spin ESTIMATED from the initial lift (Ferguson C_L): spin and lift effects are circular here",
+        None,
+        "not trained on",
+    ),
+)
+
+
+def tourcast_sets(shared: Path) -> list[RealSet]:
+    """Each TrackMan-tracked tour event with its trajectories, all rounds and round by round."""
+    sets = []
+    for event in TOURCAST_EVENTS:
+        trajectories = shared / TOURCAST / "shot_trajectory" / event.trajectories
         conversion = load_tourcast(
-            trajectories / file,
-            None if pbp is None else shared / TOURCAST / "pbp" / pbp,
-            estimate_spin=pbp is None,
+            trajectories,
+            None if event.pbp is None else shared / TOURCAST / "pbp" / event.pbp,
+            estimate_spin=event.pbp is None,
             sample_interval_s=0.1,
             skip_bad_rows=True,
         )
-        records = ShotSet(in_air(conversion.records, air))
-        whole = from_shot_set(records, conversion.trajectories, str(trajectories / file))
-        caveat += "; " + (f"in the event's air ({air.basis})" if air else "no air known: the model's air")
-        sets.append(
-            RealSet(
-                key,
-                f"{title}, all rounds",
-                whole,
-                caveat + "; every hole faces another way, so a round's wind is not one wind in the shot frame",
-                use,
-            )
-        )
+        records = ShotSet(in_air(conversion.records, event.air))
+        whole = from_shot_set(records, conversion.trajectories, str(trajectories))
+        air = f"in the event's air ({event.air.basis})" if event.air else "no air known: the model's air"
+        caveat = f"{event.caveat}; {air}"
+        every_way = "; every hole faces another way, so a round's wind is not one wind in the shot frame"
+        sets.append(RealSet(event.key, f"{event.title}, all rounds", whole, caveat + every_way, event.use))
         for session in np.unique(whole.session):
             part = whole.subset(whole.session == session)
-            sets.append(RealSet(f"{key}_{session}", f"{title}, round {session.split('-R')[-1]}", part, caveat, use))
-    sets += tour_championship_sets(shared)
-    averages = default_tour_averages_path()
-    sets.append(
-        RealSet(
-            "pga_2023_averages",
-            "TrackMan PGA TOUR 2023 averages (12 clubs)",
-            from_shot_set(tour_averages(averages), source=str(averages)),
-            "averages over players, events and weather; straight shots; the diagnosis holds out one club at a time; "
-            f"in the table's air ({KNOWN_AIR['pga-2023-table'].basis})",
-            TRAINED_ON,
-        )
-    )
+            title = f"{event.title}, round {session.split('-R')[-1]}"
+            sets.append(RealSet(f"{event.key}_{session}", title, part, caveat, event.use))
     return sets
+
+
+def averages_set() -> RealSet:
+    """TrackMan's PGA TOUR 2023 averages, one row per club, in the table's air."""
+    averages = default_tour_averages_path()
+    return RealSet(
+        "pga_2023_averages",
+        "TrackMan PGA TOUR 2023 averages (12 clubs)",
+        from_shot_set(tour_averages(averages), source=str(averages)),
+        "averages over players, events and weather; straight shots; the diagnosis holds out one club at a time; "
+        f"in the table's air ({KNOWN_AIR['pga-2023-table'].basis})",
+        TRAINED_ON,
+    )
 
 
 def tour_championship_sets(shared: Path) -> list[RealSet]:
@@ -189,8 +207,10 @@ def tour_championship_sets(shared: Path) -> list[RealSet]:
     assert held_rounds, "the TOUR Championship's last rounds are held out (shots.heldout)"
     air = KNOWN_AIR["tour-championship-2020"]
     shots = [r for r in load_pbp(path, skip_bad_rows=True).records if r.apex_m is not None]
-    caveat = (f"radar tee shots: launch, spin, apex; no spin axis recorded (0), so no side; clubs not named (par 3s: "
-              f"irons); in the event's air ({air.basis})")
+    caveat = (
+        f"radar tee shots: launch, spin, apex; no spin axis recorded (0), so no side; clubs not named (par 3s: "
+        f"irons); in the event's air ({air.basis})"
+    )
     sets = []
     for key, held_out, use in (("trained", False, TRAINED_ON), ("heldout", True, HELD_OUT)):
         part = [r for r in shots if (shot_round(r.shot_id) in held_rounds) == held_out]

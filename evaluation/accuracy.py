@@ -3,7 +3,7 @@ real training sets, through the flight core the engine's batch path runs (`fligh
 bundle's ONNX graph; Ferguson 2022's quadratics through the same call).
 
 The models: the real-data model (`--model`), the synthetic model (`--synthetic`) and Ferguson, McNally & McPhee
-2022. The sets (`evaluation.accuracy_sets`): the held-out ones of NOTES section 9 (TrackMan outdoor drivers from
+2022. The sets (`evaluation.accuracy_sets`): the held-out ones of `shots.heldout` (TrackMan outdoor drivers from
 line 2943, rounds 3-4 of the TOUR Championship 2020); the paper's own figures for context and slow shots against
 published amateur launches (`accuracy_slow`); then training sets of the real-data model: the PGA 2023 averages
 (a per-club fit), the Sentry 2022 trajectories with each shot's latent wind (`accuracy_winds`), and a fine-tuning

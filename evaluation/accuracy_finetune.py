@@ -1,5 +1,5 @@
 """The fine-tuning study of `golfflight accuracy`: `golfflight finetune` on some rounds of a tour event, measured on
-the event's later rounds before and after. It never touches a held-out set (NOTES section 9): the event is the Sony
+the event's later rounds before and after. It never touches a held-out set (`shots.heldout`): the event is the Sony
 Open 2022 (trajectories only, so its spin is the loader's estimate from the initial lift). The fine-tuning itself
 (`model_export.finetune.finetune`, torch) is passed in by the caller, so this package needs no torch.
 """

@@ -1,5 +1,5 @@
 """The real sets `golfflight accuracy` flies, read by path from the shared data folder (never copied), and the
-errors of a flight against each: the held-out sets of NOTES section 9 (`shots.heldout`: TrackMan drivers from line
+errors of a flight against each: the held-out sets (`shots.heldout`: TrackMan drivers from line
 2943, rounds 3-4 of the TOUR Championship 2020), the PGA 2023 averages table (a training set of the real-data model,
 fitted per club) and the Sentry 2022 trajectories (a training set too, kept for its full-path errors).
 """

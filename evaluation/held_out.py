@@ -1,4 +1,4 @@
-"""The held-out errors a shipped card records: each held-out set (NOTES section 9) flown through the runtime path
+"""The held-out errors a shipped card records: each held-out set (`shots.heldout`) flown through the runtime path
 (the bundle's ONNX graph in the NumPy Euler loop), calm, in its own air where it is known (the TOUR Championship
 2020: the event's, `shots.source_air`), else in the card's air; mean absolute error per observable."""
 

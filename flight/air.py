@@ -1,4 +1,4 @@
-"""Air: pressure at altitude, moist-air density and viscosity (NOTES.md section 3).
+"""Air: pressure at altitude (US Standard Atmosphere 1976), moist-air density (Tetens 1930) and viscosity (Sutherland).
 
 Every function works on floats or NumPy arrays alike, so a batch of shots can each have their own air.
 """
@@ -6,6 +6,7 @@ Every function works on floats or NumPy arrays alike, so a batch of shots can ea
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -14,6 +15,8 @@ SEA_LEVEL_PRESSURE_PA = 101325.0
 DRY_AIR_GAS_CONSTANT = 287.05  # J/(kg K)
 WATER_VAPOUR_GAS_CONSTANT = 461.5  # J/(kg K)
 ZERO_CELSIUS_K = 273.15
+STANDARD_TEMPERATURE_C = 15.0
+STANDARD_HUMIDITY_PCT = 0.0
 
 
 def pressure_at_altitude(altitude_m: ArrayLike) -> np.ndarray:
@@ -48,9 +51,32 @@ def dynamic_viscosity(temperature_c: ArrayLike) -> np.ndarray:
     return 1.458e-6 * temperature_k**1.5 / (temperature_k + 110.4)
 
 
+def _plain(value: np.ndarray) -> float | np.ndarray:
+    """A float for one air (what the engine's per-step loop wants), the array itself for a batch."""
+    return float(value) if np.ndim(value) == 0 else value
+
+
+def _density_and_viscosity(
+    temperature_c: ArrayLike, altitude_m: ArrayLike, humidity_pct: ArrayLike, pressure_pa: ArrayLike | None
+) -> tuple[float | np.ndarray, float | np.ndarray]:
+    """Moist-air density at a station pressure (or, if none, an altitude) and mu(temperature) / density."""
+    pressure = pressure_at_altitude(altitude_m) if pressure_pa is None else np.asarray(pressure_pa, dtype=float)
+    density = air_density(temperature_c, pressure, humidity_pct)
+    return _plain(density), _plain(dynamic_viscosity(temperature_c) / density)
+
+
+_one_air = lru_cache(maxsize=1024)(_density_and_viscosity)
+"""The same for one air of plain numbers, cached because a stream of shots mostly shares a few airs."""
+
+
+_NUMBER = (int, float)
+"""What one air's weather values are (a NumPy float64 is a float); anything else is flown as arrays."""
+
+
 @dataclass(frozen=True)
 class Air:
-    """The air a shot flies through: its density and its kinematic viscosity (for Reynolds numbers)."""
+    """The air a shot flies through: its density and its kinematic viscosity (for Reynolds numbers), floats for one
+    air or arrays for a batch. The only air type: requests, conditions and data sets all build one of these."""
 
     density_kg_m3: float | np.ndarray
     kinematic_viscosity_m2_s: float | np.ndarray
@@ -58,17 +84,29 @@ class Air:
     @classmethod
     def from_conditions(
         cls,
-        temperature_c: ArrayLike = 15.0,
+        temperature_c: ArrayLike = STANDARD_TEMPERATURE_C,
         altitude_m: ArrayLike = 0.0,
-        humidity_pct: ArrayLike = 0.0,
+        humidity_pct: ArrayLike = STANDARD_HUMIDITY_PCT,
         pressure_pa: ArrayLike | None = None,
-    ) -> "Air":
+    ) -> Air:
         """Air at a temperature, humidity and either a station pressure or (if none given) an altitude."""
-        pressure = pressure_at_altitude(altitude_m) if pressure_pa is None else np.asarray(pressure_pa, dtype=float)
-        density = air_density(temperature_c, pressure, humidity_pct)
-        return cls(density, dynamic_viscosity(temperature_c) / density)
+        one = (
+            isinstance(temperature_c, _NUMBER)
+            and isinstance(altitude_m, _NUMBER)
+            and isinstance(humidity_pct, _NUMBER)
+            and (pressure_pa is None or isinstance(pressure_pa, _NUMBER))
+        )
+        formulas = _one_air if one else _density_and_viscosity
+        return cls(*formulas(temperature_c, altitude_m, humidity_pct, pressure_pa))
 
     @classmethod
-    def standard(cls) -> "Air":
+    def from_density(cls, density_kg_m3: ArrayLike, temperature_c: ArrayLike = STANDARD_TEMPERATURE_C) -> Air:
+        """Air of a given density; its viscosity is still Sutherland's at the temperature (ICAO 15 degC unless
+        given), so a density alone moves the dynamic pressure and the Reynolds number as thinner air would."""
+        density = density_kg_m3 if isinstance(density_kg_m3, _NUMBER) else np.asarray(density_kg_m3, dtype=float)
+        return cls(density, _plain(dynamic_viscosity(temperature_c) / density))
+
+    @classmethod
+    def standard(cls) -> Air:
         """ICAO standard air: 15 degC, sea level, dry (rho = 1.225 kg/m^3). The density models are trained at."""
-        return cls.from_conditions(15.0, 0.0, 0.0)
+        return cls.from_conditions(STANDARD_TEMPERATURE_C, 0.0, STANDARD_HUMIDITY_PCT)

@@ -1,4 +1,4 @@
-"""Equations of motion of a spinning golf ball (paper section 2, with the errata of NOTES.md section 1).
+"""Equations of motion of a spinning golf ball (the paper's section 2, README.md; its errata marked below).
 
 Axes: x to the right of the target line seen from behind the golfer, y towards the target, z up.
 State of a batch of N balls: position r [N,3] (m), velocity v [N,3] (m/s), spin omega [N,3] (rad/s).

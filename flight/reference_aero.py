@@ -1,4 +1,4 @@
-"""The reference world's aerodynamics: lift, drag and spin decay from the literature (NOTES.md section 2).
+"""The reference world's aerodynamics: lift, drag and spin decay from the literature (docs/reference_world.md).
 
 Lift and drag depend on the spin ratio S = R|w|/|v| AND the Reynolds number Re = |v| d / nu, with the golf ball's
 drag crisis and low-Re lift collapse; spin decays through a moment coefficient fitted to TrackMan's measured Pro V1x

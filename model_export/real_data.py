@@ -14,7 +14,7 @@ Sources (`SOURCES`), each with a weight per shot in the loss:
   tour-championship-2020  rounds 1-2 of the TOUR Championship 2020 (rounds 3-4 are held out): radar tee shots with
                     launch, spin and the radar apex; tour irons on the par 3s.
   pga-2023-table    TrackMan's PGA TOUR 2023 averages: each club's average launch and its average carry, max height and
-                    land angle, in the table's air (about 0.99 of ICAO standard, NOTES section 9).
+                    land angle, in the table's air (about 0.99 of ICAO standard, `shots.source_air`).
   synthetic         calm reference-world flights of the other clubs and slower players, clean, where real data is
                     missing; shots inside the measured drivers' launch range are left out, so real data decides there.
 Every source with known air carries it in its records' condition columns (`shots.source_air`): the tour events their
@@ -52,13 +52,13 @@ from golfflight.weights_schema.bundle import sha256_of
 
 DRIVER_FILE = Path("real/trackman_driver_sessions/data.csv")
 DRIVER_TRAIN_LINES = (3, 2942)
-"""Lines of the driver file that may be trained on (NOTES section 9); `shots.heldout` refuses any other."""
+"""Lines of the driver file that may be trained on; `shots.heldout` refuses any other."""
 SENTRY_TRAJECTORIES = Path("real/pga_tourcast_trackman/shot_trajectory/shot_trajectory_2021_016_656.csv")
 SENTRY_PBP = Path("real/pga_tourcast_trackman/pbp/pbp_2021_016_656.csv")
 PLAYERS_PBP = Path("real/pga_tourcast_trackman/pbp/pbp_2020_011_011.csv")
 TOUR_CHAMPIONSHIP_PBP = Path("real/pga_tourcast_trackman/pbp/pbp_2020_060_688.csv")
 TOUR_CHAMPIONSHIP_TRAIN_ROUNDS = (1, 2)
-"""Rounds of the TOUR Championship 2020 that may be trained on (NOTES section 9); `shots.heldout` refuses 3 and 4."""
+"""Rounds of the TOUR Championship 2020 that may be trained on; `shots.heldout` refuses 3 and 4."""
 TABLE_VAL_EVERY = 3
 """Every third club of the tour-averages table (3-wood, 3-iron, 6-iron, 9-iron) is validation."""
 

@@ -1,7 +1,7 @@
 """The recordings the reference world is calibrated on: the training split of every trainable real source, each in
 its own air (`shots.source_air`), grouped into calibration cells (`shots.calibrate_reference`).
 
-Nothing held out (NOTES section 9) reaches the fit: the sources come through `model_export.real_data`'s builders,
+Nothing held out (`shots.heldout`) reaches the fit: the sources come through `model_export.real_data`'s builders,
 which refuse held-out rows, and only their `train` split is used, so the validation groups that choose the
 real-data model's weights and seed stay unseen by its teacher too.
 """

@@ -3,7 +3,7 @@
 Forward Euler at the card's step, one ONNX Runtime call per step for everything still in the air, fed v_rel and
 omega times the air's Reynolds scale (`flight.physics.reynolds_scale`, 1 in the card's air). One shot runs
 on plain Python floats with the network's inputs and output bound once to preallocated float32 buffers
-(IOBinding, one thread): per-call overheads, not arithmetic, decide single-shot latency (NOTES.md section 6).
+(IOBinding, one thread): per-call overheads, not arithmetic, decide single-shot latency (docs/benchmarks.md).
 A batch runs on NumPy [N] arrays and drops each shot from the batch as it lands. Either way a shot stops at its
 landing (first downward crossing of its ground's plane, z = elevation, the state interpolated linearly to it, exact
 for Euler's straight segments), flies on past the card's t_sim if it is still in the air, and fails alone if it has

@@ -35,8 +35,8 @@ from scipy.optimize import least_squares
 
 DECAY_TIMES_S = (1.0, 3.0, 5.0)
 TRACKMAN_SPIN_LOSS_PCT = {"Driver": (3.1, 8.8, 12.8), "5-iron": (3.4, 9.7, 15.5), "8-iron": (3.6, 9.0, 13.3)}
-"""Spin lost (%) after 1/3/5 s, TrackMan on a Pro V1x (NOTES.md section 2), flown with these clubs' launch in
-`shots.clubs.CLUBS`."""
+"""Spin lost (%) after 1/3/5 s, TrackMan on a Pro V1x (published in a TrackMan patent; docs/reference_world.md),
+flown with these clubs' launch in `shots.clubs.CLUBS`."""
 
 OBSERVABLES = ("carry_y_m", "apex_m", "landing_angle_deg")
 """What a cell can match, in the order of every per-cell array: the carry along the launch monitor's target line

@@ -1,8 +1,8 @@
 """Typical launch conditions of each club for a tour-level player, in SI (rounded from TrackMan's published
 tour averages, extended to the three wedges below PW): the centres the synthetic sessions scatter around.
 
-Launches only: the held-out table's carries, heights and land angles reach neither the reference world's
-calibration nor any training set (NOTES section 9)."""
+Launches only: the table's carries, heights and land angles are targets elsewhere (`model_export.reference_targets`,
+`model_export.real_data`), never centres here."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """Checks of the reference world that nothing is fitted to: a drive at altitude and in a 10 mph wind, against the
-rules of thumb of NOTES §2 and §3. `golfflight calibrate-reference` renders them under the calibration tables, so
-they always describe the committed parameters."""
+rules of thumb stated below (altitude, wind). `golfflight calibrate-reference` renders them under the calibration
+tables, so they always describe the committed parameters."""
 
 from __future__ import annotations
 
@@ -17,12 +17,12 @@ from golfflight.shots.markdown import signed, table
 from golfflight.shots.reference_world import CALIBRATION_AIR, fly_reference
 
 HIGH_ALTITUDE_M = 2377.0
-"""7,800 ft, the altitude of NOTES §2's rule: a 282 yd drive at sea level flies about 306 yd there (apex −6 yd,
+"""7,800 ft, the altitude of the rule of thumb: a 282 yd drive at sea level flies about 306 yd there (apex −6 yd,
 land angle −9°)."""
 ALTITUDE_RULE = {"carry_yd": 24.0, "apex_yd": -6.0, "land_deg": -9.0}
 
 WIND_DRIVE = {"ball_speed_mps": 155.0 * MPH_TO_MPS, "launch_angle_deg": 12.0, "spin_rpm": 2800.0}
-"""The drive of the wind rule (NOTES §3: on a 250 yd drive a 10 mph headwind costs about 13 yd, a tailwind adds 9)."""
+"""The drive of the wind rule of thumb (on a 250 yd drive a 10 mph headwind costs about 13 yd, a tailwind adds 9)."""
 WIND_SPEED_MPS = 10.0 * MPH_TO_MPS
 WIND_RULE_YD = {"headwind": -13.0, "tailwind": 9.0}
 WIND_FROM_DEG = {"headwind": 0.0, "tailwind": 180.0, "crosswind from the right": 90.0}

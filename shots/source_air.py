@@ -2,13 +2,13 @@
 so every source is trained and checked in its own air, never in a common guess.
 
 Figures and their basis (`SourceAir.basis`):
-- the PGA TOUR 2023 averages table: about 0.99 of ICAO standard density (NOTES section 9: the events behind the
-  2022-23 radar statistics), written as ICAO air at 1 % lower pressure;
+- the PGA TOUR 2023 averages table: about 0.99 of ICAO standard density (what the PGA TOUR events behind TrackMan's
+  2022-23 radar statistics average), written as ICAO air at 1 % lower pressure;
 - tour events: the course's elevation from ShotLink's tee heights in the event's own pbp file (median `from_z`, feet)
   and the season's afternoon climate normals of the nearest city (NOAA 1991-2020: mean daily maximum, typical
   afternoon relative humidity), not the day's weather, which the files do not record;
-- TrackMan's modelled indoor rows: TrackMan's normalisation air, 77 F at sea level (NOTES section 3; humidity not
-  stated, 50 %);
+- TrackMan's modelled indoor rows: TrackMan's normalisation air, 77 F at sea level (TrackMan's published normalize
+  conditions; humidity not stated, 50 %);
 - TrackMan's normalized 7-iron export: its stated 1,135 ft and 77 F (humidity not stated, 50 %).
 Range sessions (the driver file's outdoor rows) recorded no air: they have none here, and training fits theirs.
 """

@@ -513,8 +513,8 @@ def test_missing_data_is_announced(bundle, tmp_path, capsys):
 
 
 def test_default_models_card_tells_its_held_out_errors_as_the_runtime_flies_them():
-    """The shipped card's held-out errors are what the runtime path measures now, on the held-out rows of NOTES
-    section 9 (TrackMan lines 2943 on, TOUR Championship rounds 3-4): a stale or flattering card fails."""
+    """The shipped card's held-out errors are what the runtime path measures now, on the held-out rows of
+    shots.heldout (TrackMan lines 2943 on, TOUR Championship rounds 3-4): a stale or flattering card fails."""
     model, data = REPO / "models" / "default", shared_data_dir()
     if not (data / DRIVER_FILE).is_file() or not (model / "model_card.json").is_file():
         pytest.skip("needs the shared data and the committed models/default bundle")

@@ -1,9 +1,12 @@
-"""Air density, viscosity and wind against published values (NOTES.md section 3)."""
+"""Air density, viscosity and wind against published values (US Standard Atmosphere, Tetens, Sutherland)."""
 
 import numpy as np
 import pytest
 from golfflight.flight.air import Air, air_density, altitude_for_pressure, dynamic_viscosity, pressure_at_altitude
+from golfflight.flight.conditions import NORMALIZED_REFERENCE
 from golfflight.flight.wind import Wind, log_profile_factor, uniform_equivalent_factor, wind_vector
+from golfflight.service.api.models import ReferenceAir
+from golfflight.service.api.shots import air_of
 
 
 def test_standard_sea_level_density():
@@ -38,6 +41,27 @@ def test_station_pressure_overrides_altitude():
 def test_sutherland_viscosity_of_air():
     assert dynamic_viscosity(15.0) == pytest.approx(1.789e-5, rel=2e-3)
     assert Air.standard().kinematic_viscosity_m2_s == pytest.approx(1.461e-5, rel=3e-3)
+
+
+def test_one_air_is_floats_and_the_same_numbers_as_a_batch_of_airs():
+    """The engine's per-step loop takes floats; a data set's air is arrays; both from the same formulas."""
+    one = Air.from_conditions(31.0, 1234.0, 65.0)
+    batch = Air.from_conditions(np.array([31.0, 15.0]), np.array([1234.0, 0.0]), np.array([65.0, 0.0]))
+    assert type(one.density_kg_m3) is float and type(one.kinematic_viscosity_m2_s) is float
+    first = (batch.density_kg_m3[0], batch.kinematic_viscosity_m2_s[0])
+    assert first == pytest.approx((one.density_kg_m3, one.kinematic_viscosity_m2_s), rel=1e-14)
+    assert batch.density_kg_m3[1] == pytest.approx(Air.standard().density_kg_m3, rel=1e-14)
+
+
+def test_an_explicit_density_keeps_the_standard_viscosity():
+    """A density alone is air of that density at 15 degC: its kinematic viscosity is mu(15 degC) / density."""
+    thin = Air.from_density(1.0)
+    assert thin.density_kg_m3 == 1.0 and thin.kinematic_viscosity_m2_s == float(dynamic_viscosity(15.0)) / 1.0
+    assert Air.from_density(Air.standard().density_kg_m3) == Air.standard()
+
+
+def test_a_normalized_flight_by_default_flies_in_the_normalized_reference_air():
+    assert air_of(ReferenceAir()) == NORMALIZED_REFERENCE.air
 
 
 @pytest.mark.parametrize("from_deg, direction", [(0.0, (0, -1)), (90.0, (-1, 0)), (180.0, (0, 1)), (270.0, (1, 0))])

@@ -10,7 +10,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from golfflight.flight.air import Air
 from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.physics import initial_state
 from golfflight.service.api.app import create_app
@@ -65,8 +64,7 @@ def test_fly_model_chooses_the_bundle_and_reference_flies_the_reference_world(ca
     seven = club_named("7-iron")
     state = initial_state(*(np.array([v], dtype=float) for v in Launch(seven.ball_speed_mps, seven.launch_angle_deg,
                                                                        0.0, seven.spin_rpm, 0.0)))
-    air = air_of(None)  # the API's default: ICAO standard air
-    flight = fly_reference(state, Air(air.density_kg_m3, air.kinematic_viscosity_m2_s))
+    flight = fly_reference(state, air_of(None))  # the API's default: ICAO standard air
     assert reference["flight"]["carry_m"] == pytest.approx(float(flight.carry_m[0]), abs=1e-9)
     assert reference["flight"]["total_m"] > reference["flight"]["carry_m"] - 10.0 and "bounces" in reference["flight"]
 

@@ -39,7 +39,7 @@ def test_the_driver_sets_held_out_lines_are_diagnosed_on_their_own():
 
 
 def test_only_what_shots_heldout_holds_out_is_labelled_held_out():
-    """NOTES section 9: the driver lines from 2943 and the TOUR Championship's rounds 3-4 are held out; its rounds
+    """shots.heldout: the driver lines from 2943 and the TOUR Championship's rounds 3-4 are held out; its rounds
     1-2 and the PGA 2023 table are trained on, and are flown in their source's air (shots.source_air)."""
     shared = shared_data_dir()
     if not (shared / TOUR_CHAMPIONSHIP).is_file() or not (shared / TRACKMAN).is_file():

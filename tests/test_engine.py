@@ -8,7 +8,8 @@ import numpy as np
 import onnxruntime as ort
 import pytest
 from conftest import random_launches
-from golfflight.flight.conditions import STANDARD, AirConditions, Conditions
+from golfflight.flight.air import Air
+from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.integrator import simulate
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state, reynolds_scale
@@ -34,7 +35,7 @@ def launches(n: int, seed: int) -> list[Launch]:
 SEVEN_IRON = Launch(55.0, 16.0, 0.0, 7100.0, 0.0)
 
 
-@pytest.mark.parametrize("air", [AirConditions(), AirConditions(temperature_c=35.0, altitude_m=1600.0)])
+@pytest.mark.parametrize("air", [Air.standard(), Air.from_conditions(temperature_c=35.0, altitude_m=1600.0)])
 def test_flights_match_the_torch_simulator_within_a_centimetre(engine, air):
     """In the card's air and in hot, high air (density and Reynolds scale of the inputs both differ)."""
     torch = pytest.importorskip("torch")
@@ -76,7 +77,7 @@ def test_single_shots_equal_the_batch(engine):
     shots = launches(40, seed=4)
     conditions = [
         Conditions(
-            AirConditions(temperature_c=5.0 + i, altitude_m=50.0 * i),
+            Air.from_conditions(temperature_c=5.0 + i, altitude_m=50.0 * i),
             Wind(0.3 * i, 9.0 * i, "log" if i % 2 else "uniform"),
         )
         for i in range(len(shots))
@@ -95,7 +96,7 @@ def test_the_single_shot_latency_path_is_the_flight_core(engine):
     every figure within 1e-9 (m, s, deg), the recorded states too, in calm, log-profile and uniform wind."""
     shots = launches(24, seed=12)
     conditions = [
-        Conditions(AirConditions(temperature_c=30.0 - i), Wind(0.5 * i, 15.0 * i, "log" if i % 3 else "uniform"))
+        Conditions(Air.from_conditions(temperature_c=30.0 - i), Wind(0.5 * i, 15.0 * i, "log" if i % 3 else "uniform"))
         for i in range(len(shots))
     ]
     core = engine.fly_batch(shots, conditions, keep_states=True)
@@ -151,7 +152,7 @@ def test_headwind_shortens_crosswind_from_the_right_moves_left_altitude_lengthen
     calm = engine.fly(SEVEN_IRON)
     headwind = engine.fly(SEVEN_IRON, Conditions(wind=Wind(5.0, 0.0)))
     from_right = engine.fly(SEVEN_IRON, Conditions(wind=Wind(5.0, 90.0)))
-    denver = engine.fly(SEVEN_IRON, Conditions(AirConditions(altitude_m=1600.0)))
+    denver = engine.fly(SEVEN_IRON, Conditions(Air.from_conditions(altitude_m=1600.0)))
     assert headwind.carry_m < calm.carry_m - 3
     assert from_right.lateral_m < -1.0 and calm.lateral_m == pytest.approx(0.0, abs=1e-9)
     assert denver.carry_m > calm.carry_m + 5
@@ -165,8 +166,8 @@ def test_headwind_shortens_crosswind_from_the_right_moves_left_altitude_lengthen
 def test_thin_warm_air_lowers_the_reynolds_number_the_network_sees(engine):
     """Air of kinematic viscosity nu feeds the graph (k v_rel, k omega), k = nu_0/nu: the same spin ratio at a lower
     Reynolds number. Density alone would overstate the altitude gain (the reference world's drag crisis needs Re)."""
-    denver = AirConditions(temperature_c=25.0, altitude_m=1600.0)
-    assert AirConditions().kinematic_viscosity_m2_s == pytest.approx(engine.card.physics.kinematic_viscosity_m2_s)
+    denver = Air.from_conditions(temperature_c=25.0, altitude_m=1600.0)
+    assert Air.standard().kinematic_viscosity_m2_s == pytest.approx(engine.card.physics.kinematic_viscosity_m2_s)
     assert reynolds_scale(denver.kinematic_viscosity_m2_s, engine.nominal_viscosity) == pytest.approx(0.776, abs=0.01)
     coefficients = OnnxCoefficients(engine.bundle_dir)
     start = initial_state(*np.array([SEVEN_IRON]).T)
@@ -180,11 +181,11 @@ def test_thin_warm_air_lowers_the_reynolds_number_the_network_sees(engine):
 
 
 def test_a_drive_at_7800_ft_gains_about_what_is_published(engine):
-    """NOTES.md section 2: a 282 yd drive at sea level flies about 306 yd at 7,800 ft (+8.5 %), with a lower apex
+    """The rule of thumb: a 282 yd drive at sea level flies about 306 yd at 7,800 ft (+8.5 %), with a lower apex
     and a land angle 9 degrees shallower. The default model: +9.0 %, apex -7 yd, land -10 deg (the reference world:
     +14.8 %, docs/reference_world.md)."""
     drive = Launch(76.4, 10.4, 0.0, 2545.0, 0.0)
-    sea_level, high = (engine.fly(drive, Conditions(AirConditions(altitude_m=h))) for h in (0.0, 2377.0))
+    sea_level, high = (engine.fly(drive, Conditions(Air.from_conditions(altitude_m=h))) for h in (0.0, 2377.0))
     assert high.carry_m / sea_level.carry_m == pytest.approx(306 / 282, abs=0.035)
     assert high.apex_m < sea_level.apex_m and high.landing_angle_deg < sea_level.landing_angle_deg - 3
 

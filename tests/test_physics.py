@@ -1,4 +1,5 @@
-"""The NumPy equations of motion against cases worked by hand (NOTES.md section 1 and its errata)."""
+"""The NumPy equations of motion against cases worked by hand (the paper's equations, their errata in
+flight/physics.py)."""
 
 import numpy as np
 import pytest
@@ -131,7 +132,8 @@ def test_shot_that_never_comes_down_is_reported_not_landed():
 
 
 def test_ferguson_driver_matches_published_open_model_figures():
-    """NOTES.md section 2: Ferguson's coefficients fly the PGA driver to about 290.7 yd carry, 32.5 yd apex, 36.0 deg."""
+    """Ferguson, McNally & McPhee 2022's coefficients fly the PGA driver to about 290.7 yd carry, 32.5 yd apex,
+    36.0 deg."""
     air = Air.from_conditions(25.0, 0.0, 50.0)
     flight = simulate(launch(171 * 0.44704, 10.4, spin=2545.0), QuadraticSpinRatio(), air.density_kg_m3, dt=0.005, method="rk4")
     assert flight.carry_m[0] / 0.9144 == pytest.approx(290.7, abs=3.0)

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 import torch
 from golfflight.flight import limits
-from golfflight.flight.conditions import AirConditions, Conditions
+from golfflight.flight.air import Air
+from golfflight.flight.conditions import Conditions
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.wind import CALM, Wind
 from golfflight.service.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
@@ -38,18 +39,18 @@ launches = st.builds(
 )
 airs = st.one_of(
     st.builds(
-        AirConditions,
+        Air.from_conditions,
         temperature_c=bounded(limits.TEMPERATURE_C),
         altitude_m=bounded(limits.ALTITUDE_M),
         humidity_pct=bounded(limits.HUMIDITY_PCT),
     ),
     st.builds(
-        AirConditions,
+        Air.from_conditions,
         temperature_c=bounded(limits.TEMPERATURE_C),
-        pressure_hpa=bounded(limits.PRESSURE_HPA),
+        pressure_pa=bounded(limits.PRESSURE_HPA).map(lambda hpa: hpa * 100.0),
         humidity_pct=bounded(limits.HUMIDITY_PCT),
     ),
-    st.builds(AirConditions, density=bounded(limits.AIR_DENSITY_KG_M3)),
+    st.builds(Air.from_density, bounded(limits.AIR_DENSITY_KG_M3)),
 )
 winds = st.one_of(
     st.just(CALM),

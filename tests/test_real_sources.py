@@ -1,4 +1,4 @@
-"""The trainable sources the revised rule opened (NOTES section 9): the PGA 2023 table as one shot per club in its
+"""The trainable sources the revised rule opened (`shots.heldout`): the PGA 2023 table as one shot per club in its
 air, the TOUR Championship's rounds 1-2 in East Lake's air; the known-air sources setting the level in the joint
 prior; and the felt error that compares runs."""
 

@@ -72,7 +72,7 @@ def test_the_registry_holds_the_driver_files_second_half_and_tour_championship_r
     assert tour.rounds == (3, 4) and tour.rows() == "rounds 3-4" and not tour.whole
     assert held_out_rounds(f"/anywhere/{TOUR_CHAMPIONSHIP}") == (3, 4)
     assert held_out_rounds("/anywhere/real/trackman_driver_sessions/data.csv") == ()
-    assert held_out_set(f"/anywhere/{PGA_TABLE}") is None, "the PGA 2023 table may be trained on (NOTES section 9)"
+    assert held_out_set(f"/anywhere/{PGA_TABLE}") is None, "the PGA 2023 table may be trained on (shots.heldout)"
 
 
 def test_a_held_out_line_refuses_the_training_set(tmp_path):

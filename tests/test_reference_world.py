@@ -137,7 +137,7 @@ def test_spin_loss_matches_trackman_within_two_points():
 
 
 def test_thinner_air_carries_farther_and_flies_lower():
-    """At 1,500 m (4,900 ft) NOTES section 2's rule (+8.5 % at 7,800 ft, about 1.1 % per 1,000 ft) gives a drive
+    """At 1,500 m (4,900 ft) the rule of thumb (+8.5 % at 7,800 ft, about 1.1 % per 1,000 ft) gives a drive
     about 5 % more carry; slower, spinning shots gain less (the apex falls with the lift), but every one gains."""
     shots = launch(*SHOTS.values())
     sea = fly_reference(shots, Air.from_conditions(25.0, 0.0, 50.0))

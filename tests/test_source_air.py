@@ -25,8 +25,9 @@ def test_the_tour_table_flies_in_99_percent_of_standard_density():
 
 
 def test_east_lake_in_september_by_hand():
-    """NOTES section 3: P = 101325 (1 - 2.25577e-5 H)^5.255876; e = RH 6.1078 exp(17.27 t/(t + 237.3)) hPa;
-    rho = (P - e)/(287.05 T) + e/(461.5 T). 988 ft = 301.14 m, 29 C, 60 %."""
+    """US Standard Atmosphere and Tetens: P = 101325 (1 - 2.25577e-5 H)^5.255876;
+    e = RH 6.1078 exp(17.27 t/(t + 237.3)) hPa; rho = (P - e)/(287.05 T) + e/(461.5 T).
+    988 ft = 301.14 m, 29 C, 60 %."""
     pressure = 101325 * (1 - 2.25577e-5 * 301.1424) ** 5.255876
     vapour = 0.60 * 6.1078 * math.exp(17.27 * 29 / (29 + 237.3)) * 100
     density = (pressure - vapour) / (287.05 * 302.15) + vapour / (461.5 * 302.15)

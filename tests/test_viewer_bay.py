@@ -134,8 +134,115 @@ def test_the_event_stream_stays_open_past_the_old_five_seconds_with_keep_alives(
     assert comments >= 9
 
 
+def _latest_path(page) -> list[tuple[float, float]]:
+    """The (x, y) points of the behind view's latest flight, once it is drawn."""
+    page.wait_for_selector("#behind polyline.latest[data-done]", state="attached", timeout=10_000)
+    return [tuple(map(float, p.split(","))) for p in page.get_attribute("#behind polyline.latest", "points").split()]
+
+
+def _submit_bay_form(page) -> None:
+    """Submit the bay form and wait for the page to say the service saved it."""
+    page.evaluate("document.querySelector('#bay-message').dataset.state = ''")
+    page.click("#bay-form button[type=submit]")
+    page.wait_for_selector("#bay-message[data-state=saved]", timeout=10_000)
+
+
+def _straight_shot_on_the_centre_line(page, http) -> dict:
+    """A batch without the flag never reaches the page; the bay's own straight shot is drawn from the tee at the
+    bottom centre up the target line. The behind view's geometry."""
+    page.select_option("#club", "Driver")
+    assert http.post("/v1/shots/batch", json={"shots": [DRIVER] * 60}, headers=KEYED).status_code == 200
+    straight = http.post("/v1/shots?viewer=true", json=STRAIGHT, headers=KEYED).json()
+    assert straight["lateral_m"] == pytest.approx(0.0, abs=1e-6)
+    path = _latest_path(page)
+    assert page.locator("#shots tbody tr").count() == 1 and "Driver: 1 shot" in page.inner_text("#legend")
+    behind = page.evaluate("window.golfflightViewer.behind")
+    width, height = behind["width"], behind["height"]
+    tee_x, tee_y = behind["tee"]
+    assert tee_x == pytest.approx(width / 2) and height - 40 <= tee_y <= height  # bottom centre
+    assert behind["vanishing"][0] == pytest.approx(width / 2) and behind["vanishing"][1] < tee_y
+    target = page.locator("#behind line.target-line")
+    assert [float(target.get_attribute(a)) for a in ("x1", "x2")] == pytest.approx([width / 2] * 2)
+    assert len(path) > 30
+    assert max(abs(x - width / 2) for x, _ in path) <= 0.5, "a straight shot left the centre line"
+    assert path[0] == pytest.approx((tee_x, tee_y), abs=1.0)  # it starts on the tee
+    assert min(y for _, y in path) < tee_y - 200  # and flies up the screen
+    return behind
+
+
+def _wedge_right_of_the_line_and_labelled_distances(page, port: int, behind: dict) -> None:
+    """A wedge over Open Connect lands right of the line; every distance line has its label, none overlapping."""
+    width, tee = behind["width"], tuple(behind["tee"])
+    gspro_over_tcp(port, 1, {**WEDGE_BALL, "HLA": 4.0, "SpinAxis": 8.0})
+    page.wait_for_selector("#shots tbody tr[data-shot='2']", timeout=10_000)
+    wedge = _latest_path(page)
+    assert wedge[0] == pytest.approx(tee, abs=1.0) and wedge[-1][0] > width / 2 + 5
+    markers = page.locator("#behind line.marker-line").count()
+    labels = page.locator("#behind text.distance").all_text_contents()
+    assert markers >= 6 and len(labels) == markers and labels[:2] == ["50 yd", "100 yd"]
+    boxes = page.eval_on_selector_all(
+        "#behind text.distance", "els => els.map(e => { const b = e.getBBox(); return [b.x, b.y, b.width, b.height]; })"
+    )
+    for i, a in enumerate(boxes):  # no two labels overlap, and each is inside the picture
+        assert 0 <= a[0] and a[0] + a[2] <= width and a[1] >= 0
+        for b in boxes[i + 1 :]:
+            apart = a[0] + a[2] <= b[0] or b[0] + b[2] <= a[0] or a[1] + a[3] <= b[1] or b[1] + b[3] <= a[1]
+            assert apart, (a, b)
+    assert page.inner_text("#n-launch") == "24.0°"  # the degree sign on its number (the wedge)
+
+
+def _metric_bay_through_the_form(page, http) -> None:
+    """Metric units, then the issue's bay, PUT through the page and read back by GET /v1/bay."""
+    page.click(".units button[data-units=metric]")
+    page.wait_for_selector("#bay-message[data-state=saved]", timeout=10_000)
+    assert http.get("/v1/bay", headers=KEYED).json()["units"] == "metric"
+    assert page.inner_text("#n-carry").endswith("m") and "(m)" in page.inner_text("#shots thead")
+    for field, value in (("temperature", "30"), ("altitude", "1600"), ("wind-speed", "4.47"), ("wind-from", "0")):
+        page.fill(f"#bay-{field}", value)
+    page.select_option("#bay-surface", "green")
+    page.fill("#bay-stimp", "12")
+    _submit_bay_form(page)
+    bay = http.get("/v1/bay", headers=KEYED).json()
+    assert bay["air"] == {"temperature_c": 30.0, "altitude_m": 1600.0}
+    assert bay["wind"]["speed_mps"] == pytest.approx(4.47) and bay["wind"]["from_deg"] == 0.0
+    assert bay["ground"]["surface"] == "green" and bay["ground"]["stimp_ft"] == 12.0
+    assert bay["units"] == "metric"
+    summary = page.inner_text("#bay-summary")
+    assert "30.0°C" in summary and "1600 m" in summary and "stimp 12" in summary
+
+
+def _imperial_bay_through_the_form(page, http) -> None:
+    """Imperial: the form shows the same bay in °F, ft and mph; untouched values go back unrounded."""
+    page.click(".units button[data-units=imperial]")
+    page.wait_for_function("() => document.querySelector('#bay-altitude').value === '5249'", timeout=10_000)
+    assert page.input_value("#bay-temperature") == "86" and page.input_value("#bay-wind-speed") == "10"
+    page.fill("#bay-humidity", "40")
+    _submit_bay_form(page)
+    bay = http.get("/v1/bay", headers=KEYED).json()
+    assert bay["air"] == {"temperature_c": 30.0, "altitude_m": 1600.0, "humidity_pct": 40.0}
+    assert bay["wind"]["speed_mps"] == pytest.approx(4.47) and bay["units"] == "imperial"
+
+
+def _refused_value_and_a_bay_set_over_the_api(page, http) -> None:
+    """A refused value shows the service's own message and leaves the bay unchanged; a bay set over the API in mph
+    reads as a wind on the page, not "calm"."""
+    page.fill("#bay-humidity", "150")
+    page.click("#bay-form button[type=submit]")
+    page.wait_for_selector("#bay-message[data-state=refused]", timeout=10_000)
+    message = page.inner_text("#bay-message")
+    assert "humidity_pct" in message and "150" in message, message
+    assert http.get("/v1/bay", headers=KEYED).json()["air"]["humidity_pct"] == 40.0
+    mph = {"wind": {"speed_mph": 10.0, "from_deg": 0.0}}
+    assert http.put("/v1/bay", json=mph, headers=KEYED).status_code == 200
+    page.evaluate("loadBay()")
+    page.wait_for_function(
+        "() => document.querySelector('#bay-summary').textContent.includes('wind 10')", timeout=10_000
+    )
+
+
 @pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
 def test_the_page_behind_the_golfer_and_the_bay_form_in_chromium():
+    """One page through the steps in order: each step starts from the state the one before left."""
     port = free_port()
     with running(create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))) as http:
         base = str(http.base_url).rstrip("/")
@@ -145,94 +252,11 @@ def test_the_page_behind_the_golfer_and_the_bay_form_in_chromium():
             page.goto(f"{base}/viewer#key={KEY}")
             page.wait_for_selector("#status[data-state=live]", timeout=10_000)
             page.wait_for_function("() => document.querySelector('#bay-summary').textContent !== '—'", timeout=10_000)
-
-            # a batch without the flag never reaches the page; the bay's own shot does
-            page.select_option("#club", "Driver")
-            assert http.post("/v1/shots/batch", json={"shots": [DRIVER] * 60}, headers=KEYED).status_code == 200
-            straight = http.post("/v1/shots?viewer=true", json=STRAIGHT, headers=KEYED).json()
-            assert straight["lateral_m"] == pytest.approx(0.0, abs=1e-6)
-            page.wait_for_selector("#behind polyline.latest[data-done]", state="attached", timeout=10_000)
-            assert page.locator("#shots tbody tr").count() == 1 and "Driver: 1 shot" in page.inner_text("#legend")
-
-            behind = page.evaluate("window.golfflightViewer.behind")
-            width, height = behind["width"], behind["height"]
-            tee_x, tee_y = behind["tee"]
-            assert tee_x == pytest.approx(width / 2) and height - 40 <= tee_y <= height  # bottom centre
-            assert behind["vanishing"][0] == pytest.approx(width / 2) and behind["vanishing"][1] < tee_y
-            target = page.locator("#behind line.target-line")
-            assert [float(target.get_attribute(a)) for a in ("x1", "x2")] == pytest.approx([width / 2] * 2)
-            path = [tuple(map(float, p.split(","))) for p in page.get_attribute("#behind polyline.latest", "points").split()]
-            assert len(path) > 30
-            assert max(abs(x - width / 2) for x, _ in path) <= 0.5, "a straight shot left the centre line"
-            assert path[0] == pytest.approx((tee_x, tee_y), abs=1.0)  # it starts on the tee
-            assert min(y for _, y in path) < tee_y - 200  # and flies up the screen
-
-            gspro_over_tcp(port, 1, {**WEDGE_BALL, "HLA": 4.0, "SpinAxis": 8.0})  # a wedge right of the line
-            page.wait_for_selector("#shots tbody tr[data-shot='2']", timeout=10_000)
-            page.wait_for_selector("#behind polyline.latest[data-done]", state="attached", timeout=10_000)
-            wedge = [tuple(map(float, p.split(","))) for p in page.get_attribute("#behind polyline.latest", "points").split()]
-            assert wedge[0] == pytest.approx((tee_x, tee_y), abs=1.0) and wedge[-1][0] > width / 2 + 5
-
-            markers = page.locator("#behind line.marker-line").count()
-            labels = page.locator("#behind text.distance").all_text_contents()
-            assert markers >= 6 and len(labels) == markers and labels[:2] == ["50 yd", "100 yd"]
-            boxes = page.eval_on_selector_all(
-                "#behind text.distance", "els => els.map(e => { const b = e.getBBox(); return [b.x, b.y, b.width, b.height]; })"
-            )
-            for i, a in enumerate(boxes):  # no two labels overlap, and each is inside the picture
-                assert 0 <= a[0] and a[0] + a[2] <= width and a[1] >= 0
-                for b in boxes[i + 1 :]:
-                    apart = a[0] + a[2] <= b[0] or b[0] + b[2] <= a[0] or a[1] + a[3] <= b[1] or b[1] + b[3] <= a[1]
-                    assert apart, (a, b)
-            assert page.inner_text("#n-launch") == "24.0°"  # the degree sign on its number (the wedge)
-
-            # the bay form: metric units, then the issue's bay, PUT through the page, read back by GET /v1/bay
-            page.click(".units button[data-units=metric]")
-            page.wait_for_selector("#bay-message[data-state=saved]", timeout=10_000)
-            assert http.get("/v1/bay", headers=KEYED).json()["units"] == "metric"
-            assert page.inner_text("#n-carry").endswith("m") and "(m)" in page.inner_text("#shots thead")
-            page.fill("#bay-temperature", "30")
-            page.fill("#bay-altitude", "1600")
-            page.fill("#bay-wind-speed", "4.47")
-            page.fill("#bay-wind-from", "0")
-            page.select_option("#bay-surface", "green")
-            page.fill("#bay-stimp", "12")
-            page.evaluate("document.querySelector('#bay-message').dataset.state = ''")
-            page.click("#bay-form button[type=submit]")
-            page.wait_for_selector("#bay-message[data-state=saved]", timeout=10_000)
-            bay = http.get("/v1/bay", headers=KEYED).json()
-            assert bay["air"] == {"temperature_c": 30.0, "altitude_m": 1600.0}
-            assert bay["wind"]["speed_mps"] == pytest.approx(4.47) and bay["wind"]["from_deg"] == 0.0
-            assert bay["ground"]["surface"] == "green" and bay["ground"]["stimp_ft"] == 12.0
-            assert bay["units"] == "metric"
-            summary = page.inner_text("#bay-summary")
-            assert "30.0°C" in summary and "1600 m" in summary and "stimp 12" in summary
-
-            # imperial: the form shows the same bay in °F, ft and mph; untouched values go back unrounded
-            page.click(".units button[data-units=imperial]")
-            page.wait_for_function("() => document.querySelector('#bay-altitude').value === '5249'", timeout=10_000)
-            assert page.input_value("#bay-temperature") == "86" and page.input_value("#bay-wind-speed") == "10"
-            page.fill("#bay-humidity", "40")
-            page.evaluate("document.querySelector('#bay-message').dataset.state = ''")
-            page.click("#bay-form button[type=submit]")
-            page.wait_for_selector("#bay-message[data-state=saved]", timeout=10_000)
-            bay = http.get("/v1/bay", headers=KEYED).json()
-            assert bay["air"] == {"temperature_c": 30.0, "altitude_m": 1600.0, "humidity_pct": 40.0}
-            assert bay["wind"]["speed_mps"] == pytest.approx(4.47) and bay["units"] == "imperial"
-
-            # a refused value: the service's own message, and the bay unchanged
-            page.fill("#bay-humidity", "150")
-            page.click("#bay-form button[type=submit]")
-            page.wait_for_selector("#bay-message[data-state=refused]", timeout=10_000)
-            message = page.inner_text("#bay-message")
-            assert "humidity_pct" in message and "150" in message, message
-            assert http.get("/v1/bay", headers=KEYED).json()["air"]["humidity_pct"] == 40.0
-
-            # a bay set over the API in mph: the page reads the wind, not "calm"
-            assert http.put("/v1/bay", json={"wind": {"speed_mph": 10.0, "from_deg": 0.0}}, headers=KEYED).status_code == 200
-            page.evaluate("loadBay()")
-            page.wait_for_function("() => document.querySelector('#bay-summary').textContent.includes('wind 10')",
-                                   timeout=10_000)
+            behind = _straight_shot_on_the_centre_line(page, http)
+            _wedge_right_of_the_line_and_labelled_distances(page, port, behind)
+            _metric_bay_through_the_form(page, http)
+            _imperial_bay_through_the_form(page, http)
+            _refused_value_and_a_bay_set_over_the_api(page, http)
             assert errors == []
 
 

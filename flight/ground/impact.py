@@ -1,4 +1,4 @@
-"""Penner's impact of a spinning ball on turf (Can. J. Phys. 80, 931 (2002); NOTES.md section 7), one ball or many.
+"""Penner's impact of a spinning ball on turf (Can. J. Phys. 80, 931 (2002)), one ball or many.
 
 The turf gives under the ball, so it bounces off a contact plane tilted back towards it by the critical angle
 theta_c: the normal n' = cos(tilt) n - sin(tilt) t, t the direction of the incoming tangential velocity. Against

@@ -6,10 +6,10 @@ a normal speed of 13 m/s (in proportion to it otherwise, `flight.ground.impact`)
 (Coulomb) friction coefficient that caps the tangential impulse of an impact; `rolling_resistance` is the rolling
 deceleration on level ground in units of g, and `grass_drag_per_s` a further deceleration in proportion to the
 rolling speed (grass the ball brushes through: a fast roll slows sooner). The fairway row is fitted on THE PLAYERS
-2020 rest positions (`golfflight ground-fit`, docs/ground.md); the other rows are anchors from NOTES.md section 7
-(Penner 2002, libgolf, openfairway), not measurements, but for the firm fairway: the fitted fairway with Penner's
-restitution, the fit's least rolling resistance and half its grass drag, set by that rule and not tuned. A green's
-rolling resistance comes from its stimpmeter reading.
+2020 rest positions (`golfflight ground-fit`, docs/ground.md); the other rows are anchors from the literature
+(Penner 2002, libgolf, openfairway; docs/ground.md), not measurements, but for the firm fairway: the fitted
+fairway with Penner's restitution, the fit's least rolling resistance and half its grass drag, set by that rule and
+not tuned. A green's rolling resistance comes from its stimpmeter reading.
 """
 
 from __future__ import annotations

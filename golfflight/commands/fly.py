@@ -191,7 +191,6 @@ def fly_reference_shot(shot) -> dict:
     ground phase): the POST /v1/shots result fields."""
     import numpy as np
 
-    from golfflight.flight.air import Air
     from golfflight.flight.ground import LEVEL_FAIRWAY, ground_phase_one
     from golfflight.flight.physics import initial_state
     from golfflight.service.api.shots import air_of, conditions_of, flight_fields, launch_of
@@ -201,7 +200,7 @@ def fly_reference_shot(shot) -> dict:
     air = air_of(shot.air)
     conditions = conditions_of(shot)
     state = initial_state(*(np.array([value], dtype=float) for value in launch_of(shot)))
-    flight = fly_reference(state, Air(air.density_kg_m3, air.kinematic_viscosity_m2_s), conditions.wind)
+    flight = fly_reference(state, air, conditions.wind)
     if not flight.landed[0]:
         raise ValueError("the shot did not come down within the reference world's simulation time cap")
     position, velocity, spin = (tuple(a[0].tolist()) for a in (flight.landing_position, flight.landing_velocity,

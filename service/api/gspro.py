@@ -1,4 +1,4 @@
-"""GSPro Open Connect v1 shot messages (NOTES.md section 4), as a launch-monitor connector sends them.
+"""GSPro Open Connect v1 shot messages (fields in docs/service.md), as a launch-monitor connector sends them.
 
 The protocol is not ours, so unknown fields are ignored (connectors add their own) and known ones are matched in any
 letter case (connectors in the wild send `APIVersion` and `Backspin`); the values we use are type- and range-checked

@@ -12,7 +12,7 @@ import math
 from typing import Annotated, Literal
 
 from golfflight.flight import limits
-from golfflight.flight.conditions import NORMALIZED_REFERENCE
+from golfflight.flight.conditions import NORMALIZED_HUMIDITY_PCT, NORMALIZED_TEMPERATURE_C
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS
 from golfflight.flight.ground import SURFACES, holding_slope_deg, surface
 from golfflight.flight.limits import Range
@@ -130,10 +130,10 @@ class ReferenceAir(Strict):
 
     model_config = ConfigDict(json_schema_extra=_not_together(("altitude_m", "pressure_hpa")))
 
-    temperature_c: _in("temperature_c", "air temperature") = NORMALIZED_REFERENCE.air.temperature_c
+    temperature_c: _in("temperature_c", "air temperature") = NORMALIZED_TEMPERATURE_C
     altitude_m: _in("altitude_m", "height above sea level", True) = None
     pressure_hpa: _in("pressure_hpa", "station pressure", True) = None
-    humidity_pct: _in("humidity_pct", "relative humidity") = NORMALIZED_REFERENCE.air.humidity_pct
+    humidity_pct: _in("humidity_pct", "relative humidity") = NORMALIZED_HUMIDITY_PCT
 
     @model_validator(mode="after")
     def _one_source(self) -> ReferenceAir:

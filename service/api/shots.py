@@ -6,7 +6,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from golfflight.flight.conditions import STANDARD, AirConditions, Conditions
+from golfflight.flight.air import Air
+from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.flight.ground import LEVEL_FAIRWAY, GroundSpec, surface
 from golfflight.flight.wind import CALM, Wind
@@ -44,14 +45,15 @@ def launch_of(shot: ShotRequest) -> Launch:
     return Launch(speed, shot.launch_angle_deg, shot.launch_direction_deg, spin, axis)
 
 
-def air_of(air: AirRequest | ReferenceAir | None) -> AirConditions:
-    """Engine air from a request's air; omitted values take ICAO standard air."""
+def air_of(air: AirRequest | ReferenceAir | None) -> Air:
+    """Engine air from a request's air; omitted values take ICAO standard air (station pressure wins over altitude)."""
     if air is None:
-        return AirConditions()
+        return STANDARD.air
     given = {name: value for name, value in air.model_dump().items() if value is not None}
     if "density_kg_m3" in given:
-        return AirConditions(density=given["density_kg_m3"])
-    return AirConditions(**given)
+        return Air.from_density(given["density_kg_m3"])
+    pressure_hpa = given.pop("pressure_hpa", None)
+    return Air.from_conditions(**given, pressure_pa=None if pressure_hpa is None else pressure_hpa * 100.0)
 
 
 def wind_speed_mps(wind: WindRequest) -> float:

@@ -1,4 +1,5 @@
-"""GSPro Open Connect v1 over TCP (NOTES.md section 8), so launch-monitor connectors written for GSPro (MLM2PRO,
+"""GSPro Open Connect v1 over TCP (the wire as docs/service.md describes it), so launch-monitor connectors written
+for GSPro (MLM2PRO,
 Garmin R10, Mevo+, Square, OpenFlight) send their shots to golfflight unchanged: `golfflight serve --connect-port`.
 
 `framing` cuts the byte stream into JSON objects, `replies` answers each one (through the same GSPro mapping as

@@ -7,7 +7,7 @@ the next one read. Bytes are scanned as they come: `{`, `}`, `"` and `\\` never 
 character, so no decoding is needed to find the ends.
 
 A pause mid-object (`ObjectFramer.stall`, called by the server after a few seconds of silence) ends nothing by
-itself: objects may arrive split across packets (NOTES.md section 8), however late the rest. Only what comes next
+itself: objects may arrive split across packets (docs/service.md), however late the rest. Only what comes next
 decides: the rest of the object completes it (one object, one reply), while a new object (`{` that does not
 complete the open one as valid JSON) gets the unfinished one refused once and is read from a clean start. Giving up
 at the pause instead refused the piece and then framed its remainder as stray bytes and stray objects: five
