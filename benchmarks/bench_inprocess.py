@@ -21,7 +21,7 @@ from common import (
     write_results,
 )
 from golfflight.service.engine import BATCH_THREADS, FlightEngine
-from golfflight.service.model_location import model_dir
+from golfflight.flight.bundle_location import model_dir
 
 
 def timed(call, repeats: int, warmup: int = 1) -> list[float]:

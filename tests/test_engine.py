@@ -14,7 +14,7 @@ from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.flight.wind import Wind
 from golfflight.service.engine import FlightEngine, FlightError, Launch, ShotFlight
-from golfflight.service.model_location import model_dir
+from golfflight.flight.bundle_location import model_dir
 from golfflight.service.trajectory import resample
 
 PAPER_SINGLE_SHOT_MS = 34.9

@@ -15,7 +15,7 @@ from golfflight.flight.limits import SLOPE_DEG
 from golfflight.service.api.app import create_app
 from golfflight.service.api.gspro import GSProMessage, fly_message
 from golfflight.service.engine import FlightEngine, Launch
-from golfflight.service.model_location import model_dir
+from golfflight.flight.bundle_location import model_dir
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from servers import running, shot

@@ -15,7 +15,7 @@ from golfflight.flight.conditions import AirConditions, Conditions
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.wind import CALM, Wind
 from golfflight.service.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
-from golfflight.service.model_location import model_dir
+from golfflight.flight.bundle_location import model_dir
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

@@ -226,7 +226,7 @@ def fly_model_shot(shot, model: str | None) -> tuple[dict, dict]:
     """A checked request flown by the served model as POST /v1/shots flies it: (the result, the model's identity)."""
     from golfflight.service.api.shots import fly_shot
     from golfflight.service.engine import FlightEngine, FlightError
-    from golfflight.service.model_location import model_dir
+    from golfflight.flight.bundle_location import model_dir
 
     engine = FlightEngine(model_dir(model))
     try:
