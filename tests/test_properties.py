@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 import torch
 from golfflight.flight import limits
+from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import AirConditions, Conditions
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.wind import CALM, Wind
 from golfflight.service.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
-from golfflight.flight.bundle_location import model_dir
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
