@@ -6,6 +6,9 @@ from __future__ import annotations
 
 import json
 import shutil
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -30,6 +33,9 @@ from golfflight.model_export.accuracy_flyers import ModelFlyer
 from golfflight.service.engine import FlightEngine
 from golfflight.shots.ground_fit import RestShots, landings
 from golfflight.weights_schema.bundle import CARD_FILE, BundleError
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE_FOLDERS = ("golfflight", "flight", "service", "shots", "model_export", "weights_schema", "discovery", "sweep")
 
 SKY_BALL = Launch(75.0, 70.0, 0.0, 3000.0, 0.0)
 """In the air longer than the card's t_sim (10 s) and shorter than the engine's limit (20 s): a caller that stopped
@@ -111,3 +117,51 @@ def test_step_rules_are_named_objects_and_both_records_give_the_same_flight():
         np.testing.assert_array_equal(summary.flight_time_s, states.flight_time_s)
     euler, rk4 = (integrate(state, field, 0.05, 400, rule, heights).carry_m for rule in (FORWARD_EULER, RUNGE_KUTTA_4))
     assert not np.allclose(euler, rk4, atol=1e-6)
+
+
+INSTALLED_DEFAULTS = """
+from golfflight.cli import build_parser
+from golfflight.discovery.model import load_model
+from golfflight.flight.bundle_location import model_dir
+from golfflight.flight.flyer import load_flyer
+from golfflight.model_export.accuracy_flyers import ModelFlyer
+
+parser = build_parser()
+found = {
+    "diagnose": load_model(parser.parse_args(["diagnose", "shots.csv", "--out", "x"]).model).flyer.bundle_dir,
+    "accuracy": ModelFlyer(parser.parse_args(["accuracy"]).model).bundle,
+    "physics-check": ModelFlyer(parser.parse_args(["physics-check"]).model).bundle,
+    "evaluate": model_dir(parser.parse_args(["evaluate", "--data", "d", "--runs", "r", "--out", "o"]).bundle),
+    "ground-fit": load_flyer(parser.parse_args(["ground-fit"]).model).bundle_dir,
+}
+for command, bundle in found.items():
+    print(command, bundle)
+"""
+
+
+def test_an_installed_wheel_finds_its_bundle_for_every_command_without_model(tmp_path):
+    """Built and installed into a fresh environment's prefix, run outside the checkout: every command that flies the
+    default bundle finds <prefix>/share/golfflight/models/default."""
+    source = tmp_path / "source"
+    source.mkdir()
+    for name in ("pyproject.toml", "README.md"):
+        shutil.copy(ROOT / name, source / name)
+    for folder in PACKAGE_FOLDERS:
+        shutil.copytree(ROOT / folder, source / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(ROOT / "models" / "default", source / "models" / "default")
+    pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "-q"]
+    wheels = tmp_path / "wheels"
+    subprocess.run([*pip, "wheel", "--no-deps", "--no-build-isolation", str(source), "-w", str(wheels)], check=True)
+    prefix = tmp_path / "env"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", "--system-site-packages", str(prefix)], check=True)
+    # --ignore-installed: with --prefix, pip would otherwise uninstall the golfflight this interpreter has installed
+    install = ["install", "--no-deps", "--ignore-installed", "--prefix", str(prefix)]
+    subprocess.run([str(prefix / "bin" / "python"), *pip[1:], *install, *map(str, wheels.glob("*.whl"))], check=True)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    run = subprocess.run([str(prefix / "bin" / "python"), "-c", INSTALLED_DEFAULTS], cwd=elsewhere,
+                         env={"PATH": "/usr/bin:/bin"}, capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    shipped = prefix / "share" / "golfflight" / "models" / "default"
+    found = dict(line.split(" ", 1) for line in run.stdout.splitlines())
+    assert found == dict.fromkeys(("diagnose", "accuracy", "physics-check", "evaluate", "ground-fit"), str(shipped))
