@@ -3,7 +3,7 @@
 `load_flyer` is the only code that finds and assembles a model bundle: the lookup (`flight.bundle_location`), the
 card's step, maximum flight time (its t_sim, or the shot records' limit if longer), air and ball, checked against
 `flight.constants`. A Flyer puts its model in a given air (`in_air`: the graph fed at that air's Reynolds scale) and
-flies launches [N, LAUNCH_COLUMNS] x conditions x grounds through `flight.integrator.integrate`: each shot down to
+flies launches [N, LAUNCH_WIDTH] x conditions x grounds through `flight.integrator.integrate`: each shot down to
 its ground's plane (the state interpolated linearly to it), failing alone if it is still in the air at the maximum
 flight time, then bounced and rolled to rest on that ground (`flight.ground`) unless the flight alone was asked for.
 The engine's single-shot path (`service.engine`), discovery, accuracy, evaluation and the ground fit all fly
@@ -65,8 +65,9 @@ class Launch(NamedTuple):
     spin_axis_deg: float
 
 
-LAUNCH_COLUMNS = len(Launch._fields)
-"""The width of a launches array [N, LAUNCH_COLUMNS], in Launch's order."""
+LAUNCH_WIDTH = len(Launch._fields)
+"""The width of a launches array [N, LAUNCH_WIDTH], its columns in Launch's order (`shots.records.LAUNCH_COLUMNS`
+and `service.columns.LAUNCH_COLUMNS` name the columns of files)."""
 
 
 class FlightError(Exception):
@@ -180,7 +181,7 @@ class Flyer:
         conditions: Sequence[Conditions] | Conditions = STANDARD,
         grounds: Sequence[GroundSpec | None] | GroundSpec | None = None,
     ) -> BatchFlights:
-        """Shots (launches an [N, LAUNCH_COLUMNS] array or a sequence of Launch), each in its conditions, down to its
+        """Shots (launches an [N, LAUNCH_WIDTH] array or a sequence of Launch), each in its conditions, down to its
         ground and rolled to rest there (grounds None: the flights alone, down to z = 0), as columns."""
         return self._fly(launches, conditions, False, grounds).columns
 
@@ -232,7 +233,7 @@ class Flyer:
         if len(per_shot) != n or len(shot_grounds) != n:
             raise ValueError(f"{len(per_shot)} conditions and {len(shot_grounds)} grounds for {n} launches")
         heights = np.array([0.0 if g is None else g.elevation_m for g in shot_grounds])
-        start = initial_state(*np.asarray(launches, dtype=float).reshape(n, LAUNCH_COLUMNS).T)
+        start = initial_state(*np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH).T)
         field = self._batch_field(per_shot)
         flight = integrate(start, field, self.dt_s, self.max_steps, self.rule, GroundPlane(heights),
                            record_for(keep_states))
@@ -279,7 +280,9 @@ class Flyer:
         return EulerStates(times_s=times, positions=positions, velocities=velocities)
 
 
-def _ground_phase(flight: Flight, shots: np.ndarray, grounds: list[GroundSpec], keep_states: bool) -> GroundPhase | None:
+def _ground_phase(
+    flight: Flight, shots: np.ndarray, grounds: list[GroundSpec], keep_states: bool
+) -> GroundPhase | None:
     """The ground phase of the landed `shots` of a batch flight, each on its ground, in one batch."""
     if not shots.size:
         return None
