@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from functools import lru_cache
 from pathlib import Path
 from typing import NamedTuple, Protocol
@@ -202,7 +202,7 @@ class Flyer:
         if flight.states is not None:
             history = (np.stack([s.position for s in flight.states]), np.stack([s.velocity for s in flight.states]))
         rolled_row = np.cumsum(columns.rolled) - 1
-        rest_names = ("x_m", "y_m", "total_m", "roll_m", "bounces", "ground_time_s")
+        rest_names = [f.name for f in fields(Rest)]
         rests = zip(*(getattr(columns.rest, name).tolist() for name in rest_names), strict=True)
         numbers = zip(*(getattr(columns, name).tolist() for name in SHOT_NUMBERS), strict=True)
         results: list[ShotFlight | FlightError] = []
