@@ -21,9 +21,9 @@ import onnx
 import onnxruntime as ort
 from common import SEVEN_IRON, write_results
 from golfflight.flight.bundle_check import session_options
+from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.physics import euler_step
 from golfflight.service.engine import FlightEngine
-from golfflight.service.model_location import model_dir
 from golfflight.weights_schema.bundle import load_bundle
 from onnx import TensorProto, helper
 

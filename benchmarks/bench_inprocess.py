@@ -20,8 +20,8 @@ from common import (
     print_table,
     write_results,
 )
+from golfflight.flight.bundle_location import model_dir
 from golfflight.service.engine import BATCH_THREADS, FlightEngine
-from golfflight.service.model_location import model_dir
 
 
 def timed(call, repeats: int, warmup: int = 1) -> list[float]:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 from golfflight.flight.field import BallInAir, ScaledCoefficients, WeightedCorrection
-from golfflight.flight.integrator import GroundPlane, Method, integrate
+from golfflight.flight.integrator import STEP_RULES, GroundPlane, Method, integrate, record_for
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import CoefficientModel, initial_state
 from golfflight.flight.wind import Wind
@@ -111,10 +111,9 @@ def fly_setup(
     wind = air if air is not None else Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1])
     extra = None if correction is None else WeightedCorrection(correction, setup.correction_weights)
     field = BallInAir(coefficients, density, wind, extra)
-    record = "states" if keep_states else "summary"
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         start, ground = initial_state(**setup.launch), GroundPlane(setup.ground_height_m)
-        return integrate(start, field, dt_s, round(t_max_s / dt_s), method, ground, record)
+        return integrate(start, field, dt_s, round(t_max_s / dt_s), STEP_RULES[method], ground, record_for(keep_states))
 
 
 def simulate_setup(

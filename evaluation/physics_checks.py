@@ -423,14 +423,14 @@ class PhysicsReport:
     spin: list[SpinCheck]
 
 
-def run_physics_checks(model_dir: str | os.PathLike, data_dir: str | os.PathLike) -> PhysicsReport:
+def run_physics_checks(model_dir: str | os.PathLike | None, data_dir: str | os.PathLike) -> PhysicsReport:
     """Both checks of a bundle against the literature in `data_dir` (the shared data folder)."""
     aero, spin = Path(data_dir) / AERO_FILE, Path(data_dir) / SPIN_FILE
     for path in (aero, spin):
         if not path.is_file():
             raise FileNotFoundError(f"{path} not found (set GOLFFLIGHT_SHARED_DATA or put the shared data beside the "
                                     "repository)")
-    flyer, air = ModelFlyer(model_dir, label=f"`{model_dir}`"), Air.standard()
+    flyer, air = ModelFlyer(model_dir), Air.standard()
     literature = read_aero_literature(aero)
     measured = {name: measured_set(literature, name) for name in COEFFICIENTS}
     if not all(len(m.value) for m in measured.values()):

@@ -123,6 +123,10 @@ class ReferenceAerodynamics:
         self.params = params
         self.reynolds_per_speed = BALL_DIAMETER_M / np.asarray(kinematic_viscosity, dtype=float)
 
+    def in_air(self, kinematic_viscosity: float | np.ndarray) -> ReferenceAerodynamics:
+        """The reference world's aerodynamics in air of this kinematic viscosity (its Reynolds numbers)."""
+        return ReferenceAerodynamics(self.params, kinematic_viscosity)
+
     def coefficients(self, spin_ratio: np.ndarray, reynolds: np.ndarray) -> np.ndarray:
         """C_L, C_D, C_M, C_Q [N,4] as functions of spin ratio and Reynolds number [N]."""
         p = self.params

@@ -20,8 +20,8 @@ from golfflight.evaluation.noise_floor import Floor, noise_floors, nominal_condi
 from golfflight.evaluation.report import metres_yards
 from golfflight.evaluation.validation import Errors, Prediction, errors_of, gap
 from golfflight.flight.air import Air
-from golfflight.flight.integrator import simulate
-from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.flyer import load_flyer
+from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import initial_state
 from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics
 from golfflight.model_export.torch_physics import euler_rollout, hard_landing, spin_ratio
@@ -148,21 +148,20 @@ class BundleCheck:
     not_landed: int
 
 
+def runtime_flight(bundle_dir: str | os.PathLike | None, launch: dict[str, np.ndarray], air: Air) -> Flight:
+    """Launches (the canonical launch columns) flown in `air` by a bundle's Flyer: the runtime path of
+    `check_bundle`."""
+    flyer = load_flyer(bundle_dir)
+    return flyer.flight(initial_state(**launch), air.density_kg_m3, air.kinematic_viscosity_m2_s)
+
+
 def check_bundle(bundle_dir: str | os.PathLike, val: ValidationSet) -> BundleCheck:
-    """Validation errors of a bundle through `flight.integrator.simulate` + `OnnxCoefficients` (the runtime path) and
-    the largest per-shot difference from the torch float64 evaluation of the same weights."""
+    """Validation errors of a bundle flown by its Flyer (`flight.flyer.load_flyer`: the runtime path, for the
+    engine's maximum flight time) and the largest per-shot difference from the torch float64 evaluation of the same
+    weights."""
     from golfflight.model_export.bundle_model import config_from_card, model_from_bundle
 
-    coefficients = OnnxCoefficients(bundle_dir)
-    physics = coefficients.card.physics
-    air = val.shots.air()
-    flight = simulate(
-        initial_state(**val.shots.launch()),
-        coefficients.in_air(air.kinematic_viscosity_m2_s),
-        air.density_kg_m3,
-        dt=physics.dt_s,
-        t_max=physics.t_sim_s,
-    )
+    flight = runtime_flight(bundle_dir, val.shots.launch(), val.shots.air())
     runtime = Prediction(flight.landing_position[:, :2], flight.apex_m)
     model, card = model_from_bundle(bundle_dir)
     reference = predict_validation(model, config_from_card(card), val)
@@ -383,7 +382,7 @@ def render(runs: list[RunEvaluation], floors: list[Floor], val: ValidationSet, b
                 ("path", "L_p m", "L_p yd", "L_h m", "L_h yd"),
                 (
                     (
-                        "NumPy + ONNX Runtime (`flight.integrator.simulate`)",
+                        "NumPy + ONNX Runtime (`flight.flyer.Flyer`)",
                         *metres_yards(bundle.numpy_errors.mean_landing_m),
                         *metres_yards(bundle.numpy_errors.mean_abs_apex_m),
                     ),

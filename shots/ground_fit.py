@@ -18,9 +18,8 @@ from pathlib import Path
 
 import numpy as np
 from golfflight.flight.constants import YARD_M
+from golfflight.flight.flyer import LAUNCH_WIDTH, Flyer
 from golfflight.flight.ground import SURFACES, Surface, ground_phase
-from golfflight.flight.integrator import simulate
-from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import initial_state
 from golfflight.shots.markdown import table
@@ -51,8 +50,6 @@ theta_c 15 degrees; rolling resistance 0.12 g, grass drag 1/s): of the sets that
 SWEPT_RESISTANCE = (0.02, 0.05, 0.08, 0.12, 0.2)
 """Rolling resistances held in `resistance_sweep`."""
 
-MAX_FLIGHT_S = 20.0
-
 
 @dataclass(frozen=True)
 class RestShots:
@@ -78,19 +75,17 @@ def fairway_shots(event: str, path: str | os.PathLike) -> RestShots:
     launches = [(r.ball_speed_mps, r.launch_angle_deg, r.launch_direction_deg, r.spin_rpm, 0.0) for r in kept]
     return RestShots(
         event,
-        np.array(launches, dtype=float).reshape(-1, 5),
+        np.array(launches, dtype=float).reshape(-1, LAUNCH_WIDTH),
         np.array([rests[r.shot_id].distance_m for r in kept]),
         np.array([rests[r.shot_id].dz_m for r in kept]),
         np.array([apexes[r.shot_id].range_m if apexes[r.shot_id].range_m else np.nan for r in kept]),
     )
 
 
-def landings(shots: RestShots, model: OnnxCoefficients) -> Flight:
-    """The shots flown by the bundle (its step and air) down to planes at their rest elevations."""
-    card = model.card.physics
-    start = initial_state(*shots.launches.T)
-    return simulate(start, model, card.air_density_kg_m3, dt=card.dt_s, t_max=MAX_FLIGHT_S,
-                    ground_height_m=shots.rest_dz_m)
+def landings(shots: RestShots, flyer: Flyer) -> Flight:
+    """The shots flown by the bundle's Flyer (its step, maximum flight time and air) down to planes at their rest
+    elevations."""
+    return flyer.flight(initial_state(*shots.launches.T), ground_height_m=shots.rest_dz_m)
 
 
 def totals(flight: Flight, surface: Surface) -> np.ndarray:
@@ -170,14 +165,14 @@ class GroundFit:
         return {**asdict(self), "scores": [asdict(s) for s in self.scores]}
 
 
-def run_fit(model_dir: str | os.PathLike, data_dir: str | os.PathLike) -> GroundFit:
-    """Fit on THE PLAYERS 2020, check on the TOUR Championship 2020 (files under `data_dir`)."""
-    model = OnnxCoefficients(model_dir)
+def run_fit(flyer: Flyer, data_dir: str | os.PathLike) -> GroundFit:
+    """Fit on THE PLAYERS 2020, check on the TOUR Championship 2020 (files under `data_dir`), flying a bundle's
+    Flyer (`flight.flyer.load_flyer`)."""
     fit_name, fit_path = FIT_EVENT
     check_name, check_path = CHECK_EVENT
     fit_shots = fairway_shots(fit_name, Path(data_dir) / fit_path)
     check_shots = fairway_shots(check_name, Path(data_dir) / check_path)
-    fit_flight, check_flight = landings(fit_shots, model), landings(check_shots, model)
+    fit_flight, check_flight = landings(fit_shots, flyer), landings(check_shots, flyer)
     fairway, fit_mae = fit_fairway(fit_flight, fit_shots.distance_m)
     fit_carry, check_carry = fit_flight.carry_m, check_flight.carry_m
     constant = float(np.median(fit_shots.distance_m - fit_carry))
@@ -208,7 +203,7 @@ def run_fit(model_dir: str | os.PathLike, data_dir: str | os.PathLike) -> Ground
             )
         }
     sweep = resistance_sweep(fit_flight, fit_shots.distance_m)
-    return GroundFit(model.card.onnx.sha256, asdict(fairway), fit_mae, constant, scores, carry_check, correlations,
+    return GroundFit(flyer.card.onnx.sha256, asdict(fairway), fit_mae, constant, scores, carry_check, correlations,
                      sweep)
 
 

@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 from golfflight.flight.air import Air
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
-from golfflight.flight.integrator import simulate
+from golfflight.flight.flyer import Flyer
+from golfflight.flight.integrator import RUNGE_KUTTA_4
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import State
 from golfflight.flight.reference_aero import (
@@ -36,6 +37,20 @@ TOUR_AVERAGES_FILE = Path("reference") / "trackman_tour_averages_pga_2023.csv"
 """The PGA TOUR 2023 averages, relative to the shared data folder."""
 
 
+def reference_flyer(params: ReferenceParameters = CALIBRATED, air: Air = CALIBRATION_AIR) -> Flyer:
+    """The reference world as a Flyer: its aerodynamics flown by RK4 at REFERENCE_DT_S for up to REFERENCE_T_MAX_S,
+    in `air` unless a flight is given its own."""
+    viscosity = float(air.kinematic_viscosity_m2_s)
+    return Flyer(
+        ReferenceAerodynamics(params, viscosity),
+        dt_s=REFERENCE_DT_S,
+        max_flight_time_s=REFERENCE_T_MAX_S,
+        density_kg_m3=float(air.density_kg_m3),
+        kinematic_viscosity_m2_s=viscosity,
+        rule=RUNGE_KUTTA_4,
+    )
+
+
 def fly_reference(
     state: State,
     air: Air,
@@ -44,19 +59,10 @@ def fly_reference(
     keep_states: bool = False,
     params: ReferenceParameters = CALIBRATED,
 ) -> Flight:
-    """Fly a batch through the reference world (RK4 at REFERENCE_DT_S) until every ball has landed."""
-    model = ReferenceAerodynamics(params, air.kinematic_viscosity_m2_s)
-    return simulate(
-        state,
-        model,
-        air.density_kg_m3,
-        wind,
-        dt=REFERENCE_DT_S,
-        t_max=REFERENCE_T_MAX_S,
-        method="rk4",
-        ground_height_m=ground_height_m,
-        keep_states=keep_states,
-    )
+    """Fly a batch through the reference world (`reference_flyer`) in `air` (per shot or shared) until every ball
+    has landed."""
+    flyer = reference_flyer(params)
+    return flyer.flight(state, air.density_kg_m3, air.kinematic_viscosity_m2_s, wind, ground_height_m, keep_states)
 
 
 class ClubAverage(BaseModel):

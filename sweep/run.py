@@ -16,7 +16,7 @@ from contextlib import closing
 from dataclasses import dataclass
 from typing import Literal
 
-from golfflight.service.model_location import model_dir
+from golfflight.flight.bundle_location import model_dir
 from golfflight.shots.files import write_atomic
 from golfflight.sweep.flyer import PROBLEM, ROW, Layout
 from golfflight.sweep.sources import Source

@@ -9,10 +9,10 @@ import sys
 import pytest
 from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.evaluation.accuracy_sets import compare_clubs
+from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
 from golfflight.service.api.app import create_app
 from golfflight.service.api.models import MAX_BATCH_SHOTS
-from golfflight.service.model_location import model_dir
 from golfflight.shots.paths import shared_data_dir
 from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
 from golfflight.weights_schema.bundle import load_bundle

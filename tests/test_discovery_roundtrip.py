@@ -8,8 +8,9 @@ import json
 import numpy as np
 import pytest
 from golfflight.discovery.conceal import conceal
-from golfflight.discovery.model import DEFAULT_BUNDLE, load_model
+from golfflight.discovery.model import load_model
 from golfflight.discovery.schema import Report
+from golfflight.flight.bundle_location import model_dir
 from golfflight.service.api.models import ShotRequest
 from golfflight.service.api.shots import conditions_of
 from golfflight.service.engine import FlightEngine, Launch
@@ -43,7 +44,7 @@ def test_the_written_settings_reproduce_held_out_recordings_in_the_service(tmp_p
     assert [e.name for e in report.effects] == ["wind"] and settings["wind"]["profile"] == "uniform"
 
     held_out = conceal(WIND, 200, seed=52, model=served).shots.records  # other sessions, launches and noise
-    engine = FlightEngine(DEFAULT_BUNDLE)
+    engine = FlightEngine(model_dir())
     before, after = _service_rms(engine, held_out, None), _service_rms(engine, held_out, settings)
     claimed_before = np.array([report.heldout.before[name] for name in ("carry_y_m", "carry_x_m")])
     claimed_after = np.array([report.heldout.after[name] for name in ("carry_y_m", "carry_x_m")])

@@ -13,11 +13,12 @@ import numpy as np
 import pytest
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import diagnose
-from golfflight.discovery.model import DEFAULT_BUNDLE, from_bundle, load_model
+from golfflight.discovery.model import from_bundle, load_model
 from golfflight.discovery.noise import RADAR_NOISE
 from golfflight.discovery.own_error import measure_own_error, write_own_error
 from golfflight.discovery.recordings import from_shot_set
 from golfflight.discovery.simulator import Setup
+from golfflight.flight.bundle_location import model_dir
 from golfflight.service.engine import FlightEngine, Launch
 from golfflight.shots.paths import REPO_ROOT
 from golfflight.weights_schema.bundle import load_bundle
@@ -39,7 +40,7 @@ def _diagnose(model, hidden, seed, noise=RADAR_NOISE, correction=False):
 def test_discovery_flies_the_launches_as_the_engine_does(served):
     """Same integrator, coefficients and air: discovery's prediction is the engine's batch flight."""
     launches = [Launch(70.0, 11.0, 1.0, 2600.0, 4.0), Launch(45.0, 20.0, -2.0, 7000.0, -8.0)]
-    flights = FlightEngine(DEFAULT_BUNDLE).fly_batch(launches)
+    flights = FlightEngine(model_dir()).fly_batch(launches)
     columns = {name: np.array(values, dtype=float) for name, values in zip(Launch._fields, zip(*launches))}
     setup = Setup(columns, np.ones(2), np.full(2, served.density_kg_m3), np.zeros((2, 2)), np.zeros(2), np.ones((2, 3)))
     flown = served.simulate(setup).outcomes()

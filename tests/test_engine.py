@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import time
 
 import numpy as np
@@ -9,13 +10,13 @@ import onnxruntime as ort
 import pytest
 from conftest import random_launches
 from golfflight.flight.air import Air
+from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.integrator import simulate
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.flight.wind import Wind
 from golfflight.service.engine import FlightEngine, FlightError, Launch, ShotFlight
-from golfflight.service.model_location import model_dir
 from golfflight.service.trajectory import resample
 
 PAPER_SINGLE_SHOT_MS = 34.9
@@ -113,8 +114,9 @@ def test_a_long_flight_goes_on_past_t_sim_and_the_cap_fails_only_that_shot(engin
     sky_ball = Launch(75.0, 70.0, 0.0, 3000.0, 0.0)
     flight = engine.fly(sky_ball)
     assert flight.flight_time_s > engine.t_sim
-    capped = FlightEngine.__new__(FlightEngine)
-    capped.__dict__.update(engine.__dict__, max_steps=int(engine.t_sim / engine.dt))
+    capped = copy.copy(engine)
+    capped.flyer = copy.copy(engine.flyer)
+    capped.max_steps = int(engine.t_sim / engine.dt)
     with pytest.raises(FlightError, match="still in the air"):
         capped.fly(sky_ball)
     first, second = capped.fly_batch([sky_ball, SEVEN_IRON])

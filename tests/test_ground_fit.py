@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from golfflight.flight.flyer import load_flyer
 from golfflight.flight.ground import SURFACES
-from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.shots.ground_fit import FAIRWAY_LIES, FIT_EVENT, FITTED, fairway_shots, landings, score, totals
 from golfflight.shots.paths import REPO_ROOT, shared_data_dir
 
@@ -34,7 +34,7 @@ def test_fairway_rests_of_the_fixture_fly_land_and_roll_on(tmp_path):
     path.write_text("".join(FIXTURE.read_text().splitlines(keepends=True)[:4]))
     shots = fairway_shots("fixture", path)
     assert len(shots.launches) == 1
-    flight = landings(shots, OnnxCoefficients(REPO_ROOT / "models" / "default"))
+    flight = landings(shots, load_flyer())
     assert flight.landed.all()
     np.testing.assert_allclose(flight.landing_position[:, 2], shots.rest_dz_m, atol=1e-9)
     assert np.all(totals(flight, SURFACES["fairway"]) > flight.carry_m)
@@ -52,11 +52,11 @@ def test_the_committed_fit_error_is_what_the_code_gives():
     if not path.exists():
         pytest.skip(f"{path} is not here")
     results = json.loads(RESULTS.read_text())
-    model = OnnxCoefficients(REPO_ROOT / "models" / "default")
-    if model.card.onnx.sha256 != results["model_sha256"]:
+    flyer = load_flyer()
+    if flyer.card.onnx.sha256 != results["model_sha256"]:
         pytest.skip("models/default changed since docs/ground_fit.json: re-run `golfflight ground-fit`")
     shots = fairway_shots(name, path)
     assert len(shots.launches) > 1000
-    error = np.mean(np.abs(totals(landings(shots, model), SURFACES["fairway"]) - shots.distance_m))
+    error = np.mean(np.abs(totals(landings(shots, flyer), SURFACES["fairway"]) - shots.distance_m))
     assert error == pytest.approx(results["fit_mae_m"], abs=0.02)
     assert set(FAIRWAY_LIES) == {"ELF", "ERF"}

@@ -68,7 +68,7 @@ def test_the_wheel_installs_beside_a_package_called_service_and_flies_a_shot(tmp
     code = (
         "import service, flight\n"
         "from golfflight.service.engine import FlightEngine, Launch\n"
-        "from golfflight.service.model_location import model_dir\n"
+        "from golfflight.flight.bundle_location import model_dir\n"
         "assert service.WHO.endswith('service') and flight.WHO.endswith('flight')\n"
         f"engine = FlightEngine(model_dir({str(target / 'share/golfflight/models/default')!r}))\n"
         "import golfflight.service.engine as engine_module\n"

@@ -6,7 +6,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-DEFAULT_SYNTHETIC = "models/synthetic"
+from golfflight.flight.bundle_location import CHECKOUT_MODEL
+
+DEFAULT_SYNTHETIC = CHECKOUT_MODEL.parent / "synthetic"
+"""The synthetic-data model of a source checkout (not shipped in the wheel)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -20,9 +23,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "and a fine-tuning study on the Sony Open 2022 (rounds 1-2 tuned, 3-4 measured). Sets that are not found are "
         "skipped and said so.",
     )
-    parser.add_argument("--model", default="models/default", help="the real-data model bundle (default models/default)")
-    parser.add_argument("--synthetic", help=f"the synthetic-data model bundle (default {DEFAULT_SYNTHETIC} where it "
-                        "exists, else the --model bundle again)")
+    parser.add_argument("--model", help="the real-data model bundle (default: the served default, `golfflight serve`'s "
+                        "lookup)")
+    parser.add_argument("--synthetic", help="the synthetic-data model bundle (default: a source checkout's "
+                        "models/synthetic where it exists, else the --model bundle again)")
     parser.add_argument("--out", default="docs/accuracy.md", help="markdown file whose generated section is replaced")
     parser.add_argument("--figures", help="directory for the path-error PNG (default: figures/ beside --out)")
     parser.add_argument("--data-dir", help="shared data folder (default: $GOLFFLIGHT_SHARED_DATA or ../shared/data)")
@@ -45,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
         finetune = training.finetune
     synthetic = args.synthetic
     if synthetic is None:
-        synthetic = DEFAULT_SYNTHETIC if Path(DEFAULT_SYNTHETIC, "model_card.json").is_file() else args.model
+        synthetic = DEFAULT_SYNTHETIC if (DEFAULT_SYNTHETIC / "model_card.json").is_file() else args.model
     figures = args.figures or Path(args.out).parent / "figures"
     report = run_accuracy(args.model, args.out, figures, args.data_dir, args.finetune_epochs, synthetic=synthetic,
                           finetune=finetune)

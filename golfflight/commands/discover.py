@@ -20,7 +20,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("recordings", help="canonical shot CSV (a NAME.trajectories.csv beside it is used)")
     parser.add_argument(
         "--model",
-        help=f"model bundle directory, or '{REFERENCE}' for the reference world (default: the shipped models/default)",
+        help=f"model bundle directory, or '{REFERENCE}' for the reference world (default: the served default, "
+        "`golfflight serve`'s lookup)",
     )
     parser.add_argument("--out", required=True, help="folder for report.json, report.html, service_settings.json")
     parser.add_argument("--seed", type=int, default=0, help="seed of the fitting subsample and the bootstraps")
@@ -41,7 +42,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     prove = subparsers.add_parser("prove", help="hide effects in synthetic recordings, diagnose them blind, score")
     prove.add_argument(
-        "--model", help=f"a bundle (default: the shipped models/default) or '{REFERENCE}' (the method alone)"
+        "--model", help=f"a bundle (default: the served default) or '{REFERENCE}' (the method alone)"
     )
     prove.add_argument(
         "--truth",

@@ -16,7 +16,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--data", required=True, help="canonical shot CSV with a split column (the runs' data)")
     parser.add_argument("--runs", required=True, nargs="+", help="run directories (their best.pt) or checkpoint files")
     parser.add_argument(
-        "--bundle", help="also fly this model bundle through NumPy + ONNX Runtime and compare with torch"
+        "--bundle",
+        help="the model bundle flown through NumPy + ONNX Runtime and compared with torch (default: the served "
+        "default, `golfflight serve`'s lookup)",
     )
     parser.add_argument("--out", required=True, help="docs directory: OUT/training.md and OUT/figures/ are written")
     parser.set_defaults(run=run)
@@ -25,10 +27,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import torch
 
+    from golfflight.flight.bundle_location import model_dir
     from golfflight.model_export.evaluate import run_evaluation
 
     torch.set_num_threads(2)
-    report = run_evaluation(args.data, args.runs, args.out, bundle=args.bundle)
+    report = run_evaluation(args.data, args.runs, args.out, bundle=model_dir(args.bundle))
     print(report.markdown, end="")
     for path in report.figures:
         print(f"wrote {path}")

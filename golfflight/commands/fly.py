@@ -207,14 +207,12 @@ def fly_reference_shot(shot) -> dict:
                                                                flight.landing_spin))
     carry = float(flight.carry_m[0])
     one = ground_phase_one(position, velocity, spin, LEVEL_FAIRWAY.surface)
-    x, y, _ = one.position
-    total = math.hypot(x, y)
     result = ShotFlight(
         landing_x_m=position[0], landing_y_m=position[1], carry_m=carry, lateral_m=position[0],
         apex_m=float(flight.apex_m[0]), apex_time_s=float(flight.apex_time_s[0]),
         flight_time_s=float(flight.flight_time_s[0]), landing_angle_deg=float(flight.landing_angle_deg[0]),
         landing_speed_mps=float(flight.landing_speed_mps[0]), landing_spin_rpm=float(flight.landing_spin_rpm[0]),
-        rest=Rest(x, y, total, total - carry, one.bounces, one.time_s),
+        rest=Rest.at(one.position[0], one.position[1], carry, one.bounces, one.time_s),
     )
     fields = flight_fields(result, None)
     fields["landing"], fields["rest"] = (point.model_dump() for point in (fields["landing"], fields["rest"]))
@@ -223,9 +221,9 @@ def fly_reference_shot(shot) -> dict:
 
 def fly_model_shot(shot, model: str | None) -> tuple[dict, dict]:
     """A checked request flown by the served model as POST /v1/shots flies it: (the result, the model's identity)."""
+    from golfflight.flight.bundle_location import model_dir
     from golfflight.service.api.shots import fly_shot
     from golfflight.service.engine import FlightEngine, FlightError
-    from golfflight.service.model_location import model_dir
 
     engine = FlightEngine(model_dir(model))
     try:

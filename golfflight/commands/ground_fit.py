@@ -18,7 +18,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "it on the fairway; fit the fairway on THE PLAYERS, check on the TOUR Championship against carry plus a "
         "constant roll.",
     )
-    parser.add_argument("--model", default="models/default", help="model bundle (default models/default)")
+    parser.add_argument("--model", help="model bundle (default: the served default, `golfflight serve`'s lookup)")
     parser.add_argument("--data-dir", help="shared data folder (default: $GOLFFLIGHT_SHARED_DATA or ../shared/data)")
     parser.add_argument("--out", default="docs/ground.md", help="markdown file whose generated section is replaced")
     parser.add_argument("--results", default="docs/ground_fit.json", help="JSON results file")
@@ -26,16 +26,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from golfflight.flight.flyer import load_flyer
     from golfflight.shots.files import write_text_atomic
     from golfflight.shots.ground_fit import markdown, run_fit
     from golfflight.shots.markdown import write_generated_section
     from golfflight.shots.paths import shared_data_dir
 
     data_dir = Path(args.data_dir) if args.data_dir else shared_data_dir()
-    fit = run_fit(args.model, data_dir)
-    section = markdown(fit, args.model)
+    flyer = load_flyer(args.model)
+    model = args.model or str(flyer.bundle_dir)
+    fit = run_fit(flyer, data_dir)
+    section = markdown(fit, model)
     print(section, end="")
     write_generated_section(args.out, section, "ground-fit")
-    write_text_atomic(args.results, json.dumps({"model": args.model, **fit.as_dict()}, indent=2) + "\n")
+    write_text_atomic(args.results, json.dumps({"model": model, **fit.as_dict()}, indent=2) + "\n")
     print(f"wrote {args.out}, {args.results}")
     return 0

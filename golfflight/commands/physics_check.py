@@ -17,7 +17,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "and the spin it loses after 1, 3 and 5 s with TrackMan's measurements (the shared data's literature "
         "folder, read in place).",
     )
-    parser.add_argument("--model", default="models/default", help="model bundle (default models/default)")
+    parser.add_argument("--model", help="model bundle (default: the served default, `golfflight serve`'s lookup)")
     parser.add_argument("--data-dir", help="shared data folder (default: $GOLFFLIGHT_SHARED_DATA or ../shared/data)")
     parser.add_argument("--out", default="docs/physics_checks.md",
                         help="markdown file whose generated section is replaced (default docs/physics_checks.md)")

@@ -86,9 +86,9 @@ def shots_from_json(text: str, source: str) -> list[dict]:
 
 
 def run(args: argparse.Namespace) -> int:
+    from golfflight.flight.bundle_location import model_dir
     from golfflight.service.api.shots import fly_shots
     from golfflight.service.engine import FlightEngine
-    from golfflight.service.model_location import model_dir
 
     ids: list[str | None] = []
     problems: list[str] = []

@@ -27,6 +27,7 @@ from importlib.metadata import version
 
 from fastapi import FastAPI
 from fastapi.middleware.cors import CORSMiddleware
+from golfflight.flight.bundle_location import model_dir
 from golfflight.service.api import errors
 from golfflight.service.api.bay import BAY_FILE_ENV, Bay
 from golfflight.service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
@@ -34,7 +35,6 @@ from golfflight.service.api.request_metrics import RequestMetrics
 from golfflight.service.api.routes import bay as bay_routes
 from golfflight.service.api.routes import docs, gspro, metrics, shots, status, viewer
 from golfflight.service.api.state import ServiceState
-from golfflight.service.model_location import model_dir
 from golfflight.service.open_connect.server import ConnectAddress, OpenConnectServer
 from starlette.routing import Mount, Route
 
@@ -51,7 +51,7 @@ def create_app(
     connect: ConnectAddress | None = None,
     bay: str | os.PathLike | None = None,
 ) -> FastAPI:
-    """The service for a model bundle (default: `service.model_location.model_dir()`).
+    """The service for a model bundle (default: `flight.bundle_location.model_dir()`).
 
     `api_key` (default $GOLFFLIGHT_API_KEY) makes every route but /healthz require it; `cors_origins` (default the
     comma-separated $GOLFFLIGHT_CORS_ORIGINS) are the browser origins allowed; none means CORS stays off. `connect`

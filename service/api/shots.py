@@ -9,6 +9,7 @@ import numpy as np
 from golfflight.flight.air import Air
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
+from golfflight.flight.flyer import LAUNCH_WIDTH
 from golfflight.flight.ground import LEVEL_FAIRWAY, GroundSpec, surface
 from golfflight.flight.wind import CALM, Wind
 from golfflight.service.api.models import (
@@ -264,7 +265,7 @@ def fly_columns(engine: FlightEngine, shots: list[ShotRequest]) -> ShotColumns:
         raise ValueError("fly_columns flies no trajectories (fly_shots does)")
     n = len(shots)
     launches, conditions, grounds, replays, flats = _batch_of(shots)
-    flights = engine.fly_columns(np.array(launches, dtype=float).reshape(-1, 5), conditions, grounds)
+    flights = engine.fly_columns(np.array(launches, dtype=float).reshape(-1, LAUNCH_WIDTH), conditions, grounds)
     replay_rows = np.arange(n, n + len(replays))
     flat_rows = np.arange(n + len(replays), n + len(replays) + len(flats))
     errors: list[str | None] = [None] * n

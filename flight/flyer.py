@@ -1,0 +1,348 @@
+"""The one way a coefficient model is flown: `Flyer`, a model with its step rule, step, maximum flight time and air.
+
+`load_flyer` is the only code that finds and assembles a model bundle: the lookup (`flight.bundle_location`), the
+card's step, maximum flight time (its t_sim, or the shot records' limit if longer), air and ball, checked against
+`flight.constants`. A Flyer puts its model in a given air (`in_air`: the graph fed at that air's Reynolds scale) and
+flies launches [N, LAUNCH_WIDTH] x conditions x grounds through `flight.integrator.integrate`: each shot down to
+its ground's plane (the state interpolated linearly to it), failing alone if it is still in the air at the maximum
+flight time, then bounced and rolled to rest on that ground (`flight.ground`) unless the flight alone was asked for.
+The engine's single-shot path (`service.engine`), discovery, accuracy, evaluation and the ground fit all fly
+through it, so every one of them flies the same shot to the same numbers.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, fields
+from functools import lru_cache
+from pathlib import Path
+from typing import NamedTuple, Protocol
+
+import numpy as np
+from golfflight.flight.bundle_location import model_dir
+from golfflight.flight.conditions import STANDARD, Conditions
+from golfflight.flight.constants import BALL_MASS_KG, BALL_RADIUS_M
+from golfflight.flight.field import BallInAir
+from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, ground_phase
+from golfflight.flight.integrator import FORWARD_EULER, GroundPlane, StepRule, integrate, record_for
+from golfflight.flight.limits import FLIGHT_TIME_S
+from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.outcomes import (
+    SHOT_NUMBERS,
+    BatchFlights,
+    EulerStates,
+    Flight,
+    Rest,
+    ShotFlight,
+    landing_figures,
+)
+from golfflight.flight.physics import CoefficientModel, State, initial_state
+from golfflight.flight.wind import CALM, Wind
+from golfflight.weights_schema.bundle import CARD_FILE, BundleError
+from golfflight.weights_schema.model_card import ModelCard
+
+MAX_FLIGHT_TIME_S = FLIGHT_TIME_S.high
+"""Longest flight simulated (20 s, the shot records' limit) unless a card's t_sim is longer; a shot still in the air
+then gets a FlightError."""
+
+BATCH_THREADS = 1
+"""ORT threads of a batch step. One: on the 2-core machine, with other work running (a training job, a second
+worker), two threads took 96-120 us a shot against 35-42 for one (docs/benchmarks.md); a quiet machine gains
+about 1.5x from a second thread, so pass batch_threads=2 where the cores are the engine's alone."""
+
+NON_FINITE = "the model gave a non-finite flight for this launch"
+
+
+class Launch(NamedTuple):
+    """Launch-monitor values of one shot, SI (paper eq. 12's inputs)."""
+
+    ball_speed_mps: float
+    launch_angle_deg: float
+    launch_direction_deg: float
+    spin_rpm: float
+    spin_axis_deg: float
+
+
+LAUNCH_WIDTH = len(Launch._fields)
+"""The width of a launches array [N, LAUNCH_WIDTH], its columns in Launch's order (`shots.records.LAUNCH_COLUMNS`
+and `service.columns.LAUNCH_COLUMNS` name the columns of files)."""
+
+
+class FlightError(Exception):
+    """A shot the engine could not fly to the ground (the message says why); a batch reports it for that shot."""
+
+
+class ModelInAir(Protocol):
+    """A coefficient model that can be put in air of another kinematic viscosity (its Reynolds numbers)."""
+
+    def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray: ...
+
+    def in_air(self, kinematic_viscosity_m2_s: float | np.ndarray) -> CoefficientModel: ...
+
+
+@dataclass(frozen=True)
+class AirInputs:
+    """What the equations need of a shot's conditions: density, the wind at its reference height, whether it follows
+    the log profile (and the profile's reference height and roughness), and the kinematic viscosity."""
+
+    density_kg_m3: float
+    wind_x_mps: float
+    wind_y_mps: float
+    log_profile: bool
+    reference_height_m: float
+    roughness_m: float
+    kinematic_viscosity_m2_s: float
+
+
+@lru_cache(maxsize=1024)
+def air_inputs(conditions: Conditions) -> AirInputs:
+    """The AirInputs of a shot's conditions; cached because a batch or a stream of shots mostly shares a few."""
+    wind_x, wind_y = conditions.wind_at_reference_mps
+    wind, air = conditions.wind, conditions.air
+    return AirInputs(
+        density_kg_m3=air.density_kg_m3,
+        wind_x_mps=wind_x,
+        wind_y_mps=wind_y,
+        log_profile=wind.profile == "log" and (wind_x != 0.0 or wind_y != 0.0),
+        reference_height_m=wind.reference_height_m,
+        roughness_m=wind.roughness_m,
+        kinematic_viscosity_m2_s=air.kinematic_viscosity_m2_s,
+    )
+
+
+def step_count(max_time_s: float, dt_s: float) -> int:
+    """Steps of dt_s that reach max_time_s (a whole number of steps up to rounding)."""
+    return math.ceil(max_time_s / dt_s - 1e-9)
+
+
+class _Flown(NamedTuple):
+    """A batch's columns, the integrator's flight and the ground phase of its rolled shots (in shot order)."""
+
+    columns: BatchFlights
+    flight: Flight
+    phase: GroundPhase | None
+
+
+class Flyer:
+    """A coefficient model flown by one step rule at one step, for at most one flight time, in its nominal air unless
+    told otherwise. `card` and `bundle_dir` are a bundle's (None for a closed-form model)."""
+
+    def __init__(
+        self,
+        model: ModelInAir,
+        dt_s: float,
+        max_flight_time_s: float,
+        density_kg_m3: float,
+        kinematic_viscosity_m2_s: float,
+        rule: StepRule = FORWARD_EULER,
+        card: ModelCard | None = None,
+        bundle_dir: Path | None = None,
+    ) -> None:
+        self.model, self.rule, self.card, self.bundle_dir = model, rule, card, bundle_dir
+        self.dt_s, self.max_flight_time_s = float(dt_s), float(max_flight_time_s)
+        self.density_kg_m3, self.kinematic_viscosity_m2_s = float(density_kg_m3), float(kinematic_viscosity_m2_s)
+        self.max_steps = step_count(self.max_flight_time_s, self.dt_s)
+
+    def in_air(self, kinematic_viscosity_m2_s: float | np.ndarray | None = None) -> CoefficientModel:
+        """The model in air of this kinematic viscosity (a float, or one per ball); None: its nominal air."""
+        viscosity = self.kinematic_viscosity_m2_s if kinematic_viscosity_m2_s is None else kinematic_viscosity_m2_s
+        return self.model.in_air(viscosity)
+
+    def flight(
+        self,
+        state: State,
+        density_kg_m3: float | np.ndarray | None = None,
+        kinematic_viscosity_m2_s: float | np.ndarray | None = None,
+        wind: Wind = CALM,
+        ground_height_m: float | np.ndarray = 0.0,
+        keep_states: bool = False,
+        max_time_s: float | None = None,
+    ) -> Flight:
+        """The integrator's Flight of a batch from `state` in this air (None: the nominal) and wind down to ground
+        planes, for the maximum flight time (or `max_time_s`, for a caller that compares states at fixed times)."""
+        density = self.density_kg_m3 if density_kg_m3 is None else density_kg_m3
+        field = BallInAir(self.in_air(kinematic_viscosity_m2_s), density, wind)
+        steps = self.max_steps if max_time_s is None else step_count(max_time_s, self.dt_s)
+        event = GroundPlane(np.asarray(ground_height_m, dtype=float))
+        return integrate(state, field, self.dt_s, steps, self.rule, event, record_for(keep_states))
+
+    def unlanded_message(self, apex_m: float, height_m: float) -> str:
+        """Why a shot never came down through its ground's plane: it never rose above it, or it was still in the air
+        at the cap."""
+        if apex_m <= height_m:
+            return f"the ball never rose to its landing ground: apex {apex_m:.1f} m, ground.elevation_m {height_m:g} m"
+        return f"the ball was still in the air after {self.max_steps * self.dt_s:g} s (the simulation cap)"
+
+    def fly_columns(
+        self,
+        launches: Sequence[Launch] | np.ndarray,
+        conditions: Sequence[Conditions] | Conditions = STANDARD,
+        grounds: Sequence[GroundSpec | None] | GroundSpec | None = None,
+    ) -> BatchFlights:
+        """Shots (launches an [N, LAUNCH_WIDTH] array or a sequence of Launch), each in its conditions, down to its
+        ground and rolled to rest there (grounds None: the flights alone, down to z = 0), as columns."""
+        return self._fly(launches, conditions, False, grounds).columns
+
+    def fly_batch(
+        self,
+        launches: Sequence[Launch],
+        conditions: Sequence[Conditions] | Conditions = STANDARD,
+        keep_states: bool = False,
+        grounds: Sequence[GroundSpec] | GroundSpec | None = None,
+    ) -> list[ShotFlight | FlightError]:
+        """`fly_columns`'s numbers as one ShotFlight a shot (with its states when kept, through the bounces and the
+        roll), in the order of `launches`; a FlightError for a shot that has not landed by the maximum flight time or
+        whose flight is not finite."""
+        if len(launches) == 0:
+            return []
+        columns, flight, phase = self._fly(launches, conditions, keep_states, grounds)
+        history = None
+        if flight.states is not None:
+            history = (np.stack([s.position for s in flight.states]), np.stack([s.velocity for s in flight.states]))
+        rolled_row = np.cumsum(columns.rolled) - 1
+        rest_names = [f.name for f in fields(Rest)]
+        rests = zip(*(getattr(columns.rest, name).tolist() for name in rest_names), strict=True)
+        numbers = zip(*(getattr(columns, name).tolist() for name in SHOT_NUMBERS), strict=True)
+        results: list[ShotFlight | FlightError] = []
+        for i, (shot, rest, rolled) in enumerate(zip(numbers, rests, columns.rolled.tolist(), strict=True)):
+            if i in columns.errors:
+                results.append(FlightError(columns.errors[i]))
+                continue
+            figures = dict(zip(SHOT_NUMBERS, shot, strict=True))
+            states = None if history is None else self._shot_states(history, flight, i)
+            if rolled and states is not None:
+                states = states.through_rest(phase, int(rolled_row[i]), figures["flight_time_s"])
+            shot_rest = Rest(**dict(zip(rest_names, rest, strict=True))) if rolled else None
+            flown = ShotFlight(**figures, states=states, rest=shot_rest)
+            results.append(flown if states is None or states.finite else FlightError(NON_FINITE))
+        return results
+
+    def _fly(
+        self,
+        launches: Sequence[Launch] | np.ndarray,
+        conditions: Sequence[Conditions] | Conditions,
+        keep_states: bool,
+        grounds: Sequence[GroundSpec | None] | GroundSpec | None,
+    ) -> _Flown:
+        """The batch flight behind `fly_batch` and `fly_columns`."""
+        n = len(launches)
+        per_shot = [conditions] * n if isinstance(conditions, Conditions) else list(conditions)
+        shot_grounds = [grounds] * n if grounds is None or isinstance(grounds, GroundSpec) else list(grounds)
+        if len(per_shot) != n or len(shot_grounds) != n:
+            raise ValueError(f"{len(per_shot)} conditions and {len(shot_grounds)} grounds for {n} launches")
+        heights = np.array([0.0 if g is None else g.elevation_m for g in shot_grounds])
+        start = initial_state(*np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH).T)
+        field = self._batch_field(per_shot)
+        flight = integrate(start, field, self.dt_s, self.max_steps, self.rule, GroundPlane(heights),
+                           record_for(keep_states))
+        x, y, _ = flight.landing_position.T
+        carry, angle, speed, spin = landing_figures(x, y, *flight.landing_velocity.T, *flight.landing_spin.T)
+        numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
+        finite = np.isfinite(np.stack(numbers)).all(axis=0)
+        errors = {}
+        for i in np.flatnonzero(~(flight.landed & finite)).tolist():
+            unlanded = not flight.landed[i]
+            errors[i] = self.unlanded_message(float(flight.apex_m[i]), float(heights[i])) if unlanded else NON_FINITE
+        rolled = flight.landed & finite & np.array([g is not None for g in shot_grounds])
+        shots = np.flatnonzero(rolled)
+        phase = _ground_phase(flight, shots, [shot_grounds[i] for i in shots], keep_states)
+        columns = BatchFlights(
+            landing_x_m=x, landing_y_m=y, carry_m=carry, lateral_m=x, apex_m=flight.apex_m,
+            apex_time_s=flight.apex_time_s, flight_time_s=flight.flight_time_s, landing_angle_deg=angle,
+            landing_speed_mps=speed, landing_spin_rpm=spin, rest=Rest.of_batch(phase, shots, n, carry),
+            rolled=rolled, errors=errors,
+        )
+        return _Flown(columns, flight, phase)
+
+    def _batch_field(self, per_shot: list[Conditions]) -> BallInAir:
+        """The equations of motion for a batch, each shot in its own air and wind."""
+        inputs = [air_inputs(c) for c in per_shot]
+        wind = Wind(
+            np.array([c.wind.speed_mps for c in per_shot], dtype=float),
+            np.array([c.wind.from_deg for c in per_shot], dtype=float),
+            np.array([c.wind.profile for c in per_shot]),
+            np.array([a.reference_height_m for a in inputs], dtype=float),
+            np.array([a.roughness_m for a in inputs], dtype=float),
+        )
+        viscosity = np.array([a.kinematic_viscosity_m2_s for a in inputs], dtype=float)
+        density = np.array([a.density_kg_m3 for a in inputs], dtype=float)
+        return BallInAir(self.in_air(viscosity), density, wind)
+
+    def _shot_states(self, history: tuple[np.ndarray, np.ndarray], flight: Flight, shot: int) -> EulerStates:
+        """One shot's states up to its landing, the interpolated landing last (history: every step's positions and
+        velocities, [T, N, 3] each)."""
+        last = int(flight.last_step[shot])
+        positions = np.vstack([history[0][: last + 1, shot], flight.landing_position[shot]])
+        velocities = np.vstack([history[1][: last + 1, shot], flight.landing_velocity[shot]])
+        times = np.append(np.round(self.dt_s * np.arange(last + 1), 9), flight.flight_time_s[shot])
+        return EulerStates(times_s=times, positions=positions, velocities=velocities)
+
+
+def _ground_phase(
+    flight: Flight, shots: np.ndarray, grounds: list[GroundSpec], keep_states: bool
+) -> GroundPhase | None:
+    """The ground phase of the landed `shots` of a batch flight, each on its ground, in one batch."""
+    if not shots.size:
+        return None
+    distinct = {id(g.surface): g.surface for g in grounds}
+    surface = next(iter(distinct.values())) if len(distinct) == 1 else Surface.stack([g.surface for g in grounds])
+    return ground_phase(
+        flight.landing_position[shots],
+        flight.landing_velocity[shots],
+        flight.landing_spin[shots],
+        surface,
+        np.array([g.slope_deg for g in grounds]),
+        np.array([g.slope_dir_deg for g in grounds]),
+        keep_states,
+    )
+
+
+def check_ball(card: ModelCard, card_path: Path) -> None:
+    """The card's ball is the one `flight.constants` flies (the equations use those constants, not the card's):
+    a bundle trained on another ball would be flown as the wrong ball, so it is refused."""
+    physics = card.physics
+    pairs = (
+        (physics.ball_mass_kg, BALL_MASS_KG, "ball_mass_kg"),
+        (physics.ball_radius_m, BALL_RADIUS_M, "ball_radius_m"),
+    )
+    wrong = [f"{name} {value:g} (the engine's {ours:g})" for value, ours, name in pairs
+             if not math.isclose(value, ours, rel_tol=1e-9)]
+    if wrong:
+        raise BundleError(f"{card_path}: the card's ball is not the one the engine flies: {'; '.join(wrong)}")
+
+
+def load_flyer(bundle: str | os.PathLike | None = None, batch_threads: int = BATCH_THREADS) -> Flyer:
+    """THE way a model bundle is found and assembled: `bundle`, or None for the served default (the lookup of
+    `flight.bundle_location`), loaded and verified (BundleError otherwise), its ball checked, flown forward Euler at
+    its card's step for max(card t_sim, MAX_FLIGHT_TIME_S), in its card's air by default; `batch_threads` ORT threads
+    a step."""
+    directory = model_dir(bundle)
+    model = OnnxCoefficients(directory, batch_threads)
+    card = model.card
+    check_ball(card, directory / CARD_FILE)
+    physics = card.physics
+    return Flyer(
+        model,
+        dt_s=physics.dt_s,
+        max_flight_time_s=max(physics.t_sim_s, MAX_FLIGHT_TIME_S),
+        density_kg_m3=physics.air_density_kg_m3,
+        kinematic_viscosity_m2_s=physics.kinematic_viscosity_m2_s,
+        card=card,
+        bundle_dir=directory,
+    )
+
+
+class FixedCoefficients:
+    """A closed-form coefficient model with no Reynolds-number input: the same in any air."""
+
+    def __init__(self, model: CoefficientModel) -> None:
+        self.model = model
+
+    def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
+        return self.model(v_rel, omega)
+
+    def in_air(self, kinematic_viscosity_m2_s: float | np.ndarray) -> CoefficientModel:
+        return self.model
+

@@ -1,0 +1,167 @@
+"""The one Flyer: every caller that flies the served bundle flies the same shot to the engine's carry for the same
+maximum flight time; the lookup and the card's ball are checked where the bundle is assembled; the step rule and the
+record are objects the integrator calls."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from golfflight.discovery.model import from_bundle, load_model
+from golfflight.discovery.simulator import Setup
+from golfflight.flight.air import Air
+from golfflight.flight.bundle_location import MODEL_ENV, model_dir
+from golfflight.flight.coefficients import QuadraticSpinRatio
+from golfflight.flight.field import BallInAir
+from golfflight.flight.flyer import MAX_FLIGHT_TIME_S, Launch, load_flyer
+from golfflight.flight.integrator import (
+    FORWARD_EULER,
+    RUNGE_KUTTA_4,
+    STEP_RULES,
+    GroundPlane,
+    StatesRecord,
+    SummaryRecord,
+    integrate,
+)
+from golfflight.flight.physics import initial_state
+from golfflight.model_export.accuracy_flyers import ModelFlyer
+from golfflight.service.engine import FlightEngine
+from golfflight.shots.ground_fit import RestShots, landings
+from golfflight.weights_schema.bundle import CARD_FILE, BundleError
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE_FOLDERS = ("golfflight", "flight", "service", "shots", "model_export", "weights_schema", "discovery", "sweep")
+
+SKY_BALL = Launch(75.0, 70.0, 0.0, 3000.0, 0.0)
+"""In the air longer than the card's t_sim (10 s) and shorter than the engine's limit (20 s): a caller that stopped
+at t_sim would not land it."""
+
+
+@pytest.fixture(scope="module")
+def engine() -> FlightEngine:
+    return FlightEngine(model_dir())
+
+
+def launch_columns(launch: Launch) -> dict[str, np.ndarray]:
+    return {name: np.array([value]) for name, value in zip(Launch._fields, launch, strict=True)}
+
+
+def test_every_caller_flies_the_shot_to_the_engines_carry_for_the_same_time(engine):
+    flyer = engine.flyer
+    single = engine.fly(SKY_BALL)
+    assert single.flight_time_s > flyer.card.physics.t_sim_s
+    calm_air = Air(flyer.density_kg_m3, flyer.kinematic_viscosity_m2_s)
+    discovery = from_bundle()
+    setup = Setup(launch_columns(SKY_BALL), np.ones(1), np.full(1, discovery.density_kg_m3), np.zeros((1, 2)),
+                  np.zeros(1), np.ones((1, 3)))
+    accuracy = ModelFlyer(None)
+    level = RestShots("one", np.array([SKY_BALL]), np.full(1, np.nan), np.zeros(1), np.full(1, np.nan))
+    evaluate = pytest.importorskip("golfflight.model_export.evaluate")
+    carries = {
+        "engine.fly_batch": engine.fly_batch([SKY_BALL])[0].carry_m,
+        "engine.fly_columns (sweep)": engine.fly_columns(np.array([SKY_BALL])).carry_m[0],
+        "discovery from_bundle": discovery.fly(setup).carry_m[0],
+        "accuracy ModelFlyer": accuracy.simulate(launch_columns(SKY_BALL)).carry_m[0],
+        "evaluate runtime path": evaluate.runtime_flight(None, launch_columns(SKY_BALL), calm_air).carry_m[0],
+        "ground fit landings": landings(level, load_flyer()).carry_m[0],
+    }
+    for caller, carry in carries.items():
+        assert carry == pytest.approx(single.carry_m, abs=1e-9), caller
+    longest = max(flyer.card.physics.t_sim_s, MAX_FLIGHT_TIME_S)
+    times = {
+        "engine": engine.max_steps * engine.dt,
+        "flyer": flyer.max_flight_time_s,
+        "discovery": discovery.t_max_s,
+        "accuracy": accuracy.t_sim_s,
+        "ground fit and evaluate (load_flyer)": load_flyer().max_flight_time_s,
+    }
+    for caller, seconds in times.items():
+        assert seconds == pytest.approx(longest, abs=1e-9), caller
+
+
+def test_the_default_is_found_one_way(tmp_path, monkeypatch):
+    copy = shutil.copytree(model_dir(), tmp_path / "bundle")
+    monkeypatch.setenv(MODEL_ENV, str(copy))
+    assert load_flyer().bundle_dir == copy == load_model(None).flyer.bundle_dir
+    monkeypatch.delenv(MODEL_ENV)
+    assert load_flyer().bundle_dir == model_dir()
+
+
+@pytest.mark.parametrize(("field", "value"), [("ball_mass_kg", 0.0459), ("ball_radius_m", 0.0215)])
+def test_a_card_with_another_ball_is_refused(tmp_path, field, value):
+    bundle = shutil.copytree(model_dir(), tmp_path / "bundle")
+    card = json.loads((bundle / CARD_FILE).read_text())
+    card["physics"][field] = value
+    (bundle / CARD_FILE).write_text(json.dumps(card))
+    with pytest.raises(BundleError, match=f"ball is not the one the engine flies: {field} {value:g}"):
+        load_flyer(bundle)
+
+
+def test_step_rules_are_named_objects_and_both_records_give_the_same_flight():
+    assert STEP_RULES == {"euler": FORWARD_EULER, "rk4": RUNGE_KUTTA_4}
+    state = initial_state(np.array([70.0, 40.0, 60.0]), np.array([11.0, 25.0, 14.0]), np.zeros(3),
+                          np.array([2500.0, 8000.0, 4000.0]), np.array([0.0, 10.0, -5.0]))
+    field = BallInAir(QuadraticSpinRatio(), 1.225)
+    heights = GroundPlane(np.array([0.0, 2.0, -1.0]))
+    for rule in (FORWARD_EULER, RUNGE_KUTTA_4):
+        summary = integrate(state, field, 0.05, 400, rule, heights, SummaryRecord)
+        states = integrate(state, field, 0.05, 400, rule, heights, StatesRecord)
+        assert summary.states is None and len(states.states) == len(states.times_s) > 1
+        np.testing.assert_array_equal(summary.landing_position, states.landing_position)
+        np.testing.assert_array_equal(summary.apex_m, states.apex_m)
+        np.testing.assert_array_equal(summary.flight_time_s, states.flight_time_s)
+    euler, rk4 = (integrate(state, field, 0.05, 400, rule, heights).carry_m for rule in (FORWARD_EULER, RUNGE_KUTTA_4))
+    assert not np.allclose(euler, rk4, atol=1e-6)
+
+
+INSTALLED_DEFAULTS = """
+from golfflight.cli import build_parser
+from golfflight.discovery.model import load_model
+from golfflight.flight.bundle_location import model_dir
+from golfflight.flight.flyer import load_flyer
+from golfflight.model_export.accuracy_flyers import ModelFlyer
+
+parser = build_parser()
+found = {
+    "diagnose": load_model(parser.parse_args(["diagnose", "shots.csv", "--out", "x"]).model).flyer.bundle_dir,
+    "accuracy": ModelFlyer(parser.parse_args(["accuracy"]).model).bundle,
+    "physics-check": ModelFlyer(parser.parse_args(["physics-check"]).model).bundle,
+    "evaluate": model_dir(parser.parse_args(["evaluate", "--data", "d", "--runs", "r", "--out", "o"]).bundle),
+    "ground-fit": load_flyer(parser.parse_args(["ground-fit"]).model).bundle_dir,
+}
+for command, bundle in found.items():
+    print(command, bundle)
+"""
+
+
+def test_an_installed_wheel_finds_its_bundle_for_every_command_without_model(tmp_path):
+    """Built and installed into a fresh environment's prefix, run outside the checkout: every command that flies the
+    default bundle finds <prefix>/share/golfflight/models/default."""
+    source = tmp_path / "source"
+    source.mkdir()
+    for name in ("pyproject.toml", "README.md"):
+        shutil.copy(ROOT / name, source / name)
+    for folder in PACKAGE_FOLDERS:
+        shutil.copytree(ROOT / folder, source / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(ROOT / "models" / "default", source / "models" / "default")
+    pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "-q"]
+    wheels = tmp_path / "wheels"
+    subprocess.run([*pip, "wheel", "--no-deps", "--no-build-isolation", str(source), "-w", str(wheels)], check=True)
+    prefix = tmp_path / "env"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", "--system-site-packages", str(prefix)], check=True)
+    # --ignore-installed: with --prefix, pip would otherwise uninstall the golfflight this interpreter has installed
+    install = ["install", "--no-deps", "--ignore-installed", "--prefix", str(prefix)]
+    subprocess.run([str(prefix / "bin" / "python"), *pip[1:], *install, *map(str, wheels.glob("*.whl"))], check=True)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    run = subprocess.run([str(prefix / "bin" / "python"), "-c", INSTALLED_DEFAULTS], cwd=elsewhere, check=False,
+                         env={"PATH": "/usr/bin:/bin"}, capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    shipped = prefix / "share" / "golfflight" / "models" / "default"
+    found = dict(line.split(" ", 1) for line in run.stdout.splitlines())
+    assert found == dict.fromkeys(("diagnose", "accuracy", "physics-check", "evaluate", "ground-fit"), str(shipped))
