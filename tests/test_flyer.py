@@ -12,8 +12,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from built_wheel import PIP, build_wheel
 from golfflight.discovery.model import from_bundle, load_model
 from golfflight.discovery.simulator import Setup
+from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.flight.air import Air
 from golfflight.flight.bundle_location import MODEL_ENV, model_dir
 from golfflight.flight.coefficients import QuadraticSpinRatio
@@ -29,13 +31,11 @@ from golfflight.flight.integrator import (
     integrate,
 )
 from golfflight.flight.physics import initial_state
-from golfflight.model_export.accuracy_flyers import ModelFlyer
 from golfflight.service.engine import FlightEngine
 from golfflight.shots.ground_fit import RestShots, landings
 from golfflight.weights_schema.bundle import CARD_FILE, BundleError
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGE_FOLDERS = ("golfflight", "flight", "service", "shots", "model_export", "weights_schema", "discovery", "sweep")
 
 SKY_BALL = Launch(75.0, 70.0, 0.0, 3000.0, 0.0)
 """In the air longer than the card's t_sim (10 s) and shorter than the engine's limit (20 s): a caller that stopped
@@ -124,7 +124,7 @@ from golfflight.cli import build_parser
 from golfflight.discovery.model import load_model
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.flyer import load_flyer
-from golfflight.model_export.accuracy_flyers import ModelFlyer
+from golfflight.evaluation.accuracy_flyers import ModelFlyer
 
 parser = build_parser()
 found = {
@@ -142,21 +142,12 @@ for command, bundle in found.items():
 def test_an_installed_wheel_finds_its_bundle_for_every_command_without_model(tmp_path):
     """Built and installed into a fresh environment's prefix, run outside the checkout: every command that flies the
     default bundle finds <prefix>/share/golfflight/models/default."""
-    source = tmp_path / "source"
-    source.mkdir()
-    for name in ("pyproject.toml", "README.md"):
-        shutil.copy(ROOT / name, source / name)
-    for folder in PACKAGE_FOLDERS:
-        shutil.copytree(ROOT / folder, source / folder, ignore=shutil.ignore_patterns("__pycache__"))
-    shutil.copytree(ROOT / "models" / "default", source / "models" / "default")
-    pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "-q"]
-    wheels = tmp_path / "wheels"
-    subprocess.run([*pip, "wheel", "--no-deps", "--no-build-isolation", str(source), "-w", str(wheels)], check=True)
+    wheel = build_wheel(tmp_path)
     prefix = tmp_path / "env"
     subprocess.run([sys.executable, "-m", "venv", "--without-pip", "--system-site-packages", str(prefix)], check=True)
     # --ignore-installed: with --prefix, pip would otherwise uninstall the golfflight this interpreter has installed
     install = ["install", "--no-deps", "--ignore-installed", "--prefix", str(prefix)]
-    subprocess.run([str(prefix / "bin" / "python"), *pip[1:], *install, *map(str, wheels.glob("*.whl"))], check=True)
+    subprocess.run([str(prefix / "bin" / "python"), *PIP[1:], *install, str(wheel)], check=True)
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     run = subprocess.run([str(prefix / "bin" / "python"), "-c", INSTALLED_DEFAULTS], cwd=elsewhere, check=False,
