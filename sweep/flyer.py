@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass
 from functools import cached_property
 
-from golfflight.service.columns import (
+from golfflight.contract.columns import (
     ELEVATION_COLUMNS,
     REQUEST_COLUMNS,
     TEXT_COLUMNS,
@@ -123,7 +123,7 @@ class Flyer:
         """The rows of `table` (the layout's input columns) with their flights, in order (a pyarrow.Table)."""
         import numpy as np
         import pyarrow as pa
-        from golfflight.service.api.shots import fly_columns
+        from golfflight.contract.flying import fly_columns
 
         layout = self.layout
         table = table.select(list(layout.columns))

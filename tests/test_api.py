@@ -7,11 +7,11 @@ import subprocess
 import sys
 
 import pytest
+from golfflight.contract.requests import MAX_BATCH_SHOTS
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
 from golfflight.model_export.accuracy_flyers import ModelFlyer
 from golfflight.model_export.accuracy_sets import compare_clubs
 from golfflight.service.api.app import create_app
-from golfflight.service.api.models import MAX_BATCH_SHOTS
 from golfflight.service.model_location import model_dir
 from golfflight.shots.paths import shared_data_dir
 from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages

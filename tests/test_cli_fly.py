@@ -10,11 +10,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from golfflight.contract.flying import air_of
 from golfflight.flight.air import Air
 from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.physics import initial_state
 from golfflight.service.api.app import create_app
-from golfflight.service.api.shots import air_of
 from golfflight.service.engine import FlightEngine, Launch
 from golfflight.service.model_location import model_dir
 from golfflight.service.viewer.page import ASSETS

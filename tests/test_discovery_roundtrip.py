@@ -7,11 +7,11 @@ import json
 
 import numpy as np
 import pytest
+from golfflight.contract.flying import conditions_of
+from golfflight.contract.requests import ShotRequest
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.model import DEFAULT_BUNDLE, load_model
 from golfflight.discovery.schema import Report
-from golfflight.service.api.models import ShotRequest
-from golfflight.service.api.shots import conditions_of
 from golfflight.service.engine import FlightEngine, Launch
 from golfflight.shots.records import LAUNCH_COLUMNS, write_shots
 

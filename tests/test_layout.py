@@ -10,7 +10,7 @@ import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-FOLDERS = ("golfflight", "flight", "service", "shots", "model_export", "weights_schema", "discovery", "sweep")
+FOLDERS = ("golfflight", "flight", "service", "shots", "model_export", "weights_schema", "discovery", "sweep", "contract")
 """The repository's package folders; all but golfflight/ become golfflight.<folder> when installed."""
 
 

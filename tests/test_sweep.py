@@ -148,8 +148,8 @@ def test_the_column_path_gives_fly_shots_numbers_bit_for_bit():
     object a shot, as simulate and the HTTP batch route) fly the same batch: every number equal, not just close,
     each column present exactly where the shot's flat row has it, the same errors (a ground the ball never reaches
     fails its shot alone)."""
-    from golfflight.service.api.shots import fly_columns, fly_shots
-    from golfflight.service.columns import cell_value, check, flat_row, request_of_cells
+    from golfflight.contract.columns import cell_value, check, flat_row, request_of_cells
+    from golfflight.contract.flying import fly_columns, fly_shots
     from golfflight.service.engine import FlightEngine
     from golfflight.service.model_location import model_dir
 

@@ -1,7 +1,7 @@
 """`golfflight fly`: one shot, a club's typical launch or your own, through the served model (the bundle `serve` and
 `simulate` load: `--model DIR`, $GOLFFLIGHT_MODEL, models/default) or, with `--reference`, the reference world.
 
-The shot is checked by the HTTP contract's own request model (`service.api.models.ShotRequest`, ranges from
+The shot is checked by the HTTP contract's own request model (`contract.requests.ShotRequest`, ranges from
 `flight.limits`) before anything flies, so a value out of range is refused with the API's message, naming the
 option and the allowed range (exit 2, one line); the result has the fields of POST /v1/shots.
 """
@@ -127,7 +127,7 @@ def wind_speed_mps(args: argparse.Namespace) -> float | None:
         return args.wind_speed_mps
     from pydantic import Field, create_model
 
-    from golfflight.service.api.models import Strict, describe_errors
+    from golfflight.contract.requests import Strict, describe_errors
 
     bounds = WIND_SPEED_MPH
     in_mph = create_model("WindInMph", __base__=Strict, wind_speed_mph=(float, Field(ge=bounds.low, le=bounds.high)))
@@ -178,7 +178,7 @@ def request_of(args: argparse.Namespace) -> tuple[str, dict]:
 
 def checked(shot: dict):
     """The validated ShotRequest, or ValueError with the API's messages naming the options."""
-    from golfflight.service.api.models import ShotRequest, describe_errors
+    from golfflight.contract.requests import ShotRequest, describe_errors
 
     try:
         return ShotRequest.model_validate(shot)
@@ -191,10 +191,10 @@ def fly_reference_shot(shot) -> dict:
     ground phase): the POST /v1/shots result fields."""
     import numpy as np
 
+    from golfflight.contract.flying import air_of, conditions_of, flight_fields, launch_of
     from golfflight.flight.air import Air
     from golfflight.flight.ground import LEVEL_FAIRWAY, ground_phase_one
     from golfflight.flight.physics import initial_state
-    from golfflight.service.api.shots import air_of, conditions_of, flight_fields, launch_of
     from golfflight.service.engine import Rest, ShotFlight
     from golfflight.shots.reference_world import fly_reference
 
@@ -224,7 +224,7 @@ def fly_reference_shot(shot) -> dict:
 
 def fly_model_shot(shot, model: str | None) -> tuple[dict, dict]:
     """A checked request flown by the served model as POST /v1/shots flies it: (the result, the model's identity)."""
-    from golfflight.service.api.shots import fly_shot
+    from golfflight.contract.flying import fly_shot
     from golfflight.service.engine import FlightEngine, FlightError
     from golfflight.service.model_location import model_dir
 

@@ -18,8 +18,8 @@ from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
-from golfflight.service.api.models import BatchRequest, BatchResult
-from golfflight.service.api.shots import fly_shots
+from golfflight.contract.flying import fly_shots
+from golfflight.contract.requests import BatchRequest, BatchResult
 from golfflight.service.engine import FlightEngine
 
 BATCH_NICE = 19

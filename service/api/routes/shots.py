@@ -9,8 +9,9 @@ from concurrent.futures.process import BrokenProcessPool
 
 from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import JSONResponse, Response
-from golfflight.service.api.bay import CONDITION_FIELDS, in_bay
-from golfflight.service.api.models import (
+from golfflight.contract.bay import CONDITION_FIELDS, in_bay
+from golfflight.contract.flying import fly_shot
+from golfflight.contract.requests import (
     MAX_BATCH_SHOTS,
     MAX_BATCH_TRAJECTORIES,
     BatchRequest,
@@ -20,7 +21,6 @@ from golfflight.service.api.models import (
     body_detail,
 )
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
-from golfflight.service.api.shots import fly_shot
 from golfflight.service.api.state import ServiceState, ready_engine, service_state
 from golfflight.service.engine import FlightEngine, FlightError
 

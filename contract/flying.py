@@ -10,7 +10,7 @@ from golfflight.flight.conditions import STANDARD, AirConditions, Conditions
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.flight.ground import LEVEL_FAIRWAY, GroundSpec, surface
 from golfflight.flight.wind import CALM, Wind
-from golfflight.service.api.models import (
+from golfflight.contract.requests import (
     AirRequest,
     FlatFlight,
     GroundRequest,
@@ -26,7 +26,7 @@ from golfflight.service.api.models import (
     WindRequest,
 )
 from golfflight.service.engine import FlightEngine, FlightError, Launch, ShotFlight
-from golfflight.service.trajectory import resample
+from golfflight.contract.trajectory import resample
 
 
 def spin_from_components(back_spin_rpm: float, side_spin_rpm: float) -> tuple[float, float]:
@@ -246,7 +246,7 @@ def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> li
 
 @dataclass(frozen=True)
 class ShotColumns:
-    """`fly_shots`'s results as columns over the shots, named as `service.columns.flat_row` names them: `values` holds
+    """`fly_shots`'s results as columns over the shots, named as `contract.columns.flat_row` names them: `values` holds
     an array for each flight, normalized_* and flat_* column, valid where `present` is True (the shot flew and, for
     normalized_* and flat_*, asked for that flight); `errors` the error column (None where the shot flew)."""
 

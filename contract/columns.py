@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import re
 
-from golfflight.service.api.models import FlatFlight, FlightResult, Landing, RestPoint, ShotRequest, describe_errors
+from golfflight.contract.requests import FlatFlight, FlightResult, Landing, RestPoint, ShotRequest, describe_errors
 from pydantic import ValidationError
 
 AIR_COLUMNS = {name: name for name in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct", "density_kg_m3")}

@@ -312,7 +312,7 @@ class TrajectoryPoint(BaseModel):
 class FlightResult(BaseModel):
     """One flight to its landing on its ground (at the tee's elevation, "flat", unless the ground's elevation), then
     bounced and rolled to rest; every length in metres with yards alongside (NAME_m, NAME_yd), the landing speed in
-    m/s with mph alongside (`service.api.shots.flight_numbers` derives them all)."""
+    m/s with mph alongside (`contract.flying.flight_numbers` derives them all)."""
 
     landing: Landing
     carry_m: float = Field(description="horizontal distance from the tee to the landing point")
