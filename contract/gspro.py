@@ -13,12 +13,15 @@ from __future__ import annotations
 
 from typing import Annotated
 
+from golfflight.contract.bay import BayConditions
+from golfflight.contract.flying import flight_fields
+from golfflight.contract.inputs import conditions_from, ground_of, spin_from_components
+from golfflight.contract.refusals import describe_errors
+from golfflight.contract.requests import BALL_SPEED_MPH, SIDE_SPIN_RPM
+from golfflight.contract.results import ShotResult
 from golfflight.flight import limits
 from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.limits import Range
-from golfflight.contract.bay import BayConditions
-from golfflight.contract.requests import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotResult, describe_errors
-from golfflight.contract.flying import conditions_from, flight_fields, ground_of, spin_from_components
 from golfflight.service.engine import FlightEngine, FlightError, Launch
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from golfflight.contract.flying import air_of
+from golfflight.contract.inputs import air_of
 from golfflight.flight.air import Air
 from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.physics import initial_state

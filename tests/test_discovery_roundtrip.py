@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 import pytest
-from golfflight.contract.flying import conditions_of
+from golfflight.contract.inputs import conditions_of
 from golfflight.contract.requests import ShotRequest
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.model import DEFAULT_BUNDLE, load_model

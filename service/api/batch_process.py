@@ -19,7 +19,8 @@ from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 from golfflight.contract.flying import fly_shots
-from golfflight.contract.requests import BatchRequest, BatchResult
+from golfflight.contract.requests import BatchRequest
+from golfflight.contract.results import BatchResult
 from golfflight.service.engine import FlightEngine
 
 BATCH_NICE = 19

@@ -10,7 +10,8 @@ from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
 from golfflight.contract.gspro import GSProReply, invalid_message
-from golfflight.contract.requests import RANGES, body_detail, describe_errors
+from golfflight.contract.refusals import body_detail, describe_errors
+from golfflight.contract.requests import RANGES
 from golfflight.service.api.routes.gspro import GSPRO_PATH
 from golfflight.service.api.state import NotReady
 from starlette.exceptions import HTTPException as StarletteHTTPException

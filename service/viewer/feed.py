@@ -16,9 +16,11 @@ import time
 from collections import deque
 from dataclasses import dataclass
 
-from golfflight.contract.flying import fly_shot, launch_of
+from golfflight.contract.flying import fly_shot
 from golfflight.contract.gspro import GSProMessage, GSProReply, launch_from_ball_data
-from golfflight.contract.requests import ShotRequest, ShotResult, TrajectoryPoint, TrajectoryRequest
+from golfflight.contract.inputs import launch_of
+from golfflight.contract.requests import ShotRequest, TrajectoryRequest
+from golfflight.contract.results import ShotResult, TrajectoryPoint
 from golfflight.service.engine import FlightEngine, FlightError
 from golfflight.service.viewer.event import LaunchNumbers, ShotEvent, Source
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Depends
 from fastapi.responses import JSONResponse, Response
 from golfflight.contract.bay import BayConditions
-from golfflight.contract.requests import body_detail
+from golfflight.contract.refusals import body_detail
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
 from golfflight.service.api.state import ServiceState, service_state
 
