@@ -129,16 +129,16 @@ NOT_FIGURES = {
 """Fields of the outcome records that are deliberately no figure, and why."""
 
 
-def _record_fields(record: type, prefix: str = "") -> list[str]:
-    """The dotted field names of a dataclass, a nested dataclass's (`rest: Rest | None`) as rest.x_m, ...; a field
-    named in NOT_FIGURES is not opened."""
+def outcome_fields(record: type, prefix: str = "") -> list[str]:
+    """The fields of an outcome record (a dataclass), a nested dataclass's (`rest: Rest | None`) dotted as rest.x_m,
+    rest.y_m, ...; a field named in NOT_FIGURES is not opened."""
     hints = typing.get_type_hints(record)
     names = []
     for field in dataclasses.fields(record):
         name = prefix + field.name
         nested = [t for t in (hints[field.name], *typing.get_args(hints[field.name])) if dataclasses.is_dataclass(t)]
         if nested and name not in NOT_FIGURES:
-            names += _record_fields(nested[0], name + ".")
+            names += outcome_fields(nested[0], name + ".")
         else:
             names.append(name)
     return names
@@ -148,7 +148,7 @@ def unreported_fields(record: type) -> list[str]:
     """Fields of an outcome record (a dataclass such as ShotFlight or BatchFlights) that no figure reports and
     NOT_FIGURES does not name: each is a figure missing from `FIGURES`."""
     sources = {figure.source for figure in FIGURES}
-    return [name for name in _record_fields(record) if name not in sources and name not in NOT_FIGURES]
+    return [name for name in outcome_fields(record) if name not in sources and name not in NOT_FIGURES]
 
 
 _READERS = tuple((figure.name, attrgetter(figure.source)) for figure in FIGURES)
