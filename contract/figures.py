@@ -65,19 +65,24 @@ REST = Point(
 @dataclass(frozen=True)
 class Figure:
     """One number of a flight's outcome: its name in every output (SI, NAME_UNIT; the imperial twin follows from it,
-    `twin_of`), where the outcome record holds it (a field name, dotted into `rest`), its unit and the words
-    `golfflight fly` prints it with, what it means (the HTTP schema's description), its type, the point it is a
-    coordinate of (reported inside that object over HTTP), and whether the flat flight (down to the tee's
-    elevation, beside one that lands higher or lower) reports it too."""
+    `twin_of`), its unit and the words `golfflight fly` prints it with, what it means (the HTTP schema's
+    description), where the outcome record holds it when not under its own name (`source`, dotted into `rest`), its
+    type, the point it is a coordinate of (reported inside that object over HTTP), and whether the flat flight (down
+    to the tee's elevation, beside one that lands higher or lower) reports it too."""
 
     name: str
-    source: str
     unit: str
     label: str
     description: str | None = None
+    source: str | None = None
     kind: type = float
     point: Point | None = None
     flat: bool = False
+
+    @property
+    def record_field(self) -> str:
+        """The outcome record's field that holds it (dotted into `rest`)."""
+        return self.source or self.name
 
     @property
     def coordinate(self) -> str:
@@ -95,25 +100,23 @@ ACROSS = "right (+) of the target line"
 ALONG = "down the target line"
 
 FIGURES: tuple[Figure, ...] = (
-    Figure("landing_x_m", "landing_x_m", "m", "landing across", ACROSS, point=LANDING, flat=True),
-    Figure("landing_y_m", "landing_y_m", "m", "landing along", ALONG, point=LANDING, flat=True),
-    Figure("carry_m", "carry_m", "m", "carry", "horizontal distance from the tee to the landing point", flat=True),
-    Figure("lateral_m", "lateral_m", "m", "lateral", "landing point right (+) or left (-) of the target line",
-           flat=True),
-    Figure("apex_m", "apex_m", "m", "apex", "greatest height"),
-    Figure("apex_time_s", "apex_time_s", "s", "apex time"),
-    Figure("flight_time_s", "flight_time_s", "s", "flight time", flat=True),
-    Figure("landing_angle_deg", "landing_angle_deg", "deg", "landing angle", "descent angle below the horizontal",
-           flat=True),
-    Figure("landing_speed_mps", "landing_speed_mps", "m/s", "landing speed"),
-    Figure("landing_spin_rpm", "landing_spin_rpm", "rpm", "landing spin"),
-    Figure("total_m", "rest.total_m", "m", "total",
-           "horizontal distance from the tee to the rest point (carry and roll)"),
-    Figure("roll_m", "rest.roll_m", "m", "roll",
-           "total minus carry: the run after landing (negative: the ball came back)"),
-    Figure("rest_x_m", "rest.x_m", "m", "rest across", ACROSS, point=REST),
-    Figure("rest_y_m", "rest.y_m", "m", "rest along", ALONG, point=REST),
-    Figure("bounces", "rest.bounces", "", "bounces", "hops after the landing before the ball rolls", kind=int),
+    Figure("landing_x_m", "m", "landing across", ACROSS, point=LANDING, flat=True),
+    Figure("landing_y_m", "m", "landing along", ALONG, point=LANDING, flat=True),
+    Figure("carry_m", "m", "carry", "horizontal distance from the tee to the landing point", flat=True),
+    Figure("lateral_m", "m", "lateral", "landing point right (+) or left (-) of the target line", flat=True),
+    Figure("apex_m", "m", "apex", "greatest height"),
+    Figure("apex_time_s", "s", "apex time"),
+    Figure("flight_time_s", "s", "flight time", flat=True),
+    Figure("landing_angle_deg", "deg", "landing angle", "descent angle below the horizontal", flat=True),
+    Figure("landing_speed_mps", "m/s", "landing speed"),
+    Figure("landing_spin_rpm", "rpm", "landing spin"),
+    Figure("total_m", "m", "total", "horizontal distance from the tee to the rest point (carry and roll)",
+           source="rest.total_m"),
+    Figure("roll_m", "m", "roll", "total minus carry: the run after landing (negative: the ball came back)",
+           source="rest.roll_m"),
+    Figure("rest_x_m", "m", "rest across", ACROSS, source="rest.x_m", point=REST),
+    Figure("rest_y_m", "m", "rest along", ALONG, source="rest.y_m", point=REST),
+    Figure("bounces", "", "bounces", "hops after the landing before the ball rolls", source="rest.bounces", kind=int),
 )
 """Every figure of a flight rolled to rest, in the order the HTTP result and the columns give them."""
 
@@ -147,12 +150,12 @@ def outcome_fields(record: type, prefix: str = "") -> list[str]:
 def unreported_fields(record: type) -> list[str]:
     """Fields of an outcome record (a dataclass such as ShotFlight or BatchFlights) that no figure reports and
     NOT_FIGURES does not name: each is a figure missing from `FIGURES`."""
-    sources = {figure.source for figure in FIGURES}
+    sources = {figure.record_field for figure in FIGURES}
     return [name for name in outcome_fields(record) if name not in sources and name not in NOT_FIGURES]
 
 
-_READERS = tuple((figure.name, attrgetter(figure.source)) for figure in FIGURES)
-_FLAT_READERS = tuple((figure.name, attrgetter(figure.source)) for figure in FLAT_FIGURES)
+_READERS = tuple((figure.name, attrgetter(figure.record_field)) for figure in FIGURES)
+_FLAT_READERS = tuple((figure.name, attrgetter(figure.record_field)) for figure in FLAT_FIGURES)
 
 
 def flight_numbers(flight) -> dict:

@@ -47,7 +47,7 @@ class FlightWithSpinDecay(ShotFlight):
 @pytest.mark.parametrize("record", [ShotFlight, BatchFlights])
 def test_every_field_of_the_outcome_records_is_a_figure_or_said_to_be_none(record):
     assert unreported_fields(record) == []
-    assert {figure.source for figure in FIGURES} <= set(outcome_fields(record)), "a figure reads a field gone"
+    assert {figure.record_field for figure in FIGURES} <= set(outcome_fields(record)), "a figure reads a field gone"
 
 
 def test_every_field_said_to_be_no_figure_is_a_field_of_an_outcome_record():
