@@ -240,10 +240,10 @@ def table_row(figure: Figure, result: dict) -> str:
     if figure.kind is int:
         return f"  {figure.label:<18} {result[figure.name]:8d}"
     decimals = DECIMALS[figure.unit]
-    row = f"  {figure.label:<18} {result[figure.name] + 0.0:8.{decimals}f} {figure.unit:<3}"  # + 0.0: no -0.0
+    row = f"  {figure.label:<18} {result[figure.name] + 0.0:8.{decimals}f} {figure.unit}"  # + 0.0: no -0.0
     if figure.twin is not None:
         row += f" {result[figure.twin] + 0.0:8.{decimals}f} {figure.twin.rsplit('_', 1)[1]}"
-    return row.rstrip()
+    return row
 
 
 def run(args: argparse.Namespace) -> int:
