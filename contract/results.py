@@ -4,7 +4,7 @@ object), so a figure added there is in every result, the OpenAPI schema and the 
 
 from __future__ import annotations
 
-from golfflight.contract.figures import FIGURES, FLAT_FIGURES, Figure, Point
+from golfflight.contract.figures import FIGURES, FLAT_FIGURES, LANDING, REST, Figure, Point
 from golfflight.contract.requests import ReferenceAir
 from pydantic import BaseModel, Field, create_model
 
@@ -22,13 +22,14 @@ POINT_MODELS: dict[str, type[BaseModel]] = {
 }
 """A point's name (landing, rest) -> the model of its coordinates."""
 
-Landing = POINT_MODELS["landing"]
-RestPoint = POINT_MODELS["rest"]
+Landing = POINT_MODELS[LANDING.name]
+RestPoint = POINT_MODELS[REST.name]
 
 
 def _figure_fields(figures: tuple[Figure, ...], described: bool = True) -> dict:
     """Model fields of `figures` in their order: each with its imperial twin after it, a point's coordinates as the
-    point's object where its first coordinate stands."""
+    point's object where its first coordinate stands; `described` False leaves out the descriptions (the flat
+    flight's schema has never had them)."""
     fields: dict = {}
     for figure in figures:
         if figure.point is not None:
