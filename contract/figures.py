@@ -34,9 +34,9 @@ def with_imperial(numbers: dict) -> dict:
     out = {}
     for name, value in numbers.items():
         out[name] = value
-        twin = twin_of(name)
-        if twin is not None:
-            out[twin[0]] = value / twin[1]
+        for si, imperial, unit in IMPERIAL_TWINS:
+            if name.endswith(si):
+                out[name.removesuffix(si) + imperial] = value / unit
     return out
 
 

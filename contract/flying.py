@@ -35,13 +35,19 @@ def _trajectory(flight: ShotFlight, request: TrajectoryRequest) -> list[Trajecto
     ]
 
 
+_POINT_NUMBERS = tuple(
+    (name, point, tuple((key, f"{name}_{key}") for key in point.model_fields)) for name, point in POINT_MODELS.items()
+)
+"""Each point of a result, its model, and its coordinates' names in the model and among a flight's numbers
+(x_m, landing_x_m), ..."""
+
+
 def _points(numbers: dict) -> dict:
     """A flight's numbers with each point's (NAME_x_m, NAME_y_m, NAME_x_yd, NAME_y_yd) as the result's point."""
     fields = dict(numbers)
-    for name, point in POINT_MODELS.items():
-        named = {key: f"{name}_{key}" for key in point.model_fields}
-        if all(number in fields for number in named.values()):
-            fields[name] = point.model_construct(**{key: fields.pop(number) for key, number in named.items()})
+    for name, point, named in _POINT_NUMBERS:
+        if named[0][1] in fields:
+            fields[name] = point.model_construct(**{key: fields.pop(number) for key, number in named})
     return fields
 
 
