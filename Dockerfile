@@ -16,6 +16,7 @@ COPY model_export ./model_export
 COPY evaluation ./evaluation
 COPY discovery ./discovery
 COPY sweep ./sweep
+COPY contract ./contract
 COPY models/default ./models/default
 # `pip install .` puts the bundle in /usr/local/share/golfflight/models/default (pyproject data-files)
 RUN pip install --no-cache-dir . && rm -rf /app/* && useradd --create-home --uid 10001 golfflight

@@ -22,8 +22,8 @@ import onnxruntime as ort
 from common import SEVEN_IRON, write_results
 from golfflight.flight.bundle_check import session_options
 from golfflight.flight.bundle_location import model_dir
+from golfflight.flight.engine import FlightEngine
 from golfflight.flight.physics import euler_step
-from golfflight.service.engine import FlightEngine
 from golfflight.weights_schema.bundle import load_bundle
 from onnx import TensorProto, helper
 

@@ -15,8 +15,8 @@ import time
 from common import DRIVER, SEVEN_IRON, median_of_rounds, mixed_launches, percentiles_ms, print_table, write_results
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import RPM_TO_RADPS
+from golfflight.flight.engine import BATCH_THREADS, FlightEngine
 from golfflight.flight.ground import LEVEL_FAIRWAY, GroundSpec, ground_phase_one, surface
-from golfflight.service.engine import BATCH_THREADS, FlightEngine
 
 SLOPED_GREEN = GroundSpec(surface("green", 11.0), elevation_m=-2.0, slope_deg=1.5, slope_dir_deg=30.0)
 """A sloped ground: its roll is stepped (0.25 s midpoint steps) rather than solved in closed form."""

@@ -21,7 +21,7 @@ from common import (
     write_results,
 )
 from golfflight.flight.bundle_location import model_dir
-from golfflight.service.engine import BATCH_THREADS, FlightEngine
+from golfflight.flight.engine import BATCH_THREADS, FlightEngine
 
 
 def timed(call, repeats: int, warmup: int = 1) -> list[float]:

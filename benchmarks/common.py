@@ -16,7 +16,7 @@ REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from golfflight.service.engine import Launch
+from golfflight.flight.engine import Launch
 from golfflight.shots.clubs import CLUBS
 
 RESULTS = REPO / "benchmarks" / "results.json"

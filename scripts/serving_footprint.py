@@ -24,7 +24,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import httpx
 import psutil
-from golfflight.service.api.models import MAX_BATCH_TRAJECTORIES
+from golfflight.contract.requests import MAX_BATCH_TRAJECTORIES
 
 SHOT = {"ball_speed_mph": 171.0, "launch_angle_deg": 10.4, "back_spin_rpm": 2545.0, "side_spin_rpm": -300.0}
 LARGEST_BATCH = 10_000

@@ -21,7 +21,7 @@ from golfflight.sweep.flyer import Flyer
 PIECES_PER_WORKER = 2
 """Pieces queued per local worker: one flying and one waiting, so a worker never idles while the driver writes."""
 
-WORKER_IMPORTS = ["golfflight.service.engine", "golfflight.service.api.shots", "golfflight.sweep.flyer"]
+WORKER_IMPORTS = ["golfflight.flight.engine", "golfflight.contract.flying", "golfflight.sweep.flyer"]
 """Modules the local pool's fork server imports before it forks the workers."""
 
 _flyer: Flyer | None = None

@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass
 from functools import cached_property
 
-from golfflight.service.columns import (
+from golfflight.contract.columns import (
     ELEVATION_COLUMNS,
     REQUEST_COLUMNS,
     TEXT_COLUMNS,
@@ -107,7 +107,7 @@ class Flyer:
     def __init__(self, bundle_dir: str, sha256: str, source):
         """Load the bundle at `bundle_dir` (its own path on each node of a cluster) and refuse it unless its ONNX
         graph is the one the driver checked (`sha256`); `source` (`sweep.sources`) turns pieces into rows."""
-        from golfflight.service.engine import FlightEngine
+        from golfflight.flight.engine import FlightEngine
 
         self.engine = FlightEngine(bundle_dir, batch_threads=1)
         if self.engine.sha256 != sha256:
@@ -123,7 +123,7 @@ class Flyer:
         """The rows of `table` (the layout's input columns) with their flights, in order (a pyarrow.Table)."""
         import numpy as np
         import pyarrow as pa
-        from golfflight.service.api.shots import fly_columns
+        from golfflight.contract.flying import fly_columns
 
         layout = self.layout
         table = table.select(list(layout.columns))

@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from golfflight.service.columns import REQUEST_COLUMNS, TEXT_COLUMNS, cell_value, check, request_of_cells
+from golfflight.contract.columns import REQUEST_COLUMNS, TEXT_COLUMNS, cell_value, check, request_of_cells
 
 
 class GridError(ValueError):

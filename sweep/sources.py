@@ -16,7 +16,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from golfflight.service.columns import columns_message
+from golfflight.contract.columns import columns_message
 from golfflight.shots.records import reading
 from golfflight.sweep.grid import Grid
 

@@ -2,11 +2,11 @@
 
 import numpy as np
 import pytest
+from golfflight.contract.inputs import air_of
+from golfflight.contract.requests import ReferenceAir
 from golfflight.flight.air import Air, air_density, altitude_for_pressure, dynamic_viscosity, pressure_at_altitude
 from golfflight.flight.conditions import NORMALIZED_REFERENCE
 from golfflight.flight.wind import Wind, log_profile_factor, uniform_equivalent_factor, wind_vector
-from golfflight.service.api.models import ReferenceAir
-from golfflight.service.api.shots import air_of
 
 
 def test_standard_sea_level_density():

@@ -1,6 +1,6 @@
-"""The simulator bay's conditions (service.api.bay): a shot without its own flies in the bay's air, wind and ground
-(over HTTP, in a batch and over GSPro Open Connect's TCP), a shot's own win, PUT /v1/bay validates like a shot and
-is kept in the bay file across restarts, written whole or not at all."""
+"""The simulator bay's conditions (contract.bay; the server's store: service.api.bay): a shot without its own flies
+in the bay's air, wind and ground (over HTTP, in a batch and over GSPro Open Connect's TCP), a shot's own win,
+PUT /v1/bay validates like a shot and is kept in the bay file across restarts, written whole or not at all."""
 
 from __future__ import annotations
 
@@ -8,9 +8,10 @@ import json
 import socket
 
 import pytest
+from golfflight.contract.bay import BayConditions, in_bay
+from golfflight.contract.requests import AirRequest, GroundRequest, ShotRequest, WindRequest
 from golfflight.service.api.app import create_app
-from golfflight.service.api.bay import Bay, BayConditions, BayFileError, in_bay
-from golfflight.service.api.models import AirRequest, GroundRequest, ShotRequest, WindRequest
+from golfflight.service.api.bay import Bay, BayFileError
 from golfflight.service.open_connect.server import ConnectAddress
 
 from tests.servers import free_port, running, shot

@@ -10,12 +10,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from golfflight.contract.inputs import air_of
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import MPH_TO_MPS
+from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.physics import initial_state
 from golfflight.service.api.app import create_app
-from golfflight.service.api.shots import air_of
-from golfflight.service.engine import FlightEngine, Launch
 from golfflight.service.viewer.page import ASSETS
 from golfflight.shots.clubs import CLUB_ALIASES, CLUB_NAMES, CLUBS, canonical_club_name, club_key, club_named
 from golfflight.shots.reference_world import fly_reference

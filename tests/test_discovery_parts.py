@@ -128,7 +128,7 @@ def test_service_settings_from_effects():
 def test_a_fitted_wind_as_a_station_reading_is_a_wind_the_service_accepts():
     """With the log profile's mean factor along the flights (1.2 here), the uniform 4.8 m/s is a 4.0 m/s 10 m
     reading; both validate as the service's wind option."""
-    from golfflight.service.api.models import WindRequest
+    from golfflight.contract.requests import WindRequest
 
     wind = EffectResult(name="wind", parameters={"speed_mps": 4.8, "from_deg": 5.0}, uncertainty={})
     settings = service_settings([wind], ICAO, wind_factor=1.2)

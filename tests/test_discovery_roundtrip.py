@@ -7,13 +7,13 @@ import json
 
 import numpy as np
 import pytest
+from golfflight.contract.inputs import conditions_of
+from golfflight.contract.requests import ShotRequest
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.model import load_model
 from golfflight.discovery.schema import Report
 from golfflight.flight.bundle_location import model_dir
-from golfflight.service.api.models import ShotRequest
-from golfflight.service.api.shots import conditions_of
-from golfflight.service.engine import FlightEngine, Launch
+from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.shots.records import LAUNCH_COLUMNS, write_shots
 
 from golfflight.cli import main

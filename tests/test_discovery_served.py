@@ -19,7 +19,7 @@ from golfflight.discovery.own_error import measure_own_error, write_own_error
 from golfflight.discovery.recordings import from_shot_set
 from golfflight.discovery.simulator import Setup
 from golfflight.flight.bundle_location import model_dir
-from golfflight.service.engine import FlightEngine, Launch
+from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.shots.paths import REPO_ROOT
 from golfflight.weights_schema.bundle import load_bundle
 

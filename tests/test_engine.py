@@ -9,15 +9,15 @@ import numpy as np
 import onnxruntime as ort
 import pytest
 from conftest import random_launches
+from golfflight.contract.trajectory import resample
 from golfflight.flight.air import Air
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import STANDARD, Conditions
+from golfflight.flight.engine import FlightEngine, FlightError, Launch, ShotFlight
 from golfflight.flight.integrator import simulate
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.flight.wind import Wind
-from golfflight.service.engine import FlightEngine, FlightError, Launch, ShotFlight
-from golfflight.service.trajectory import resample
 
 PAPER_SINGLE_SHOT_MS = 34.9
 """Phys-NN+ one shot on a CPU, the paper's Table 2."""

@@ -19,6 +19,7 @@ from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.flight.air import Air
 from golfflight.flight.bundle_location import MODEL_ENV, model_dir
 from golfflight.flight.coefficients import QuadraticSpinRatio
+from golfflight.flight.engine import FlightEngine
 from golfflight.flight.field import BallInAir
 from golfflight.flight.flyer import MAX_FLIGHT_TIME_S, Launch, load_flyer
 from golfflight.flight.integrator import (
@@ -31,7 +32,6 @@ from golfflight.flight.integrator import (
     integrate,
 )
 from golfflight.flight.physics import initial_state
-from golfflight.service.engine import FlightEngine
 from golfflight.shots.ground_fit import RestShots, landings
 from golfflight.weights_schema.bundle import CARD_FILE, BundleError
 

@@ -9,13 +9,13 @@ import json
 import math
 
 import pytest
+from golfflight.contract.gspro import GSProMessage, fly_message
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import YARD_M
+from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.ground import SURFACES, GroundSpec, holding_slope_deg
 from golfflight.flight.limits import SLOPE_DEG
 from golfflight.service.api.app import create_app
-from golfflight.service.api.gspro import GSProMessage, fly_message
-from golfflight.service.engine import FlightEngine, Launch
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from servers import running, shot

@@ -11,8 +11,8 @@ import threading
 import time
 
 import pytest
+from golfflight.contract.gspro import GSProReply
 from golfflight.service.api.app import create_app
-from golfflight.service.api.gspro import GSProReply
 from golfflight.service.open_connect.framing import MAX_MESSAGE_BYTES, ObjectFramer, Refused
 from golfflight.service.open_connect.replies import reply_to
 from golfflight.service.open_connect.server import INTERNAL_ERROR, PAUSE_S, ConnectAddress, OpenConnectServer

@@ -14,9 +14,9 @@ from golfflight.flight import limits
 from golfflight.flight.air import Air
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import Conditions
+from golfflight.flight.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.wind import CALM, Wind
-from golfflight.service.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

@@ -148,10 +148,10 @@ def test_the_column_path_gives_fly_shots_numbers_bit_for_bit():
     object a shot, as simulate and the HTTP batch route) fly the same batch: every number equal, not just close,
     each column present exactly where the shot's flat row has it, the same errors (a ground the ball never reaches
     fails its shot alone)."""
+    from golfflight.contract.columns import cell_value, check, flat_row, request_of_cells
+    from golfflight.contract.flying import fly_columns, fly_shots
     from golfflight.flight.bundle_location import model_dir
-    from golfflight.service.api.shots import fly_columns, fly_shots
-    from golfflight.service.columns import cell_value, check, flat_row, request_of_cells
-    from golfflight.service.engine import FlightEngine
+    from golfflight.flight.engine import FlightEngine
 
     rows = launch_rows(200, seed=3)
     rows[5].update(ground_elevation_m=90.0)  # never rises that high: a FlightError for this shot only

@@ -13,9 +13,9 @@ import golfflight.model_export.export as export
 import golfflight.model_export.training as training
 import pytest
 import torch
+from golfflight.flight.engine import FlightEngine
 from golfflight.model_export.export import export_checkpoint
 from golfflight.model_export.training import TrainConfig, load_checkpoint, train
-from golfflight.service.engine import FlightEngine
 
 TINY = ["--variant", "phys-nn-pm", "--hidden", "16,8", "--batch-size", "32", "--threads", "1", "--limit", "64"]
 

@@ -11,10 +11,10 @@ import json
 import socket
 
 import pytest
+from golfflight.contract.columns import result_columns
+from golfflight.contract.results import FlatFlight, FlightResult, Landing, RestPoint
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.service.api.app import create_app
-from golfflight.service.api.models import FlatFlight, FlightResult, Landing, RestPoint
-from golfflight.service.columns import result_columns
 from golfflight.service.open_connect.server import ConnectAddress
 
 from golfflight.cli import main

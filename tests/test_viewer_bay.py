@@ -13,12 +13,12 @@ from functools import partial
 import browser
 import httpx
 import pytest
+from golfflight.contract.flying import fly_shot
+from golfflight.contract.requests import ShotRequest
 from golfflight.flight.bundle_location import model_dir
+from golfflight.flight.engine import FlightEngine
 from golfflight.service.api.app import create_app
-from golfflight.service.api.models import ShotRequest
 from golfflight.service.api.routes import viewer as viewer_routes
-from golfflight.service.api.shots import fly_shot
-from golfflight.service.engine import FlightEngine
 from golfflight.service.open_connect.server import ConnectAddress
 from golfflight.service.viewer.feed import ShotFeed
 from golfflight.service.viewer.stream import KEEPALIVE_FRAME, KEEPALIVE_S, events, serving_server

@@ -1,7 +1,7 @@
 """`golfflight fly`: one shot, a club's typical launch or your own, through the served model (the bundle `serve` and
 `simulate` load: `--model DIR`, $GOLFFLIGHT_MODEL, models/default) or, with `--reference`, the reference world.
 
-The shot is checked by the HTTP contract's own request model (`service.api.models.ShotRequest`, ranges from
+The shot is checked by the HTTP contract's own request model (`contract.requests.ShotRequest`, ranges from
 `flight.limits`) before anything flies, so a value out of range is refused with the API's message, naming the
 option and the allowed range (exit 2, one line); the result has the fields of POST /v1/shots.
 """
@@ -15,6 +15,7 @@ import re
 
 from pydantic import ValidationError
 
+from golfflight.contract.figures import FIGURES, Figure
 from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.limits import WIND_SPEED_MPS, Range
 from golfflight.shots.clubs import CLUB_NAMES, club_named
@@ -41,15 +42,8 @@ FLAGS = {
 }
 """Request field -> the option that sets it, to name the option in a refusal."""
 
-TABLE = (
-    ("carry", "carry_m", "carry_yd"),
-    ("total", "total_m", "total_yd"),
-    ("apex", "apex_m", "apex_yd"),
-    ("lateral", "lateral_m", "lateral_yd"),
-    ("roll", "roll_m", "roll_yd"),
-)
-"""Rows of the printed table with a length: (label, metres field, yards field), both the result's own (POST
-/v1/shots' names; nothing is converted here)."""
+DECIMALS = {"m": 1, "s": 2, "deg": 1, "m/s": 1, "rpm": 0}
+"""Decimals the table prints a figure with, by its unit (`contract.figures.Figure.unit`); a count prints whole."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -127,7 +121,8 @@ def wind_speed_mps(args: argparse.Namespace) -> float | None:
         return args.wind_speed_mps
     from pydantic import Field, create_model
 
-    from golfflight.service.api.models import Strict, describe_errors
+    from golfflight.contract.refusals import describe_errors
+    from golfflight.contract.requests import Strict
 
     bounds = WIND_SPEED_MPH
     in_mph = create_model("WindInMph", __base__=Strict, wind_speed_mph=(float, Field(ge=bounds.low, le=bounds.high)))
@@ -178,7 +173,8 @@ def request_of(args: argparse.Namespace) -> tuple[str, dict]:
 
 def checked(shot: dict):
     """The validated ShotRequest, or ValueError with the API's messages naming the options."""
-    from golfflight.service.api.models import ShotRequest, describe_errors
+    from golfflight.contract.refusals import describe_errors
+    from golfflight.contract.requests import ShotRequest
 
     try:
         return ShotRequest.model_validate(shot)
@@ -191,10 +187,11 @@ def fly_reference_shot(shot) -> dict:
     ground phase): the POST /v1/shots result fields."""
     import numpy as np
 
+    from golfflight.contract.flying import flight_fields
+    from golfflight.contract.inputs import air_of, conditions_of, launch_of
+    from golfflight.flight.engine import Rest, ShotFlight
     from golfflight.flight.ground import LEVEL_FAIRWAY, ground_phase_one
     from golfflight.flight.physics import initial_state
-    from golfflight.service.api.shots import air_of, conditions_of, flight_fields, launch_of
-    from golfflight.service.engine import Rest, ShotFlight
     from golfflight.shots.reference_world import fly_reference
 
     air = air_of(shot.air)
@@ -221,9 +218,9 @@ def fly_reference_shot(shot) -> dict:
 
 def fly_model_shot(shot, model: str | None) -> tuple[dict, dict]:
     """A checked request flown by the served model as POST /v1/shots flies it: (the result, the model's identity)."""
+    from golfflight.contract.flying import fly_shot
     from golfflight.flight.bundle_location import model_dir
-    from golfflight.service.api.shots import fly_shot
-    from golfflight.service.engine import FlightEngine, FlightError
+    from golfflight.flight.engine import FlightEngine, FlightError
 
     engine = FlightEngine(model_dir(model))
     try:
@@ -232,6 +229,18 @@ def fly_model_shot(shot, model: str | None) -> tuple[dict, dict]:
         raise ValueError(str(error)) from None
     identity = {"bundle": str(engine.bundle_dir), "variant": engine.variant, "sha256": engine.sha256}
     return result.model_dump(exclude_none=True), identity
+
+
+def table_row(figure: Figure, result: dict) -> str:
+    """One figure of a result (POST /v1/shots' fields) as the table prints it: its words, its value in its unit, and
+    its imperial twin's beside it (the result's own; nothing is converted here)."""
+    if figure.kind is int:
+        return f"  {figure.label:<18} {result[figure.name]:8d}"
+    decimals = DECIMALS[figure.unit]
+    row = f"  {figure.label:<18} {result[figure.name] + 0.0:8.{decimals}f} {figure.unit}"  # + 0.0: no -0.0
+    if figure.twin is not None:
+        row += f" {result[figure.twin] + 0.0:8.{decimals}f} {figure.twin.rsplit('_', 1)[1]}"
+    return row
 
 
 def run(args: argparse.Namespace) -> int:
@@ -250,12 +259,7 @@ def run(args: argparse.Namespace) -> int:
         if isinstance(values, dict):
             launch += f"; {part} " + ", ".join(f"{key} {value:g}" for key, value in values.items())
     print(f"{club} ({flown_by}): {launch}")
-    for label, metres, yards in TABLE:
-        value, in_yards = result[metres] + 0.0, result[yards] + 0.0  # no -0.0
-        print(f"  {label:<18} {value:8.1f} m {in_yards:8.1f} yd")
-    print(f"  {'landing angle':<18} {result['landing_angle_deg']:8.1f} deg")
-    print(f"  {'flight time':<18} {result['flight_time_s']:8.2f} s   apex at {result['apex_time_s']:.2f} s")
-    print(f"  {'landing speed':<18} {result['landing_speed_mps']:8.1f} m/s {result['landing_speed_mph']:6.1f} mph")
-    print(f"  {'landing spin':<18} {result['landing_spin_rpm']:8.0f} rpm")
-    print(f"  {'bounces':<18} {result['bounces']:8d}")
+    for figure in FIGURES:
+        if figure.point is None:
+            print(table_row(figure, result))
     return 0

@@ -6,7 +6,7 @@ altitude_m, pressure_hpa, humidity_pct, density_kg_m3, wind_speed_mps or wind_sp
 wind_reference_height_m, normalized, and the ground: ground_surface, stimp_ft, ground_elevation_m or
 ground_elevation_ft, slope_deg, slope_dir_deg). A canonical shot file works as is: its identity and outcome columns are
 passed over, its shot_id echoed. Output: {"results": [...]} as JSON, or a flat CSV when --out ends in .csv: the
-result's fields as columns (`service.columns.result_columns`), its points flattened (rest_x_m, rest_x_yd, ...), every
+result's fields as columns (`contract.columns.result_columns`), its points flattened (rest_x_m, rest_x_yd, ...), every
 length in metres and yards, the landing speed in m/s and mph.
 
 A bad shot (a value out of range or not a number, an extra cell, a shot_id seen before) refuses the file with its
@@ -21,7 +21,7 @@ import json
 import sys
 from pathlib import Path
 
-from golfflight.service.columns import cell_value, check, columns_message, flat_row, request_of_cells
+from golfflight.contract.columns import cell_value, check, columns_message, flat_row, request_of_cells
 from golfflight.shots.records import reading
 
 
@@ -86,9 +86,9 @@ def shots_from_json(text: str, source: str) -> list[dict]:
 
 
 def run(args: argparse.Namespace) -> int:
+    from golfflight.contract.flying import fly_shots
     from golfflight.flight.bundle_location import model_dir
-    from golfflight.service.api.shots import fly_shots
-    from golfflight.service.engine import FlightEngine
+    from golfflight.flight.engine import FlightEngine
 
     ids: list[str | None] = []
     problems: list[str] = []

@@ -1,5 +1,5 @@
 """The HTTP service: `create_app` assembles FastAPI's "bigger applications" layout, the routers of
-`service.api.routes` over the plain functions of `service.api` (shots, gspro), the engine reaching them through a
+`service.api.routes` over the plain functions of the shot contract (`contract`), the engine reaching them through a
 dependency (`service.api.state.ready_engine`, from `app.state`).
 
 Single shots simulate inline in `async def` routes. Batches fly in a child process at a lower CPU priority

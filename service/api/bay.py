@@ -1,44 +1,19 @@
-"""The simulator bay's conditions: the air, wind and ground a shot flies in when it brings none of its own, and the
-units the bay's screen shows. A launch monitor's connector sends ball data only (GSPro Open Connect has no field for
-the weather or the green): in a simulator the course's conditions come from the simulator, here from the bay.
-
-One `BayConditions` per server, set at start (`golfflight serve --bay FILE`) and changed live (GET/PUT /v1/bay),
-validated by the same request models and limits as a shot's conditions, and kept across restarts in FILE (written
-whole or not at all, `shots.files.write_text_atomic`). A shot's own conditions win, field by field (`in_bay`).
+"""The server's simulator bay: one set of bay conditions (`contract.bay.BayConditions`) per server, set at start
+(`golfflight serve --bay FILE`) and changed live (GET/PUT /v1/bay), kept across restarts in FILE (written whole or
+not at all, `shots.files.write_text_atomic`).
 """
 
 from __future__ import annotations
 
 import threading
 from pathlib import Path
-from typing import Literal
 
-from golfflight.service.api.models import AirRequest, GroundRequest, ShotRequest, Strict, WindRequest
+from golfflight.contract.bay import BayConditions
 from golfflight.shots.files import write_text_atomic
-from pydantic import Field, ValidationError
+from pydantic import ValidationError
 
-CONDITION_FIELDS = ("air", "wind", "ground")
 BAY_FILE_ENV = "GOLFFLIGHT_BAY_FILE"
 """Where `golfflight serve --bay FILE` tells its worker processes the bay file is."""
-
-
-class BayConditions(Strict):
-    """What a shot without conditions of its own flies in, and the units the bay's screen shows; the same `air`,
-    `wind` and `ground` objects as a shot request (omitted: ICAO standard air, calm, a level fairway)."""
-
-    air: AirRequest | None = None
-    wind: WindRequest | None = None
-    ground: GroundRequest | None = None
-    units: Literal["imperial", "metric"] = Field(
-        "imperial", description="what the bay's screen shows: yards, mph and feet, or metres and m/s"
-    )
-
-
-def in_bay(shot: ShotRequest, bay: BayConditions) -> ShotRequest:
-    """The shot with the bay's air, wind and ground wherever it gives none of its own."""
-    updates = {name: getattr(bay, name) for name in CONDITION_FIELDS
-               if getattr(shot, name) is None and getattr(bay, name) is not None}
-    return shot.model_copy(update=updates) if updates else shot
 
 
 class BayFileError(ValueError):

@@ -9,8 +9,9 @@ from fastapi import FastAPI, Request
 from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
-from golfflight.service.api.gspro import GSProReply, invalid_message
-from golfflight.service.api.models import RANGES, body_detail, describe_errors
+from golfflight.contract.gspro import GSProReply, invalid_message
+from golfflight.contract.refusals import body_detail, describe_errors
+from golfflight.contract.requests import RANGES
 from golfflight.service.api.routes.gspro import GSPRO_PATH
 from golfflight.service.api.state import NotReady
 from starlette.exceptions import HTTPException as StarletteHTTPException

@@ -9,7 +9,7 @@ from __future__ import annotations
 import hmac
 import json
 
-from golfflight.service.api.models import body_detail
+from golfflight.contract.refusals import body_detail
 from golfflight.service.viewer.page import PUBLIC_PATHS
 
 API_KEY_ENV = "GOLFFLIGHT_API_KEY"

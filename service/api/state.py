@@ -11,12 +11,12 @@ from pathlib import Path
 from typing import Literal
 
 from fastapi import Depends, Request
+from golfflight.contract.gspro import GSProMessage, GSProReply, fly_message
+from golfflight.flight.engine import FlightEngine
 from golfflight.service.api.batch_process import BatchProcess
 from golfflight.service.api.bay import Bay
-from golfflight.service.api.gspro import GSProMessage, GSProReply, fly_message
 from golfflight.service.api.latency import Rolling
 from golfflight.service.api.metrics import ServiceMetrics
-from golfflight.service.engine import FlightEngine
 from golfflight.service.viewer.event import Source
 from golfflight.service.viewer.feed import ShotFeed
 

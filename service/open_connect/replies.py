@@ -2,7 +2,7 @@
 
 Heartbeats and messages without ball data get no reply (GSPro sends none: a connector that waits for one would
 resend). Everything that is not a valid message gets Code 500 with a Message saying what is wrong, as the HTTP
-route's does (`service.api.gspro.invalid_message`).
+route's does (`contract.gspro.invalid_message`).
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 
-from golfflight.service.api.gspro import GSProMessage, GSProReply, invalid_message
+from golfflight.contract.gspro import GSProMessage, GSProReply, invalid_message
 from golfflight.service.open_connect.framing import Refused
 from pydantic import ValidationError
 

@@ -14,7 +14,7 @@ import logging
 import os
 from dataclasses import dataclass
 
-from golfflight.service.api.gspro import GSProReply
+from golfflight.contract.gspro import GSProReply
 from golfflight.service.open_connect.framing import ObjectFramer, Refused
 from golfflight.service.open_connect.replies import Answer, reply_to
 

@@ -11,7 +11,7 @@ import json
 from pathlib import Path
 from typing import Literal
 
-from golfflight.service.api.models import ShotResult
+from golfflight.contract.results import ShotResult
 from pydantic import BaseModel, Field
 
 SCHEMA_PATH = Path(__file__).with_name("event.schema.json")

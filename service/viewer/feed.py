@@ -16,10 +16,12 @@ import time
 from collections import deque
 from dataclasses import dataclass
 
-from golfflight.service.api.gspro import GSProMessage, GSProReply, launch_from_ball_data
-from golfflight.service.api.models import ShotRequest, ShotResult, TrajectoryPoint, TrajectoryRequest
-from golfflight.service.api.shots import fly_shot, launch_of
-from golfflight.service.engine import FlightEngine, FlightError
+from golfflight.contract.flying import fly_shot
+from golfflight.contract.gspro import GSProMessage, GSProReply, launch_from_ball_data
+from golfflight.contract.inputs import launch_of
+from golfflight.contract.requests import ShotRequest, TrajectoryRequest
+from golfflight.contract.results import ShotResult, TrajectoryPoint
+from golfflight.flight.engine import FlightEngine, FlightError
 from golfflight.service.viewer.event import LaunchNumbers, ShotEvent, Source
 
 HISTORY = 50

@@ -19,7 +19,7 @@ import signal
 import time
 from collections.abc import AsyncIterator, Callable
 
-from golfflight.service.engine import FlightEngine
+from golfflight.flight.engine import FlightEngine
 from golfflight.service.viewer.feed import ShotFeed, Viewer
 
 KEEPALIVE_S = 15.0

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Depends
 from fastapi.responses import JSONResponse, Response
-from golfflight.service.api.bay import BayConditions
-from golfflight.service.api.models import body_detail
+from golfflight.contract.bay import BayConditions
+from golfflight.contract.refusals import body_detail
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
 from golfflight.service.api.state import ServiceState, service_state
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Depends
 from fastapi.responses import Response
-from golfflight.service.api.gspro import GSProMessage, GSProReply
+from golfflight.contract.gspro import GSProMessage, GSProReply
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
 from golfflight.service.api.state import ServiceState, service_state
 

@@ -9,20 +9,14 @@ from concurrent.futures.process import BrokenProcessPool
 
 from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import JSONResponse, Response
-from golfflight.service.api.bay import CONDITION_FIELDS, in_bay
-from golfflight.service.api.models import (
-    MAX_BATCH_SHOTS,
-    MAX_BATCH_TRAJECTORIES,
-    BatchRequest,
-    BatchResult,
-    ShotRequest,
-    ShotResult,
-    body_detail,
-)
+from golfflight.contract.bay import CONDITION_FIELDS, in_bay
+from golfflight.contract.flying import fly_shot
+from golfflight.contract.refusals import body_detail
+from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, BatchRequest, ShotRequest
+from golfflight.contract.results import BatchResult, ShotResult
+from golfflight.flight.engine import FlightEngine, FlightError
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
-from golfflight.service.api.shots import fly_shot
 from golfflight.service.api.state import ServiceState, ready_engine, service_state
-from golfflight.service.engine import FlightEngine, FlightError
 
 BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has been restarted): send the batch again"
 

@@ -7,11 +7,11 @@ from importlib.metadata import version
 
 from fastapi import APIRouter, Depends
 from fastapi.responses import JSONResponse, Response
-from golfflight.service.api.models import ShotRequest
+from golfflight.contract.flying import fly_shot
+from golfflight.contract.requests import ShotRequest
+from golfflight.flight.engine import FlightEngine
 from golfflight.service.api.routes.responses import ERROR_RESPONSES
-from golfflight.service.api.shots import fly_shot
 from golfflight.service.api.state import ServiceState, ready_engine, service_state
-from golfflight.service.engine import FlightEngine
 from golfflight.weights_schema.model_card import ModelCard
 
 PROBE_SHOT = ShotRequest(ball_speed_mps=55.0, launch_angle_deg=16.0, spin_rpm=7100.0)

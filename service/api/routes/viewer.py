@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Depends, Header
 from fastapi.responses import JSONResponse, Response, StreamingResponse
+from golfflight.flight.engine import FlightEngine
 from golfflight.service.api.state import ServiceState, ready_engine, service_state
-from golfflight.service.engine import FlightEngine
 from golfflight.service.viewer.feed import TooManyViewers
 from golfflight.service.viewer.page import ASSETS, PAGE_PATH, SECURITY_HEADERS
 from golfflight.service.viewer.stream import events, last_event_id

@@ -8,7 +8,7 @@ joining the 0.1 s states with straight lines would show kinks at every step.
 from __future__ import annotations
 
 import numpy as np
-from golfflight.service.engine import EulerStates
+from golfflight.flight.engine import EulerStates
 
 
 def resample(states: EulerStates, rate_hz: float) -> tuple[np.ndarray, np.ndarray]:

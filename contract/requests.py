@@ -1,4 +1,4 @@
-"""The HTTP contract: pydantic request and response models (SI inside, imperial only in fields named for it).
+"""What a shot request may say: pydantic request models (SI inside, imperial only in fields named for it).
 
 Every number is range-checked against `flight.limits` (NaN and infinity refused), types are strict (no "55" for
 55), unknown fields are refused, and each launch quantity comes in exactly one form: ball_speed_mps or
@@ -8,7 +8,6 @@ into the OpenAPI schema (oneOf / not), so a schema-driven client or fuzzer build
 
 from __future__ import annotations
 
-import math
 from typing import Annotated, Literal
 
 from golfflight.flight import limits
@@ -281,137 +280,3 @@ class BatchRequest(Strict):
                 f"shots: {asked} shots ask for a trajectory, at most {MAX_BATCH_TRAJECTORIES} may in one batch"
             )
         return self
-
-
-class Landing(BaseModel):
-    """Where the ball comes down, on its ground's plane (the tee's elevation unless the ground's elevation); metres
-    with yards alongside."""
-
-    x_m: float = Field(description="right (+) of the target line")
-    y_m: float = Field(description="down the target line")
-    x_yd: float
-    y_yd: float
-
-
-class RestPoint(BaseModel):
-    """Where the ball comes to rest after bouncing and rolling; metres with yards alongside."""
-
-    x_m: float = Field(description="right (+) of the target line")
-    y_m: float = Field(description="down the target line")
-    x_yd: float
-    y_yd: float
-
-
-class TrajectoryPoint(BaseModel):
-    t_s: float
-    x_m: float
-    y_m: float
-    z_m: float
-
-
-class FlightResult(BaseModel):
-    """One flight to its landing on its ground (at the tee's elevation, "flat", unless the ground's elevation), then
-    bounced and rolled to rest; every length in metres with yards alongside (NAME_m, NAME_yd), the landing speed in
-    m/s with mph alongside (`service.api.shots.flight_numbers` derives them all)."""
-
-    landing: Landing
-    carry_m: float = Field(description="horizontal distance from the tee to the landing point")
-    carry_yd: float
-    lateral_m: float = Field(description="landing point right (+) or left (-) of the target line")
-    lateral_yd: float
-    apex_m: float = Field(description="greatest height")
-    apex_yd: float
-    apex_time_s: float
-    flight_time_s: float
-    landing_angle_deg: float = Field(description="descent angle below the horizontal")
-    landing_speed_mps: float
-    landing_speed_mph: float
-    landing_spin_rpm: float
-    total_m: float = Field(description="horizontal distance from the tee to the rest point (carry and roll)")
-    total_yd: float
-    roll_m: float = Field(description="total minus carry: the run after landing (negative: the ball came back)")
-    roll_yd: float
-    rest: RestPoint
-    bounces: int = Field(description="hops after the landing before the ball rolls")
-    trajectory: list[TrajectoryPoint] | None = Field(
-        None, description="only when asked for: the flight, the bounces (an impact twice: in and out) and the roll"
-    )
-
-
-class NormalizedFlight(FlightResult):
-    """The same launch flown in calm reference air."""
-
-    conditions: ReferenceAir
-
-
-class FlatFlight(BaseModel):
-    """The same flight down to the tee's elevation ("flat", TrackMan's figures), beside one that lands higher or
-    lower."""
-
-    landing: Landing
-    carry_m: float
-    carry_yd: float
-    lateral_m: float
-    lateral_yd: float
-    flight_time_s: float
-    landing_angle_deg: float
-
-
-class ShotResult(FlightResult):
-    """The flight in the conditions given, and in reference conditions when asked for."""
-
-    normalized: NormalizedFlight | None = None
-    flat: FlatFlight | None = Field(
-        None, description="only when the ground's elevation (elevation_m or elevation_ft) is not 0: the flight to z = 0"
-    )
-
-
-class ShotFailure(BaseModel):
-    """A batch shot the engine could not fly (the rest of the batch is unaffected)."""
-
-    error: str = Field(description="why, e.g. the ball was still in the air at the simulation cap")
-
-
-class BatchResult(BaseModel):
-    results: list[ShotResult | ShotFailure]
-
-
-def _plain(value):
-    """A request value as JSON can carry it (NaN and infinity as text; objects and lists left out)."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return str(value)
-    return value if isinstance(value, (str, int, float, bool)) or value is None else None
-
-
-def describe_error(error: dict, ranges: dict[str, Range] = RANGES) -> dict:
-    """One 422 detail: FastAPI's own `loc`, `msg` and `type`, plus the field as a dotted path, the value sent, the
-    allowed range (from `ranges`, by field name), the batch index of the shot, and a `message` in plain words that
-    says all of it."""
-    path = [p for p in error["loc"] if p != "body"]
-    field = ".".join(str(p) for p in path) or "body"
-    msg = error["msg"].removeprefix("Value error, ")
-    entry: dict = {"loc": list(error["loc"]), "msg": msg, "type": error["type"], "field": field}
-    parts = [f"{field}: {msg}"]
-    if len(path) >= 2 and path[0] == "shots" and isinstance(path[1], int):
-        entry["shot"] = path[1]
-        parts[0] = f"shot {path[1]}: {'.'.join(str(p) for p in path[2:]) or 'shot'}: {msg}"
-    value = _plain(error.get("input")) if error["type"] != "missing" else None
-    if value is not None:
-        entry["value"] = value
-        parts.append(f"(got {value!r})")
-    name = path[-1] if path else None
-    if isinstance(name, str) and name in ranges and error["type"] != "extra_forbidden":
-        entry["allowed"] = ranges[name].describe()
-        parts.append(f"; allowed {entry['allowed']}")
-    entry["message"] = " ".join(parts).replace(" ;", ";")
-    return entry
-
-
-def body_detail(message: str, kind: str) -> dict:
-    """A 422/413 detail about the body as a whole (not one field), shaped like `describe_error`'s."""
-    return {"loc": ["body"], "msg": message, "type": kind, "field": "body", "message": message}
-
-
-def describe_errors(errors, ranges: dict[str, Range] = RANGES) -> list[dict]:
-    """422 details naming the field, the value and the allowed range (see `describe_error`)."""
-    return [describe_error(error, ranges) for error in errors]

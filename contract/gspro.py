@@ -13,13 +13,16 @@ from __future__ import annotations
 
 from typing import Annotated
 
+from golfflight.contract.bay import BayConditions
+from golfflight.contract.flying import flight_fields
+from golfflight.contract.inputs import conditions_from, ground_of, spin_from_components
+from golfflight.contract.refusals import describe_errors
+from golfflight.contract.requests import BALL_SPEED_MPH, SIDE_SPIN_RPM
+from golfflight.contract.results import ShotResult
 from golfflight.flight import limits
 from golfflight.flight.constants import MPH_TO_MPS
+from golfflight.flight.engine import FlightEngine, FlightError, Launch
 from golfflight.flight.limits import Range
-from golfflight.service.api.bay import BayConditions
-from golfflight.service.api.models import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotResult, describe_errors
-from golfflight.service.api.shots import conditions_from, flight_fields, ground_of, spin_from_components
-from golfflight.service.engine import FlightEngine, FlightError, Launch
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 
@@ -153,7 +156,7 @@ def invalid_message(errors: list) -> str:
 
 
 def fly_message(engine: FlightEngine, message: GSProMessage, bay: BayConditions | None = None) -> GSProReply:
-    """The reply to a message with BallData: Code 200 with its flight in the bay's conditions (`service.api.bay`;
+    """The reply to a message with BallData: Code 200 with its flight in the bay's conditions (`contract.bay`;
     without a bay: standard air, calm, rolled to rest on a level fairway), or Code 500 saying why it could not fly.
     Open Connect carries ball data only: its shots always fly in the bay's air, wind and ground."""
     bay = bay or BayConditions()

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import re
 
-from golfflight.service.api.models import FlatFlight, FlightResult, Landing, RestPoint, ShotRequest, describe_errors
+from golfflight.contract.refusals import describe_errors
+from golfflight.contract.requests import ShotRequest
+from golfflight.contract.results import POINT_MODELS, FlatFlight, FlightResult
 from pydantic import ValidationError
 
 AIR_COLUMNS = {name: name for name in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct", "density_kg_m3")}
@@ -135,9 +137,6 @@ def check(item, csv_columns: bool = True) -> ShotRequest | list[str]:
         return problems
 
 
-NESTED_POINTS = {"landing": Landing, "rest": RestPoint}
-"""Result fields that are points, flattened to NAME_FIELD: NAME_x_m, NAME_y_m, NAME_x_yd, NAME_y_yd."""
-
 ELEVATION_COLUMNS = ("ground_elevation_m", "ground_elevation_ft")
 """Columns that can put the ground off the tee's elevation, so that flat_* columns come back (`result_columns`)."""
 
@@ -152,7 +151,7 @@ def flat_row(result: dict) -> dict:
         if not flight:
             continue
         for key, value in flight.items():
-            if key in NESTED_POINTS:
+            if key in POINT_MODELS:
                 row.update({f"{prefix}{key}_{field}": number for field, number in value.items()})
             elif key not in LEFT_OUT:
                 row[prefix + key] = value
@@ -160,10 +159,12 @@ def flat_row(result: dict) -> dict:
 
 
 def _flat_names(fields, prefix: str = "") -> list[str]:
+    """The columns of a result model's fields, as `flat_row` names them: a point's coordinates as NAME_FIELD (NAME_x_m,
+    NAME_y_m, NAME_x_yd, NAME_y_yd)."""
     names = []
     for key in fields:
-        if key in NESTED_POINTS:
-            names += [f"{prefix}{key}_{field}" for field in NESTED_POINTS[key].model_fields]
+        if key in POINT_MODELS:
+            names += [f"{prefix}{key}_{field}" for field in POINT_MODELS[key].model_fields]
         elif key not in LEFT_OUT:
             names.append(prefix + key)
     return names

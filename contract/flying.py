@@ -1,106 +1,28 @@
-"""Plain functions between the contract and the engine: requests in, results out (shared by HTTP and the CLI)."""
+"""Plain functions between the contract and the engine: requests in, results out (shared by HTTP, GSPro, the
+viewer, the command line and sweep)."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
-from golfflight.flight.air import Air
-from golfflight.flight.conditions import STANDARD, Conditions
-from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from golfflight.flight.flyer import LAUNCH_WIDTH
-from golfflight.flight.ground import LEVEL_FAIRWAY, GroundSpec, surface
-from golfflight.flight.wind import CALM, Wind
-from golfflight.service.api.models import (
-    AirRequest,
+from golfflight.contract.figures import flat_numbers, flight_numbers
+from golfflight.contract.inputs import air_of, conditions_of, ground_of, lands_off_the_flat, launch_of, reference_of
+from golfflight.contract.requests import ShotRequest, TrajectoryRequest
+from golfflight.contract.results import (
+    POINT_MODELS,
     FlatFlight,
-    GroundRequest,
-    Landing,
     NormalizedFlight,
-    ReferenceAir,
-    RestPoint,
     ShotFailure,
-    ShotRequest,
     ShotResult,
     TrajectoryPoint,
-    TrajectoryRequest,
-    WindRequest,
 )
-from golfflight.service.engine import FlightEngine, FlightError, Launch, ShotFlight
-from golfflight.service.trajectory import resample
-
-
-def spin_from_components(back_spin_rpm: float, side_spin_rpm: float) -> tuple[float, float]:
-    """(total spin rpm, spin axis deg) from back and side spin; + side spin tilts the axis right (a fade)."""
-    return math.hypot(back_spin_rpm, side_spin_rpm), math.degrees(math.atan2(side_spin_rpm, back_spin_rpm))
-
-
-def launch_of(shot: ShotRequest) -> Launch:
-    """The SI launch of a request, whichever unit form it used."""
-    speed = shot.ball_speed_mps if shot.ball_speed_mps is not None else shot.ball_speed_mph * MPH_TO_MPS
-    if shot.spin_rpm is not None:
-        spin, axis = shot.spin_rpm, shot.spin_axis_deg or 0.0
-    else:
-        spin, axis = spin_from_components(shot.back_spin_rpm, shot.side_spin_rpm or 0.0)
-    return Launch(speed, shot.launch_angle_deg, shot.launch_direction_deg, spin, axis)
-
-
-def air_of(air: AirRequest | ReferenceAir | None) -> Air:
-    """Engine air from a request's air; omitted values take ICAO standard air (station pressure wins over altitude)."""
-    if air is None:
-        return STANDARD.air
-    given = {name: value for name, value in air.model_dump().items() if value is not None}
-    if "density_kg_m3" in given:
-        return Air.from_density(given["density_kg_m3"])
-    pressure_hpa = given.pop("pressure_hpa", None)
-    return Air.from_conditions(**given, pressure_pa=None if pressure_hpa is None else pressure_hpa * 100.0)
-
-
-def wind_speed_mps(wind: WindRequest) -> float:
-    """The SI wind speed of a request's (or a bay's) wind, whichever unit form it used."""
-    return wind.speed_mps if wind.speed_mps is not None else wind.speed_mph * MPH_TO_MPS
-
-
-def wind_of(wind: WindRequest | None) -> Wind:
-    speed = 0.0 if wind is None else wind_speed_mps(wind)
-    if speed == 0.0:
-        return CALM
-    return Wind(speed, wind.from_deg, wind.profile, wind.reference_height_m)
-
-
-def conditions_from(air: AirRequest | None, wind: WindRequest | None) -> Conditions:
-    """Engine conditions from a request's (or a bay's) air and wind; neither = standard air, calm."""
-    if air is None and wind is None:
-        return STANDARD
-    return Conditions(air_of(air), wind_of(wind))
-
-
-def conditions_of(shot: ShotRequest) -> Conditions:
-    return conditions_from(shot.air, shot.wind)
-
-
-def elevation_m(ground: GroundRequest | None) -> float:
-    """The SI elevation of a request's (or a bay's) ground, whichever unit form it used; 0 (the tee's) if none."""
-    if ground is None or (ground.elevation_m is None and ground.elevation_ft is None):
-        return 0.0
-    return ground.elevation_m if ground.elevation_m is not None else ground.elevation_ft * FOOT_M
-
-
-def ground_of(ground: GroundRequest | None) -> GroundSpec:
-    """The engine's ground from a request's; omitted = level fairway at the tee's elevation."""
-    if ground is None:
-        return LEVEL_FAIRWAY
-    return GroundSpec(
-        surface(ground.surface, ground.stimp_ft), elevation_m(ground), ground.slope_deg, ground.slope_dir_deg
-    )
-
-
-def reference_of(shot: ShotRequest) -> ReferenceAir | None:
-    """The reference air of the normalized flight, or None when none was asked for."""
-    if shot.normalized is False:
-        return None
-    return ReferenceAir() if shot.normalized is True else shot.normalized
+from golfflight.contract.trajectory import resample
+from golfflight.flight.conditions import Conditions
+from golfflight.flight.engine import FlightEngine, FlightError, Launch, ShotFlight
+from golfflight.flight.flyer import LAUNCH_WIDTH
+from golfflight.flight.ground import GroundSpec
+from golfflight.flight.wind import CALM
 
 
 def _trajectory(flight: ShotFlight, request: TrajectoryRequest) -> list[TrajectoryPoint]:
@@ -114,79 +36,26 @@ def _trajectory(flight: ShotFlight, request: TrajectoryRequest) -> list[Trajecto
     ]
 
 
-IMPERIAL_TWINS = (("_m", "_yd", YARD_M), ("_mps", "_mph", MPH_TO_MPS))
-"""(SI suffix, imperial suffix, SI units per imperial unit): every result number named NAME_m (a length) gets
-NAME_yd beside it, every NAME_mps (a speed) NAME_mph: the one place the results' imperial fields are defined."""
-
-
-def with_imperial(numbers: dict) -> dict:
-    """`numbers` with each SI length and speed followed by its imperial twin (`IMPERIAL_TWINS`): value / unit."""
-    out = {}
-    for name, value in numbers.items():
-        out[name] = value
-        for si, imperial, unit in IMPERIAL_TWINS:
-            if name.endswith(si):
-                out[name.removesuffix(si) + imperial] = value / unit
-    return out
-
-
-def flight_numbers(flight) -> dict:
-    """The flat numbers of a flight rolled to rest under their column names (yards alongside metres, mph alongside
-    m/s: `with_imperial`), from one ShotFlight (floats) or a batch's `BatchFlights` (arrays): the one definition of
-    both forms."""
-    rest = flight.rest
-    return with_imperial({
-        "landing_x_m": flight.landing_x_m,
-        "landing_y_m": flight.landing_y_m,
-        "carry_m": flight.carry_m,
-        "lateral_m": flight.lateral_m,
-        "apex_m": flight.apex_m,
-        "apex_time_s": flight.apex_time_s,
-        "flight_time_s": flight.flight_time_s,
-        "landing_angle_deg": flight.landing_angle_deg,
-        "landing_speed_mps": flight.landing_speed_mps,
-        "landing_spin_rpm": flight.landing_spin_rpm,
-        "total_m": rest.total_m,
-        "roll_m": rest.roll_m,
-        "rest_x_m": rest.x_m,
-        "rest_y_m": rest.y_m,
-        "bounces": rest.bounces,
-    })
-
-
-def flat_numbers(flight) -> dict:
-    """The flat numbers of a flight flown down to z = 0, from a ShotFlight or a `BatchFlights` (`flight_numbers`)."""
-    return with_imperial({
-        "landing_x_m": flight.landing_x_m,
-        "landing_y_m": flight.landing_y_m,
-        "carry_m": flight.carry_m,
-        "lateral_m": flight.lateral_m,
-        "flight_time_s": flight.flight_time_s,
-        "landing_angle_deg": flight.landing_angle_deg,
-    })
-
-
-POINTS = (("landing", Landing), ("rest", RestPoint))
-"""Result fields that are points; their numbers are NAME_FIELD (landing_x_m, landing_x_yd, ...)."""
+_POINT_NUMBERS = tuple(
+    (name, point, tuple((key, f"{name}_{key}") for key in point.model_fields)) for name, point in POINT_MODELS.items()
+)
+"""Each point of a result, its model, and its coordinates' names in the model and among a flight's numbers
+(x_m, landing_x_m), ..."""
 
 
 def _points(numbers: dict) -> dict:
-    """A flight's numbers with NAME_x_m, NAME_y_m, NAME_x_yd and NAME_y_yd as the result's points."""
+    """A flight's numbers with each point's (NAME_x_m, NAME_y_m, NAME_x_yd, NAME_y_yd) as the result's point."""
     fields = dict(numbers)
-    for name, point in POINTS:
-        if f"{name}_x_m" in fields:
-            fields[name] = point.model_construct(**{key: fields.pop(f"{name}_{key}") for key in point.model_fields})
+    for name, point, named in _POINT_NUMBERS:
+        if named[0][1] in fields:
+            fields[name] = point.model_construct(**{key: fields.pop(number) for key, number in named})
     return fields
 
 
 def flight_fields(flight: ShotFlight, trajectory: TrajectoryRequest | None) -> dict:
     """The FlightResult fields of an engine flight rolled to rest (yards alongside metres)."""
-    return {**_points(flight_numbers(flight)), "trajectory": None if trajectory is None else _trajectory(flight, trajectory)}
-
-
-def lands_off_the_flat(shot: ShotRequest) -> bool:
-    """Whether the shot's ground lies above or below the tee's, so that its flat flight is returned beside it."""
-    return elevation_m(shot.ground) != 0.0
+    path = None if trajectory is None else _trajectory(flight, trajectory)
+    return {**_points(flight_numbers(flight)), "trajectory": path}
 
 
 def flat_fields(flight: ShotFlight) -> FlatFlight:
@@ -249,7 +118,7 @@ def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> li
 
 @dataclass(frozen=True)
 class ShotColumns:
-    """`fly_shots`'s results as columns over the shots, named as `service.columns.flat_row` names them: `values` holds
+    """`fly_shots`'s results as columns over the shots, named as `contract.columns.flat_row` names them: `values` holds
     an array for each flight, normalized_* and flat_* column, valid where `present` is True (the shot flew and, for
     normalized_* and flat_*, asked for that flight); `errors` the error column (None where the shot flew)."""
 

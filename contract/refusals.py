@@ -1,0 +1,50 @@
+"""How a refused request reads: each problem names the field, the value sent and the allowed range, in the shape
+every 4xx body, the GSPro reply and the command line's messages share."""
+
+from __future__ import annotations
+
+import math
+
+from golfflight.contract.requests import RANGES
+from golfflight.flight.limits import Range
+
+
+def _plain(value):
+    """A request value as JSON can carry it (NaN and infinity as text; objects and lists left out)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    return value if isinstance(value, (str, int, float, bool)) or value is None else None
+
+
+def describe_error(error: dict, ranges: dict[str, Range] = RANGES) -> dict:
+    """One 422 detail: FastAPI's own `loc`, `msg` and `type`, plus the field as a dotted path, the value sent, the
+    allowed range (from `ranges`, by field name), the batch index of the shot, and a `message` in plain words that
+    says all of it."""
+    path = [p for p in error["loc"] if p != "body"]
+    field = ".".join(str(p) for p in path) or "body"
+    msg = error["msg"].removeprefix("Value error, ")
+    entry: dict = {"loc": list(error["loc"]), "msg": msg, "type": error["type"], "field": field}
+    parts = [f"{field}: {msg}"]
+    if len(path) >= 2 and path[0] == "shots" and isinstance(path[1], int):
+        entry["shot"] = path[1]
+        parts[0] = f"shot {path[1]}: {'.'.join(str(p) for p in path[2:]) or 'shot'}: {msg}"
+    value = _plain(error.get("input")) if error["type"] != "missing" else None
+    if value is not None:
+        entry["value"] = value
+        parts.append(f"(got {value!r})")
+    name = path[-1] if path else None
+    if isinstance(name, str) and name in ranges and error["type"] != "extra_forbidden":
+        entry["allowed"] = ranges[name].describe()
+        parts.append(f"; allowed {entry['allowed']}")
+    entry["message"] = " ".join(parts).replace(" ;", ";")
+    return entry
+
+
+def body_detail(message: str, kind: str) -> dict:
+    """A 422/413 detail about the body as a whole (not one field), shaped like `describe_error`'s."""
+    return {"loc": ["body"], "msg": message, "type": kind, "field": "body", "message": message}
+
+
+def describe_errors(errors, ranges: dict[str, Range] = RANGES) -> list[dict]:
+    """422 details naming the field, the value and the allowed range (see `describe_error`)."""
+    return [describe_error(error, ranges) for error in errors]
