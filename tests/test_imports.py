@@ -1,5 +1,6 @@
-"""Who may import whom, read from the sources (ast), not from a running process: the HTTP package (`service/api/`)
-is imported by nothing outside it but the command that starts the app, and the shot contract holds no HTTP code."""
+"""Who may import whom, read from the sources (ast), not from a running process: every package imports only the
+floors below its own (docs/architecture.md), the HTTP package (`service/api/`) is imported by nothing outside it
+but the command that starts the app, and the shot contract holds no HTTP code."""
 
 from __future__ import annotations
 
@@ -31,6 +32,31 @@ def imported(path: Path) -> set[str]:
     return names
 
 
+FLOORS = {
+    "weights_schema": 0,
+    "flight": 1,
+    "shots": 2,
+    "contract": 2,
+    "service": 3,
+    "sweep": 3,
+    "discovery": 3,
+    "evaluation": 3,
+    "model_export": 4,
+    "golfflight": 5,
+}
+"""Each package folder's floor: the flight core at the bottom (on the bundle's card schema), shot records and the
+shot contract on it, the service, sweep, discovery and evaluation above, training over evaluation, the command line
+on top. A package imports only from floors below its own, never sideways."""
+
+
+def _package(name: str) -> str | None:
+    """The package folder a golfflight module belongs to (golfflight/ itself for the command line)."""
+    parts = name.split(".")
+    if parts[0] != "golfflight":
+        return None
+    return parts[1] if len(parts) > 1 and parts[1] in FLOORS else "golfflight"
+
+
 def _within(name: str, package: str) -> bool:
     return name == package or name.startswith(package + ".")
 
@@ -39,6 +65,21 @@ def test_imported_reads_plain_and_from_imports(tmp_path):
     source = tmp_path / "example.py"
     source.write_text("import golfflight.service.api.app\nfrom golfflight.service import api\n")
     assert {"golfflight.service.api.app", "golfflight.service.api"} <= imported(source)
+
+
+def test_every_package_folder_has_a_floor():
+    assert {p.name for p in ROOT.iterdir() if (p / "__init__.py").is_file()} == set(FLOORS)
+
+
+def test_every_package_imports_only_from_the_floors_below_it():
+    offenders = []
+    for folder, floor in FLOORS.items():
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            for name in sorted(imported(path)):
+                target = _package(name)
+                if target not in (None, folder) and FLOORS[target] >= floor:
+                    offenders.append(f"{path.relative_to(ROOT)} (floor {floor}) imports {name} (floor {FLOORS[target]})")
+    assert offenders == []
 
 
 def test_nothing_outside_the_http_package_imports_it_but_the_command_that_starts_the_app():
