@@ -22,8 +22,8 @@ from service.api.models import (
 )
 from service.api.routes.responses import ERROR_RESPONSES, json_response
 from service.api.shots import fly_shot
-from service.api.state import ServiceState, ready_engine, service_state
-from service.engine import FlightEngine, FlightError
+from service.api.state import ServiceState, ready_engine, service_state, state_of
+from service.engine import FlightError
 
 BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has been restarted): send the batch again"
 
@@ -42,14 +42,12 @@ ShowOnViewer = Query(
     response_model_exclude_none=True,
     responses={422: {"description": "invalid launch or conditions, or a shot that cannot land"}, **ERROR_RESPONSES},
 )
-async def shot(
-    request: ShotRequest,
-    engine: FlightEngine = Depends(ready_engine),
-    state: ServiceState = Depends(service_state),
-    viewer: bool = ShowOnViewer,
-) -> Response:
+async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer) -> Response:
     """Fly one shot: launch in SI or launch-monitor units, optional wind, air, ground, normalized and trajectory;
     the bay's conditions (GET /v1/bay) where the shot gives none."""
+    # The one validation is FastAPI's of `request`; the state comes from the app, not from dependencies (`state_of`)
+    state = state_of(http)
+    engine = state.ready_engine()
     request = in_bay(request, state.bay.conditions)
     started = time.perf_counter()
     try:
