@@ -170,7 +170,7 @@ def main() -> None:
                 order = services if (i + round_) % 2 == 0 else services[::-1]
                 own.append(timed(lambda: fly_shot(engine, shot)))
                 for service in order:
-                    http[service.name].append(timed(lambda: service.post("/v1/shots", shot_body)))
+                    http[service.name].append(timed(lambda s=service: s.post("/v1/shots", shot_body)))
                 for service in order:
                     tcp[service.name].append(timed(service.tcp.fly))
             inprocess.append(own)
@@ -182,7 +182,7 @@ def main() -> None:
             for j in range(args.batches):
                 runs.append(timed(lambda: fly_shots(engine, batch_shots)))
                 for service in services if (j + round_) % 2 == 0 else services[::-1]:
-                    batch[service.name].append(timed(lambda: service.post("/v1/shots/batch", batch_body)))
+                    batch[service.name].append(timed(lambda s=service: s.post("/v1/shots/batch", batch_body)))
             inprocess_batch.append(runs)
             for service in services:
                 service.batch.append(batch[service.name])

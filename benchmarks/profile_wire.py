@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import functools
+import json
 import os
 import subprocess
 import sys
@@ -85,18 +86,18 @@ def serve(port: int, loop: str, http: str) -> None:
     from uvicorn.protocols.http import h11_impl
 
     import service.api.routes.shots as shot_route
-    import service.api.shots as shots
+    from service.api import shots
     from service.api.app import create_app
     from service.api.state import ServiceState
     from service.engine import FlightEngine
 
-    for module in ("httptools_impl",):
-        try:
-            protocols = __import__(f"uvicorn.protocols.http.{module}", fromlist=["x"])
-            _wrap(protocols.HttpToolsProtocol, "data_received", "parse")
-            _wrap(protocols.RequestResponseCycle, "send", "send")
-        except ImportError:
-            pass
+    try:  # httptools_impl imports httptools itself
+        from uvicorn.protocols.http import httptools_impl
+    except ImportError:
+        httptools_impl = None
+    if httptools_impl is not None:
+        _wrap(httptools_impl.HttpToolsProtocol, "data_received", "parse")
+        _wrap(httptools_impl.RequestResponseCycle, "send", "send")
     _wrap(h11_impl.H11Protocol, "data_received", "parse")
     _wrap(h11_impl.RequestResponseCycle, "send", "send")
     _wrap(starlette.requests.Request, "json", "json")
@@ -112,7 +113,7 @@ def serve(port: int, loop: str, http: str) -> None:
 
     async def app(scope, receive, send):
         if scope["type"] == "http" and scope["path"] == "/_profile":
-            body = repr(dict(TOTALS)).encode()
+            body = json.dumps(TOTALS).encode()
             TOTALS.clear()
             await send({"type": "http.response.start", "status": 200, "headers": []})
             await send({"type": "http.response.body", "body": body})
@@ -157,7 +158,7 @@ def measure(args: argparse.Namespace) -> None:
                 client.post("/v1/shots", json=SHOT).json()
                 walls.append(time.perf_counter() - started)
             cpu = time.process_time() - cpu
-            server_side = eval(client.get("/_profile").text)  # noqa: S307 - our own server's repr of a dict of floats
+            server_side = client.get("/_profile").json()
     finally:
         server.terminate()
         try:
