@@ -116,8 +116,8 @@ class ObjectFramer:
         if not (text.startswith(b"{") and text.endswith(b"}")):
             return None
         try:
-            json.loads(text)
-        except (ValueError, RecursionError):
+            json.loads(text.decode("utf-8"))  # as text: json.loads would take UTF-16 or UTF-32 bytes too
+        except (ValueError, RecursionError):  # UnicodeDecodeError is a ValueError
             return None
         return text
 
