@@ -31,10 +31,10 @@ import numpy as np
 from common import REPO, SEVEN_IRON, mixed_launches, write_results
 from server import Server, free_port, start
 
-from service.api.models import BatchRequest, ShotRequest
-from service.api.shots import fly_shot, fly_shots
-from service.engine import FlightEngine
-from service.model_location import model_dir
+from golfflight.service.api.models import BatchRequest, ShotRequest
+from golfflight.service.api.shots import fly_shot, fly_shots
+from golfflight.service.engine import FlightEngine
+from golfflight.service.model_location import model_dir
 
 SHOT = {
     "ball_speed_mps": SEVEN_IRON.ball_speed_mps,

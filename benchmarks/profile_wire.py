@@ -85,11 +85,11 @@ def serve(port: int, loop: str, http: str) -> None:
     import uvicorn
     from uvicorn.protocols.http import h11_impl
 
-    import service.api.routes.shots as shot_route
-    from service.api import shots
-    from service.api.app import create_app
-    from service.api.state import ServiceState
-    from service.engine import FlightEngine
+    import golfflight.service.api.routes.shots as shot_route
+    from golfflight.service.api import shots
+    from golfflight.service.api.app import create_app
+    from golfflight.service.api.state import ServiceState
+    from golfflight.service.engine import FlightEngine
 
     try:  # httptools_impl imports httptools itself
         from uvicorn.protocols.http import httptools_impl

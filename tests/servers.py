@@ -50,8 +50,8 @@ def running(app, ready_path: str = "/healthz", timeout_s: float = 20.0) -> Itera
 @contextmanager
 def keyed_service(key: str) -> Iterator[tuple[httpx.Client, int, object]]:
     """(client, Open Connect port, app) of one service with an API key, listening on HTTP and on Open Connect TCP."""
-    from service.api.app import create_app
-    from service.open_connect.server import ConnectAddress
+    from golfflight.service.api.app import create_app
+    from golfflight.service.open_connect.server import ConnectAddress
 
     port = free_port()
     app = create_app(api_key=key, cors_origins=[], connect=ConnectAddress(port))

@@ -19,11 +19,11 @@ from prometheus_client.multiprocess import MultiProcessCollector
 from prometheus_client.parser import text_string_to_metric_families
 from servers import free_port, running, shot
 
-from service.api.app import create_app
-from service.api.guards import API_KEY_ENV
-from service.api.metrics import MULTIPROC_ENV, shared_across_workers
-from service.model_location import model_dir
-from weights_schema.bundle import load_bundle
+from golfflight.service.api.app import create_app
+from golfflight.service.api.guards import API_KEY_ENV
+from golfflight.service.api.metrics import MULTIPROC_ENV, shared_across_workers
+from golfflight.service.model_location import model_dir
+from golfflight.weights_schema.bundle import load_bundle
 
 KEY = "metrics-test-key-5b1e0c7a"
 KEYED = {"x-api-key": KEY}

@@ -15,11 +15,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from golfflight.cli import main
-from service.api.app import create_app
-from service.api.gspro import GSProReply
-from service.open_connect.framing import MAX_MESSAGE_BYTES, ObjectFramer, Refused
-from service.open_connect.replies import _read_by_python, reply_to
-from service.open_connect.server import INTERNAL_ERROR, PAUSE_S, ConnectAddress, OpenConnectServer
+from golfflight.service.api.app import create_app
+from golfflight.service.api.gspro import GSProReply
+from golfflight.service.open_connect.framing import MAX_MESSAGE_BYTES, ObjectFramer, Refused
+from golfflight.service.open_connect.replies import _read_by_python, reply_to
+from golfflight.service.open_connect.server import INTERNAL_ERROR, PAUSE_S, ConnectAddress, OpenConnectServer
 from tests.servers import free_port, running
 
 RESEND_S = 5.0

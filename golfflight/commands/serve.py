@@ -99,12 +99,12 @@ def fast_io() -> dict[str, str]:
 def run(args: argparse.Namespace) -> int:
     import uvicorn
 
-    from flight.bundle_check import verify_bundle
-    from service.api.bay import BAY_FILE_ENV, Bay
-    from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
-    from service.api.metrics import shared_across_workers
-    from service.model_location import MODEL_ENV, model_dir
-    from service.open_connect.server import CONNECT_HOST_ENV, CONNECT_PORT_ENV
+    from golfflight.flight.bundle_check import verify_bundle
+    from golfflight.service.api.bay import BAY_FILE_ENV, Bay
+    from golfflight.service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
+    from golfflight.service.api.metrics import shared_across_workers
+    from golfflight.service.model_location import MODEL_ENV, model_dir
+    from golfflight.service.open_connect.server import CONNECT_HOST_ENV, CONNECT_PORT_ENV
 
     if args.workers < 1:
         raise ValueError(f"--workers must be at least 1, got {args.workers}")

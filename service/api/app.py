@@ -30,15 +30,15 @@ from fastapi import FastAPI
 from fastapi.middleware.cors import CORSMiddleware
 from starlette.routing import Mount, Route
 
-from service.api import errors
-from service.api.bay import BAY_FILE_ENV, Bay
-from service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
-from service.api.request_metrics import RequestMetrics
-from service.api.routes import bay as bay_routes
-from service.api.routes import docs, gspro, metrics, shots, status, viewer
-from service.api.state import ServiceState
-from service.model_location import model_dir
-from service.open_connect.server import ConnectAddress, OpenConnectServer
+from golfflight.service.api import errors
+from golfflight.service.api.bay import BAY_FILE_ENV, Bay
+from golfflight.service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
+from golfflight.service.api.request_metrics import RequestMetrics
+from golfflight.service.api.routes import bay as bay_routes
+from golfflight.service.api.routes import docs, gspro, metrics, shots, status, viewer
+from golfflight.service.api.state import ServiceState
+from golfflight.service.model_location import model_dir
+from golfflight.service.open_connect.server import ConnectAddress, OpenConnectServer
 
 
 def _origins(text: str | None) -> list[str]:

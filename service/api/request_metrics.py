@@ -11,8 +11,8 @@ import time
 
 from starlette.routing import BaseRoute, Match
 
-from service.api.latency import Rolling
-from service.api.metrics import ServiceMetrics
+from golfflight.service.api.latency import Rolling
+from golfflight.service.api.metrics import ServiceMetrics
 
 UNMATCHED = "<unmatched>"
 """Route label of a request whose path no route serves (a 404)."""

@@ -12,14 +12,14 @@ from typing import Literal
 
 from fastapi import Depends, Request
 
-from service.api.bay import Bay
-from service.api.batch_process import BatchProcess
-from service.api.gspro import GSProMessage, GSProReply, fly_message
-from service.api.latency import Rolling
-from service.api.metrics import ServiceMetrics
-from service.engine import FlightEngine
-from service.viewer.event import Source
-from service.viewer.feed import ShotFeed
+from golfflight.service.api.bay import Bay
+from golfflight.service.api.batch_process import BatchProcess
+from golfflight.service.api.gspro import GSProMessage, GSProReply, fly_message
+from golfflight.service.api.latency import Rolling
+from golfflight.service.api.metrics import ServiceMetrics
+from golfflight.service.engine import FlightEngine
+from golfflight.service.viewer.event import Source
+from golfflight.service.viewer.feed import ShotFeed
 
 
 class NotReady(Exception):

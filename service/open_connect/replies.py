@@ -12,8 +12,8 @@ from collections.abc import Callable
 
 from pydantic import ValidationError
 
-from service.api.gspro import GSProMessage, GSProReply, invalid_message
-from service.open_connect.framing import Refused
+from golfflight.service.api.gspro import GSProMessage, GSProReply, invalid_message
+from golfflight.service.open_connect.framing import Refused
 
 Answer = Callable[[GSProMessage], GSProReply]
 """Flies a message that carries BallData: the service's shared GSPro answer (timing, the engine, its readiness)."""

@@ -5,9 +5,9 @@ from __future__ import annotations
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
-from service.api.gspro import GSProMessage, GSProReply
-from service.api.routes.responses import ERROR_RESPONSES, json_response
-from service.api.state import state_of
+from golfflight.service.api.gspro import GSProMessage, GSProReply
+from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
+from golfflight.service.api.state import state_of
 
 GSPRO_PATH = "/v1/gspro"
 GSPRO_STATUS = {200: 200, 500: 422, 503: 503}

@@ -10,8 +10,8 @@ from concurrent.futures.process import BrokenProcessPool
 from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import JSONResponse, Response
 
-from service.api.bay import CONDITION_FIELDS, in_bay
-from service.api.models import (
+from golfflight.service.api.bay import CONDITION_FIELDS, in_bay
+from golfflight.service.api.models import (
     MAX_BATCH_SHOTS,
     MAX_BATCH_TRAJECTORIES,
     BatchRequest,
@@ -20,10 +20,10 @@ from service.api.models import (
     ShotResult,
     body_detail,
 )
-from service.api.routes.responses import ERROR_RESPONSES, json_response
-from service.api.shots import fly_shot
-from service.api.state import ServiceState, ready_engine, service_state, state_of
-from service.engine import FlightError
+from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
+from golfflight.service.api.shots import fly_shot
+from golfflight.service.api.state import ServiceState, ready_engine, service_state, state_of
+from golfflight.service.engine import FlightError
 
 BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has been restarted): send the batch again"
 
