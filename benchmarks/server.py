@@ -10,6 +10,7 @@ import subprocess
 import sys
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import httpx
 import psutil
@@ -61,12 +62,15 @@ class Server:
         return code, time.monotonic() - started
 
 
-def start(workers: int = 1, model: str | None = None, env: dict[str, str] | None = None) -> Server:
-    """Start `golfflight serve` on a free loopback port; returns once every worker answers /healthz."""
+def start(
+    workers: int = 1, model: str | None = None, env: dict[str, str] | None = None, tree: Path = REPO
+) -> Server:
+    """Start `golfflight serve` of the checkout `tree` (default this one; another for an A/B run) on a free loopback
+    port; returns once every worker answers /healthz."""
     port = free_port()
     command = [sys.executable, "-m", "golfflight", "serve", "--host", HOST, "--port", str(port)]
     command += ["--workers", str(workers)] + (["--model", model] if model else [])
-    process = subprocess.Popen(command, cwd=REPO, env={**os.environ, **(env or {})}, stdout=subprocess.DEVNULL)
+    process = subprocess.Popen(command, cwd=tree, env={**os.environ, **(env or {})}, stdout=subprocess.DEVNULL)
     server = Server(process, f"http://{HOST}:{port}", port)
     deadline = time.monotonic() + 60
     ready = 0

@@ -1,4 +1,5 @@
-"""A real uvicorn server on 127.0.0.1 in a thread for tests that need one (the service as clients see it)."""
+"""A real uvicorn server on 127.0.0.1 in a thread for tests that need one (the service as clients see it), on the
+event loop and HTTP parser `golfflight serve` picks (`fast_io`)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ from contextlib import contextmanager
 
 import httpx
 import uvicorn
+
+from golfflight.commands.serve import fast_io
 
 
 def free_port() -> int:
@@ -23,7 +26,7 @@ def running(app, ready_path: str = "/healthz", timeout_s: float = 20.0) -> Itera
     """Serve `app` on a free loopback port until the block ends; yields a keep-alive client, once `ready_path`
     answers 200 (or any answer, for apps whose model is meant to fail)."""
     port = free_port()
-    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning", **fast_io()))
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
     try:

@@ -14,7 +14,7 @@ import pytest
 from golfflight.contract.gspro import GSProReply
 from golfflight.service.api.app import create_app
 from golfflight.service.open_connect.framing import MAX_MESSAGE_BYTES, ObjectFramer, Refused
-from golfflight.service.open_connect.replies import reply_to
+from golfflight.service.open_connect.replies import _read_by_python, reply_to
 from golfflight.service.open_connect.server import INTERNAL_ERROR, PAUSE_S, ConnectAddress, OpenConnectServer
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -155,6 +155,47 @@ def test_any_bytes_are_answered_or_passed_over_never_raised(data):
         if item is not None:
             reply = reply_to(item, lambda message: GSProReply(Code=200, Message="flown"))
             assert reply is None or reply.Code in (200, 500)
+
+
+WHITESPACE = st.sampled_from([b"", b" ", b"\n", b"\r\n", b"\t", b"\x0b", b"\x0c"])
+
+
+def _brace_count_only(data: bytes) -> list[bytes | Refused]:
+    framer = ObjectFramer(limit=100)
+    framer._whole_object = lambda data: None  # the framing the one-whole-object shortcut must agree with
+    return framer.feed(data)
+
+
+@settings(deadline=None)
+@given(st.dictionaries(TRICKY_TEXT, JSON_VALUES, max_size=4), WHITESPACE, WHITESPACE, st.binary(max_size=3))
+def test_a_whole_object_in_one_piece_is_framed_as_the_brace_count_frames_it(obj, before, after, noise):
+    for data in (before + json.dumps(obj, ensure_ascii=False).encode() + after, noise + b"{" + noise + b"}" + noise):
+        assert ObjectFramer(limit=100).feed(data) == _brace_count_only(data)
+
+
+GSPRO_VALUES = st.none() | st.booleans() | st.integers(-10, 10**6) | st.floats(allow_nan=True) | TRICKY_TEXT
+
+
+@settings(deadline=None)
+@given(
+    st.fixed_dictionaries({}, optional={
+        "BallData": st.dictionaries(st.sampled_from(["Speed", "speed", "VLA", "HLA", "TotalSpin", "BackSpin",
+                                                     "SideSpin", "SpinAxis", "Other"]), GSPRO_VALUES, max_size=5),
+        "ShotNumber": GSPRO_VALUES,
+        "ShotDataOptions": st.dictionaries(st.sampled_from(["IsHeartBeat", "ContainsBallData", "isheartbeat"]),
+                                           GSPRO_VALUES, max_size=2),
+        "DeviceID": GSPRO_VALUES,
+    })
+)
+def test_a_message_read_once_by_pydantic_gets_the_reply_pythons_json_reading_gives(message):
+    """reply_to validates straight from the bytes; the reply is the one json.loads + validation gives."""
+    item = json.dumps(message).encode()
+
+    def answer(message):
+        return GSProReply(Code=200, Message="flown", ShotNumber=message.ShotNumber)
+
+    fast, slow = reply_to(item, answer), _read_by_python(item, answer)
+    assert (fast and fast.model_dump()) == (slow and slow.model_dump())
 
 
 @pytest.fixture(scope="module")

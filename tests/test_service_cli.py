@@ -54,3 +54,18 @@ def test_simulate_names_bad_values_and_unknown_columns(tmp_path, capsys):
 def test_serve_refuses_a_directory_without_a_bundle(tmp_path, capsys):
     assert main(["serve", "--model", str(tmp_path)]) == 2
     assert "not a model bundle" in capsys.readouterr().err
+
+
+def test_serve_names_uvloop_and_httptools_where_they_import_and_falls_back_where_not(monkeypatch):
+    from golfflight.commands import serve
+
+    assert serve.fast_io() == {"loop": "uvloop", "http": "httptools"}  # runtime dependencies of the serving install
+    real = serve.importlib.import_module
+
+    def without_uvloop(name: str):
+        if name == "uvloop":
+            raise ImportError("no uvloop here (as on Windows)")
+        return real(name)
+
+    monkeypatch.setattr(serve.importlib, "import_module", without_uvloop)
+    assert serve.fast_io() == {"loop": "asyncio", "http": "httptools"}

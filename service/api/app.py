@@ -1,6 +1,7 @@
 """The HTTP service: `create_app` assembles FastAPI's "bigger applications" layout, the routers of
 `service.api.routes` over the plain functions of the shot contract (`contract`), the engine reaching them through a
-dependency (`service.api.state.ready_engine`, from `app.state`).
+dependency (`service.api.state.ready_engine`, from `app.state`), or, on the single-shot routes, where FastAPI's
+solving of dependencies was a tenth of a request, read directly (`state_of`, `ServiceState.ready_engine`).
 
 Single shots simulate inline in `async def` routes. Batches fly in a child process at a lower CPU priority
 (`batch_process`), so a fitting studio's thousands of shots neither hold the GIL nor take a core from a simulator

@@ -44,6 +44,18 @@ class RequestMetrics:
     def __init__(self, app, metrics: ServiceMetrics, routes: list[BaseRoute], rolling: Rolling, timed_routes: set[str]):
         self.app, self.metrics, self.routes = app, metrics, routes
         self.rolling, self.timed_routes = rolling, frozenset(timed_routes)
+        self._series: dict[tuple[str, str, int], tuple] = {}
+
+    def _series_of(self, route: str, method: str, status: int) -> tuple:
+        """The (request counter, duration histogram) of one label set, looked up in prometheus-client once and kept:
+        a bounded set (route templates x standard methods x statuses), so no per-request label lookup."""
+        key = (route, method, status)
+        series = self._series.get(key)
+        if series is None:
+            series = (self.metrics.requests.labels(route, method, str(status)),
+                      self.metrics.request_seconds.labels(route, method))
+            self._series[key] = series
+        return series
 
     async def __call__(self, scope, receive, send):
         if scope["type"] != "http":
@@ -65,7 +77,8 @@ class RequestMetrics:
             seconds = time.perf_counter() - started
             route = route_template(self.routes, scope, path)
             method = scope["method"] if scope["method"] in METHODS else "other"
-            self.metrics.requests.labels(route, method, str(status)).inc()
-            self.metrics.request_seconds.labels(route, method).observe(seconds)
+            requests, durations = self._series_of(route, method, status)
+            requests.inc()
+            durations.observe(seconds)
             if route in self.timed_routes:
                 self.rolling.add(seconds)

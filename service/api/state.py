@@ -40,6 +40,7 @@ class ServiceState:
         self.batches = BatchProcess(bundle_dir)
         self.feed = ShotFeed()
         self.metrics = ServiceMetrics(self.model_labels)
+        self._simulation_seconds = {kind: self.metrics.simulation_seconds.labels(kind) for kind in ("shot", "batch")}
 
     def model_labels(self) -> dict[str, str] | None:
         """The loaded model's variant and ONNX SHA-256 and the package version (/metrics' info labels)."""
@@ -48,9 +49,16 @@ class ServiceState:
         return {"variant": self.engine.variant, "sha256": self.engine.sha256, "version": version("golfflight")}
 
     def record_simulation(self, kind: Literal["shot", "batch"], seconds: float) -> None:
-        """One simulation's engine time, into /v1/latency's window and /metrics' histogram."""
+        """One simulation's engine time, into /v1/latency's window and /metrics' histogram (its two label sets
+        bound once, at start-up, not looked up per shot)."""
         self.simulation.add(seconds)
-        self.metrics.simulation_seconds.labels(kind).observe(seconds)
+        self._simulation_seconds[kind].observe(seconds)
+
+    def ready_engine(self) -> FlightEngine:
+        """The loaded engine; NotReady (503) while the model loads or after it failed to."""
+        if self.engine is None:
+            raise NotReady(self.error or "the model is still loading")
+        return self.engine
 
     def load(self) -> None:
         """Load the model here and in the batch process; either failing leaves the service up to say why."""
@@ -85,8 +93,12 @@ async def service_state(request: Request) -> ServiceState:
     return request.app.state.service
 
 
+def state_of(request: Request) -> ServiceState:
+    """The app's `ServiceState`, for the simulation routes: a plain attribute read where a dependency costs FastAPI a
+    dependency graph to solve on every request (about a tenth of a single shot's time over HTTP)."""
+    return request.app.state.service
+
+
 async def ready_engine(state: ServiceState = Depends(service_state)) -> FlightEngine:
     """The loaded engine; NotReady (503) while the model loads or after it failed to."""
-    if state.engine is None:
-        raise NotReady(state.error or "the model is still loading")
-    return state.engine
+    return state.ready_engine()

@@ -22,6 +22,17 @@ def reply_to(item: bytes | Refused, answer: Answer) -> GSProReply | None:
     """The reply to one framed object (or refusal); None for a heartbeat or a message without ball data."""
     if isinstance(item, Refused):
         return GSProReply(Code=500, Message=item.message)
+    try:  # parsed and validated in one pass by pydantic-core: a valid message is read once
+        message = GSProMessage.model_validate_json(item)
+    except ValidationError:
+        return _read_by_python(item, answer)
+    return None if message.BallData is None else answer(message)
+
+
+def _read_by_python(item: bytes, answer: Answer) -> GSProReply | None:
+    """`reply_to` for an object pydantic-core's own JSON reading refused: read by Python's json and validated, so
+    a refusal says what it always said (the JSON error, or each field's problem: `invalid_message`) and whatever
+    Python's parser takes that pydantic-core's does not (UTF-16, a lone surrogate in a string) flies as before."""
     try:
         data = json.loads(item)
     except ValueError as error:  # JSONDecodeError, or UnicodeDecodeError for bytes that are not UTF-8
@@ -32,6 +43,4 @@ def reply_to(item: bytes | Refused, answer: Answer) -> GSProReply | None:
         message = GSProMessage.model_validate(data)
     except ValidationError as error:
         return GSProReply(Code=500, Message=invalid_message(error.errors()))
-    if message.BallData is None:
-        return None
-    return answer(message)
+    return None if message.BallData is None else answer(message)

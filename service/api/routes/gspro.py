@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Depends
+from fastapi import APIRouter, Request
 from fastapi.responses import Response
 from golfflight.contract.gspro import GSProMessage, GSProReply
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
-from golfflight.service.api.state import ServiceState, service_state
+from golfflight.service.api.state import state_of
 
 GSPRO_PATH = "/v1/gspro"
 GSPRO_STATUS = {200: 200, 500: 422, 503: 503}
@@ -24,7 +24,7 @@ router = APIRouter()
         **ERROR_RESPONSES,
     },
 )
-async def gspro(message: GSProMessage, state: ServiceState = Depends(service_state)) -> Response:
+async def gspro(message: GSProMessage, http: Request) -> Response:
     """A GSPro Open Connect v1 message: a shot gets its flight with Code 200, a heartbeat just Code 200; an
     invalid message or a failed flight gets HTTP 422 with Open Connect's error reply (Code 500, a Message)."""
     if message.is_heartbeat:
@@ -32,5 +32,5 @@ async def gspro(message: GSProMessage, state: ServiceState = Depends(service_sta
     if message.BallData is None:
         nothing = GSProReply(Code=200, Message="no ball data: nothing to fly", ShotNumber=message.ShotNumber)
         return json_response(nothing)
-    reply = state.gspro_reply(message)
+    reply = state_of(http).gspro_reply(message)
     return json_response(reply, GSPRO_STATUS[reply.Code])

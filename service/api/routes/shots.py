@@ -14,9 +14,9 @@ from golfflight.contract.flying import fly_shot
 from golfflight.contract.refusals import body_detail
 from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, BatchRequest, ShotRequest
 from golfflight.contract.results import BatchResult, ShotResult
-from golfflight.flight.engine import FlightEngine, FlightError
+from golfflight.flight.engine import FlightError
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
-from golfflight.service.api.state import ServiceState, ready_engine, service_state
+from golfflight.service.api.state import ServiceState, ready_engine, service_state, state_of
 
 BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has been restarted): send the batch again"
 
@@ -35,14 +35,12 @@ ShowOnViewer = Query(
     response_model_exclude_none=True,
     responses={422: {"description": "invalid launch or conditions, or a shot that cannot land"}, **ERROR_RESPONSES},
 )
-async def shot(
-    request: ShotRequest,
-    engine: FlightEngine = Depends(ready_engine),
-    state: ServiceState = Depends(service_state),
-    viewer: bool = ShowOnViewer,
-) -> Response:
+async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer) -> Response:
     """Fly one shot: launch in SI or launch-monitor units, optional wind, air, ground, normalized and trajectory;
     the bay's conditions (GET /v1/bay) where the shot gives none."""
+    # The one validation is FastAPI's of `request`; the state comes from the app, not from dependencies (`state_of`)
+    state = state_of(http)
+    engine = state.ready_engine()
     request = in_bay(request, state.bay.conditions)
     started = time.perf_counter()
     try:
