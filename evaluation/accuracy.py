@@ -326,7 +326,7 @@ def _pga(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport):
     report.pga = per_model(flyers, lambda flyer: compare_clubs(flyer, clubs, air))
     lines += [
         (
-            f"Not held out (NOTES section 9): `golfflight train-real` trains the real-data model on this table, so its "
+            f"Not held out (`shots.heldout`): `golfflight train-real` trains the real-data model on this table, so its "
             f"column is a training fit. Each club's average launch (launch direction and spin axis 0) against "
             f"TrackMan's average carry, max height and land angle, {len(clubs)} clubs, every model flown in the "
             f"table's air (`shots.source_air.PGA_2023_TABLE`, rho {air.density_kg_m3:.3f} kg/m^3: "
@@ -632,7 +632,7 @@ def run_accuracy(
     report = AccuracyReport("", labels=[f.label for f in flyers])
     lines = _header(flyers, "none of these sets records its weather; the TOUR Championship and the PGA table are "
                             "flown in their own air (`shots.source_air`), every model alike.")
-    lines += ["", "## Held-out sets (never trained on, never used to choose a model; NOTES section 9)", ""]
+    lines += ["", "## Held-out sets (never trained on, never used to choose a model; `shots.heldout`)", ""]
     lines += _drivers(data_dir, flyers, report)
     lines += ["", *_tour_championship(data_dir, flyers, report)]
     lines += ["", "## Context", "", *_paper(), "", *_slow(flyers, report)]

@@ -6,7 +6,7 @@ card's step, maximum flight time (its t_sim, or the shot records' limit if longe
 flies launches [N, LAUNCH_WIDTH] x conditions x grounds through `flight.integrator.integrate`: each shot down to
 its ground's plane (the state interpolated linearly to it), failing alone if it is still in the air at the maximum
 flight time, then bounced and rolled to rest on that ground (`flight.ground`) unless the flight alone was asked for.
-The engine's single-shot path (`service.engine`), discovery, accuracy, evaluation and the ground fit all fly
+The engine's single-shot path (`flight.engine`), discovery, accuracy, evaluation and the ground fit all fly
 through it, so every one of them flies the same shot to the same numbers.
 """
 
@@ -67,7 +67,7 @@ class Launch(NamedTuple):
 
 LAUNCH_WIDTH = len(Launch._fields)
 """The width of a launches array [N, LAUNCH_WIDTH], its columns in Launch's order (`shots.records.LAUNCH_COLUMNS`
-and `service.columns.LAUNCH_COLUMNS` name the columns of files)."""
+and `contract.columns.LAUNCH_COLUMNS` name the columns of files)."""
 
 
 class FlightError(Exception):

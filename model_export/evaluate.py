@@ -199,7 +199,14 @@ def coefficient_samples(model: nn.Module, config: TrainConfig, val: ValidationSe
         batch = val.tensors.take(torch.arange(start, min(start + VALIDATION_BATCH, len(val))))
         scale = batch.reynolds_scale.double()
         trajectory = euler_rollout(
-            batch.position, batch.velocity, batch.spin, model, batch.density, config.dt_s, config.t_sim_s, scale[:, None]
+            batch.position,
+            batch.velocity,
+            batch.spin,
+            model,
+            batch.density,
+            config.dt_s,
+            config.t_sim_s,
+            scale[:, None],
         )
         landing_time = hard_landing(trajectory).time_s
         times = torch.arange(trajectory.positions.shape[0], dtype=torch.float64)[:, None] * config.dt_s
@@ -240,12 +247,14 @@ def coefficient_summary(samples: CoefficientSamples, scale: np.ndarray, model: n
     relative_drag = np.median(drag / samples.reference_drag - 1.0)
     lift_gap = lift - samples.reference_lift
     low_c_q, high_c_q = np.percentile(samples.c_q, [5, 95])
-    text = (f"Figure 7 in numbers ({label}, {len(samples.spin_ratio)} in-flight steps): raw C_L median "
-            f"{np.median(samples.c_lift):.2f} (99.9th percentile {np.percentile(samples.c_lift, 99.9):.2f}); C_Q median "
-            f"{np.median(samples.c_q):.2f} (5th-95th percentile {low_c_q:.2f}-{high_c_q:.2f}); effective C_D against "
-            f"the reference world's at the same states: median relative difference {relative_drag:+.1%}; effective "
-            f"C_L minus the reference's: median {np.median(lift_gap[~high]):+.3f} below S = {HIGH_SPIN_RATIO:g}, "
-            f"{np.median(lift_gap[high]):+.3f} above ({int(high.sum())} steps)")
+    text = (
+        f"Figure 7 in numbers ({label}, {len(samples.spin_ratio)} in-flight steps): raw C_L median "
+        f"{np.median(samples.c_lift):.2f} (99.9th percentile {np.percentile(samples.c_lift, 99.9):.2f}); C_Q median "
+        f"{np.median(samples.c_q):.2f} (5th-95th percentile {low_c_q:.2f}-{high_c_q:.2f}); effective C_D against "
+        f"the reference world's at the same states: median relative difference {relative_drag:+.1%}; effective "
+        f"C_L minus the reference's: median {np.median(lift_gap[~high]):+.3f} below S = {HIGH_SPIN_RATIO:g}, "
+        f"{np.median(lift_gap[high]):+.3f} above ({int(high.sum())} steps)"
+    )
     if hasattr(model, "log_p_m"):
         text += f"; learned p_M = {float(model.p_m):.4f}"
     return text + "."
@@ -308,62 +317,69 @@ def _gap_cell(world_gap: tuple[float, float | None] | None) -> str:
     return f"{landing:.2f}" + ("" if apex is None else f" / {apex:.2f}")
 
 
-def render(runs: list[RunEvaluation], floors: list[Floor], val: ValidationSet, bundle: BundleCheck | None) -> str:
-    """Markdown: Table 1 with the paper's numbers, the noise floors, and the shipped bundle's runtime check."""
-    rows = []
-    for run in sorted(runs, key=_order):
-        paper = PAPER_TABLE1.get(run.variant)
-        paper_cells = (
-            ("–", "–", "–")
-            if paper is None
-            else (
-                f"{paper.landing_yd:.2f}",
-                "–" if paper.max_height_yd is None else f"{paper.max_height_yd:.2f}",
-                f"{paper.epochs}, {LOSS[paper.loss]}",
-            )
-        )
-        rows.append(
-            (
-                f"{DISPLAY.get(run.variant, run.variant)} (`{run.name}`)",
-                f"{run.epochs_trained} ({run.best_epoch})",
-                LOSS[run.config.loss],
-                *metres_yards(run.errors.mean_landing_m),
-                *metres_yards(run.errors.mean_abs_apex_m),
-                _gap_cell(run.world_gap),
-                *paper_cells,
-                int(np.isfinite(run.errors.landing_m).sum()),
-                _minutes(run.train_seconds),
-            )
-        )
-    lines = [
+def _paper_cells(variant: str) -> tuple[str, str, str]:
+    """The paper's Table 1 landing, max height and (epochs, loss) of a variant, or dashes where it has no row."""
+    paper = PAPER_TABLE1.get(variant)
+    if paper is None:
+        return ("–", "–", "–")
+    return (
+        f"{paper.landing_yd:.2f}",
+        "–" if paper.max_height_yd is None else f"{paper.max_height_yd:.2f}",
+        f"{paper.epochs}, {LOSS[paper.loss]}",
+    )
+
+
+def _table1_row(run: RunEvaluation) -> tuple[Any, ...]:
+    """One run's Table 1 row: how it trained, its errors, its gap to the nominal world, the paper's row beside."""
+    return (
+        f"{DISPLAY.get(run.variant, run.variant)} (`{run.name}`)",
+        f"{run.epochs_trained} ({run.best_epoch})",
+        LOSS[run.config.loss],
+        *metres_yards(run.errors.mean_landing_m),
+        *metres_yards(run.errors.mean_abs_apex_m),
+        _gap_cell(run.world_gap),
+        *_paper_cells(run.variant),
+        int(np.isfinite(run.errors.landing_m).sum()),
+        _minutes(run.train_seconds),
+    )
+
+
+TABLE1_HEADER = (
+    "model (run)",
+    "epochs (best)",
+    "loss",
+    "L_p m",
+    "L_p yd",
+    "L_h m",
+    "L_h yd",
+    "vs nominal world m",
+    "paper L_p yd",
+    "paper L_h yd",
+    "paper epochs, loss",
+    "val shots",
+    "train time",
+)
+
+
+def _table1_lines(runs: list[RunEvaluation], val: ValidationSet) -> list[str]:
+    """The validation set, Table 1 (runs in the paper's order) and what its 'vs nominal world' column means."""
+    return [
         f"Validation: {len(val)} shots of `{val.path.name}` (rows marked `val`, after the training filters).",
         "",
         "### Table 1: mean landing error (L_p) and mean absolute max-height error (L_h) on validation",
         "",
-        *table(
-            (
-                "model (run)",
-                "epochs (best)",
-                "loss",
-                "L_p m",
-                "L_p yd",
-                "L_h m",
-                "L_h yd",
-                "vs nominal world m",
-                "paper L_p yd",
-                "paper L_h yd",
-                "paper epochs, loss",
-                "val shots",
-                "train time",
-            ),
-            rows,
-            align="lrlrrrrrrrlrr",
-        ),
+        *table(TABLE1_HEADER, [_table1_row(run) for run in sorted(runs, key=_order)], align="lrlrrrrrrrlrr"),
         "",
         (
             "'vs nominal world': mean landing distance / max-height difference between the model and the reference "
             "world in the nominal floor's conditions, on the same recorded launches (the model-form error alone)."
         ),
+    ]
+
+
+def _noise_floor_lines(floors: list[Floor]) -> list[str]:
+    """The reference world's own errors on the recorded launches, one row a floor."""
+    return [
         "",
         "### Noise floor: the reference world itself, fed the recorded (noisy) launches",
         "",
@@ -373,35 +389,46 @@ def render(runs: list[RunEvaluation], floors: list[Floor], val: ValidationSet, b
             align="llrrrr",
         ),
     ]
-    if bundle is not None:
-        lines += [
-            "",
-            f"### Shipped bundle `{bundle.bundle}` ({bundle.variant}) through the runtime path",
-            "",
-            *table(
-                ("path", "L_p m", "L_p yd", "L_h m", "L_h yd"),
-                (
-                    (
-                        "NumPy + ONNX Runtime (`flight.flyer.Flyer`)",
-                        *metres_yards(bundle.numpy_errors.mean_landing_m),
-                        *metres_yards(bundle.numpy_errors.mean_abs_apex_m),
-                    ),
-                    (
-                        "torch float64, same weights",
-                        *metres_yards(bundle.torch_errors.mean_landing_m),
-                        *metres_yards(bundle.torch_errors.mean_abs_apex_m),
-                    ),
-                ),
-                align="lrrrr",
-            ),
-            "",
+
+
+def _bundle_lines(bundle: BundleCheck) -> list[str]:
+    """The shipped bundle's errors through the runtime path and the torch path, and how far the two differ."""
+    return [
+        "",
+        f"### Shipped bundle `{bundle.bundle}` ({bundle.variant}) through the runtime path",
+        "",
+        *table(
+            ("path", "L_p m", "L_p yd", "L_h m", "L_h yd"),
             (
-                f"Largest per-shot difference between the two paths: landing {bundle.max_landing_difference_m * 1e3:.3f} mm, "
-                f"max height {bundle.max_apex_difference_m * 1e3:.3f} mm (the runtime's apex lies between the steps, "
-                "on the parabola through the highest one and its neighbours, up to about g dt^2/8 = 12 mm above the "
-                f"torch path's highest step); {bundle.not_landed} shots did not land within t_sim in the runtime path."
+                (
+                    "NumPy + ONNX Runtime (`flight.flyer.Flyer`)",
+                    *metres_yards(bundle.numpy_errors.mean_landing_m),
+                    *metres_yards(bundle.numpy_errors.mean_abs_apex_m),
+                ),
+                (
+                    "torch float64, same weights",
+                    *metres_yards(bundle.torch_errors.mean_landing_m),
+                    *metres_yards(bundle.torch_errors.mean_abs_apex_m),
+                ),
             ),
-        ]
+            align="lrrrr",
+        ),
+        "",
+        (
+            "Largest per-shot difference between the two paths: landing "
+            f"{bundle.max_landing_difference_m * 1e3:.3f} mm, "
+            f"max height {bundle.max_apex_difference_m * 1e3:.3f} mm (the runtime's apex lies between the steps, "
+            "on the parabola through the highest one and its neighbours, up to about g dt^2/8 = 12 mm above the "
+            f"torch path's highest step); {bundle.not_landed} shots did not land within t_sim in the runtime path."
+        ),
+    ]
+
+
+def render(runs: list[RunEvaluation], floors: list[Floor], val: ValidationSet, bundle: BundleCheck | None) -> str:
+    """Markdown: Table 1 with the paper's numbers, the noise floors, and the shipped bundle's runtime check."""
+    lines = _table1_lines(runs, val) + _noise_floor_lines(floors)
+    if bundle is not None:
+        lines += _bundle_lines(bundle)
     return "\n".join(lines) + "\n"
 
 

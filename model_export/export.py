@@ -60,16 +60,23 @@ LAUNCH_STATE = (
 )
 EQUATIONS = [
     "v_rel = v - v_wind (v_wind = 0 in training)",
-    "(C_L, C_D, C_M, C_Q) = graph(k v_rel, k omega), evaluated once per step, k = nu_0 / nu with nu the kinematic "
-    "viscosity of the air (dynamic viscosity / density) and nu_0 = physics.kinematic_viscosity_m2_s: the same spin "
-    "ratio at the Reynolds number of the actual air (k = 1 in the card's air)",
+    (
+        "(C_L, C_D, C_M, C_Q) = graph(k v_rel, k omega), evaluated once per step, k = nu_0 / nu with nu the kinematic "
+        "viscosity of the air (dynamic viscosity / density) and nu_0 = physics.kinematic_viscosity_m2_s: the same spin "
+        "ratio at the Reynolds number of the actual air (k = 1 in the card's air)"
+    ),
     "q = C_Q * rho * |v_rel|^2 (C_Q = 0.5 is the usual dynamic pressure 1/2 rho |v|^2)",
     "F_drag = -C_D * q * A * v_rel / |v_rel|, A = pi R^2",
-    "F_lift = C_L * q * A * (omega x v_rel) / |omega x v_rel| (Magnus force along omega x v: back spin lifts the ball, "
-    "a positive spin axis curves it right; the paper's eq. 4 has the opposite order, an erratum)",
+    (
+        "F_lift = C_L * q * A * (omega x v_rel) / |omega x v_rel| (Magnus force along omega x v: "
+        "back spin lifts the ball, a positive spin axis curves it right; the paper's eq. 4 has the opposite order, "
+        "an erratum)"
+    ),
     "T = -C_M * q * d * A * omega / |omega|, d = 2R",
-    "dr/dt = v; dv/dt = (F_drag + F_lift) / m - g e_z; domega/dt = T / I with I = 2/5 m R^2 "
-    "(spin magnitude only decreases; the paper's eq. 14 sign is an erratum)",
+    (
+        "dr/dt = v; dv/dt = (F_drag + F_lift) / m - g e_z; domega/dt = T / I with I = 2/5 m R^2 "
+        "(spin magnitude only decreases; the paper's eq. 14 sign is an erratum)"
+    ),
     "every |x| in a denominator is max(|x|, 1e-12)",
     "forward Euler: r, v, omega at step i+1 = value at step i + dt * derivative at step i, from t = 0 to t_sim",
 ]
@@ -112,7 +119,9 @@ class LeanPhysNN(nn.Module):
                 self.tail.weight[column, column] = head_scale[name] if name in model.heads else 0.0
             if self.learned_moment:
                 self.tail.weight[OUTPUT_COLUMNS.index("C_M"), -1] = BALL_RADIUS_M * float(model.p_m.detach())
-            self.tail.bias.copy_(torch.tensor([0.0, 0.0, 0.0, 0.0 if model.learned_pressure else BASE_DYNAMIC_PRESSURE]))
+            self.tail.bias.copy_(
+                torch.tensor([0.0, 0.0, 0.0, 0.0 if model.learned_pressure else BASE_DYNAMIC_PRESSURE])
+            )
 
     def forward(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
         speed = torch.linalg.vector_norm(v_rel, dim=-1, keepdim=True)
@@ -200,7 +209,9 @@ def describe_architecture(model: nn.Module) -> Architecture:
         equations.append("C_Q = 0.5")
     return Architecture(
         kind="mlp",
-        input_normalisation=f"x = [|v_rel| / {VELOCITY_SCALE_MPS}, |omega| / {SPIN_SCALE_RADPS}] (2 values: speed and spin rate)",
+        input_normalisation=(
+            f"x = [|v_rel| / {VELOCITY_SCALE_MPS}, |omega| / {SPIN_SCALE_RADPS}] (2 values: speed and spin rate)"
+        ),
         hidden_units=list(model.hidden),
         activation="relu",
         heads=[f"h_{head}" for head in model.heads],
@@ -211,6 +222,7 @@ def describe_architecture(model: nn.Module) -> Architecture:
 
 
 def _versions() -> dict[str, str]:
+    """The versions that wrote the bundle, and when (the card's producer)."""
     return {
         "golfflight": importlib.metadata.version("golfflight"),
         "python": platform.python_version(),
@@ -219,6 +231,109 @@ def _versions() -> dict[str, str]:
         "onnxruntime": ort.__version__,
         "numpy": np.__version__,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+    }
+
+
+def _onnx_section(onnx_sha256: str) -> dict[str, Any]:
+    """The card's account of the graph file: its hash, opset, tensors and what it computes."""
+    spec = {"dtype": "float32", "shape": ["N", 3]}
+    return {
+        "file": ONNX_FILE,
+        "sha256": onnx_sha256,
+        "opset": OPSET,
+        "inputs": [
+            TensorSpec(
+                name=VELOCITY_INPUT,
+                unit="m/s",
+                description="ball velocity relative to the air, per ball",
+                **spec,
+            ),
+            TensorSpec(name=SPIN_INPUT, unit="rad/s", description="ball spin vector, per ball", **spec),
+        ],
+        "outputs": [
+            TensorSpec(
+                name=OUTPUT,
+                dtype="float32",
+                shape=["N", 4],
+                unit="1",
+                description="aerodynamic coefficients per ball",
+            )
+        ],
+        "output_columns": list(OUTPUT_COLUMNS),
+        "contents": "the whole coefficient model: input normalisation, network or polynomial, output "
+        "transforms (sigmoid heads, p_M S, constant C_Q); the equations of motion are not in the graph",
+    }
+
+
+def _physics_section(config: TrainConfig) -> dict[str, Any]:
+    """The ball, the air and the integration the graph was trained in: what a consumer must simulate."""
+    return {
+        "ball_mass_kg": BALL_MASS_KG,
+        "ball_radius_m": BALL_RADIUS_M,
+        "ball_area_m2": BALL_AREA_M2,
+        "ball_inertia_kg_m2": BALL_INERTIA_KG_M2,
+        "gravity_mps2": GRAVITY_MPS2,
+        "tee_height_m": TEE_HEIGHT_M,
+        "air_density_kg_m3": float(Air.standard().density_kg_m3),
+        "kinematic_viscosity_m2_s": float(Air.standard().kinematic_viscosity_m2_s),
+        "density_note": "ICAO standard air (15 degC, sea level, dry). Shots with recorded conditions were "
+        "trained with their own density and viscosity (density range in training_data); simulate a shot "
+        "with the density and viscosity of its air.",
+        "integrator": "forward-euler",
+        "dt_s": config.dt_s,
+        "t_sim_s": config.t_sim_s,
+        "landing_search_start_s": LANDING_SEARCH_START_S,
+        "axes": AXES,
+        "launch_state": LAUNCH_STATE,
+        "equations": EQUATIONS,
+        "landing": LANDING,
+    }
+
+
+def _training_data_section(payload: dict[str, Any]) -> dict[str, Any]:
+    """The checkpoint's data summary and how it was split into training and validation."""
+    return {
+        **payload["data"],
+        "split": payload.get(
+            "split",
+            "validation = the rows marked 'val' in the file's split column (never a random shuffle); "
+            "training = the rows marked 'train'",
+        ),
+    }
+
+
+def _training_section(config: TrainConfig, payload: dict[str, Any]) -> dict[str, Any]:
+    """How the checkpoint was trained: optimiser, loss, epochs and the settings that reproduce it."""
+    return {
+        "optimizer": "adam",
+        "learning_rate": config.lr,
+        "batch_size": config.batch_size,
+        "epochs": payload["epoch"],
+        "best_epoch": payload["metrics"]["epoch"],
+        "loss": config.loss,
+        "loss_description": payload.get(
+            "loss_description",
+            "L_p = mean |soft-argmax landing (x, y) - target|"
+            + (" + L_h = mean |parabola apex - apex|" if config.loss == "lp+lh" else "")
+            + " over the shots that have each target, in metres",
+        ),
+        "latent_conditions": payload.get("latent_conditions"),
+        "seed": config.seed,
+        "grad_clip_norm": config.grad_clip_norm,
+        "soft_argmax_temperature_m": config.soft_argmax_temperature_m,
+        "limit": config.limit,
+    }
+
+
+def _validation_section(payload: dict[str, Any]) -> dict[str, Any]:
+    """The best epoch's errors on the validation shots, in metres and yards."""
+    metrics = payload["metrics"]
+    return {
+        "n_shots": payload["data"]["n_val"],
+        "landing_error_m": metrics["landing_error_m"],
+        "landing_error_yd": metrics["landing_error_yd"],
+        "max_height_error_m": metrics.get("max_height_error_m"),
+        "max_height_error_yd": metrics.get("max_height_error_yd"),
     }
 
 
@@ -231,95 +346,16 @@ def build_card(
     probe_points: int,
 ) -> ModelCard:
     """Assemble and validate the model card of a checkpoint `payload` (config, data summary, metrics)."""
-    metrics = payload["metrics"]
-    data = payload["data"]
-    spec = dict(dtype="float32", shape=["N", 3])
     return ModelCard.model_validate(
         {
             "schema_version": SCHEMA_VERSION,
             "variant": config.variant,
             "architecture": describe_architecture(model),
-            "onnx": {
-                "file": ONNX_FILE,
-                "sha256": onnx_sha256,
-                "opset": OPSET,
-                "inputs": [
-                    TensorSpec(
-                        name=VELOCITY_INPUT,
-                        unit="m/s",
-                        description="ball velocity relative to the air, per ball",
-                        **spec,
-                    ),
-                    TensorSpec(name=SPIN_INPUT, unit="rad/s", description="ball spin vector, per ball", **spec),
-                ],
-                "outputs": [
-                    TensorSpec(
-                        name=OUTPUT,
-                        dtype="float32",
-                        shape=["N", 4],
-                        unit="1",
-                        description="aerodynamic coefficients per ball",
-                    )
-                ],
-                "output_columns": list(OUTPUT_COLUMNS),
-                "contents": "the whole coefficient model: input normalisation, network or polynomial, output "
-                "transforms (sigmoid heads, p_M S, constant C_Q); the equations of motion are not in the graph",
-            },
-            "physics": {
-                "ball_mass_kg": BALL_MASS_KG,
-                "ball_radius_m": BALL_RADIUS_M,
-                "ball_area_m2": BALL_AREA_M2,
-                "ball_inertia_kg_m2": BALL_INERTIA_KG_M2,
-                "gravity_mps2": GRAVITY_MPS2,
-                "tee_height_m": TEE_HEIGHT_M,
-                "air_density_kg_m3": float(Air.standard().density_kg_m3),
-                "kinematic_viscosity_m2_s": float(Air.standard().kinematic_viscosity_m2_s),
-                "density_note": "ICAO standard air (15 degC, sea level, dry). Shots with recorded conditions were "
-                "trained with their own density and viscosity (density range in training_data); simulate a shot "
-                "with the density and viscosity of its air.",
-                "integrator": "forward-euler",
-                "dt_s": config.dt_s,
-                "t_sim_s": config.t_sim_s,
-                "landing_search_start_s": LANDING_SEARCH_START_S,
-                "axes": AXES,
-                "launch_state": LAUNCH_STATE,
-                "equations": EQUATIONS,
-                "landing": LANDING,
-            },
-            "training_data": {
-                **data,
-                "split": payload.get(
-                    "split",
-                    "validation = the rows marked 'val' in the file's split column (never a random shuffle); "
-                    "training = the rows marked 'train'",
-                ),
-            },
-            "training": {
-                "optimizer": "adam",
-                "learning_rate": config.lr,
-                "batch_size": config.batch_size,
-                "epochs": payload["epoch"],
-                "best_epoch": metrics["epoch"],
-                "loss": config.loss,
-                "loss_description": payload.get(
-                    "loss_description",
-                    "L_p = mean |soft-argmax landing (x, y) - target|"
-                    + (" + L_h = mean |parabola apex - apex|" if config.loss == "lp+lh" else "")
-                    + " over the shots that have each target, in metres",
-                ),
-                "latent_conditions": payload.get("latent_conditions"),
-                "seed": config.seed,
-                "grad_clip_norm": config.grad_clip_norm,
-                "soft_argmax_temperature_m": config.soft_argmax_temperature_m,
-                "limit": config.limit,
-            },
-            "validation": {
-                "n_shots": data["n_val"],
-                "landing_error_m": metrics["landing_error_m"],
-                "landing_error_yd": metrics["landing_error_yd"],
-                "max_height_error_m": metrics.get("max_height_error_m"),
-                "max_height_error_yd": metrics.get("max_height_error_yd"),
-            },
+            "onnx": _onnx_section(onnx_sha256),
+            "physics": _physics_section(config),
+            "training_data": _training_data_section(payload),
+            "training": _training_section(config, payload),
+            "validation": _validation_section(payload),
             "export_check": {"probe_points": probe_points, "max_abs_coefficient_difference": difference},
             "producer": _versions(),
         }

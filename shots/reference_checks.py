@@ -20,11 +20,13 @@ HIGH_ALTITUDE_M = 2377.0
 """7,800 ft, the altitude of the rule of thumb: a 282 yd drive at sea level flies about 306 yd there (apex −6 yd,
 land angle −9°)."""
 ALTITUDE_RULE = {"carry_yd": 24.0, "apex_yd": -6.0, "land_deg": -9.0}
+"""The rule of thumb's changes at HIGH_ALTITUDE_M against sea level: carry and apex in yards, land angle in degrees."""
 
 WIND_DRIVE = {"ball_speed_mps": 155.0 * MPH_TO_MPS, "launch_angle_deg": 12.0, "spin_rpm": 2800.0}
 """The drive of the wind rule of thumb (on a 250 yd drive a 10 mph headwind costs about 13 yd, a tailwind adds 9)."""
 WIND_SPEED_MPS = 10.0 * MPH_TO_MPS
 WIND_RULE_YD = {"headwind": -13.0, "tailwind": 9.0}
+"""The wind rule of thumb's carry change (yd) of WIND_DRIVE in a WIND_SPEED_MPS headwind or tailwind."""
 WIND_FROM_DEG = {"headwind": 0.0, "tailwind": 180.0, "crosswind from the right": 90.0}
 
 
@@ -82,7 +84,7 @@ def render_checks_markdown(params: ReferenceParameters = CALIBRATED) -> list[str
         ["sea level", f"{sea.carry_yd:.1f}", f"{sea.apex_yd:.1f}", f"{sea.land_deg:.1f}"],
         [f"{HIGH_ALTITUDE_M:,.0f} m", f"{high.carry_yd:.1f}", f"{high.apex_yd:.1f}", f"{high.land_deg:.1f}"],
         ["change", *(signed(c) for c in change)],
-        ["rule (NOTES §2: 282 → 306 yd)", *(signed(r) for r in rule)],
+        ["rule (`ALTITUDE_RULE`: 282 → 306 yd)", *(signed(r) for r in rule)],
     ])
     calm, windy = wind_check(params)
     out += ["", (f"The wind rule's drive (155 mph, 12°, 2,800 rpm; calm carry {calm.carry_yd:.1f} yd) in a 10 mph "
@@ -94,5 +96,5 @@ def render_checks_markdown(params: ReferenceParameters = CALIBRATED) -> list[str
                      signed(uniform.side_yd), signed(log.side_yd),
                      signed(WIND_RULE_YD[name]) if name in WIND_RULE_YD else "–"])
     out += table(["wind", "carry change, uniform (yd)", "log profile (yd)", "side, uniform (yd)", "log profile (yd)",
-                  "rule (NOTES §3, yd)"], rows)
+                  "rule (`WIND_RULE_YD`, yd)"], rows)
     return out

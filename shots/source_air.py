@@ -54,7 +54,8 @@ TOUR_TABLE_DENSITY_RATIO = 0.99
 PGA_2023_TABLE = SourceAir(
     temperature_c=15.0, humidity_pct=0.0,
     pressure_hpa=float(pressure_at_altitude(0.0)) / 100.0 * TOUR_TABLE_DENSITY_RATIO,
-    basis="0.99 of ICAO standard density (NOTES section 9: the PGA TOUR events behind the 2022-23 radar statistics)",
+    basis="0.99 of ICAO standard density (what the PGA TOUR events behind TrackMan's 2022-23 radar statistics "
+          "average; docs/training_real.md)",
 )
 TOUR_CHAMPIONSHIP_2020 = SourceAir(
     temperature_c=29.0, humidity_pct=60.0, altitude_m=988.0 * FOOT_M,
@@ -73,7 +74,8 @@ SENTRY_2022 = SourceAir(
 )
 TRACKMAN_NORMALIZATION = SourceAir(
     temperature_c=25.0, humidity_pct=50.0, altitude_m=0.0,
-    basis="TrackMan's normalisation air, 77 F at sea level (NOTES section 3; humidity not stated: 50 %)",
+    basis="TrackMan's normalisation air, 77 F at sea level (TrackMan's published normalize conditions; humidity "
+          "not stated: 50 %)",
 )
 TRACKMAN_NORMALIZED_7IRON = SourceAir(
     temperature_c=25.0, humidity_pct=50.0, altitude_m=1135.0 * FOOT_M,

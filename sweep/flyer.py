@@ -2,7 +2,7 @@
 
 One `Flyer` holds one FlightEngine (ONNX Runtime on one thread: the workers are the parallelism) and is what every
 engine runs: called in each process of the local pool, and as Ray Data's callable class (one per actor). Each row
-goes through the request model and the batch `golfflight simulate` flies (`service.api.shots.fly_columns`: the
+goes through the request model and the batch `golfflight simulate` flies (`contract.flying.fly_columns`: the
 same engine batch as `fly_shots`, its numbers straight into columns, no result object a shot), so the numbers are
 the same; a row the request model refuses keeps its place with the reason in `problem` and no flight,
 for the driver to report with the row's place in the input (only the driver knows it).

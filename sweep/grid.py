@@ -1,7 +1,7 @@
 """A sweep's launches as a grid: the cartesian product of value lists, one per column, generated a range of rows at a
 time (a grid of a billion rows costs nothing until its rows are asked for).
 
-Each axis is `COLUMN=SPEC` with the columns of a launches file (`service.columns`) and SPEC one of
+Each axis is `COLUMN=SPEC` with the columns of a launches file (`contract.columns`) and SPEC one of
 - `START:STOP:COUNT`: COUNT evenly spaced numbers from START to STOP, both included (`ball_speed_mps=30:80:11`);
 - `V1,V2,...`: a list of numbers or words (`wind_from_deg=0,90,180,270`, `ground_surface=fairway,green`);
 - `V`: one value, the same in every row (`altitude_m=1600`).

@@ -6,7 +6,7 @@ driver runs by both engines (`sweep.ray_input` for Ray): a file's chunk of rows 
 grid's range of row numbers; one row, so that Ray Data, which regroups rows into blocks as it likes, hands each actor
 call exactly one piece (`batch_size=1`), and a pool worker is sent a few bytes for a grid. `expand(piece)`: the
 input rows of a piece, which the worker flies as one engine batch. CSV cells are read as text and parsed as
-`golfflight simulate` parses them (`service.columns.cell_value`).
+`golfflight simulate` parses them (`contract.columns.cell_value`).
 """
 
 from __future__ import annotations

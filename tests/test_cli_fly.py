@@ -14,9 +14,11 @@ from golfflight.contract.inputs import air_of
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.engine import FlightEngine, Launch
+from golfflight.flight.flyer import Flyer
 from golfflight.flight.physics import initial_state
 from golfflight.service.api.app import create_app
 from golfflight.service.viewer.page import ASSETS
+from golfflight.shots import reference_world
 from golfflight.shots.clubs import CLUB_ALIASES, CLUB_NAMES, CLUBS, canonical_club_name, club_key, club_named
 from golfflight.shots.reference_world import fly_reference
 
@@ -140,6 +142,18 @@ def test_mph_wind_out_of_range_and_both_units_are_refused(capsys):
         assert len(err.splitlines()) == 1 and "not both" in err and argv[0] in err and argv[2] in err, err
     assert main(["fly", "--spin-axis-deg", "3", "--side-spin-rpm", "400"]) == 2
     assert "--spin-axis-deg goes with --spin-rpm" in capsys.readouterr().err
+
+
+def test_a_reference_shot_the_world_cannot_bring_down_is_refused_in_one_line(monkeypatch, capsys):
+    world = reference_world.reference_flyer()
+    short = Flyer(world.model, world.dt_s, 1.0, world.density_kg_m3, world.kinematic_viscosity_m2_s, world.rule)
+    monkeypatch.setattr(reference_world, "reference_flyer", lambda: short)
+    assert main(["fly", "--club", "Driver", "--reference"]) == 2
+    err = capsys.readouterr().err
+    assert err.splitlines() == [
+        "golfflight fly: error: the reference world could not fly the shot: the ball was still in the air after 1 s "
+        "(the simulation cap)"
+    ]
 
 
 @pytest.mark.parametrize("typed", ["7i", "7 iron", "7-Iron", "7-iron", "7IRON", "i7", " 7 Iron "])

@@ -6,8 +6,6 @@ import ast
 import tomllib
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parents[1]
 MAX_LINES = 80
 """A function of this many lines (from its `def` to its last line, as ast counts them) or more fails."""
@@ -54,11 +52,6 @@ def test_every_package_folder_and_the_script_folders_are_read():
     assert all(path.is_dir() for path in python_folders())
 
 
-@pytest.mark.xfail(
-    strict=False,
-    reason="model_export/export.py build_card and model_export/evaluate.py render are split in another branch of "
-    "issue 24; remove this marker once it is merged",
-)
 def test_no_function_has_80_lines_or_more():
     offenders = [
         entry for folder in python_folders() for path in sorted(folder.rglob("*.py")) for entry in long_functions(path)

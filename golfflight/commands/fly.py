@@ -183,35 +183,18 @@ def checked(shot: dict):
 
 
 def fly_reference_shot(shot) -> dict:
-    """A checked request flown through the reference world and rolled to rest on the level fairway (the engine's
-    ground phase): the POST /v1/shots result fields."""
-    import numpy as np
-
+    """A checked request flown by the reference world's Flyer (`shots.reference_world.reference_flyer`) in its air
+    and wind and rolled to rest on the level fairway, as the engine flies a shot: the POST /v1/shots result fields."""
     from golfflight.contract.flying import flight_fields
-    from golfflight.contract.inputs import air_of, conditions_of, launch_of
-    from golfflight.flight.engine import Rest, ShotFlight
-    from golfflight.flight.ground import LEVEL_FAIRWAY, ground_phase_one
-    from golfflight.flight.physics import initial_state
-    from golfflight.shots.reference_world import fly_reference
+    from golfflight.contract.inputs import conditions_of, launch_of
+    from golfflight.flight.flyer import FlightError
+    from golfflight.flight.ground import LEVEL_FAIRWAY
+    from golfflight.shots.reference_world import reference_flyer
 
-    air = air_of(shot.air)
-    conditions = conditions_of(shot)
-    state = initial_state(*(np.array([value], dtype=float) for value in launch_of(shot)))
-    flight = fly_reference(state, air, conditions.wind)
-    if not flight.landed[0]:
-        raise ValueError("the shot did not come down within the reference world's simulation time cap")
-    position, velocity, spin = (tuple(a[0].tolist()) for a in (flight.landing_position, flight.landing_velocity,
-                                                               flight.landing_spin))
-    carry = float(flight.carry_m[0])
-    one = ground_phase_one(position, velocity, spin, LEVEL_FAIRWAY.surface)
-    result = ShotFlight(
-        landing_x_m=position[0], landing_y_m=position[1], carry_m=carry, lateral_m=position[0],
-        apex_m=float(flight.apex_m[0]), apex_time_s=float(flight.apex_time_s[0]),
-        flight_time_s=float(flight.flight_time_s[0]), landing_angle_deg=float(flight.landing_angle_deg[0]),
-        landing_speed_mps=float(flight.landing_speed_mps[0]), landing_spin_rpm=float(flight.landing_spin_rpm[0]),
-        rest=Rest.at(one.position[0], one.position[1], carry, one.bounces, one.time_s),
-    )
-    fields = flight_fields(result, None)
+    flown = reference_flyer().fly_batch([launch_of(shot)], conditions_of(shot), grounds=LEVEL_FAIRWAY)[0]
+    if isinstance(flown, FlightError):
+        raise ValueError(f"the reference world could not fly the shot: {flown}")
+    fields = flight_fields(flown, None)
     fields["landing"], fields["rest"] = (point.model_dump() for point in (fields["landing"], fields["rest"]))
     return {key: value for key, value in fields.items() if value is not None}
 
