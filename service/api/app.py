@@ -13,8 +13,8 @@ of the routes: a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and
 (`service.api.errors`). Given a connect address, the lifespan also opens GSPro Open Connect over TCP on the same
 loop (`service.open_connect`). Every shot flown, from any input, goes to the live viewer's feed (GET /viewer,
 `service.viewer`). GET/PUT /v1/bay hold the simulator bay's air, wind and ground, which Open Connect shots and shots
-without conditions of their own fly in (`service.api.bay`). /docs loads its script and style from an installed package, not a CDN (`routes.docs`; ReDoc
-is off). The outermost middleware counts and times every request for GET /metrics (Prometheus) and /v1/latency
+without conditions of their own fly in (`service.api.bay`). /docs loads its script and style from an installed
+package, not a CDN (`routes.docs`; ReDoc is off). The outermost middleware counts and times every request for GET /metrics (Prometheus) and /v1/latency
 (`service.api.request_metrics`).
 """
 
