@@ -133,7 +133,7 @@ def p(samples: list[float], q: float) -> float:
     return float(np.percentile(samples, q)) * 1e3
 
 
-def main() -> None:
+def parse_args() -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--shots", type=int, default=500, help="single shots a round, each way")
@@ -143,100 +143,100 @@ def main() -> None:
     parser.add_argument("--versus-without", nargs="*", default=[], metavar="MODULE",
                         help="modules hidden from the --versus server (as if not installed)")
     parser.add_argument("--no-write", action="store_true", help="leave benchmarks/results.json as it is")
-    args = parser.parse_args()
+    return parser.parse_args()
 
-    engine = FlightEngine(model_dir())
-    shot = ShotRequest.model_validate(SHOT)
-    shot_body = json.dumps(SHOT).encode()
-    batch_body = json.dumps({"shots": [launch._asdict() for launch in mixed_launches(1024)]}).encode()
-    batch_shots = BatchRequest.model_validate_json(batch_body).shots
-    services = [Service("after" if args.versus else "this tree", REPO, [])]
-    if args.versus:
-        services.append(Service("before", Path(args.versus).resolve(), args.versus_without))
-    inprocess, inprocess_batch = [], []
-    try:
-        for service in services:  # warm-up: connections, caches, the batch process
-            for _ in range(200):
-                service.post("/v1/shots", shot_body)
-                service.tcp.fly()
-            service.post("/v1/shots/batch", batch_body)
-        for _ in range(200):
-            fly_shot(engine, shot)
-        fly_shots(engine, batch_shots)
-        for round_ in range(args.rounds):
-            own, http, tcp = [], {s.name: [] for s in services}, {s.name: [] for s in services}
-            for i in range(args.shots):
-                order = services if (i + round_) % 2 == 0 else services[::-1]
-                own.append(timed(lambda: fly_shot(engine, shot)))
-                for service in order:
-                    http[service.name].append(timed(lambda s=service: s.post("/v1/shots", shot_body)))
-                for service in order:
-                    tcp[service.name].append(timed(service.tcp.fly))
-            inprocess.append(own)
-            for service in services:
-                service.single.append(http[service.name])
-                service.connect.append(tcp[service.name])
-                service.flight_p50.append(service.http.get("/v1/latency").json()["simulation"]["p50_ms"])
-            runs, batch = [], {s.name: [] for s in services}
-            for j in range(args.batches):
-                runs.append(timed(lambda: fly_shots(engine, batch_shots)))
-                for service in services if (j + round_) % 2 == 0 else services[::-1]:
-                    batch[service.name].append(timed(lambda s=service: s.post("/v1/shots/batch", batch_body)))
-            inprocess_batch.append(runs)
-            for service in services:
-                service.batch.append(batch[service.name])
-            for service in services if round_ % 2 == 0 else services[::-1]:
-                service.viewer.append(service.viewer_events(args.viewer_shots, round_))
-            print(f"round {round_ + 1}/{args.rounds}: in process {p(own, 50):.3f} ms, "
-                  + ", ".join(f"{s.name} HTTP {p(s.single[-1], 50):.3f} ms, TCP {p(s.connect[-1], 50):.3f} ms, "
-                              f"batch {statistics.median(s.batch[-1]) * 1e3:.1f} ms" for s in services)
-                  + f", batch in process {statistics.median(runs) * 1e3:.1f} ms", flush=True)
-    finally:
-        for service in services:
-            service.close()
 
-    def median_of_rounds(rounds: list[list[float]], q: float) -> float:
-        return statistics.median(p(samples, q) for samples in rounds)
-
-    flight = median_of_rounds(inprocess, 50)
-    flight_batch = statistics.median(statistics.median(r) for r in inprocess_batch) * 1e3
-    rows = [{"name": "in process: one 7-iron (fly_shot)", "unit": "ms", "p50": flight,
-             "p99": median_of_rounds(inprocess, 99)},
-            {"name": "in process: batch of 1,024 (fly_shots)", "unit": "ms", "p50": flight_batch}]
+def warm_up(
+    services: list[Service], engine: FlightEngine, shot, shot_body: bytes, batch_shots, batch_body: bytes
+) -> None:
+    """Connections, caches and the batch process, before anything is timed."""
     for service in services:
-        label = "" if len(services) == 1 else f" [{service.name}]"
-        server_flight = statistics.median(service.flight_p50)
-        single, single99 = median_of_rounds(service.single, 50), median_of_rounds(service.single, 99)
-        connect = median_of_rounds(service.connect, 50)
-        batch = statistics.median(statistics.median(r) for r in service.batch) * 1e3
-        rows += [
-            {"name": f"server's own flight (/v1/latency){label}", "unit": "ms", "p50": server_flight},
-            {"name": f"HTTP single shot, keep-alive{label}", "unit": "ms", "p50": single, "p99": single99,
-             "over_in_process_ms": single - flight, "over_server_flight_ms": single - server_flight,
-             "ratio_to_in_process": single / flight,
-             "target": "p50 <= server's flight + 0.5 ms, p99 <= 2.5 ms",
-             "met": single <= server_flight + 0.5 and single99 <= 2.5},
-            {"name": f"Open Connect TCP reply{label}", "unit": "ms", "p50": connect,
-             "p99": median_of_rounds(service.connect, 99), "over_in_process_ms": connect - flight,
-             "over_server_flight_ms": connect - server_flight, "ratio_to_in_process": connect / flight,
-             "target": "p50 <= server's flight + 0.3 ms", "met": connect <= server_flight + 0.3},
-            {"name": f"HTTP batch of 1,024{label}", "unit": "ms", "p50": batch,
-             "p99": statistics.median(max(r) for r in service.batch) * 1e3, "over_in_process_ms": batch - flight_batch,
-             "ratio_to_in_process": batch / flight_batch, "target": "<= 1.5 x in process",
-             "met": batch <= 1.5 * flight_batch},
-            {"name": f"viewer: shot sent to its event on the stream{label}", "unit": "ms",
-             "p50": median_of_rounds(service.viewer, 50), "p99": median_of_rounds(service.viewer, 99)},
-        ]
-    if len(services) == 2:
-        after, before = services
-        for what, pick in (("HTTP single shot p50", lambda s, r: p(s.single[r], 50)),
-                           ("HTTP single shot p99", lambda s, r: p(s.single[r], 99)),
-                           ("Open Connect TCP reply p50", lambda s, r: p(s.connect[r], 50)),
-                           ("HTTP batch of 1,024", lambda s, r: statistics.median(s.batch[r]) * 1e3),
-                           ("viewer event p50", lambda s, r: p(s.viewer[r], 50))):
-            ratios = [pick(after, r) / pick(before, r) for r in range(args.rounds)]
-            rows.append({"name": f"after / before: {what}", "unit": "", "per_round": ratios,
-                         "p50": statistics.median(ratios)})
+        for _ in range(200):
+            service.post("/v1/shots", shot_body)
+            service.tcp.fly()
+        service.post("/v1/shots/batch", batch_body)
+    for _ in range(200):
+        fly_shot(engine, shot)
+    fly_shots(engine, batch_shots)
+
+
+def one_round(round_: int, args: argparse.Namespace, services: list[Service], engine: FlightEngine, shot,
+              shot_body: bytes, batch_shots, batch_body: bytes) -> tuple[list[float], list[float]]:
+    """One round, every way interleaved shot by shot and batch by batch; the services keep their own timings, the
+    in-process single shots and batches are returned."""
+    own, http, tcp = [], {s.name: [] for s in services}, {s.name: [] for s in services}
+    for i in range(args.shots):
+        order = services if (i + round_) % 2 == 0 else services[::-1]
+        own.append(timed(lambda: fly_shot(engine, shot)))
+        for service in order:
+            http[service.name].append(timed(lambda s=service: s.post("/v1/shots", shot_body)))
+        for service in order:
+            tcp[service.name].append(timed(service.tcp.fly))
+    for service in services:
+        service.single.append(http[service.name])
+        service.connect.append(tcp[service.name])
+        service.flight_p50.append(service.http.get("/v1/latency").json()["simulation"]["p50_ms"])
+    runs, batch = [], {s.name: [] for s in services}
+    for j in range(args.batches):
+        runs.append(timed(lambda: fly_shots(engine, batch_shots)))
+        for service in services if (j + round_) % 2 == 0 else services[::-1]:
+            batch[service.name].append(timed(lambda s=service: s.post("/v1/shots/batch", batch_body)))
+    for service in services:
+        service.batch.append(batch[service.name])
+    for service in services if round_ % 2 == 0 else services[::-1]:
+        service.viewer.append(service.viewer_events(args.viewer_shots, round_))
+    print(f"round {round_ + 1}/{args.rounds}: in process {p(own, 50):.3f} ms, "
+          + ", ".join(f"{s.name} HTTP {p(s.single[-1], 50):.3f} ms, TCP {p(s.connect[-1], 50):.3f} ms, "
+                      f"batch {statistics.median(s.batch[-1]) * 1e3:.1f} ms" for s in services)
+          + f", batch in process {statistics.median(runs) * 1e3:.1f} ms", flush=True)
+    return own, runs
+
+
+def median_of_rounds(rounds: list[list[float]], q: float) -> float:
+    return statistics.median(p(samples, q) for samples in rounds)
+
+
+def service_rows(service: Service, label: str, flight: float, flight_batch: float) -> list[dict]:
+    """One service's rows: its own flight, HTTP and TCP single shots, the batch and the viewer, against in process."""
+    server_flight = statistics.median(service.flight_p50)
+    single, single99 = median_of_rounds(service.single, 50), median_of_rounds(service.single, 99)
+    connect = median_of_rounds(service.connect, 50)
+    batch = statistics.median(statistics.median(r) for r in service.batch) * 1e3
+    return [
+        {"name": f"server's own flight (/v1/latency){label}", "unit": "ms", "p50": server_flight},
+        {"name": f"HTTP single shot, keep-alive{label}", "unit": "ms", "p50": single, "p99": single99,
+         "over_in_process_ms": single - flight, "over_server_flight_ms": single - server_flight,
+         "ratio_to_in_process": single / flight,
+         "target": "p50 <= server's flight + 0.5 ms, p99 <= 2.5 ms",
+         "met": single <= server_flight + 0.5 and single99 <= 2.5},
+        {"name": f"Open Connect TCP reply{label}", "unit": "ms", "p50": connect,
+         "p99": median_of_rounds(service.connect, 99), "over_in_process_ms": connect - flight,
+         "over_server_flight_ms": connect - server_flight, "ratio_to_in_process": connect / flight,
+         "target": "p50 <= server's flight + 0.3 ms", "met": connect <= server_flight + 0.3},
+        {"name": f"HTTP batch of 1,024{label}", "unit": "ms", "p50": batch,
+         "p99": statistics.median(max(r) for r in service.batch) * 1e3, "over_in_process_ms": batch - flight_batch,
+         "ratio_to_in_process": batch / flight_batch, "target": "<= 1.5 x in process",
+         "met": batch <= 1.5 * flight_batch},
+        {"name": f"viewer: shot sent to its event on the stream{label}", "unit": "ms",
+         "p50": median_of_rounds(service.viewer, 50), "p99": median_of_rounds(service.viewer, 99)},
+    ]
+
+
+def paired_rows(after: Service, before: Service, rounds: int) -> list[dict]:
+    """after / before, round by round (the same minute of the machine's drift on both sides)."""
+    rows = []
+    for what, pick in (("HTTP single shot p50", lambda s, r: p(s.single[r], 50)),
+                       ("HTTP single shot p99", lambda s, r: p(s.single[r], 99)),
+                       ("Open Connect TCP reply p50", lambda s, r: p(s.connect[r], 50)),
+                       ("HTTP batch of 1,024", lambda s, r: statistics.median(s.batch[r]) * 1e3),
+                       ("viewer event p50", lambda s, r: p(s.viewer[r], 50))):
+        ratios = [pick(after, r) / pick(before, r) for r in range(rounds)]
+        rows.append({"name": f"after / before: {what}", "unit": "", "per_round": ratios,
+                     "p50": statistics.median(ratios)})
+    return rows
+
+
+def print_rows(rows: list[dict], args: argparse.Namespace) -> None:
     print(f"\nThe wire, {args.rounds} rounds x {args.shots} shots and {args.batches} batches each way (medians of the"
           " rounds; overhead = the figure minus the in-process one)\n")
     print("| measurement | p50 | p99 | overhead vs in process | vs server's flight | ratio to in process | met |")
@@ -252,6 +252,38 @@ def main() -> None:
                  f"{row['ratio_to_in_process']:.2f}x" if "ratio_to_in_process" in row else "",
                  ("yes" if row["met"] else "NO") + f" ({row['target']})" if "met" in row else ""]
         print(f"| {row['name']} | " + " | ".join(cells) + " |")
+
+
+def main() -> None:
+    args = parse_args()
+    engine = FlightEngine(model_dir())
+    shot = ShotRequest.model_validate(SHOT)
+    shot_body = json.dumps(SHOT).encode()
+    batch_body = json.dumps({"shots": [launch._asdict() for launch in mixed_launches(1024)]}).encode()
+    batch_shots = BatchRequest.model_validate_json(batch_body).shots
+    services = [Service("after" if args.versus else "this tree", REPO, [])]
+    if args.versus:
+        services.append(Service("before", Path(args.versus).resolve(), args.versus_without))
+    inprocess, inprocess_batch = [], []
+    try:
+        warm_up(services, engine, shot, shot_body, batch_shots, batch_body)
+        for round_ in range(args.rounds):
+            own, runs = one_round(round_, args, services, engine, shot, shot_body, batch_shots, batch_body)
+            inprocess.append(own)
+            inprocess_batch.append(runs)
+    finally:
+        for service in services:
+            service.close()
+    flight = median_of_rounds(inprocess, 50)
+    flight_batch = statistics.median(statistics.median(r) for r in inprocess_batch) * 1e3
+    rows = [{"name": "in process: one 7-iron (fly_shot)", "unit": "ms", "p50": flight,
+             "p99": median_of_rounds(inprocess, 99)},
+            {"name": "in process: batch of 1,024 (fly_shots)", "unit": "ms", "p50": flight_batch}]
+    for service in services:
+        rows += service_rows(service, "" if len(services) == 1 else f" [{service.name}]", flight, flight_batch)
+    if len(services) == 2:
+        rows += paired_rows(*services, args.rounds)
+    print_rows(rows, args)
     if not args.no_write:
         write_results("wire", rows)
 
