@@ -87,10 +87,6 @@ class FlightEngine:
         """Steps to the maximum flight time, the Flyer's: both paths fail a shot still in the air after them."""
         return self.flyer.max_steps
 
-    @max_steps.setter
-    def max_steps(self, steps: int) -> None:
-        self.flyer.max_steps = steps
-
     @property
     def variant(self) -> str:
         return self.card.variant

@@ -8,7 +8,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.coefficients import QuadraticSpinRatio
+from golfflight.flight.engine import FlightEngine
 from golfflight.flight.integrator import simulate
 from golfflight.flight.physics import initial_state
 from golfflight.shots.heldout import ROUND_COLUMN, HeldOutSet, held_out_set
@@ -83,3 +85,9 @@ def trainable_copy(root: Path, out: Path) -> Path:
         else:
             _write_trainable_rows(path, target, held)
     return out
+
+
+@pytest.fixture(scope="module")
+def engine() -> FlightEngine:
+    """The shipped model's engine, loaded once a test module."""
+    return FlightEngine(model_dir())

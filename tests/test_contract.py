@@ -207,8 +207,8 @@ def test_a_batch_process_that_dies_is_replaced(http):
 
 def test_a_shot_that_does_not_land_in_time_fails_alone(app, http):
     engine = app.state.service.engine
-    saved = engine.max_steps
-    engine.max_steps = 12  # 1.2 s: a putt-like shot lands, a 7-iron is still up
+    saved = engine.flyer.max_steps
+    engine.flyer.max_steps = 12  # 1.2 s: a putt-like shot lands, a 7-iron is still up
     try:
         putt = {"ball_speed_mps": 3.0, "launch_angle_deg": 5.0, "spin_rpm": 100.0}
         single = http.post("/v1/shots", json=SEVEN_IRON)
@@ -220,4 +220,4 @@ def test_a_shot_that_does_not_land_in_time_fails_alone(app, http):
         assert "still in the air" in batch[1]["error"]
         assert batch[0]["carry_m"] > 0 and batch[2] == batch[0]
     finally:
-        engine.max_steps = saved
+        engine.flyer.max_steps = saved

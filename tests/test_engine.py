@@ -11,9 +11,8 @@ import pytest
 from conftest import random_launches
 from golfflight.contract.trajectory import resample
 from golfflight.flight.air import Air
-from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import STANDARD, Conditions
-from golfflight.flight.engine import FlightEngine, FlightError, Launch, ShotFlight
+from golfflight.flight.engine import FlightError, Launch, ShotFlight
 from golfflight.flight.integrator import simulate
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state, reynolds_scale
@@ -22,10 +21,6 @@ from golfflight.flight.wind import Wind
 PAPER_SINGLE_SHOT_MS = 34.9
 """Phys-NN+ one shot on a CPU, the paper's Table 2."""
 
-
-@pytest.fixture(scope="module")
-def engine() -> FlightEngine:
-    return FlightEngine(model_dir())
 
 
 def launches(n: int, seed: int) -> list[Launch]:
@@ -116,7 +111,7 @@ def test_a_long_flight_goes_on_past_t_sim_and_the_cap_fails_only_that_shot(engin
     assert flight.flight_time_s > engine.t_sim
     capped = copy.copy(engine)
     capped.flyer = copy.copy(engine.flyer)
-    capped.max_steps = int(engine.t_sim / engine.dt)
+    capped.flyer.max_steps = int(engine.t_sim / engine.dt)
     with pytest.raises(FlightError, match="still in the air"):
         capped.fly(sky_ball)
     first, second = capped.fly_batch([sky_ball, SEVEN_IRON])

@@ -19,7 +19,6 @@ from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.flight.air import Air
 from golfflight.flight.bundle_location import MODEL_ENV, model_dir
 from golfflight.flight.coefficients import QuadraticSpinRatio
-from golfflight.flight.engine import FlightEngine
 from golfflight.flight.field import BallInAir
 from golfflight.flight.flyer import MAX_FLIGHT_TIME_S, Launch, load_flyer
 from golfflight.flight.integrator import (
@@ -41,10 +40,6 @@ SKY_BALL = Launch(75.0, 70.0, 0.0, 3000.0, 0.0)
 """In the air longer than the card's t_sim (10 s) and shorter than the engine's limit (20 s): a caller that stopped
 at t_sim would not land it."""
 
-
-@pytest.fixture(scope="module")
-def engine() -> FlightEngine:
-    return FlightEngine(model_dir())
 
 
 def launch_columns(launch: Launch) -> dict[str, np.ndarray]:

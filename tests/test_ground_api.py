@@ -139,10 +139,6 @@ def test_simulate_takes_ground_columns_and_writes_the_rest(tmp_path):
     assert main(["simulate", str(bad)]) == 2
 
 
-@pytest.fixture(scope="module")
-def engine():
-    return FlightEngine(model_dir())
-
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(

@@ -14,7 +14,7 @@ from golfflight.flight import limits
 from golfflight.flight.air import Air
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import Conditions
-from golfflight.flight.engine import MAX_FLIGHT_TIME_S, FlightEngine, Launch, ShotFlight
+from golfflight.flight.engine import MAX_FLIGHT_TIME_S, Launch, ShotFlight
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.wind import CALM, Wind
 from hypothesis import HealthCheck, given, settings
@@ -71,10 +71,6 @@ def no_flush_to_zero():
     which breaks hypothesis' float generation; properties run with IEEE floats, as the service does."""
     torch.set_flush_denormal(False)
 
-
-@pytest.fixture(scope="module")
-def engine() -> FlightEngine:
-    return FlightEngine(model_dir())
 
 
 def assert_sound(flight: ShotFlight) -> None:

@@ -16,8 +16,6 @@ import httpx
 import pytest
 from golfflight.contract.flying import fly_shot
 from golfflight.contract.requests import ShotRequest
-from golfflight.flight.bundle_location import model_dir
-from golfflight.flight.engine import FlightEngine
 from golfflight.service.api.app import create_app
 from golfflight.service.api.routes import viewer as viewer_routes
 from golfflight.service.open_connect.server import ConnectAddress
@@ -31,10 +29,6 @@ KEYED = {"x-api-key": KEY}
 DRIVER = {"ball_speed_mph": 167.0, "launch_angle_deg": 10.9, "back_spin_rpm": 2686.0, "side_spin_rpm": -250.0}
 WEDGE_BALL = {"Speed": 102.0, "VLA": 24.0, "HLA": -1.5, "TotalSpin": 8600.0, "SpinAxis": 2.0}
 
-
-@pytest.fixture(scope="module")
-def engine() -> FlightEngine:
-    return FlightEngine(model_dir())
 
 
 @pytest.fixture(scope="module")

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import asyncio
 import time
+from contextlib import contextmanager
 from functools import partial
 
 import browser
@@ -15,8 +16,6 @@ import httpx
 import pytest
 from golfflight.contract.flying import fly_shot
 from golfflight.contract.requests import ShotRequest
-from golfflight.flight.bundle_location import model_dir
-from golfflight.flight.engine import FlightEngine
 from golfflight.service.api.app import create_app
 from golfflight.service.api.routes import viewer as viewer_routes
 from golfflight.service.open_connect.server import ConnectAddress
@@ -27,10 +26,6 @@ from test_viewer import DRIVER, KEY, KEYED, WEDGE_BALL, gspro_over_tcp, next_eve
 
 STRAIGHT = {"ball_speed_mph": 160.0, "launch_angle_deg": 11.0, "spin_rpm": 2700.0, "spin_axis_deg": 0.0}
 
-
-@pytest.fixture(scope="module")
-def engine() -> FlightEngine:
-    return FlightEngine(model_dir())
 
 
 @pytest.fixture(scope="module")
@@ -240,49 +235,52 @@ def _refused_value_and_a_bay_set_over_the_api(page, http) -> None:
     )
 
 
-@pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
-def test_the_page_behind_the_golfer_and_the_bay_form_in_chromium():
-    """One page through the steps in order: each step starts from the state the one before left."""
+@contextmanager
+def live_viewer(width: int, height: int):
+    """(page, HTTP client, Open Connect port, the page's script errors) of a keyed service's viewer, open and live
+    in headless Chromium at width x height."""
     port = free_port()
     with running(create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))) as http:
         base = str(http.base_url).rstrip("/")
-        with browser.headless_page(1400, 1000) as page:
+        with browser.headless_page(width, height) as page:
             errors: list[str] = []
             page.on("pageerror", lambda error: errors.append(str(error)))
             page.goto(f"{base}/viewer#key={KEY}")
             page.wait_for_selector("#status[data-state=live]", timeout=10_000)
-            page.wait_for_function("() => document.querySelector('#bay-summary').textContent !== '—'", timeout=10_000)
-            behind = _straight_shot_on_the_centre_line(page, http)
-            _wedge_right_of_the_line_and_labelled_distances(page, port, behind)
-            _metric_bay_through_the_form(page, http)
-            _imperial_bay_through_the_form(page, http)
-            _refused_value_and_a_bay_set_over_the_api(page, http)
-            assert errors == []
+            yield page, http, port, errors
+
+
+@pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
+def test_the_page_behind_the_golfer_and_the_bay_form_in_chromium():
+    """One page through the steps in order: each step starts from the state the one before left."""
+    with live_viewer(1400, 1000) as (page, http, port, errors):
+        page.wait_for_function("() => document.querySelector('#bay-summary').textContent !== '—'", timeout=10_000)
+        behind = _straight_shot_on_the_centre_line(page, http)
+        _wedge_right_of_the_line_and_labelled_distances(page, port, behind)
+        _metric_bay_through_the_form(page, http)
+        _imperial_bay_through_the_form(page, http)
+        _refused_value_and_a_bay_set_over_the_api(page, http)
+        assert errors == []
 
 
 @pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
 def test_the_narrow_layout_keeps_the_lateral_column_and_whole_dots():
-    port = free_port()
-    with running(create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))) as http:
-        base = str(http.base_url).rstrip("/")
-        with browser.headless_page(390, 844) as page:
-            page.goto(f"{base}/viewer#key={KEY}")
-            page.wait_for_selector("#status[data-state=live]", timeout=10_000)
-            for number, (hla, axis) in enumerate(((-6.0, -20.0), (0.0, 0.0), (6.0, 25.0)), start=1):
-                gspro_over_tcp(port, number, {**WEDGE_BALL, "HLA": hla, "SpinAxis": axis})
-            page.wait_for_selector("#shots tbody tr[data-shot='3']", timeout=10_000)
-            assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")  # no sideways scroll
-            scroll = page.locator(".shots .scroll")
-            assert scroll.evaluate("e => e.scrollWidth <= e.clientWidth"), "the shot table is cut"
-            lateral = page.locator("#shots th", has_text="lateral")
-            assert lateral.is_visible() and lateral.bounding_box()["x"] + lateral.bounding_box()["width"] <= 390
-            for view in ("#dispersion",):
-                box = page.locator(view).bounding_box()
-                for dot in page.locator(f"{view} circle.dot").all():
-                    b = dot.bounding_box()  # each dot whole, inside its picture
-                    assert box["x"] <= b["x"] and b["x"] + b["width"] <= box["x"] + box["width"]
-                    assert abs(b["width"] - b["height"]) < 0.5
-            for ring in page.locator("#dispersion circle.rest-dot").all():  # rings in the club's colour, not dark
-                assert ring.evaluate("e => getComputedStyle(e).stroke") != "rgb(12, 17, 20)"
-            tile = page.locator("#n-landing-angle").bounding_box()
-            assert tile["height"] < 40  # number and degree sign on one line
+    with live_viewer(390, 844) as (page, _, port, _errors):
+        for number, (hla, axis) in enumerate(((-6.0, -20.0), (0.0, 0.0), (6.0, 25.0)), start=1):
+            gspro_over_tcp(port, number, {**WEDGE_BALL, "HLA": hla, "SpinAxis": axis})
+        page.wait_for_selector("#shots tbody tr[data-shot='3']", timeout=10_000)
+        assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")  # no sideways scroll
+        scroll = page.locator(".shots .scroll")
+        assert scroll.evaluate("e => e.scrollWidth <= e.clientWidth"), "the shot table is cut"
+        lateral = page.locator("#shots th", has_text="lateral")
+        assert lateral.is_visible() and lateral.bounding_box()["x"] + lateral.bounding_box()["width"] <= 390
+        for view in ("#dispersion",):
+            box = page.locator(view).bounding_box()
+            for dot in page.locator(f"{view} circle.dot").all():
+                b = dot.bounding_box()  # each dot whole, inside its picture
+                assert box["x"] <= b["x"] and b["x"] + b["width"] <= box["x"] + box["width"]
+                assert abs(b["width"] - b["height"]) < 0.5
+        for ring in page.locator("#dispersion circle.rest-dot").all():  # rings in the club's colour, not dark
+            assert ring.evaluate("e => getComputedStyle(e).stroke") != "rgb(12, 17, 20)"
+        tile = page.locator("#n-landing-angle").bounding_box()
+        assert tile["height"] < 40  # number and degree sign on one line
