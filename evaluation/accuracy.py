@@ -191,7 +191,7 @@ def _header(flyers: Sequence[Flyer], rho_note: str) -> list[str]:
         *table(("column", "model"), rows, align="ll"),
         "",
         (
-            f"Every model is flown through `flight.integrator.simulate` (NumPy physics, forward Euler, dt "
+            f"Every model is flown through `flight.flyer.Flyer` (NumPy physics, forward Euler, dt "
             f"{flyers[0].dt_s:g} s, up to {flyers[0].t_sim_s:g} s), calm, in the air named above: {rho_note}"
         ),
     ]
