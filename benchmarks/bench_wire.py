@@ -1,5 +1,6 @@
-"""The wire's cost as a difference in one run: a 7-iron flown in process, over HTTP (keep-alive httpx) and over GSPro
-Open Connect TCP, interleaved shot by shot, and a batch of 1,024 in process and over HTTP, interleaved run by run.
+"""The wire's cost as a difference in one run: a 7-iron flown in process, over HTTP (keep-alive, from httpx and from a
+raw socket) and over GSPro Open Connect TCP, interleaved shot by shot, and a batch of 1,024 in process and over HTTP,
+interleaved run by run.
 Prints a table (overhead in ms beside the absolute figures, and the ratio), writes the `wire` section of results.json.
 
 python benchmarks/bench_wire.py [--rounds 5] [--shots 500] [--batches 3]
@@ -75,6 +76,36 @@ class Connector:
         self.sock.close()
 
 
+class RawHttp:
+    """One keep-alive HTTP/1.1 connection with no client library: the request's bytes built once, the answer framed
+    by its Content-Length and parsed by the C JSON parser. What a simulator's client in C++ or C# pays for the
+    wire is about this (nearly nothing), so the server's and the loopback's share of a request shows without
+    httpx's own CPU (pure Python, a fifth of a request in `profile_wire.py`)."""
+
+    def __init__(self, port: int, path: str, body: bytes):
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=30)
+        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.request = (f"POST {path} HTTP/1.1\r\nhost: 127.0.0.1\r\ncontent-type: application/json\r\n"
+                        f"content-length: {len(body)}\r\n\r\n").encode() + body
+
+    def post(self) -> dict:
+        self.sock.sendall(self.request)
+        data = b""
+        while True:
+            data += self.sock.recv(65536)
+            head, blank, rest = data.partition(b"\r\n\r\n")
+            if not blank:
+                continue
+            length = next(int(line.split(b":")[1]) for line in head.split(b"\r\n")
+                          if line.lower().startswith(b"content-length:"))
+            if len(rest) >= length:
+                assert head.startswith(b"HTTP/1.1 200"), head
+                return json.loads(rest[:length])
+
+    def close(self) -> None:
+        self.sock.close()
+
+
 class Service:
     """One `golfflight serve` (HTTP and Open Connect) under test, its clients and its samples."""
 
@@ -90,7 +121,8 @@ class Service:
         self.server: Server = start(1, env=env, tree=tree)
         self.http = httpx.Client(base_url=self.server.base_url, timeout=120)
         self.tcp = Connector(connect)
-        self.single, self.connect, self.batch, self.flight_p50, self.viewer = [], [], [], [], []
+        self.raw = RawHttp(self.server.port, "/v1/shots", json.dumps(SHOT).encode())
+        self.single, self.raw_single, self.connect, self.batch, self.flight_p50, self.viewer = [], [], [], [], [], []
 
     def viewer_events(self, shots: int, round_: int) -> list[float]:
         """Seconds from sending a shot with ?viewer=true to its event arriving on an open GET /v1/events stream
@@ -118,6 +150,7 @@ class Service:
 
     def close(self) -> None:
         self.http.close()
+        self.raw.close()
         self.tcp.close()
         self.server.stop()
 
@@ -153,6 +186,7 @@ def warm_up(
     for service in services:
         for _ in range(200):
             service.post("/v1/shots", shot_body)
+            service.raw.post()
             service.tcp.fly()
         service.post("/v1/shots/batch", batch_body)
     for _ in range(200):
@@ -164,16 +198,20 @@ def one_round(round_: int, args: argparse.Namespace, services: list[Service], en
               shot_body: bytes, batch_shots, batch_body: bytes) -> tuple[list[float], list[float]]:
     """One round, every way interleaved shot by shot and batch by batch; the services keep their own timings, the
     in-process single shots and batches are returned."""
-    own, http, tcp = [], {s.name: [] for s in services}, {s.name: [] for s in services}
+    own = []
+    http, raw, tcp = ({s.name: [] for s in services} for _ in range(3))
     for i in range(args.shots):
         order = services if (i + round_) % 2 == 0 else services[::-1]
         own.append(timed(lambda: fly_shot(engine, shot)))
         for service in order:
             http[service.name].append(timed(lambda s=service: s.post("/v1/shots", shot_body)))
         for service in order:
+            raw[service.name].append(timed(service.raw.post))
+        for service in order:
             tcp[service.name].append(timed(service.tcp.fly))
     for service in services:
         service.single.append(http[service.name])
+        service.raw_single.append(raw[service.name])
         service.connect.append(tcp[service.name])
         service.flight_p50.append(service.http.get("/v1/latency").json()["simulation"]["p50_ms"])
     runs, batch = [], {s.name: [] for s in services}
@@ -186,7 +224,8 @@ def one_round(round_: int, args: argparse.Namespace, services: list[Service], en
     for service in services if round_ % 2 == 0 else services[::-1]:
         service.viewer.append(service.viewer_events(args.viewer_shots, round_))
     print(f"round {round_ + 1}/{args.rounds}: in process {p(own, 50):.3f} ms, "
-          + ", ".join(f"{s.name} HTTP {p(s.single[-1], 50):.3f} ms, TCP {p(s.connect[-1], 50):.3f} ms, "
+          + ", ".join(f"{s.name} HTTP {p(s.single[-1], 50):.3f} ms (raw client {p(s.raw_single[-1], 50):.3f} ms), "
+                      f"TCP {p(s.connect[-1], 50):.3f} ms, "
                       f"batch {statistics.median(s.batch[-1]) * 1e3:.1f} ms" for s in services)
           + f", batch in process {statistics.median(runs) * 1e3:.1f} ms", flush=True)
     return own, runs
@@ -200,6 +239,7 @@ def service_rows(service: Service, label: str, flight: float, flight_batch: floa
     """One service's rows: its own flight, HTTP and TCP single shots, the batch and the viewer, against in process."""
     server_flight = statistics.median(service.flight_p50)
     single, single99 = median_of_rounds(service.single, 50), median_of_rounds(service.single, 99)
+    raw, raw99 = median_of_rounds(service.raw_single, 50), median_of_rounds(service.raw_single, 99)
     connect = median_of_rounds(service.connect, 50)
     batch = statistics.median(statistics.median(r) for r in service.batch) * 1e3
     return [
@@ -209,6 +249,11 @@ def service_rows(service: Service, label: str, flight: float, flight_batch: floa
          "ratio_to_in_process": single / flight,
          "target": "p50 <= server's flight + 0.5 ms, p99 <= 2.5 ms",
          "met": single <= server_flight + 0.5 and single99 <= 2.5},
+        {"name": f"HTTP single shot, keep-alive raw socket client{label}", "unit": "ms", "p50": raw, "p99": raw99,
+         "over_in_process_ms": raw - flight, "over_server_flight_ms": raw - server_flight,
+         "ratio_to_in_process": raw / flight,
+         "target": "p50 <= server's flight + 0.5 ms, p99 <= 2.5 ms",
+         "met": raw <= server_flight + 0.5 and raw99 <= 2.5},
         {"name": f"Open Connect TCP reply{label}", "unit": "ms", "p50": connect,
          "p99": median_of_rounds(service.connect, 99), "over_in_process_ms": connect - flight,
          "over_server_flight_ms": connect - server_flight, "ratio_to_in_process": connect / flight,
@@ -227,6 +272,7 @@ def paired_rows(after: Service, before: Service, rounds: int) -> list[dict]:
     rows = []
     for what, pick in (("HTTP single shot p50", lambda s, r: p(s.single[r], 50)),
                        ("HTTP single shot p99", lambda s, r: p(s.single[r], 99)),
+                       ("HTTP single shot p50, raw socket client", lambda s, r: p(s.raw_single[r], 50)),
                        ("Open Connect TCP reply p50", lambda s, r: p(s.connect[r], 50)),
                        ("HTTP batch of 1,024", lambda s, r: statistics.median(s.batch[r]) * 1e3),
                        ("viewer event p50", lambda s, r: p(s.viewer[r], 50))):

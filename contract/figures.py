@@ -10,6 +10,7 @@ record that is no figure is named in `NOT_FIGURES` with the reason (`unreported_
 from __future__ import annotations
 
 import dataclasses
+import functools
 import typing
 from dataclasses import dataclass
 from operator import attrgetter
@@ -21,8 +22,10 @@ IMPERIAL_TWINS = (("_m", "_yd", YARD_M), ("_mps", "_mph", MPH_TO_MPS))
 NAME_yd beside it, every NAME_mps (a speed) NAME_mph: the one place the results' imperial fields are defined."""
 
 
+@functools.cache
 def twin_of(name: str) -> tuple[str, float] | None:
-    """(the imperial twin's name, SI units per imperial unit) of a result number, or None if it has none."""
+    """(the imperial twin's name, SI units per imperial unit) of a result number, or None if it has none (kept per
+    name: every shot's result asks for the same few dozen)."""
     for si, imperial, unit in IMPERIAL_TWINS:
         if name.endswith(si):
             return name.removesuffix(si) + imperial, unit
@@ -34,9 +37,9 @@ def with_imperial(numbers: dict) -> dict:
     out = {}
     for name, value in numbers.items():
         out[name] = value
-        for si, imperial, unit in IMPERIAL_TWINS:
-            if name.endswith(si):
-                out[name.removesuffix(si) + imperial] = value / unit
+        twin = twin_of(name)
+        if twin is not None:
+            out[twin[0]] = value / twin[1]
     return out
 
 

@@ -29,8 +29,8 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 def _spelled_as_fields(data, fields) -> dict:
     """`data` with each key that matches a field but for letter case renamed to the field (unknown keys kept); a
     field given twice with different values is refused."""
-    if not isinstance(data, dict):
-        return data
+    if not isinstance(data, dict) or all(key in fields for key in data):
+        return data  # every key spelled as its field already: nothing to rename (a message as connectors send it)
     names = {name.casefold(): name for name in fields}
     renamed: dict = {}
     for key, value in data.items():

@@ -47,13 +47,14 @@ Point = tuple[float, float, float, float]
 
 @dataclass(eq=False)
 class Entry:
-    """One published shot: its request, its result without the trajectory and the trajectory it came with (None:
-    fly it again), until `frame`, its server-sent event, is rendered; only the frame is kept after that."""
+    """One published shot: its request (a GSPro message's is made from the message when first rendered, not on the
+    shot's path), its result without the trajectory and the trajectory it came with (None: fly it again), until
+    `frame`, its server-sent event, is rendered; only the frame is kept after that."""
 
     id: int
     source: Source
     received_unix_s: float
-    shot: ShotRequest | None
+    shot: ShotRequest | GSProMessage | None
     result: ShotResult | None
     path: list[Point] | None
     shot_number: int | None = None
@@ -122,7 +123,7 @@ class ShotFeed:
         return tuple(self._viewers)
 
     def publish(
-        self, source: Source, shot: ShotRequest, result: ShotResult | None, shot_number: int | None = None
+        self, source: Source, shot: ShotRequest | GSProMessage, result: ShotResult | None, shot_number: int | None = None
     ) -> None:
         """A shot flown (`result` None: flown in a batch, its result not at hand). A trajectory the client asked for
         is kept thinned to MAX_POINTS plain tuples, so the history holds little more than its rendered events."""
@@ -145,7 +146,7 @@ class ShotFeed:
     def publish_gspro(self, source: Source, message: GSProMessage, reply: GSProReply) -> None:
         """A GSPro message's shot, if it flew (Code 200)."""
         if reply.Code == 200 and reply.Flight is not None:
-            self.publish(source, gspro_request(message), reply.Flight, message.ShotNumber)
+            self.publish(source, message, reply.Flight, message.ShotNumber)
 
     def subscribe(self, after_id: int | None = None) -> Viewer:
         """A new viewer's queue, holding the kept shots after `after_id` (all of them without one, or when the id
@@ -175,11 +176,12 @@ class ShotFeed:
 
 
 def _encode(entry: Entry, engine: FlightEngine) -> str:
+    shot = entry.shot if isinstance(entry.shot, ShotRequest) else gspro_request(entry.shot)
     if entry.path is not None:
         trajectory = [TrajectoryPoint.model_construct(t_s=t, x_m=x, y_m=y, z_m=z) for t, x, y, z in entry.path]
         result = entry.result
     else:
-        traced_shot = entry.shot.model_copy(
+        traced_shot = shot.model_copy(
             update={"trajectory": TrajectoryRequest(rate_hz=VIEW_RATE_HZ), "normalized": False}
         )
         traced = fly_shot(engine, traced_shot)
@@ -190,7 +192,7 @@ def _encode(entry: Entry, engine: FlightEngine) -> str:
         source=entry.source,
         received_unix_s=entry.received_unix_s,
         shot_number=entry.shot_number,
-        launch=LaunchNumbers(**launch_of(entry.shot)._asdict()),
+        launch=LaunchNumbers(**launch_of(shot)._asdict()),
         flight=result.model_copy(update={"trajectory": trajectory, "normalized": None}),
     )
     return f"id: {entry.id}\nevent: shot\ndata: {event.model_dump_json(exclude_none=True)}\n\n"

@@ -5,6 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 from golfflight.contract.gspro import GSProMessage, GSProReply
+from golfflight.service.api.routes.direct import DirectRoute
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
 from golfflight.service.api.state import state_of
 
@@ -12,7 +13,7 @@ GSPRO_PATH = "/v1/gspro"
 GSPRO_STATUS = {200: 200, 500: 422, 503: 503}
 """HTTP status of each Open Connect reply code on POST /v1/gspro."""
 
-router = APIRouter()
+router = APIRouter(route_class=DirectRoute)
 
 
 @router.post(

@@ -7,7 +7,7 @@ from __future__ import annotations
 import time
 from concurrent.futures.process import BrokenProcessPool
 
-from fastapi import APIRouter, Depends, Query, Request
+from fastapi import APIRouter, Query, Request
 from fastapi.responses import JSONResponse, Response
 from golfflight.contract.bay import CONDITION_FIELDS, in_bay
 from golfflight.contract.flying import fly_shot
@@ -15,12 +15,13 @@ from golfflight.contract.refusals import body_detail
 from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, BatchRequest, ShotRequest
 from golfflight.contract.results import BatchResult, ShotResult
 from golfflight.flight.engine import FlightError
+from golfflight.service.api.routes.direct import DirectRoute
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
-from golfflight.service.api.state import ServiceState, ready_engine, service_state, state_of
+from golfflight.service.api.state import state_of
 
 BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has been restarted): send the batch again"
 
-router = APIRouter(prefix="/v1/shots")
+router = APIRouter(prefix="/v1/shots", route_class=DirectRoute)
 
 ShowOnViewer = Query(
     False,
@@ -38,7 +39,7 @@ ShowOnViewer = Query(
 async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer) -> Response:
     """Fly one shot: launch in SI or launch-monitor units, optional wind, air, ground, normalized and trajectory;
     the bay's conditions (GET /v1/bay) where the shot gives none."""
-    # The one validation is FastAPI's of `request`; the state comes from the app, not from dependencies (`state_of`)
+    # `request` was validated once (`DirectRoute`); the state comes from the app, not from dependencies (`state_of`)
     state = state_of(http)
     engine = state.ready_engine()
     request = in_bay(request, state.bay.conditions)
@@ -62,13 +63,12 @@ async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer)
     description=f"Fly up to {MAX_BATCH_SHOTS:,} shots together in one engine batch (at most "
     f"{MAX_BATCH_TRAJECTORIES} of them with a trajectory); results come back in order and a shot that cannot "
     "land gets an error entry of its own.",
-    dependencies=[Depends(ready_engine)],
 )
-async def batch(
-    request: BatchRequest, http: Request, state: ServiceState = Depends(service_state), viewer: bool = ShowOnViewer
-) -> Response:
-    """FastAPI has validated `request` (a 422 otherwise); the batch process flies its raw body, or the shots with the
-    bay's conditions filled in when the bay has any."""
+async def batch(request: BatchRequest, http: Request, viewer: bool = ShowOnViewer) -> Response:
+    """`request` is valid (a 422 otherwise); the batch process flies its raw body, or the shots with the bay's
+    conditions filled in when the bay has any."""
+    state = state_of(http)
+    state.ready_engine()
     bay = state.bay.conditions
     if any(getattr(bay, name) is not None for name in CONDITION_FIELDS):
         request = BatchRequest(shots=[in_bay(shot, bay) for shot in request.shots])
