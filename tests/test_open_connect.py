@@ -446,3 +446,41 @@ def test_serve_refuses_tcp_with_several_workers_and_a_busy_port(capsys):
         taken = busy.getsockname()[1]
         assert main(["serve", "--port", str(free_port()), "--connect-port", str(taken)]) == 2
     assert f"127.0.0.1:{taken}" in capsys.readouterr().err
+
+
+def test_a_connector_that_takes_no_replies_stops_being_read_not_buffered_without_end():
+    """Replies a connector does not read pile up to the transport's high-water mark (past it by at most the replies to
+    one read's messages); then the connection is no longer read (the connector's own sends back up in TCP) until it
+    takes its replies, and then every shot is answered."""
+    padding = "x" * 1000  # about a real reply's size
+
+    def answer(message):
+        return GSProReply(Code=200, Message=padding, ShotNumber=message.ShotNumber)
+
+    async def session() -> tuple[int, bool, int]:
+        server = OpenConnectServer(answer)
+        await server.start(ConnectAddress(0))
+        client = socket.socket()
+        client.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        client.setblocking(False)
+        await asyncio.get_running_loop().sock_connect(client, ("127.0.0.1", server.port))
+        shots = 20_000  # 20 MB of replies: more than the loopback's socket buffers take
+        data = b"".join(encoded(shot(n)) for n in range(shots))
+        sender = asyncio.get_running_loop().sock_sendall(client, data)
+        sending = asyncio.ensure_future(sender)
+        await asyncio.sleep(1.0)
+        (connection,) = server.connections
+        buffered, reading = connection.transport.get_write_buffer_size(), connection.transport.is_reading()
+        replies = 0  # each reply is one flat object: one closing brace
+        while replies < shots:
+            replies += (await asyncio.get_running_loop().sock_recv(client, 1 << 16)).count(b"}")
+        await sending
+        client.close()
+        await server.close()
+        return buffered, reading, replies
+
+    buffered, reading, answered = asyncio.run(session())
+    print(f"replies buffered when reading paused: {buffered:,} bytes")
+    assert not reading
+    assert buffered < 2 * 2**20  # the high-water mark (64 kB) and the replies to the last read's messages
+    assert answered == 20_000
