@@ -1,5 +1,6 @@
-"""`DirectRoute`: a valid single shot, batch or GSPro message reaches its endpoint without FastAPI's request path, gets
-the same answer as through it, and everything else is still answered by FastAPI (issue 25)."""
+"""`DirectRoute` and `DirectLanes`: a valid single shot, batch or GSPro message reaches its endpoint without FastAPI's
+router and request handling, gets the same answer as through them, and everything else is still answered by FastAPI
+(issue 25)."""
 
 from __future__ import annotations
 
@@ -7,14 +8,14 @@ import json
 
 import pytest
 from fastapi import APIRouter, Depends, FastAPI, Request
-from pydantic import ValidationError
-from servers import running
-from starlette.requests import Request as StarletteRequest
-
+from fastapi.routing import APIRoute
 from golfflight.contract.gspro import GSProMessage
 from golfflight.contract.requests import BatchRequest, ShotRequest
 from golfflight.service.api.app import create_app
-from golfflight.service.api.routes.direct import DirectRoute
+from golfflight.service.api.direct import DirectRoute
+from pydantic import ValidationError
+
+from tests.servers import running
 
 SHOT = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}
 JSON = {"content-type": "application/json"}
@@ -28,16 +29,15 @@ def client():
 
 @pytest.fixture
 def fastapi_requests(monkeypatch) -> list[str]:
-    """The paths of requests whose body FastAPI's own request handling read (with `Request.json`, which the direct
-    path never calls)."""
+    """The paths of requests that FastAPI's router handed to a route (the direct path never reaches the router)."""
     seen: list[str] = []
-    read = StarletteRequest.json
+    handle = APIRoute.handle
 
-    async def counted(request):
-        seen.append(request.url.path)
-        return await read(request)
+    async def counted(route, scope, receive, send):
+        seen.append(scope["path"])
+        return await handle(route, scope, receive, send)
 
-    monkeypatch.setattr(StarletteRequest, "json", counted)
+    monkeypatch.setattr(APIRoute, "handle", counted)
     return seen
 
 

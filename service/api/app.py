@@ -9,13 +9,14 @@ bay's single shots; more concurrency comes from `golfflight serve --workers N` (
 process each). The model loads during the lifespan's startup, before uvicorn opens the port (and before the Open
 Connect port accepts): the first request is served; /healthz answers 503 only if the model failed to load. In front
 of the routes: a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and CORS only for configured origins
-($GOLFFLIGHT_CORS_ORIGINS); every refusal is a 4xx whose body names the field, the value and the allowed range
+($GOLFFLIGHT_CORS_ORIGINS); inside those, a valid simulation request goes straight to its endpoint
+(`service.api.direct`); every refusal is a 4xx whose body names the field, the value and the allowed range
 (`service.api.errors`). Given a connect address, the lifespan also opens GSPro Open Connect over TCP on the same
 loop (`service.open_connect`). Every shot flown, from any input, goes to the live viewer's feed (GET /viewer,
 `service.viewer`). GET/PUT /v1/bay hold the simulator bay's air, wind and ground, which Open Connect shots and shots
 without conditions of their own fly in (`service.api.bay`). /docs loads its script and style from an installed
-package, not a CDN (`routes.docs`; ReDoc is off). The outermost middleware counts and times every request for GET /metrics (Prometheus) and /v1/latency
-(`service.api.request_metrics`).
+package, not a CDN (`routes.docs`; ReDoc is off). The outermost middleware counts and times every request for
+GET /metrics (Prometheus) and /v1/latency (`service.api.request_metrics`).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from fastapi.middleware.cors import CORSMiddleware
 from golfflight.flight.bundle_location import model_dir
 from golfflight.service.api import errors
 from golfflight.service.api.bay import BAY_FILE_ENV, Bay
+from golfflight.service.api.direct import DirectLanes
 from golfflight.service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV, MAX_BODY_BYTES, ApiKey, BodyLimit
 from golfflight.service.api.request_metrics import RequestMetrics
 from golfflight.service.api.routes import bay as bay_routes
@@ -93,6 +95,8 @@ def create_app(
         redoc_url=None,  # ReDoc's bundle fetches its logo from a CDN
     )
     app.state.service = state
+    routers = (shots.router, gspro.router, bay_routes.router, status.router, metrics.router, viewer.router, docs.router)
+    app.add_middleware(DirectLanes, routes=[route for router in routers for route in router.routes])  # innermost
     if api_key:
         app.add_middleware(ApiKey, key=api_key)
     if cors_origins:
@@ -104,7 +108,6 @@ def create_app(
         )
     app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)
     errors.install(app)
-    routers = (shots.router, gspro.router, bay_routes.router, status.router, metrics.router, viewer.router, docs.router)
     for router in routers:
         app.include_router(router)
     docs.mount_assets(app)

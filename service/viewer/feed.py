@@ -3,8 +3,8 @@
 Publishing never waits and costs a few appends: a slow or dead viewer only loses the oldest shots it has not been
 sent yet (its queue drops them), it never holds up a shot's reply. A shot's event is rendered once, by the first
 viewer stream that sends it, not on the shot's path: a result without a trajectory is flown again with one on the
-engine's single-shot path (about a millisecond on an idle machine); a batch's results come back from the batch process as bytes
-that the worker does not parse, so its last HISTORY shots (the most a viewer keeps) are flown again whole.
+engine's single-shot path (about a millisecond on an idle machine); a batch's results come back from the batch process
+as bytes that the worker does not parse, so its last HISTORY shots (the most a viewer keeps) are flown again whole.
 Everything here runs on the service's event loop.
 """
 
@@ -123,7 +123,11 @@ class ShotFeed:
         return tuple(self._viewers)
 
     def publish(
-        self, source: Source, shot: ShotRequest | GSProMessage, result: ShotResult | None, shot_number: int | None = None
+        self,
+        source: Source,
+        shot: ShotRequest | GSProMessage,
+        result: ShotResult | None,
+        shot_number: int | None = None,
     ) -> None:
         """A shot flown (`result` None: flown in a batch, its result not at hand). A trajectory the client asked for
         is kept thinned to MAX_POINTS plain tuples, so the history holds little more than its rendered events."""

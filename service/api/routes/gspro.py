@@ -5,7 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 from golfflight.contract.gspro import GSProMessage, GSProReply
-from golfflight.service.api.routes.direct import DirectRoute
+from golfflight.service.api.direct import DirectRoute
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
 from golfflight.service.api.state import state_of
 

@@ -15,7 +15,7 @@ from golfflight.contract.refusals import body_detail
 from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, BatchRequest, ShotRequest
 from golfflight.contract.results import BatchResult, ShotResult
 from golfflight.flight.engine import FlightError
-from golfflight.service.api.routes.direct import DirectRoute
+from golfflight.service.api.direct import DirectRoute
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
 from golfflight.service.api.state import state_of
 
@@ -39,7 +39,7 @@ ShowOnViewer = Query(
 async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer) -> Response:
     """Fly one shot: launch in SI or launch-monitor units, optional wind, air, ground, normalized and trajectory;
     the bay's conditions (GET /v1/bay) where the shot gives none."""
-    # `request` was validated once (`DirectRoute`); the state comes from the app, not from dependencies (`state_of`)
+    # `request` was validated once (`service.api.direct`); the state comes from the app (`state_of`), not dependencies
     state = state_of(http)
     engine = state.ready_engine()
     request = in_bay(request, state.bay.conditions)

@@ -1,0 +1,122 @@
+"""The direct path for the simulation routes' usual request: a body sent as `application/json` that validates, with a
+query of true/false flags at most, goes from the app's own middleware (metrics, body limit, API key, CORS) straight
+to the endpoint. Any other request (a body that is refused, another content type, another query, the model not yet
+loaded) goes on through FastAPI's exception handling, router and request handling as before, so every refusal and
+the OpenAPI document stay FastAPI's.
+
+Per single shot, FastAPI's request handling (body reading, a `json.loads`, the dependency solver) and the layers
+around a route (exception middleware, exit stacks, the router) cost about as much as all of the service's other
+work beside the flight (`docs/benchmarks.md`, issue 25). A route opts in by its class (`DirectRoute`);
+`DirectLanes` is the innermost of the app's middleware and serves those routes' direct requests.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+from fastapi.routing import APIRoute
+from golfflight.service.api.state import NotReady
+from pydantic import BaseModel, ValidationError
+from starlette.requests import Request
+from starlette.responses import Response
+
+FLAG_SPELLINGS = {b"true": True, b"false": False, b"1": True, b"0": False}
+"""Spellings of a boolean query flag taken on the direct path; any other spelling goes through FastAPI's own
+reading of it (which takes more and refuses the rest with a 422)."""
+
+JSON = b"application/json"
+
+
+class DirectRoute(APIRoute):
+    """An APIRoute whose valid requests `DirectLanes` hands straight to the endpoint. The endpoint is `async def`,
+    returns a `Response` and takes one body model, the `Request` and boolean query flags, nothing else (no
+    dependencies, path, header or cookie parameters: those only FastAPI's path solves)."""
+
+    def __init__(self, path: str, endpoint: Any, **kwargs: Any):
+        super().__init__(path, endpoint, **kwargs)
+        dependant = self.dependant
+        unsupported = [
+            *dependant.dependencies, *dependant.path_params, *dependant.header_params, *dependant.cookie_params
+        ] + [flag for flag in dependant.query_params if flag.field_info.annotation is not bool]
+        if unsupported or self.body_field is None or dependant.request_param_name is None:
+            raise TypeError(f"{path}: DirectRoute takes one body model, the Request and bool query flags only")
+        self.body_model: type[BaseModel] = self.body_field.field_info.annotation
+        self._names = self.body_field.name, dependant.request_param_name
+        self._flags = {flag.alias.encode(): (flag.name, flag.field_info.default) for flag in dependant.query_params}
+
+    def flags(self, query: bytes) -> dict[str, bool] | None:
+        """The flags of a query such as `viewer=true`, defaults for the rest; None for anything else."""
+        values = {name: default for name, default in self._flags.values()}
+        for pair in query.split(b"&") if query else ():
+            key, _, value = pair.partition(b"=")
+            if key not in self._flags or value not in FLAG_SPELLINGS:
+                return None
+            values[self._flags[key][0]] = FLAG_SPELLINGS[value]
+        return values
+
+    async def direct(self, request: Request, body: bytes) -> Response | None:
+        """The endpoint's response to a request with this body, or None when FastAPI's path must answer it."""
+        flags = self.flags(request.scope["query_string"])
+        if flags is None or _content_type(request.scope["headers"]) != JSON:
+            return None
+        try:
+            model = self.body_model.model_validate_json(body)
+        except ValidationError:
+            return None  # FastAPI reads it again and refuses it in its own words
+        body_name, request_name = self._names
+        response = await self.endpoint(**{body_name: model, request_name: request}, **flags)
+        if not isinstance(response, Response):
+            raise TypeError(f"{self.path}: a DirectRoute endpoint returns a Response, not {type(response)}")
+        return response
+
+
+class DirectLanes:
+    """Pure ASGI, the innermost of the app's middleware: a request to one of `routes` (by method and exact path) is
+    read whole and tried on its route's direct path; what that path leaves is passed on, its body replayed."""
+
+    def __init__(self, app, routes: Iterable[APIRoute]):
+        self.app = app
+        direct = [route for route in routes if isinstance(route, DirectRoute)]
+        self.lanes = {(method, route.path): route for route in direct for method in route.methods}
+
+    async def __call__(self, scope, receive, send):
+        route = self.lanes.get((scope["method"], scope["path"])) if scope["type"] == "http" else None
+        if route is None:
+            await self.app(scope, receive, send)
+            return
+        messages, chunks = [], []
+        while True:
+            message = await receive()
+            messages.append(message)
+            if message["type"] != "http.request":
+                break
+            chunks.append(message.get("body", b""))
+            if not message.get("more_body", False):
+                break
+        scope["route"] = route  # as the router would set it: the metrics label the request by its template
+        try:
+            response = await route.direct(Request(scope, _replay(messages, receive)), b"".join(chunks))
+        except NotReady:
+            response = None  # FastAPI's path answers it (503) as it answers every route
+        if response is not None:
+            await response(scope, receive, send)
+            return
+        await self.app(scope, _replay(messages, receive), send)
+
+
+def _replay(messages: list[dict], receive):
+    """A `receive` that gives `messages` again, then whatever comes next."""
+    pending = list(messages)
+
+    async def replay():
+        return pending.pop(0) if pending else await receive()
+
+    return replay
+
+
+def _content_type(headers: list[tuple[bytes, bytes]]) -> bytes | None:
+    for name, value in headers:
+        if name == b"content-type":
+            return value.lower()
+    return None
