@@ -6,7 +6,7 @@ these too. Shots fly inline on the loop (no thread): one takes about half a mill
 thread costs, and the replies measured with several connectors sending at once stay in milliseconds
 (docs/service.md), against the 5 s after which a connector sends a shot again. Each connection is an
 `asyncio.Protocol`: bytes are framed and answered in the callback that receives them, with no stream buffer, task
-or wake-up between the socket and the reply (a tenth of Open Connect's own cost over the flight, issue 25).
+or wake-up between the socket and the reply (docs/benchmarks.md, issue 25).
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ class OpenConnectServer:
     def __init__(self, answer: Answer):
         self.answer = answer
         self._server: asyncio.Server | None = None
-        self.connections: set[Connection] = set()
+        self.connections: set[Connection] = set()  # open now; each leaves when its connector goes or at `close`
 
     async def start(self, address: ConnectAddress, *, listening: bool = True) -> None:
         """Take the port (OSError when it cannot be had) and accept connectors on it, or with `listening` False only
