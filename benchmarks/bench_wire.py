@@ -34,7 +34,7 @@ from golfflight.contract.flying import fly_shot, fly_shots
 from golfflight.contract.requests import BatchRequest, ShotRequest
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine
-from server import Server, free_port, start
+from server import RawHttp, Server, free_port, start
 
 SHOT = {
     "ball_speed_mps": SEVEN_IRON.ball_speed_mps,
@@ -71,36 +71,6 @@ class Connector:
                 continue
             assert reply["Code"] == 200, reply
             return reply
-
-    def close(self) -> None:
-        self.sock.close()
-
-
-class RawHttp:
-    """One keep-alive HTTP/1.1 connection with no client library: the request's bytes built once, the answer framed
-    by its Content-Length and parsed by the C JSON parser. What a simulator's client in C++ or C# pays for the
-    wire is about this (nearly nothing), so the server's and the loopback's share of a request shows without
-    httpx's own CPU (pure Python, a fifth of a request in `profile_wire.py`)."""
-
-    def __init__(self, port: int, path: str, body: bytes):
-        self.sock = socket.create_connection(("127.0.0.1", port), timeout=30)
-        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.request = (f"POST {path} HTTP/1.1\r\nhost: 127.0.0.1\r\ncontent-type: application/json\r\n"
-                        f"content-length: {len(body)}\r\n\r\n").encode() + body
-
-    def post(self) -> dict:
-        self.sock.sendall(self.request)
-        data = b""
-        while True:
-            data += self.sock.recv(65536)
-            head, blank, rest = data.partition(b"\r\n\r\n")
-            if not blank:
-                continue
-            length = next(int(line.split(b":")[1]) for line in head.split(b"\r\n")
-                          if line.lower().startswith(b"content-length:"))
-            if len(rest) >= length:
-                assert head.startswith(b"HTTP/1.1 200"), head
-                return json.loads(rest[:length])
 
     def close(self) -> None:
         self.sock.close()

@@ -1,8 +1,10 @@
 """`golfflight serve` in a subprocess on a free 127.0.0.1 port for the reliability scripts: start, wait for /healthz,
-measure its memory (the supervisor and every worker), stop it with SIGTERM and report how it ended."""
+measure its memory (the supervisor and every worker), stop it with SIGTERM and report how it ended; and a raw
+keep-alive HTTP client for the wire's benchmarks."""
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import socket
@@ -24,6 +26,36 @@ def free_port() -> int:
     with socket.socket() as probe:
         probe.bind((HOST, 0))
         return probe.getsockname()[1]
+
+
+class RawHttp:
+    """One keep-alive HTTP/1.1 connection with no client library: the request's bytes built once, the answer framed
+    by its Content-Length and parsed by the C JSON parser. What a simulator's client in C++ or C# pays for the
+    wire is about this (nearly nothing), so the server's and the loopback's share of a request shows without
+    httpx's own CPU (pure Python, a fifth of a request in `profile_wire.py`)."""
+
+    def __init__(self, port: int, path: str, body: bytes):
+        self.sock = socket.create_connection((HOST, port), timeout=30)
+        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.request = (f"POST {path} HTTP/1.1\r\nhost: 127.0.0.1\r\ncontent-type: application/json\r\n"
+                        f"content-length: {len(body)}\r\n\r\n").encode() + body
+
+    def post(self) -> dict:
+        self.sock.sendall(self.request)
+        data = b""
+        while True:
+            data += self.sock.recv(65536)
+            head, blank, rest = data.partition(b"\r\n\r\n")
+            if not blank:
+                continue
+            length = next(int(line.split(b":")[1]) for line in head.split(b"\r\n")
+                          if line.lower().startswith(b"content-length:"))
+            if len(rest) >= length:
+                assert head.startswith(b"HTTP/1.1 200"), head
+                return json.loads(rest[:length])
+
+    def close(self) -> None:
+        self.sock.close()
 
 
 @dataclass

@@ -5,9 +5,9 @@ python benchmarks/wire_floor.py [--rounds 3] [--requests 1500] [--work-us N]
 Two servers in processes of their own, each spending `--work-us` of busy CPU per request (default: the in-process
 7-iron's p50, measured first, so both sides sleep and wake as they do around a real flight) and answering a
 1 kB body: an asyncio Protocol on uvloop that writes back what it got (Open Connect's shape), and a bare ASGI app on
-uvicorn with uvloop and httptools (`golfflight serve`'s choice) answering a POST. A raw keep-alive socket client
-(as `bench_wire.RawHttp`) times round trips; the figure is the round trip minus the work. Prints a table and writes
-the `wire_floor` section of results.json.
+uvicorn with uvloop and httptools (`golfflight serve`'s choice) answering a POST. Raw keep-alive socket clients (for
+HTTP `server.RawHttp`, as in `bench_wire.py`) time round trips; the figure is the round trip minus the work. Prints
+a table and writes the `wire_floor` section of results.json.
 """
 
 from __future__ import annotations
@@ -68,30 +68,36 @@ def serve_http(port: int, work: float) -> None:
                 access_log=False)
 
 
-class Client:
-    """A raw keep-alive connection sending `request` and reading an answer of len(ANSWER) bytes after its head."""
+def connected(port: int, timeout_s: float = 30.0) -> None:
+    """Return once something listens on `port`."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            socket.create_connection(("127.0.0.1", port), timeout=timeout_s).close()
+            return
+        except ConnectionRefusedError:
+            assert time.monotonic() < deadline, "the floor server did not start"
+            time.sleep(0.1)
 
-    def __init__(self, port: int, request: bytes, http: bool):
-        deadline = time.monotonic() + 30
-        while True:
-            try:
-                self.sock = socket.create_connection(("127.0.0.1", port), timeout=30)
-                break
-            except ConnectionRefusedError:
-                assert time.monotonic() < deadline, "the floor server did not start"
-                time.sleep(0.1)
+
+class TcpClient:
+    """A raw connection to the TCP floor server: the shot's bytes out, the 1 kB answer back."""
+
+    def __init__(self, port: int):
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=30)
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.request, self.http = request, http
 
-    def round_trip(self) -> float:
-        started = time.perf_counter()
-        self.sock.sendall(self.request)
-        data = b""
-        while True:
-            data += self.sock.recv(65536)
-            body = data.partition(b"\r\n\r\n")[2] if self.http else data
-            if len(body) >= len(ANSWER):
-                return time.perf_counter() - started
+    def post(self) -> None:
+        self.sock.sendall(BODY)
+        received = 0
+        while received < len(ANSWER):
+            received += len(self.sock.recv(65536))
+
+
+def timed(call) -> float:
+    started = time.perf_counter()
+    call()
+    return time.perf_counter() - started
 
 
 def in_process_p50() -> float:
@@ -123,26 +129,25 @@ def main() -> None:
         kind, port, work = args.serve
         (serve_tcp if kind == "tcp" else serve_http)(int(port), float(work))
         return
-    from server import free_port
+    from server import RawHttp, free_port
 
     work = args.work_us / 1e6 if args.work_us is not None else in_process_p50()
-    http_request = (f"POST /v1/shots HTTP/1.1\r\nhost: 127.0.0.1\r\ncontent-type: application/json\r\n"
-                    f"content-length: {len(BODY)}\r\n\r\n").encode() + BODY
     servers, clients = [], {}
     try:
-        for kind, request in (("tcp", BODY), ("http", http_request)):
+        for kind in ("tcp", "http"):
             port = free_port()
             servers.append(subprocess.Popen([sys.executable, __file__, "--serve", kind, str(port), str(work)]))
-            clients[kind] = Client(port, request, kind == "http")
+            connected(port)
+            clients[kind] = TcpClient(port) if kind == "tcp" else RawHttp(port, "/v1/shots", BODY)
         for client in clients.values():
             for _ in range(300):
-                client.round_trip()
+                client.post()
         samples = {kind: [] for kind in clients}
         for _ in range(args.rounds):
             rounds = {kind: [] for kind in clients}
             for _ in range(args.requests):
                 for kind, client in clients.items():
-                    rounds[kind].append(client.round_trip())
+                    rounds[kind].append(timed(client.post))
             for kind in clients:
                 samples[kind].append(statistics.median(rounds[kind]) - work)
     finally:

@@ -16,6 +16,7 @@ from collections.abc import Iterable
 from typing import Any
 
 from fastapi.routing import APIRoute
+from golfflight.service.api.request_body import read_body, replay
 from golfflight.service.api.state import NotReady
 from pydantic import BaseModel, ValidationError
 from starlette.requests import Request
@@ -85,34 +86,16 @@ class DirectLanes:
         if route is None:
             await self.app(scope, receive, send)
             return
-        messages, chunks = [], []
-        while True:
-            message = await receive()
-            messages.append(message)
-            if message["type"] != "http.request":
-                break
-            chunks.append(message.get("body", b""))
-            if not message.get("more_body", False):
-                break
+        messages, body = await read_body(receive)  # within the body limit: its middleware is outside this one
         scope["route"] = route  # as the router would set it: the metrics label the request by its template
         try:
-            response = await route.direct(Request(scope, _replay(messages, receive)), b"".join(chunks))
+            response = await route.direct(Request(scope, replay(messages, receive)), body)
         except NotReady:
             response = None  # FastAPI's path answers it (503) as it answers every route
         if response is not None:
             await response(scope, receive, send)
             return
-        await self.app(scope, _replay(messages, receive), send)
-
-
-def _replay(messages: list[dict], receive):
-    """A `receive` that gives `messages` again, then whatever comes next."""
-    pending = list(messages)
-
-    async def replay():
-        return pending.pop(0) if pending else await receive()
-
-    return replay
+        await self.app(scope, replay(messages, receive), send)
 
 
 def _content_type(headers: list[tuple[bytes, bytes]]) -> bytes | None:

@@ -10,6 +10,7 @@ import hmac
 import json
 
 from golfflight.contract.refusals import body_detail
+from golfflight.service.api.request_body import read_body, replay
 from golfflight.service.viewer.page import PUBLIC_PATHS
 
 API_KEY_ENV = "GOLFFLIGHT_API_KEY"
@@ -60,23 +61,11 @@ class BodyLimit:
                 return
             await self.app(scope, receive, send)
             return
-        messages, received = [], 0
-        while True:
-            message = await receive()
-            messages.append(message)
-            if message["type"] != "http.request":
-                break
-            received += len(message.get("body", b""))
-            if received > self.limit:
-                await self._refuse(send, f"over {self.limit:,}")
-                return
-            if not message.get("more_body", False):
-                break
-
-        async def replay():
-            return messages.pop(0) if messages else await receive()
-
-        await self.app(scope, replay, send)
+        read = await read_body(receive, self.limit)
+        if read is None:
+            await self._refuse(send, f"over {self.limit:,}")
+            return
+        await self.app(scope, replay(read[0], receive), send)
 
     async def _refuse(self, send, size: str) -> None:
         message = f"request body of {size} bytes refused: the limit is {self.limit:,} bytes"
