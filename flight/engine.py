@@ -28,7 +28,7 @@ from golfflight.flight.flyer import (
     air_inputs,
     load_flyer,
 )
-from golfflight.flight.ground import GroundSpec, ground_phase, ground_phase_one
+from golfflight.flight.ground import GroundSpec, ground_phase, ground_phase_one, putt_phase
 from golfflight.flight.outcomes import BatchFlights, EulerStates, Rest, ShotFlight, landing_figures, parabola_apex
 from golfflight.flight.physics import euler_step, initial_state, reynolds_scale
 from golfflight.flight.wind import log_profile_factor
@@ -173,6 +173,24 @@ class FlightEngine:
             landing_x_m=land[0], landing_y_m=land[1], carry_m=carry, lateral_m=land[0], apex_m=apex,
             apex_time_s=apex_time, flight_time_s=flight_time, landing_angle_deg=angle, landing_speed_mps=speed,
             landing_spin_rpm=spin, states=states, rest=rest,
+        )
+
+    def putt(self, launch: Launch, ground: GroundSpec, keep_states: bool = False) -> ShotFlight:
+        """Skid and roll one putt to rest on `ground` (`flight.ground.putt_phase`): the ball never leaves it, so the
+        flight's figures are its start's (landing at the tee, carry, apex, times and landing angle 0, the launch's
+        speed and spin). A putt is played on that ground itself from the origin: its states lie on the ground's plane
+        through (0, 0, 0) (z = 0 when level), and `ground.elevation_m`, the height a flight comes down to, plays no
+        part. ValueError for a slope steeper than the surface holds a ball on."""
+        rolled = putt_phase(*launch, ground.surface, ground.slope_deg, ground.slope_dir_deg, keep_states)
+        states = None
+        if rolled.path is not None:
+            path = rolled.path
+            states = EulerStates(times_s=path.times_s, positions=path.positions, velocities=path.velocities)
+        x, y, _ = rolled.position
+        return ShotFlight(
+            landing_x_m=0.0, landing_y_m=0.0, carry_m=0.0, lateral_m=0.0, apex_m=0.0, apex_time_s=0.0,
+            flight_time_s=0.0, landing_angle_deg=0.0, landing_speed_mps=launch.ball_speed_mps,
+            landing_spin_rpm=launch.spin_rpm, states=states, rest=Rest.at(x, y, 0.0, 0, rolled.time_s),
         )
 
     def fly_batch(

@@ -1,0 +1,120 @@
+"""Putts: a ball that starts on the ground at the origin, skids, then rolls to rest (a bay's putter shots).
+
+Start: a putter launches the ball at a few degrees with little spin, a hop at most a few millimetres high and a few
+centimetres long (0.2 mm and 2 cm at 1.83 m/s and 2 degrees), too small to matter, so the launch velocity is
+projected onto the ground's plane through the origin (its vertical part dropped on level ground). The spin is the
+flight's, omega = |omega| (cos psi, 0, -sin psi): back spin (+x for a putt towards +y) makes the ball skid longer
+and roll off slower.
+
+Skid: the contact point slips at s = v + R n x omega. Kinetic friction mu g cos(phi) against the slip slows the
+centre by mu g cos(phi) and spins the ball up by (5/2) mu g cos(phi) / R, so the slip falls at (7/2) mu g cos(phi)
+along its own direction: the skid lasts |s0| / ((7/2) mu g cos(phi)) and ends rolling at `phase._rolling`'s velocity
+(friction at the contact point keeps the angular momentum about it), the centre moving at the mean of its start and
+end velocities. On a slope gravity changes that angular momentum at a steady rate, adding 5/7 of its along-plane
+part times the skid's duration (`phase._downhill`); the duration is taken as on the level: within 1 cm and 1 mm/s of
+a fine integration of the skid on 2-4 degree slopes.
+
+Roll: as after a landing (`flight.ground.phase`): rolling resistance, grass drag and 5/7 of gravity along a slope,
+level ground in closed form, slopes in ROLL_STEP_S steps, so a putt on a slope breaks downhill.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
+from golfflight.flight.ground.phase import (
+    MAX_ROLL_TIME_S,
+    ROLL_STEP_S,
+    GroundPath,
+    _check_slopes,
+    _downhill,
+    _level_states,
+    _rolling,
+    _slope_step,
+    _stop,
+)
+from golfflight.flight.ground.surfaces import Surface
+from golfflight.flight.ground.vectors import TINY, add, cross, dot, norm, times
+
+SKID_FRICTION = 0.3
+"""Kinetic friction coefficient of a golf ball sliding on a green. It sets only where the skid ends, not the speed
+the ball rolls off at; no measured value for greens was found in the sources at hand, so it is set by where putts
+are seen to start rolling, 15-20 % along their length (Cochran and Stobbs, "The Search for the Perfect Swing",
+1968, as quoted by G. Mangum, puttingzone.com): a spinless putt skids 24 c_r / (24 c_r + 25 mu) of its level run,
+14-18 % with 0.3 on stimp 11-8 greens."""
+
+_ORIGIN = (0.0, 0.0, 0.0)
+
+
+class PuttPhase(NamedTuple):
+    """Where a putt came to rest (x, y, z) on its plane through the origin, its time on the ground, the skid's duration
+    and length, and, when kept, its path from the start (the start, the skid's end, every ROLL_STEP_S of the roll,
+    the rest)."""
+
+    position: tuple[float, float, float]
+    time_s: float
+    skid_time_s: float
+    skid_m: float
+    path: GroundPath | None
+
+
+def putt_phase(
+    ball_speed_mps: float,
+    launch_angle_deg: float,
+    launch_direction_deg: float,
+    spin_rpm: float,
+    spin_axis_deg: float,
+    surface: Surface,
+    slope_deg: float = 0.0,
+    slope_dir_deg: float = 0.0,
+    keep_path: bool = False,
+) -> PuttPhase:
+    """Skid and roll a putt launched from the origin to rest on a plane sloped by `slope_deg` towards `slope_dir_deg`
+    (`phase.plane_normals`), on plain floats. ValueError if the slope is steeper than the surface holds a ball on."""
+    _check_slopes(np.float64(slope_deg), np.float64(surface.rolling_resistance))
+    phi, beta = math.radians(slope_deg), math.radians(slope_dir_deg)
+    normal = (math.sin(phi) * math.sin(beta), math.sin(phi) * math.cos(beta), math.cos(phi))
+    gamma, heading, psi = (math.radians(a) for a in (launch_angle_deg, launch_direction_deg, spin_axis_deg))
+    launch = times(ball_speed_mps, (math.cos(gamma) * math.sin(heading), math.cos(gamma) * math.cos(heading),
+                                    math.sin(gamma)))
+    velocity = add(launch, normal, -dot(launch, normal))
+    omega = spin_rpm * RPM_TO_RADPS
+    spin = (omega * math.cos(psi), 0.0, -omega * math.sin(psi))
+    slip = add(velocity, cross(normal, spin), BALL_RADIUS_M)
+    skid_time = norm(slip) / (3.5 * SKID_FRICTION * GRAVITY_MPS2 * normal[2])
+    downhill = _downhill(normal)
+    rolling = add(_rolling(velocity, spin, normal), downhill, skid_time)
+    start = add(times(0.5 * skid_time, velocity), rolling, 0.5 * skid_time)
+    rows = [(0.0, _ORIGIN, velocity)] + ([(skid_time, start, rolling)] if skid_time > 0.0 else [])
+    drag = float(surface.grass_drag_per_s)
+    if slope_deg == 0.0:
+        speed, deceleration = norm(rolling), float(surface.rolling_resistance) * GRAVITY_MPS2
+        distance, roll_time = _stop(speed, deceleration, drag)
+        direction = times(1.0 / max(speed, TINY), rolling)
+        if keep_path:
+            for t in np.arange(ROLL_STEP_S, roll_time - 1e-9, ROLL_STEP_S).tolist():
+                run, now = _level_states(speed, deceleration, drag, t)
+                rows.append((skid_time + t, add(start, direction, run), times(now, direction)))
+        rest, time = add(start, direction, distance), skid_time + float(roll_time)
+    else:
+        brake = float(surface.rolling_resistance) * GRAVITY_MPS2 * normal[2]
+        position, time = start, skid_time
+        for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
+            stops, taken, rest, position, rolling = _slope_step(position, rolling, downhill, brake, drag)
+            time += float(taken)
+            if stops:
+                break
+            if keep_path:
+                rows.append((time, position, rolling))
+        else:
+            rest = position
+    rest = tuple(float(c) for c in rest)
+    path = None
+    if keep_path:
+        rows.append((time, rest, (0.0, 0.0, 0.0)))
+        path = GroundPath(np.array([r[0] for r in rows]), np.array([r[1] for r in rows], dtype=float),
+                          np.array([r[2] for r in rows], dtype=float))
+    return PuttPhase(rest, time, skid_time, norm(start), path)
