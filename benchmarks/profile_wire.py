@@ -106,15 +106,14 @@ def _time_direct_validation() -> None:
 def serve(port: int, loop: str, http: str) -> None:
     """The service on uvicorn with the parts wrapped; GET /_profile answers TOTALS and resets them."""
     import fastapi.routing
-    import golfflight.service.api.routes.shots as shot_route
+    import golfflight.service.runtime.runtime as bay_runtime
     import pydantic
     import starlette.requests
     import starlette.responses
     import uvicorn
     from golfflight.contract import flying
     from golfflight.flight.engine import FlightEngine
-    from golfflight.service.api.app import create_app
-    from golfflight.service.api.state import ServiceState
+    from golfflight.service.app import create_app
     from uvicorn.protocols.http import h11_impl
 
     try:  # httptools_impl imports httptools itself
@@ -129,12 +128,12 @@ def serve(port: int, loop: str, http: str) -> None:
     _wrap(starlette.requests.Request, "json", "json")
     _wrap(fastapi.routing, "solve_dependencies", "validate")
     _time_direct_validation()
-    _wrap(shot_route, "in_bay", "bay")
+    _wrap(bay_runtime, "in_bay", "bay")
     _wrap(FlightEngine, "fly", "flight")
     _wrap(flying, "result_of", "result")
     _wrap(pydantic.BaseModel, "model_dump_json", "serialise")
     _wrap(starlette.responses.Response, "__init__", "serialise")
-    _wrap(ServiceState, "record_simulation", "record")
+    _wrap(bay_runtime.BayRuntime, "record_simulation", "record")
 
     inner = create_app()
 

@@ -1,9 +1,12 @@
-"""The simulator bay's conditions: the air, wind and ground a shot flies in when it brings none of its own, and the
-units the bay's screen shows. A launch monitor's connector sends ball data only (GSPro Open Connect has no field for
-the weather or the green): in a simulator the course's conditions come from the simulator, here from the bay.
+"""The simulator bay's conditions: the air, wind and ground a shot flies in when it brings none of its own, the
+player at the mat (GSPro's club and handedness) and the units the bay's screen shows. A launch monitor's connector
+sends ball data only (GSPro Open Connect has no field for the weather or the green): in a simulator the course's
+conditions and the club selected come from the simulator, here from the bay.
 
 Validated by the same request models and limits as a shot's conditions; a shot's own conditions win, field by field
-(`in_bay`). The server keeps one, changed live and stored in a file (`service.api.bay.Bay`).
+(`in_bay`). The server keeps one, changed live and stored in a file (`service.runtime.bay.Bay`). A partial update
+(`BayUpdate`, PATCH /v1/bay) replaces the parts it names and leaves the rest; the player's two fields merge one by
+one.
 """
 
 from __future__ import annotations
@@ -15,17 +18,73 @@ from pydantic import Field
 
 CONDITION_FIELDS = ("air", "wind", "ground")
 
+GSPRO_CLUBS: dict[str, str] = {
+    "DR": "Driver",
+    **{f"W{n}": f"{n}-wood" for n in range(2, 8)},
+    **{f"H{n}": f"{n}-hybrid" for n in range(2, 8)},
+    **{f"I{n}": f"{n}-iron" for n in range(1, 10)},
+    "PW": "Pitching wedge",
+    "GW": "Gap wedge",
+    "SW": "Sand wedge",
+    "LW": "Lob wedge",
+    "PT": "Putter",
+}
+"""GSPro's club codes (Open Connect's Code 201 `Player.Club`), in the bag's order, with the name a screen shows."""
+
+PUTTER = "PT"
+"""The club code that makes a bay shot a putt: it rolls on the bay's ground from the start."""
+
+ClubCode = Literal[tuple(GSPRO_CLUBS)]
+
+
+class Player(Strict):
+    """Who is at the mat: the club selected (a GSPro club code) and the hand they play. Connectors hear of every
+    change as Open Connect's Code 201 player information."""
+
+    club: ClubCode = Field("DR", description=f"GSPro club code: {', '.join(GSPRO_CLUBS)}")
+    handed: Literal["RH", "LH"] = Field("RH", description="right- or left-handed")
+
 
 class BayConditions(Strict):
-    """What a shot without conditions of its own flies in, and the units the bay's screen shows; the same `air`,
-    `wind` and `ground` objects as a shot request (omitted: ICAO standard air, calm, a level fairway)."""
+    """What a shot without conditions of its own flies in, who plays, and the units the bay's screen shows; the same
+    `air`, `wind` and `ground` objects as a shot request (omitted: ICAO standard air, calm, a level fairway)."""
 
     air: AirRequest | None = None
     wind: WindRequest | None = None
     ground: GroundRequest | None = None
+    player: Player = Field(default_factory=Player)
     units: Literal["imperial", "metric"] = Field(
         "imperial", description="what the bay's screen shows: yards, mph and feet, or metres and m/s"
     )
+
+
+class PlayerUpdate(Strict):
+    """The player's fields to change; an omitted one keeps its value."""
+
+    club: ClubCode | None = Field(None, description=f"GSPro club code: {', '.join(GSPRO_CLUBS)}")
+    handed: Literal["RH", "LH"] | None = None
+
+
+class BayUpdate(Strict):
+    """A partial change of the bay (PATCH /v1/bay): each part named replaces that part (null clears air, wind or
+    ground back to standard air, calm, a level fairway); a part left out stays as it is; `player` changes only
+    the fields it gives."""
+
+    air: AirRequest | None = None
+    wind: WindRequest | None = None
+    ground: GroundRequest | None = None
+    player: PlayerUpdate | None = None
+    units: Literal["imperial", "metric"] | None = None
+
+    def applied_to(self, bay: BayConditions) -> BayConditions:
+        """`bay` with this update's parts in place; validated as a whole again."""
+        given = self.model_dump(exclude_unset=True)
+        parts = {name: getattr(self, name) for name in CONDITION_FIELDS if name in given}
+        if self.units is not None:
+            parts["units"] = self.units
+        if self.player is not None:
+            parts["player"] = bay.player.model_copy(update=self.player.model_dump(exclude_none=True))
+        return BayConditions.model_validate({**dict(bay), **parts})
 
 
 def in_bay(shot: ShotRequest, bay: BayConditions) -> ShotRequest:

@@ -78,14 +78,28 @@ def result_of(
 
 def fly_shot(engine: FlightEngine, shot: ShotRequest) -> ShotResult:
     """One shot (and its normalized replay) on the engine's single-shot path; FlightError if it cannot land."""
-    launch, keep, ground = launch_of(shot), shot.trajectory is not None, ground_of(shot.ground)
+    return flown_shot(engine, shot)[0]
+
+
+def flown_shot(
+    engine: FlightEngine, shot: ShotRequest, *, keep_states: bool = False, putt: bool = False, flat: bool = True
+) -> tuple[ShotResult, ShotFlight]:
+    """`fly_shot`'s result and the flight it was read from (its states through the ground phase to rest when
+    `keep_states`, for a renderer: the numbers and the picture of one flight). A `putt` rolls on the shot's ground
+    from the start (`FlightEngine.putt`: no flight, so no normalized or flat flight); `flat` False leaves the flat
+    flight out (a GSPro reply has no field for it). FlightError if it cannot land."""
+    launch, ground = launch_of(shot), ground_of(shot.ground)
+    keep = keep_states or shot.trajectory is not None
+    if putt:
+        flight = engine.putt(launch, ground, keep)
+        return result_of(shot, flight), flight
     flight = engine.fly(launch, conditions_of(shot), keep, ground)
     reference = reference_of(shot)
     normalized = None
     if reference is not None:
-        normalized = engine.fly(launch, Conditions(air_of(reference), CALM), keep, ground)
-    flat = engine.fly(launch, conditions_of(shot)) if lands_off_the_flat(shot) else None
-    return result_of(shot, flight, normalized, flat)
+        normalized = engine.fly(launch, Conditions(air_of(reference), CALM), shot.trajectory is not None, ground)
+    flat_flight = engine.fly(launch, conditions_of(shot)) if flat and lands_off_the_flat(shot) else None
+    return result_of(shot, flight, normalized, flat_flight), flight
 
 
 def _batch_of(shots: list[ShotRequest]) -> tuple[list[Launch], list[Conditions], list, list[int], list[int]]:
@@ -102,8 +116,11 @@ def _batch_of(shots: list[ShotRequest]) -> tuple[list[Launch], list[Conditions],
     return launches, conditions, grounds, replays, flats
 
 
-def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> list[ShotResult | ShotFailure]:
-    """One engine batch for `shots`, their normalized replays and their flat flights; results in order."""
+def _fly_group(
+    engine: FlightEngine, shots: list[ShotRequest], keep: bool
+) -> tuple[list[ShotResult | ShotFailure], list[ShotFlight | FlightError]]:
+    """One engine batch for `shots`, their normalized replays and their flat flights; results in order, and each
+    shot's own flight."""
     launches, conditions, grounds, replays, flats = _batch_of(shots)
     flights = engine.fly_batch(launches, conditions, keep, grounds)
     replayed = dict(zip(replays, flights[len(shots) : len(shots) + len(replays)], strict=True))
@@ -113,7 +130,7 @@ def _fly_group(engine: FlightEngine, shots: list[ShotRequest], keep: bool) -> li
         own = (flights[i], replayed.get(i), flat.get(i))
         failure = next((f for f in own if isinstance(f, FlightError)), None)
         results.append(ShotFailure(error=str(failure)) if failure else result_of(shot, *own))
-    return results
+    return results, flights[: len(shots)]
 
 
 @dataclass(frozen=True)
@@ -160,14 +177,27 @@ def fly_columns(engine: FlightEngine, shots: list[ShotRequest]) -> ShotColumns:
 
 
 def fly_shots(engine: FlightEngine, shots: list[ShotRequest]) -> list[ShotResult | ShotFailure]:
-    """Many shots in engine batches (normalized replays ride along); results in order. Shots asking for a
-    trajectory fly in a batch of their own, so the rest do not keep every integrator state."""
-    traced = [i for i, shot in enumerate(shots) if shot.trajectory is not None]
-    if not traced or len(traced) == len(shots):
-        return _fly_group(engine, shots, keep=bool(traced))
-    plain = [i for i, shot in enumerate(shots) if shot.trajectory is None]
+    """Many shots in engine batches (normalized replays ride along); results in order."""
+    return flown_shots(engine, shots)[0]
+
+
+def flown_shots(
+    engine: FlightEngine, shots: list[ShotRequest], shown: int = 0
+) -> tuple[list[ShotResult | ShotFailure], dict[int, ShotFlight]]:
+    """`fly_shots`'s results, and the flights of the last `shown` shots that flew, their states kept through the
+    ground phase (for a renderer), by index. Shots asking for a trajectory or shown fly in a batch of their own, so
+    the rest do not keep every integrator state."""
+    first_shown = len(shots) - min(shown, len(shots))
+    traced = [i for i, shot in enumerate(shots) if shot.trajectory is not None or i >= first_shown]
+    plain = [i for i, shot in enumerate(shots) if shot.trajectory is None and i < first_shown]
     results: list[ShotResult | ShotFailure | None] = [None] * len(shots)
+    kept: dict[int, ShotFlight] = {}
     for indices, keep in ((plain, False), (traced, True)):
-        for i, result in zip(indices, _fly_group(engine, [shots[i] for i in indices], keep), strict=True):
+        if not indices:
+            continue
+        group, flights = _fly_group(engine, [shots[i] for i in indices], keep)
+        for i, result, flight in zip(indices, group, flights, strict=True):
             results[i] = result
-    return results
+            if i >= first_shown and not isinstance(flight, FlightError):
+                kept[i] = flight
+    return results, kept

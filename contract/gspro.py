@@ -5,19 +5,19 @@ letter case (connectors in the wild send `APIVersion` and `Backspin`); the value
 like every other launch (GSPRO_RANGES, quoted in the error message). The BallData of a heartbeat or of a message
 that says it carries none is not read (connectors pad it with zeros). Speeds are mph, angles degrees (HLA + =
 right), spins rpm. BackSpin and SideSpin are used only when TotalSpin is absent (or zero while they are not);
-+ SideSpin curves the ball right. HTTP (`POST /v1/gspro`) and TCP (`service.open_connect`) answer through
-`fly_message` and `invalid_message`.
++ SideSpin curves the ball right. HTTP (`POST /v1/gspro`) and TCP (`service.open_connect`) answer through the bay
+runtime (`service.runtime`, with `shot_request`, `shot_reply` and `invalid_message`).
 """
 
 from __future__ import annotations
 
 from typing import Annotated
 
-from golfflight.contract.bay import BayConditions
-from golfflight.contract.flying import flight_fields
-from golfflight.contract.inputs import conditions_from, ground_of, spin_from_components
+from golfflight.contract.bay import BayConditions, in_bay
+from golfflight.contract.flying import flown_shot
+from golfflight.contract.inputs import spin_from_components
 from golfflight.contract.refusals import describe_errors
-from golfflight.contract.requests import BALL_SPEED_MPH, SIDE_SPIN_RPM
+from golfflight.contract.requests import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotRequest
 from golfflight.contract.results import ShotResult
 from golfflight.flight import limits
 from golfflight.flight.constants import MPH_TO_MPS
@@ -92,7 +92,8 @@ class GSProOptions(_Lenient):
 
 
 class GSProMessage(_Lenient):
-    """One Open Connect v1 message (ClubData is accepted and not used: the flight needs the ball only)."""
+    """One Open Connect v1 message (ClubData is kept for the bay's screens and not used: the flight needs the ball
+    only)."""
 
     DeviceID: str | None = None
     Units: str | None = None
@@ -155,15 +156,40 @@ def invalid_message(errors: list) -> str:
     return "; ".join(detail["message"] for detail in describe_errors(errors, GSPRO_RANGES))
 
 
-def fly_message(engine: FlightEngine, message: GSProMessage, bay: BayConditions | None = None) -> GSProReply:
+def shot_request(message: GSProMessage) -> ShotRequest:
+    """The /v1/shots request of a message's ball (launch only: Open Connect carries no conditions, the bay gives
+    them); ValueError naming the field when one it needs is missing. Built without re-validation: GSProBallData
+    has checked every value against GSPRO_RANGES."""
+    launch = launch_from_ball_data(message.BallData)
+    return ShotRequest.model_construct(
+        ball_speed_mps=launch.ball_speed_mps,
+        launch_angle_deg=launch.launch_angle_deg,
+        launch_direction_deg=launch.launch_direction_deg,
+        spin_rpm=launch.spin_rpm,
+        spin_axis_deg=launch.spin_axis_deg,
+    )
+
+
+def shot_reply(message: GSProMessage, result: ShotResult) -> GSProReply:
+    """Code 200 with a shot's flight."""
+    return GSProReply(Code=200, Message="shot received", ShotNumber=message.ShotNumber, Flight=result)
+
+
+def failed_reply(message: GSProMessage, error: Exception) -> GSProReply:
+    """Code 500 saying why the shot could not fly."""
+    return GSProReply(Code=500, Message=str(error), ShotNumber=message.ShotNumber)
+
+
+def fly_message(
+    engine: FlightEngine, message: GSProMessage, bay: BayConditions | None = None, putt: bool = False
+) -> GSProReply:
     """The reply to a message with BallData: Code 200 with its flight in the bay's conditions (`contract.bay`;
     without a bay: standard air, calm, rolled to rest on a level fairway), or Code 500 saying why it could not fly.
-    Open Connect carries ball data only: its shots always fly in the bay's air, wind and ground."""
-    bay = bay or BayConditions()
+    Open Connect carries ball data only: its shots always fly in the bay's air, wind and ground. The served bay
+    flies messages through `service.runtime`, which keeps the flight's states for its screens too."""
     try:
-        flight = engine.fly(launch_from_ball_data(message.BallData), conditions_from(bay.air, bay.wind),
-                            ground=ground_of(bay.ground))
+        request = in_bay(shot_request(message), bay or BayConditions())
+        result, _ = flown_shot(engine, request, putt=putt, flat=False)
     except (ValueError, FlightError) as error:
-        return GSProReply(Code=500, Message=str(error), ShotNumber=message.ShotNumber)
-    result = ShotResult.model_construct(**flight_fields(flight, None))
-    return GSProReply(Code=200, Message="shot received", ShotNumber=message.ShotNumber, Flight=result)
+        return failed_reply(message, error)
+    return shot_reply(message, result)

@@ -50,7 +50,7 @@ def running(app, ready_path: str = "/healthz", timeout_s: float = 20.0) -> Itera
 @contextmanager
 def keyed_service(key: str) -> Iterator[tuple[httpx.Client, int, object]]:
     """(client, Open Connect port, app) of one service with an API key, listening on HTTP and on Open Connect TCP."""
-    from golfflight.service.api.app import create_app
+    from golfflight.service.app import create_app
     from golfflight.service.open_connect.server import ConnectAddress
 
     port = free_port()

@@ -12,7 +12,7 @@ from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.evaluation.accuracy_sets import compare_clubs
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from golfflight.shots.paths import shared_data_dir
 from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
 from golfflight.weights_schema.bundle import load_bundle
@@ -271,9 +271,9 @@ def test_latency_reports_rolling_percentiles_and_a_probe(client):
 
 def test_the_service_imports_no_torch():
     code = (
-        "import sys, golfflight.service.api.app, golfflight.flight.engine\n"
+        "import sys, golfflight.service.app, golfflight.flight.engine\n"
         "import golfflight.commands.serve, golfflight.commands.simulate\n"
-        "golfflight.service.api.app.create_app()\n"
+        "golfflight.service.app.create_app()\n"
         "assert 'torch' not in sys.modules, 'torch imported on the serving path'"
     )
     subprocess.run([sys.executable, "-c", code], check=True)

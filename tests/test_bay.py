@@ -10,8 +10,8 @@ import socket
 import pytest
 from golfflight.contract.bay import BayConditions, in_bay
 from golfflight.contract.requests import AirRequest, GroundRequest, ShotRequest, WindRequest
-from golfflight.service.api.app import create_app
-from golfflight.service.api.bay import Bay, BayFileError
+from golfflight.service.app import create_app
+from golfflight.service.runtime.bay import Bay, BayFileError
 from golfflight.service.open_connect.server import ConnectAddress
 
 from tests.servers import free_port, running, shot
@@ -76,6 +76,7 @@ def test_http_batch_and_open_connect_shots_fly_in_the_bay_and_it_survives_a_rest
         answer = http.put("/v1/bay", json=DENVER_HEAT)
         assert answer.status_code == 200, answer.text
         assert http.get("/v1/bay").json() == {**DENVER_HEAT, "units": "imperial",
+                                               "player": {"club": "DR", "handed": "RH"},
                                                "wind": {**DENVER_HEAT["wind"], "profile": "uniform",
                                                         "reference_height_m": 10.0},
                                                "ground": {**DENVER_HEAT["ground"], "elevation_m": 0.0,

@@ -14,7 +14,7 @@ import pytest
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from golfflight.weights_schema.bundle import BundleError, sha256_of
 from onnx import numpy_helper
 from servers import running

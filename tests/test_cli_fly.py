@@ -16,7 +16,7 @@ from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.flyer import Flyer
 from golfflight.flight.physics import initial_state
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from golfflight.service.viewer.page import ASSETS
 from golfflight.shots import reference_world
 from golfflight.shots.clubs import CLUB_ALIASES, CLUB_NAMES, CLUBS, canonical_club_name, club_key, club_named

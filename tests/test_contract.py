@@ -13,7 +13,7 @@ import pytest
 from golfflight.contract.flying import fly_shots
 from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, RANGES, ShotRequest
 from golfflight.flight import limits
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from golfflight.service.api.guards import MAX_BODY_BYTES
 from servers import running
 
@@ -206,7 +206,7 @@ def test_a_batch_process_that_dies_is_replaced(http):
 
 
 def test_a_shot_that_does_not_land_in_time_fails_alone(app, http):
-    engine = app.state.service.engine
+    engine = app.state.runtime.engine
     saved = engine.flyer.max_steps
     engine.flyer.max_steps = 12  # 1.2 s: a putt-like shot lands, a 7-iron is still up
     try:

@@ -11,7 +11,7 @@ from fastapi import APIRouter, Depends, FastAPI, Request
 from fastapi.routing import APIRoute
 from golfflight.contract.gspro import GSProMessage
 from golfflight.contract.requests import BatchRequest, ShotRequest
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from golfflight.service.api.direct import DirectRoute
 from pydantic import ValidationError
 

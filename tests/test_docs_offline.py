@@ -10,7 +10,7 @@ from urllib.parse import urljoin, urlsplit
 
 import browser
 import pytest
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from golfflight.service.api.routes.docs import ASSETS_DIR
 from servers import running
 

@@ -12,7 +12,7 @@ import time
 
 import httpx
 import pytest
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from golfflight.service.api.guards import API_KEY_ENV
 from servers import free_port, running
 

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 import schemathesis
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from hypothesis import HealthCheck, given, settings
 from schemathesis import GenerationMode
 from schemathesis.checks import negative_data_rejection, positive_data_acceptance

@@ -15,7 +15,7 @@ from golfflight.flight.constants import YARD_M
 from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.ground import SURFACES, GroundSpec, holding_slope_deg
 from golfflight.flight.limits import SLOPE_DEG
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from servers import running, shot

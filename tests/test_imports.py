@@ -1,6 +1,8 @@
 """Who may import whom, read from the sources (ast), not from a running process: every package imports only the
 floors below its own (docs/architecture.md), the HTTP package (`service/api/`) is imported by nothing outside it
-but the command that starts the app, and the shot contract holds no HTTP code."""
+but the service's assembly and the command that starts it, the bay runtime imports none of its adapters (HTTP,
+Open Connect, the viewer) and they import neither each other nor the HTTP app, and the shot contract holds no HTTP
+code."""
 
 from __future__ import annotations
 
@@ -11,6 +13,10 @@ ROOT = Path(__file__).resolve().parents[1]
 HTTP_PACKAGE = "golfflight.service.api"
 HTTP_FOLDER = ROOT / "service" / "api"
 STARTS_THE_APP = ROOT / "golfflight" / "commands" / "serve.py"
+ASSEMBLES_THE_SERVICE = ROOT / "service" / "app.py"
+RUNTIME = "golfflight.service.runtime"
+ADAPTERS = ("golfflight.service.api", "golfflight.service.open_connect", "golfflight.service.viewer")
+"""The bay runtime's adapters: each sits on the runtime and none imports another (`service.app` joins them)."""
 TIMES_THE_APP_FROM_INSIDE = ROOT / "benchmarks" / "profile_wire.py"
 """The profile of one request wraps the HTTP package's own functions to time them (docs/benchmarks.md)."""
 HTTP_LIBRARIES = ("fastapi", "starlette", "uvicorn")
@@ -88,7 +94,8 @@ def test_nothing_outside_the_http_package_imports_it_but_the_command_that_starts
     offenders = [
         f"{path.relative_to(ROOT)} imports {name}"
         for path in _modules()
-        if not path.is_relative_to(HTTP_FOLDER) and path not in (STARTS_THE_APP, TIMES_THE_APP_FROM_INSIDE)
+        if not path.is_relative_to(HTTP_FOLDER)
+        and path not in (STARTS_THE_APP, ASSEMBLES_THE_SERVICE, TIMES_THE_APP_FROM_INSIDE)
         for name in sorted(imported(path))
         if _within(name, HTTP_PACKAGE)
     ]
@@ -101,5 +108,30 @@ def test_the_shot_contract_holds_no_http_code():
         for path in sorted((ROOT / "contract").rglob("*.py"))
         for name in sorted(imported(path))
         if any(_within(name, library) for library in HTTP_LIBRARIES)
+    ]
+    assert offenders == []
+
+
+def _folder(package: str) -> Path:
+    return ROOT.joinpath(*package.split(".")[1:])
+
+
+def test_the_bay_runtime_imports_no_adapter_and_no_http_library():
+    offenders = [
+        f"{path.relative_to(ROOT)} imports {name}"
+        for path in sorted(_folder(RUNTIME).rglob("*.py"))
+        for name in sorted(imported(path))
+        if any(_within(name, other) for other in (*ADAPTERS, *HTTP_LIBRARIES, "golfflight.service.app"))
+    ]
+    assert offenders == []
+
+
+def test_the_adapters_import_neither_each_other_nor_the_assembly():
+    offenders = [
+        f"{path.relative_to(ROOT)} imports {name}"
+        for adapter in ADAPTERS
+        for path in sorted(_folder(adapter).rglob("*.py"))
+        for name in sorted(imported(path))
+        if any(_within(name, other) for other in (*ADAPTERS, "golfflight.service.app") if other != adapter)
     ]
     assert offenders == []

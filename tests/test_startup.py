@@ -13,7 +13,7 @@ from pathlib import Path
 
 import httpx
 import uvicorn
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from golfflight.service.open_connect.server import ConnectAddress
 from servers import free_port
 

@@ -14,7 +14,7 @@ import pytest
 from golfflight.contract.columns import result_columns
 from golfflight.contract.results import FlatFlight, FlightResult, Landing, RestPoint
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from golfflight.service.api.app import create_app
+from golfflight.service.app import create_app
 from golfflight.service.open_connect.server import ConnectAddress
 
 from golfflight.cli import main

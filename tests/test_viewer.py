@@ -14,13 +14,15 @@ from functools import partial
 import browser
 import httpx
 import pytest
-from golfflight.contract.flying import fly_shot
+import numpy as np
+from golfflight.contract.flying import flown_shot
 from golfflight.contract.requests import ShotRequest
-from golfflight.service.api.app import create_app
-from golfflight.service.api.routes import viewer as viewer_routes
+from golfflight.service.app import create_app
 from golfflight.service.open_connect.server import ConnectAddress
+from golfflight.service.runtime.feed import HISTORY, ShotFeed, TooManyViewers
+from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.viewer.event import SCHEMA_PATH, ShotEvent, schema_text
-from golfflight.service.viewer.feed import HISTORY, MAX_POINTS, ShotFeed, TooManyViewers, thin
+from golfflight.service.viewer.frames import MAX_POINTS, frame
 from golfflight.service.viewer.stream import events
 from servers import free_port, keyed_service, running
 
@@ -67,25 +69,23 @@ def test_the_event_schema_is_current():
     )
 
 
-def test_thin_keeps_both_ends_and_at_most_the_limit():
-    points = list(range(20_001))
-    kept = thin(points)
-    assert len(kept) <= MAX_POINTS and kept[0] == 0 and kept[-1] == 20_000
-    assert thin(points[:10]) == points[:10]
+def publish(feed: ShotFeed, engine, request: ShotRequest, source: str = "http", putt: bool = False):
+    """Fly a request as the runtime does (states kept) and publish it; the feed's entry."""
+    result, flight = flown_shot(engine, request, keep_states=True, putt=putt)
+    return feed.publish(source, request, result, flight.states, flight.flight_time_s, putt=putt)
 
 
 def test_the_feed_keeps_its_last_shots_and_a_full_viewer_drops_its_oldest(engine):
     request = ShotRequest(**DRIVER)
-    result = fly_shot(engine, request)
     feed = ShotFeed(history=5)
     stalled = feed.subscribe()
     for _ in range(12):
-        feed.publish("http", request, result)
+        publish(feed, engine, request)
     assert [entry.id for entry in stalled.pending] == [8, 9, 10, 11, 12] and stalled.dropped == 7
     assert [entry.id for entry in feed.subscribe().pending] == [8, 9, 10, 11, 12]
     assert [entry.id for entry in feed.subscribe(after_id=10).pending] == [11, 12]
     restarted = feed.subscribe(after_id=400)  # an id from before a restart: everything kept
-    assert len(restarted.pending) == 5
+    assert len(restarted.pending) == 5 and len(feed.session) == 12
     for viewer in feed.viewers:
         feed.unsubscribe(viewer)
     assert feed.viewers == ()
@@ -98,26 +98,34 @@ def test_too_many_viewers_are_refused():
         feed.subscribe()
 
 
-def test_each_input_is_rendered_from_its_own_result_with_a_trajectory_to_rest(engine):
-    plain = ShotRequest(**DRIVER)
-    traced = ShotRequest(**DRIVER, trajectory={"rate_hz": 1000})
+GREEN_BELOW = {"surface": "green", "stimp_ft": 12.0, "elevation_m": -3.0}
+
+
+@pytest.mark.parametrize(
+    ("shot", "putt"),
+    [
+        (DRIVER, False),
+        ({**DRIVER, "trajectory": {"rate_hz": 1000}}, False),
+        ({**DRIVER, "ground": GREEN_BELOW, "wind": {"speed_mps": 8.0, "from_deg": 0.0},
+          "air": {"altitude_m": 1600.0, "temperature_c": 30.0}}, False),
+        ({"ball_speed_mps": 1.83, "launch_angle_deg": 2.0, "spin_rpm": 100.0, "ground": GREEN_BELOW}, True),
+    ],
+)
+def test_the_drawn_path_is_the_answered_flight_through_its_landing_to_its_rest(engine, shot, putt):
+    request = ShotRequest(**shot)
     feed = ShotFeed()
-    feed.publish("http", plain, fly_shot(engine, plain))
-    feed.publish("http", traced, fly_shot(engine, traced))
-    feed.publish_batch([plain] * (HISTORY + 7))
-    entries = list(feed.subscribe().pending)
-    assert len(entries) == HISTORY and [e.source for e in entries[-2:]] == ["batch", "batch"]
-    own = fly_shot(engine, plain)
-    for entry in (*entries[:2], entries[-1]):
-        event = ShotEvent.model_validate_json(feed.frame(entry, engine).split("data: ", 1)[1])
-        flight = event.flight
-        assert flight.carry_yd == own.carry_yd and flight.apex_m == own.apex_m
-        assert event.launch.ball_speed_mps == pytest.approx(167.0 * 0.44704)
-        assert 30 <= len(flight.trajectory) <= MAX_POINTS
-        end = flight.trajectory[-1]  # through the bounces and the roll
-        assert (end.x_m, end.y_m, end.z_m) == pytest.approx((flight.rest.x_m, flight.rest.y_m, 0.0), abs=1e-6)
-        assert flight.total_yd == own.total_yd and flight.bounces == own.bounces
-        assert entry.shot is None and entry.result is None and entry.path is None  # only the event is kept
+    entry = publish(feed, engine, request, putt=putt)
+    answered = entry.result
+    event = ShotEvent.model_validate_json(frame(entry).split("data: ", 1)[1])
+    flight = event.flight
+    assert flight.carry_m == answered.carry_m and flight.rest == answered.rest
+    assert 2 <= len(flight.trajectory) <= MAX_POINTS
+    points = np.array([(p.x_m, p.y_m, p.z_m) for p in flight.trajectory])
+    floor = request.ground.elevation_m if request.ground is not None and not putt else 0.0
+    assert points[-1] == pytest.approx((answered.rest.x_m, answered.rest.y_m, floor), abs=1e-9)
+    landing = (answered.landing.x_m, answered.landing.y_m, floor)
+    assert np.min(np.linalg.norm(points - landing, axis=1)) < 1e-9  # the landing itself, not a chord beside it
+    assert event.putt is putt and entry.frame is not None and entry.states is None  # only the event is kept
 
 
 def test_a_stream_ends_after_its_lifetime_and_lets_its_viewer_go(engine):
@@ -126,9 +134,9 @@ def test_a_stream_ends_after_its_lifetime_and_lets_its_viewer_go(engine):
     async def stream() -> tuple[ShotFeed, list[str], float]:
         feed = ShotFeed()
         viewer = feed.subscribe()
-        feed.publish("http", request, fly_shot(engine, request))
+        publish(feed, engine, request)
         started = time.monotonic()
-        frames = [frame async for frame in events(feed, viewer, engine, lifetime_s=0.3)]
+        frames = [frame async for frame in events(feed, viewer, lifetime_s=0.3)]
         return feed, frames, time.monotonic() - started
 
     feed, frames, seconds = asyncio.run(stream())
@@ -192,7 +200,7 @@ def test_shots_over_http_batch_and_tcp_reach_an_open_stream_in_milliseconds(serv
 
 def test_a_stalled_viewer_never_delays_a_shot(service, monkeypatch):
     http, _, app = service
-    feed = app.state.service.feed
+    feed = app.state.runtime.feed
     monkeypatch.setattr(viewer_routes, "events", partial(events, lifetime_s=120))  # stalled, not just slow to close
 
     def timed(shot: dict, n: int) -> list[float]:
@@ -232,7 +240,7 @@ def test_a_stalled_viewer_never_delays_a_shot(service, monkeypatch):
 
 def test_too_many_viewers_get_503_saying_so(service):
     http, _, app = service
-    state = app.state.service
+    state = app.state.runtime
     kept, state.feed = state.feed, ShotFeed(max_viewers=0)
     try:
         answer = http.get("/v1/events", headers=KEYED)

@@ -16,8 +16,8 @@ import httpx
 import pytest
 from golfflight.contract.flying import fly_shot
 from golfflight.contract.requests import ShotRequest
-from golfflight.service.api.app import create_app
-from golfflight.service.api.routes import viewer as viewer_routes
+from golfflight.service.app import create_app
+from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.open_connect.server import ConnectAddress
 from golfflight.service.viewer.feed import ShotFeed
 from golfflight.service.viewer.stream import KEEPALIVE_FRAME, KEEPALIVE_S, events, serving_server
@@ -62,9 +62,9 @@ def test_only_the_bays_own_shots_reach_the_viewer_unless_a_request_asks(service,
         batch = {"shots": [DRIVER, {**DRIVER, "ball_speed_mph": 120.0}]}
         assert http.post("/v1/shots/batch?viewer=true", json=batch, headers=KEYED).status_code == 200
         assert [next_event(lines).source, next_event(lines).source] == ["batch", "batch"]
-    kept = [entry.source for entry in app.state.service.feed.subscribe().pending]
-    for viewer in app.state.service.feed.viewers:
-        app.state.service.feed.unsubscribe(viewer)
+    kept = [entry.source for entry in app.state.runtime.feed.subscribe().pending]
+    for viewer in app.state.runtime.feed.viewers:
+        app.state.runtime.feed.unsubscribe(viewer)
     assert "batch" in kept and kept.count("http") <= 2  # earlier tests' tagged shots at most; none untagged
 
 

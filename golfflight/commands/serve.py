@@ -7,7 +7,7 @@ GRACEFUL_SHUTDOWN_S) before the workers exit. --connect-port also takes GSPro Op
 process (`service.open_connect`), on loopback unless --connect-host says otherwise: the protocol has no key.
 Several workers share their Prometheus metrics through files in $PROMETHEUS_MULTIPROC_DIR (a temporary directory
 unless set), so GET /metrics answers for the whole server whichever worker takes the scrape. --bay FILE keeps the
-simulator bay's conditions (air, wind, ground, units: GET/PUT /v1/bay, `service.api.bay`) there across restarts;
+simulator bay's conditions (air, wind, ground, units: GET/PUT /v1/bay, `service.runtime.bay`) there across restarts;
 a file that is not bay conditions stops the start with one line naming it and the field.
 """
 
@@ -101,9 +101,9 @@ def run(args: argparse.Namespace) -> int:
 
     from golfflight.flight.bundle_check import verify_bundle
     from golfflight.flight.bundle_location import MODEL_ENV, model_dir
-    from golfflight.service.api.bay import BAY_FILE_ENV, Bay
+    from golfflight.service.runtime.bay import BAY_FILE_ENV, Bay
     from golfflight.service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
-    from golfflight.service.api.metrics import shared_across_workers
+    from golfflight.service.runtime.metrics import shared_across_workers
     from golfflight.service.open_connect.server import CONNECT_HOST_ENV, CONNECT_PORT_ENV
 
     if args.workers < 1:
@@ -144,7 +144,7 @@ def run(args: argparse.Namespace) -> int:
         )
     with shared_across_workers(args.workers):  # GET /metrics sums every worker's counts
         uvicorn.run(
-            "golfflight.service.api.app:create_app",
+            "golfflight.service.app:create_app",
             factory=True,
             host=args.host,
             port=args.port,

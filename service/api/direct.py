@@ -17,7 +17,7 @@ from typing import Any
 
 from fastapi.routing import APIRoute
 from golfflight.service.api.request_body import read_body, replay
-from golfflight.service.api.state import NotReady
+from golfflight.service.runtime import NotReady
 from pydantic import BaseModel, ValidationError
 from starlette.requests import Request
 from starlette.responses import Response

@@ -12,8 +12,8 @@ from fastapi.responses import JSONResponse, Response
 from golfflight.contract.gspro import GSProReply, invalid_message
 from golfflight.contract.refusals import body_detail, describe_errors
 from golfflight.contract.requests import RANGES
-from golfflight.service.api.routes.gspro import GSPRO_PATH
-from golfflight.service.api.state import NotReady
+from golfflight.service.api.paths import GSPRO_PATH
+from golfflight.service.runtime import NotReady
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 NOT_JSON = "the body is not JSON text in UTF-8"

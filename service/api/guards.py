@@ -11,7 +11,6 @@ import json
 
 from golfflight.contract.refusals import body_detail
 from golfflight.service.api.request_body import read_body, replay
-from golfflight.service.viewer.page import PUBLIC_PATHS
 
 API_KEY_ENV = "GOLFFLIGHT_API_KEY"
 """Environment variable holding the API key; when set (non-empty) every route but /healthz requires it."""
@@ -22,9 +21,9 @@ CORS_ORIGINS_ENV = "GOLFFLIGHT_CORS_ORIGINS"
 MAX_BODY_BYTES = 8 * 1024 * 1024
 """Largest request body accepted (a full 10,000-shot batch with every option is about 4.5 MB)."""
 
-OPEN_PATHS = frozenset({"/healthz", *PUBLIC_PATHS})
-"""Routes answered without the API key (load balancers and health checks hold no secret; the viewer page holds no
-data and asks for the key to open its event stream)."""
+OPEN_PATHS = frozenset({"/healthz"})
+"""Routes always answered without the API key (load balancers and health checks hold no secret); the assembly adds
+the pages that hold no data (the viewer's, which asks for the key to open its event stream)."""
 
 
 async def _send_json(send, status: int, body: dict, headers: list[tuple[bytes, bytes]] = ()) -> None:
@@ -73,11 +72,11 @@ class BodyLimit:
 
 
 class ApiKey:
-    """Requires `X-API-Key: KEY` (or `Authorization: Bearer KEY`) on every route except OPEN_PATHS; CORS preflight
-    requests pass (they carry no credentials; the CORS middleware outside answers them)."""
+    """Requires `X-API-Key: KEY` (or `Authorization: Bearer KEY`) on every route except OPEN_PATHS and `open_paths`;
+    CORS preflight requests pass (they carry no credentials; the CORS middleware outside answers them)."""
 
-    def __init__(self, app, key: str):
-        self.app, self._key = app, key.encode()
+    def __init__(self, app, key: str, open_paths: frozenset[str] = frozenset()):
+        self.app, self._key, self._open = app, key.encode(), OPEN_PATHS | open_paths
 
     def _authorised(self, headers: dict[bytes, bytes]) -> bool:
         given = headers.get(b"x-api-key")
@@ -87,7 +86,7 @@ class ApiKey:
         return hmac.compare_digest(given, self._key)
 
     async def __call__(self, scope, receive, send):
-        if scope["type"] != "http" or scope["path"] in OPEN_PATHS or scope["method"] == "OPTIONS":
+        if scope["type"] != "http" or scope["path"] in self._open or scope["method"] == "OPTIONS":
             await self.app(scope, receive, send)
             return
         if self._authorised(dict(scope["headers"])):

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import time
 
-from golfflight.service.api.latency import Rolling
-from golfflight.service.api.metrics import ServiceMetrics
+from golfflight.service.runtime.latency import Rolling
+from golfflight.service.runtime.metrics import ServiceMetrics
 from starlette.routing import BaseRoute, Match
 
 UNMATCHED = "<unmatched>"

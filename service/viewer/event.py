@@ -9,15 +9,13 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Literal
-
+from golfflight.contract.bay import Player
+from golfflight.contract.requests import AirRequest, GroundRequest, WindRequest
 from golfflight.contract.results import ShotResult
+from golfflight.service.runtime.feed import Source
 from pydantic import BaseModel, Field
 
 SCHEMA_PATH = Path(__file__).with_name("event.schema.json")
-
-Source = Literal["http", "batch", "gspro-http", "open-connect"]
-"""Where a shot came in: POST /v1/shots, POST /v1/shots/batch, POST /v1/gspro, GSPro Open Connect over TCP."""
 
 
 class LaunchNumbers(BaseModel):
@@ -31,15 +29,28 @@ class LaunchNumbers(BaseModel):
 
 
 class ShotEvent(BaseModel):
-    """One shot for the viewer: its launch and its flight result, the trajectory always included (resampled for
-    drawing, at most `feed.MAX_POINTS` points; through the ground phase to rest when the result has one)."""
+    """One shot for the viewer: its launch and the flight result answered, with the trajectory of that very flight
+    (its states resampled for drawing, at most `frames.MAX_POINTS` points, passing exactly through the landing, each
+    impact and the rest), and what it was flown in and with."""
 
     id: int = Field(ge=1, description="rising per service process; the event's SSE id (Last-Event-ID resumes after it)")
     source: Source
     received_unix_s: float = Field(description="when the shot arrived, seconds since 1970 (UTC)")
     shot_number: int | None = Field(None, description="the connector's ShotNumber (GSPro Open Connect)")
     launch: LaunchNumbers
-    flight: ShotResult = Field(description="the flight result the client got back (a /v1/shots result)")
+    flight: ShotResult = Field(description="the flight result the client got back (a /v1/shots result), its "
+                               "trajectory the states it was computed from, through the bounces and roll to rest")
+    player: Player | None = Field(None, description="who was at the mat: the bay's club and hand when the shot was "
+                                  "flown (the bay's own shots: HTTP single shots, GSPro over HTTP and TCP)")
+    putt: bool = Field(False, description="rolled on the ground from the start (the putter was selected)")
+    club_data: dict[str, float | int | str | bool | None] | None = Field(
+        None, description="the connector's ClubData as sent (GSPro Open Connect: Speed, AngleOfAttack, FaceToTarget, "
+        "Lie, Loft, Path, SpeedAtImpact, VerticalFaceImpact, HorizontalFaceImpact, ClosureRate), not used by the flight"
+    )
+    air: AirRequest | None = Field(None, description="the air it flew in (none: ICAO standard air)")
+    wind: WindRequest | None = Field(None, description="the wind it flew in (none: calm)")
+    ground: GroundRequest | None = Field(None, description="the ground it came down, bounced and rolled on (none: a "
+                                         "level fairway at the tee's height)")
 
 
 def schema_text() -> str:

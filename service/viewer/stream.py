@@ -15,12 +15,13 @@ with Last-Event-ID, losing nothing that is kept.
 
 from __future__ import annotations
 
+import re
 import signal
 import time
 from collections.abc import AsyncIterator, Callable
 
-from golfflight.flight.engine import FlightEngine
-from golfflight.service.viewer.feed import ShotFeed, Viewer
+from golfflight.service.runtime.feed import ShotFeed, Viewer
+from golfflight.service.viewer.frames import frame
 
 KEEPALIVE_S = 15.0
 """Longest a stream stays silent: a `: keep-alive` comment is sent after this long without a shot."""
@@ -34,9 +35,17 @@ RETRY_MS = 500
 KEEPALIVE_FRAME = ": keep-alive\n\n"
 
 
+SHOT_ID = re.compile(r"[0-9]{1,18}")
+"""A shot id as this service writes them: ASCII digits (`str.isdigit` also takes "²", which `int` refuses), short
+enough for `int` (which refuses over 4,300 digits)."""
+
+
 def last_event_id(header: str | None) -> int | None:
-    """The Last-Event-ID a reconnecting page sends, or None when absent or not a shot id."""
-    return int(header) if header is not None and header.strip().isdigit() else None
+    """The Last-Event-ID a reconnecting page sends, or None when absent or not a shot id of ours (the page then
+    gets every kept shot, as a new page does)."""
+    if header is None or not SHOT_ID.fullmatch(header.strip()):
+        return None
+    return int(header.strip())
 
 
 def serving_server() -> Callable[[], bool]:
@@ -53,7 +62,6 @@ def serving_server() -> Callable[[], bool]:
 async def events(
     feed: ShotFeed,
     viewer: Viewer,
-    engine: FlightEngine,
     lifetime_s: float | None = None,
     keepalive_s: float = KEEPALIVE_S,
     stopping: Callable[[], bool] | None = None,
@@ -77,9 +85,8 @@ async def events(
             if ends is not None:
                 wait = min(wait, ends - now)
             entry = await viewer.next(max(wait, 0.0))
-            frame = None if entry is None else feed.frame(entry, engine)
-            if frame is not None:
-                yield frame
+            if entry is not None:
+                yield frame(entry)
                 quiet_since = time.monotonic()
     finally:
         feed.unsubscribe(viewer)

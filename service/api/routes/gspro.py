@@ -1,15 +1,15 @@
-"""POST /v1/gspro: a GSPro Open Connect v1 message over HTTP, answered as over TCP (`ServiceState.gspro_reply`)."""
+"""POST /v1/gspro: a GSPro Open Connect v1 message over HTTP, answered as over TCP (`BayRuntime.fly_gspro`)."""
 
 from __future__ import annotations
 
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 from golfflight.contract.gspro import GSProMessage, GSProReply
+from golfflight.service.api.dependencies import runtime_of
 from golfflight.service.api.direct import DirectRoute
+from golfflight.service.api.paths import GSPRO_PATH
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
-from golfflight.service.api.state import state_of
 
-GSPRO_PATH = "/v1/gspro"
 GSPRO_STATUS = {200: 200, 500: 422, 503: 503}
 """HTTP status of each Open Connect reply code on POST /v1/gspro."""
 
@@ -33,5 +33,5 @@ async def gspro(message: GSProMessage, http: Request) -> Response:
     if message.BallData is None:
         nothing = GSProReply(Code=200, Message="no ball data: nothing to fly", ShotNumber=message.ShotNumber)
         return json_response(nothing)
-    reply = state_of(http).gspro_reply(message)
+    reply = runtime_of(http).fly_gspro(message)
     return json_response(reply, GSPRO_STATUS[reply.Code])

@@ -1,4 +1,4 @@
-"""GET /metrics: the service's Prometheus metrics in the text exposition format (`service.api.metrics`), behind the
+"""GET /metrics: the service's Prometheus metrics in the text exposition format (`service.runtime.metrics`), behind the
 API key like every route but /healthz. Answered while the model loads too (the model's info metric appears once it
 is loaded): a scrape should tell a loading server from a dead one."""
 
@@ -6,9 +6,10 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Depends
 from fastapi.responses import PlainTextResponse, Response
-from golfflight.service.api.metrics import CONTENT_TYPE
+from golfflight.service.api.dependencies import bay_runtime
 from golfflight.service.api.routes.responses import ERROR_RESPONSES
-from golfflight.service.api.state import ServiceState, service_state
+from golfflight.service.runtime import BayRuntime
+from golfflight.service.runtime.metrics import CONTENT_TYPE
 
 METRICS_PATH = "/metrics"
 
@@ -16,7 +17,7 @@ router = APIRouter()
 
 
 @router.get(METRICS_PATH, response_class=PlainTextResponse, responses={401: ERROR_RESPONSES[401]})
-async def metrics(state: ServiceState = Depends(service_state)) -> Response:
+async def metrics(runtime: BayRuntime = Depends(bay_runtime)) -> Response:
     """Requests and errors by route, request and simulation latency histograms, shots per batch and the model's
     variant and hash (`golfflight_model_info`), summed over every worker of the server."""
-    return Response(state.metrics.exposition(), media_type=CONTENT_TYPE)
+    return Response(runtime.metrics.exposition(), media_type=CONTENT_TYPE)

@@ -10,8 +10,9 @@ from fastapi.responses import JSONResponse, Response
 from golfflight.contract.flying import fly_shot
 from golfflight.contract.requests import ShotRequest
 from golfflight.flight.engine import FlightEngine
+from golfflight.service.api.dependencies import bay_runtime, ready_engine
 from golfflight.service.api.routes.responses import ERROR_RESPONSES
-from golfflight.service.api.state import ServiceState, ready_engine, service_state
+from golfflight.service.runtime import BayRuntime
 from golfflight.weights_schema.model_card import ModelCard
 
 PROBE_SHOT = ShotRequest(ball_speed_mps=55.0, launch_angle_deg=16.0, spin_rpm=7100.0)
@@ -21,19 +22,23 @@ router = APIRouter()
 
 
 @router.get("/healthz")
-async def healthz(state: ServiceState = Depends(service_state)) -> JSONResponse:
-    """Ready (200) once the model is loaded, with its variant and hash; 503 while loading or if it failed."""
-    if state.engine is None:
-        status = "failed" if state.error else "loading"
-        return JSONResponse({"status": status, "error": state.error, "model_dir": str(state.bundle_dir)}, 503)
-    engine = state.engine
+async def healthz(runtime: BayRuntime = Depends(bay_runtime)) -> JSONResponse:
+    """Ready (200) once the model is loaded, with its variant and hash; "degraded" (still 200: every shot flies)
+    with `problems` saying what to repair, e.g. a bay file broken while serving; 503 while loading or if it
+    failed."""
+    if runtime.engine is None:
+        status = "failed" if runtime.error else "loading"
+        return JSONResponse({"status": status, "error": runtime.error, "model_dir": str(runtime.bundle_dir)}, 503)
+    engine = runtime.engine
     model = {
         "variant": engine.variant,
         "sha256": engine.sha256,
-        "dir": str(state.bundle_dir),
+        "dir": str(runtime.bundle_dir),
         "load_seconds": engine.load_seconds,
     }
-    return JSONResponse({"status": "ready", "model": model, "version": version("golfflight")})
+    problems = runtime.problems()
+    answer = {"status": "degraded" if problems else "ready", "model": model, "version": version("golfflight")}
+    return JSONResponse({**answer, "problems": problems} if problems else answer)
 
 
 @router.get("/v1/model", response_model=ModelCard, responses=ERROR_RESPONSES)
@@ -44,7 +49,7 @@ async def model_card(engine: FlightEngine = Depends(ready_engine)) -> Response:
 
 @router.get("/v1/latency", responses=ERROR_RESPONSES)
 async def latency(
-    engine: FlightEngine = Depends(ready_engine), state: ServiceState = Depends(service_state)
+    engine: FlightEngine = Depends(ready_engine), runtime: BayRuntime = Depends(bay_runtime)
 ) -> JSONResponse:
     """Rolling p50/p95/p99 of simulation time and whole requests, and a probe shot timed now."""
     started = time.perf_counter()
@@ -52,8 +57,8 @@ async def latency(
     probe_ms = (time.perf_counter() - started) * 1e3
     return JSONResponse(
         {
-            "simulation": state.simulation.summary(),
-            "request": state.requests.summary(),
+            "simulation": runtime.simulation.summary(),
+            "request": runtime.requests.summary(),
             "probe": {"shot": PROBE_SHOT.model_dump(exclude_none=True), "simulation_ms": probe_ms},
         }
     )

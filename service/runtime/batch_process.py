@@ -2,9 +2,10 @@
 
 With batches on a thread, a batch of 100 shared the GIL and the cores with the event loop, and single shots queued
 behind it: p99 65 ms against 9.4 ms without batches (docs/reliability.md). A child process has its own GIL, and its
-nice value lets the kernel run a waiting single shot first. The child (`service.batch_child`, no HTTP code) loads and
-verifies the bundle itself. It gets the request body the server has already validated and parses it again: bytes
-cross the process boundary for free, while pickling 100 parsed shots held the server's GIL for over a millisecond.
+nice value lets the kernel run a waiting single shot first. The child (`service.runtime.batch_child`, no HTTP code)
+loads and verifies the bundle itself. It gets the request body the server has already validated and parses it
+again: bytes cross the process boundary for free, while pickling 100 parsed shots held the server's GIL for over a
+millisecond. Only the few shots a screen shows come back as objects, with their states.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
-from golfflight.service import batch_child
+from golfflight.service.runtime import batch_child
 
 
 class BatchProcess:
@@ -37,16 +38,17 @@ class BatchProcess:
         """Start the child and wait until it has loaded the model; returns the model's ONNX hash."""
         return self._pool.submit(batch_child.ready).result()
 
-    async def submit(self, body: bytes) -> tuple[bytes, float]:
-        """The encoded BatchResult of a validated BatchRequest body, and the simulation seconds. A child found dead
+    async def submit(self, body: bytes, shown: int = 0) -> tuple[bytes, float, batch_child.Shown]:
+        """The encoded BatchResult of a validated BatchRequest body, the simulation seconds, and the last `shown`
+        shots with their states (`batch_child.fly_and_encode`). A child found dead
         (killed, out of memory) is replaced before the batch is sent; one that dies under this batch is replaced
         for the next and this one raises BrokenProcessPool."""
         pool = self._pool
         try:
-            future = pool.submit(batch_child.fly_and_encode, body)
+            future = pool.submit(batch_child.fly_and_encode, body, shown)
         except BrokenProcessPool:
             pool = self._replace(pool)
-            future = pool.submit(batch_child.fly_and_encode, body)
+            future = pool.submit(batch_child.fly_and_encode, body, shown)
         try:
             return await asyncio.wrap_future(future)
         except BrokenProcessPool:

@@ -1,5 +1,5 @@
 """Rolling latency figures of the running service (GET /v1/latency): server-side simulation time and whole requests,
-fed by the same measurements as /metrics' histograms (`service.api.metrics`)."""
+fed by the same measurements as /metrics' histograms (`service.runtime.metrics`)."""
 
 from __future__ import annotations
 

@@ -6,8 +6,9 @@ share prometheus-client's multiprocess mode: each writes its samples to files in
 scrape sums every worker's files (`shared_across_workers`, used by `golfflight serve`). One process alone keeps them
 in memory. Either way a scrape of a pod gives the whole pod's counts.
 
-The same measurements feed /v1/latency's rolling windows (`ServiceState.record_simulation`, `RequestMetrics`): the
-windows give exact percentiles of one worker's last 10,000, the histograms cumulative buckets over every worker.
+The same measurements feed /v1/latency's rolling windows (`BayRuntime.record_simulation`, the HTTP app's
+`RequestMetrics`): the windows give exact percentiles of one worker's last 10,000, the histograms cumulative buckets
+over every worker.
 """
 
 from __future__ import annotations

@@ -1,0 +1,125 @@
+"""The server's simulator bay: one set of bay conditions (`contract.bay.BayConditions`) per server, set at start
+(`golfflight serve --bay FILE`) and changed live (GET/PUT/PATCH /v1/bay), kept across restarts in FILE (written whole
+or not at all, `shots.files.write_text_atomic`).
+
+A file broken or removed while serving never stops a shot: the last good bay stays in force and `problem` says what
+is wrong with the file (GET /healthz shows it as "degraded") until a PUT or PATCH writes it again. Only at start does
+a broken file stop the server (`BayFileError`): there is no good bay to keep yet.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from pathlib import Path
+
+from golfflight.contract.bay import BayConditions, Player
+from golfflight.shots.files import write_text_atomic
+from pydantic import ValidationError
+
+BAY_FILE_ENV = "GOLFFLIGHT_BAY_FILE"
+"""Where `golfflight serve --bay FILE` tells its worker processes the bay file is."""
+
+PlayerListener = Callable[[Player], None]
+"""Told of the new player whenever the bay's player changes (Open Connect sends connectors Code 201)."""
+
+
+class BayFileError(ValueError):
+    """A bay file that cannot be read as bay conditions: the message names the file and the field."""
+
+
+class Bay:
+    """The server's current bay conditions, and the file they are kept in (if any). Thread-safe: the HTTP routes
+    and the Open Connect listener read it, PUT and PATCH /v1/bay change it. With a file, a change another worker
+    process wrote there (`golfflight serve --workers N`) is read at the next use (one stat per read)."""
+
+    def __init__(self, path: str | Path | None = None) -> None:
+        self.path = None if path is None else Path(path)
+        self._lock = threading.Lock()
+        self._conditions, self._stamp = BayConditions(), None
+        self._problem: str | None = None
+        self._listeners: list[PlayerListener] = []
+        if self.path is not None and self._file_stamp() is not None:
+            self._conditions, self._stamp = self._read(), self._file_stamp()
+
+    def on_player_change(self, listener: PlayerListener) -> None:
+        """Call `listener` with the new player after each change of the bay's player (from any source)."""
+        self._listeners.append(listener)
+
+    @property
+    def problem(self) -> str | None:
+        """What is wrong with the bay file now (None: nothing): the last good bay is in force meanwhile."""
+        with self._lock:
+            self._refresh()
+            return self._problem
+
+    def _file_stamp(self) -> int | None:
+        try:
+            return self.path.stat().st_mtime_ns
+        except OSError:
+            return None
+
+    def _refresh(self) -> None:
+        """Re-read the bay file if it changed since it was last read or written; a file that is gone or broken
+        keeps the last good bay and says why in `problem`."""
+        if self.path is None:
+            return
+        stamp = self._file_stamp()
+        if stamp is None:
+            if self._stamp is not None:
+                self._problem = (f"{self.path}: the bay file is gone; the last good bay stays in force until "
+                                 "PUT /v1/bay writes it again")
+            return
+        if stamp == self._stamp:
+            return
+        self._stamp = stamp
+        try:
+            conditions = self._read()
+        except (BayFileError, OSError) as error:
+            self._problem = f"{error}; the last good bay stays in force until PUT /v1/bay writes the file again"
+            return
+        self._problem = None
+        self._replace(conditions)
+
+    def _read(self) -> BayConditions:
+        try:
+            return BayConditions.model_validate_json(self.path.read_bytes())
+        except ValidationError as error:
+            problems = "; ".join(
+                f"{'.'.join(str(p) for p in e['loc']) or 'body'}: {e['msg']}" for e in error.errors(include_url=False))
+            raise BayFileError(f"{self.path}: not bay conditions ({problems})") from None
+        except OSError as error:
+            raise BayFileError(f"{self.path}: cannot be read ({error.strerror or error})") from None
+
+    def _replace(self, conditions: BayConditions) -> None:
+        changed = conditions.player != self._conditions.player
+        self._conditions = conditions
+        if changed:
+            for listener in self._listeners:
+                listener(conditions.player)
+
+    @property
+    def conditions(self) -> BayConditions:
+        with self._lock:
+            self._refresh()
+            return self._conditions
+
+    def update(self, change: Callable[[BayConditions], BayConditions]) -> BayConditions:
+        """Apply `change` to the bay in force and keep the result (as `set`), with no other change in between: a
+        PATCH changes only what it names even while another request changes the rest."""
+        with self._lock:
+            self._refresh()
+            return self._set(change(self._conditions))
+
+    def set(self, conditions: BayConditions) -> BayConditions:
+        """Replace the bay's conditions, writing them to the bay file first (whole or not at all): a failed write
+        leaves the bay as it was. A successful write clears the file's problem."""
+        with self._lock:
+            return self._set(conditions)
+
+    def _set(self, conditions: BayConditions) -> BayConditions:
+        if self.path is not None:
+            write_text_atomic(self.path, conditions.model_dump_json(indent=2, exclude_none=True) + "\n")
+            self._stamp, self._problem = self._file_stamp(), None
+        self._replace(conditions)
+        return conditions

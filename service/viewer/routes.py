@@ -1,0 +1,69 @@
+"""GET /viewer (the live shot viewer page, its script and style), GET /v1/events (its server-sent event stream) and
+GET /v1/session.csv (the session's shots): the viewer's adapter on the bay runtime, mounted by the service's
+assembly (`service.app`).
+
+The page and the stream are left out of the OpenAPI document: the page is no API, and an endless stream is no
+operation a client or a fuzzer can call and validate; the stream's payload has its JSON Schema in
+service/viewer/event.schema.json.
+"""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, Header, Request
+from fastapi.responses import JSONResponse, Response, StreamingResponse
+from golfflight.service.runtime import BayRuntime
+from golfflight.service.runtime.feed import TooManyViewers
+from golfflight.service.viewer.page import ASSETS, PAGE_PATH, SECURITY_HEADERS
+from golfflight.service.viewer.session_csv import session_csv
+from golfflight.service.viewer.stream import events, last_event_id
+
+EVENTS_PATH = "/v1/events"
+SESSION_PATH = "/v1/session.csv"
+
+router = APIRouter()
+
+
+def _runtime(request: Request) -> BayRuntime:
+    return request.app.state.runtime
+
+
+def _asset(name: str) -> Response:
+    content, media_type = ASSETS[name]
+    return Response(content, media_type=media_type, headers=SECURITY_HEADERS)
+
+
+@router.get(PAGE_PATH, include_in_schema=False)
+async def page() -> Response:
+    """The viewer (no key needed: it asks for one when the event stream wants it)."""
+    return _asset("viewer.html")
+
+
+@router.get(PAGE_PATH + "/{name}", include_in_schema=False)
+async def asset(name: str) -> Response:
+    """The page's script or style; any other name is 404 (no file a client names is read)."""
+    if name not in ASSETS or name == "viewer.html":
+        return JSONResponse({"detail": "not found"}, 404)
+    return _asset(name)
+
+
+@router.get(EVENTS_PATH, include_in_schema=False)
+async def shot_events(request: Request, last_event: str | None = Header(None, alias="last-event-id")) -> Response:
+    """Every shot flown from now on (and the kept ones, or those after Last-Event-ID) as server-sent events."""
+    runtime = _runtime(request)
+    runtime.ready_engine()
+    try:
+        viewer = runtime.feed.subscribe(last_event_id(last_event))
+    except TooManyViewers as error:
+        return JSONResponse({"detail": f"{error}: close one and try again"}, 503)
+    headers = {"cache-control": "no-store", "x-accel-buffering": "no"}
+    return StreamingResponse(events(runtime.feed, viewer), media_type="text/event-stream", headers=headers)
+
+
+@router.get(SESSION_PATH, response_class=Response, responses={200: {"content": {"text/csv": {}}}})
+async def session(request: Request) -> Response:
+    """The session's shots (every shot the bay's screens were sent since the service started, the last 10,000) as
+    CSV in `golfflight simulate`'s columns: launch and conditions in, the result out, with the shot's id, time,
+    source and club."""
+    text = session_csv(list(_runtime(request).feed.session))
+    headers = {"content-disposition": 'attachment; filename="golfflight-session.csv"', "cache-control": "no-store"}
+    return Response(text, media_type="text/csv; charset=utf-8", headers=headers)
