@@ -11,11 +11,13 @@ from __future__ import annotations
 import re
 
 from golfflight.contract.refusals import describe_errors
-from golfflight.contract.requests import ShotRequest
+from golfflight.contract.requests import WEATHER_FIELDS, ShotRequest
 from golfflight.contract.results import POINT_MODELS, FlatFlight, FlightResult
 from pydantic import ValidationError
 
-AIR_COLUMNS = {name: name for name in ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct", "density_kg_m3")}
+AIR_COLUMNS = {name: name for name in (*WEATHER_FIELDS, "density_kg_m3")}
+"""Air columns are the request's air fields, every unit form (temperature_c or temperature_f, altitude_m or
+altitude_ft) under its own name."""
 WIND_COLUMNS = {
     "wind_speed_mps": "speed_mps",
     "wind_speed_mph": "speed_mph",

@@ -29,12 +29,17 @@ def launch_of(shot: ShotRequest) -> Launch:
 
 
 def air_of(air: AirRequest | ReferenceAir | None) -> Air:
-    """Engine air from a request's air; omitted values take ICAO standard air (station pressure wins over altitude)."""
+    """Engine air from a request's air, whichever unit forms it used (Fahrenheit and feet taken as Celsius and
+    metres); omitted values take ICAO standard air (station pressure wins over altitude)."""
     if air is None:
         return STANDARD.air
     given = {name: value for name, value in air.model_dump().items() if value is not None}
     if "density_kg_m3" in given:
         return Air.from_density(given["density_kg_m3"])
+    if "temperature_f" in given:
+        given["temperature_c"] = (given.pop("temperature_f") - 32.0) * 5.0 / 9.0
+    if "altitude_ft" in given:
+        given["altitude_m"] = given.pop("altitude_ft") * FOOT_M
     pressure_hpa = given.pop("pressure_hpa", None)
     return Air.from_conditions(**given, pressure_pa=None if pressure_hpa is None else pressure_hpa * 100.0)
 

@@ -9,29 +9,57 @@ from golfflight.contract.requests import RANGES
 from golfflight.flight.limits import Range
 
 
+QUOTED_CHARS = 40
+"""Most characters of a value (or a field name) a refusal quotes; a longer one is cut, "…" in place of the rest, so
+that a refusal never echoes a whole body."""
+
+
+def _quoted(text: str) -> str:
+    """`text` cut to QUOTED_CHARS characters."""
+    return text if len(text) <= QUOTED_CHARS else text[: QUOTED_CHARS - 1] + "…"
+
+
+def _encodable(text: str) -> str:
+    """`text` with its lone surrogates (which a JSON escape such as \\ud800 puts into a request's text, but which no
+    UTF-8 body can carry out) written as backslash escapes, the six characters \\ud800."""
+    return text.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
+def _shown(part):
+    """A value or a field name as a refusal shows it: text cut (`_quoted`) and UTF-8 encodable (`_encodable`)."""
+    return _encodable(_quoted(part)) if isinstance(part, str) else part
+
+
 def _plain(value):
-    """A request value as JSON can carry it (NaN and infinity as text; objects and lists left out)."""
+    """A request value as a UTF-8 JSON body can carry it: NaN and infinity as text; text, and a whole number too
+    long to quote, cut and UTF-8 encodable (`_shown`); objects and lists left out. The message quotes text as Python
+    writes it, a lone surrogate as its escape too."""
     if isinstance(value, float) and not math.isfinite(value):
         return str(value)
-    return value if isinstance(value, (str, int, float, bool)) or value is None else None
+    if isinstance(value, int) and not isinstance(value, bool) and len(str(value)) > QUOTED_CHARS:
+        return _shown(str(value))
+    if isinstance(value, str):
+        return _shown(value)
+    return value if isinstance(value, (int, float, bool)) or value is None else None
 
 
 def describe_error(error: dict, ranges: dict[str, Range] = RANGES) -> dict:
     """One 422 detail: FastAPI's own `loc`, `msg` and `type`, plus the field as a dotted path, the value sent, the
     allowed range (from `ranges`, by field name), the batch index of the shot, and a `message` in plain words that
     says all of it."""
-    path = [p for p in error["loc"] if p != "body"]
+    path = [_shown(p) for p in error["loc"] if p != "body"]
     field = ".".join(str(p) for p in path) or "body"
-    msg = error["msg"].removeprefix("Value error, ")
-    entry: dict = {"loc": list(error["loc"]), "msg": msg, "type": error["type"], "field": field}
+    msg = _encodable(error["msg"].removeprefix("Value error, "))
+    entry: dict = {"loc": [_shown(p) for p in error["loc"]], "msg": msg, "type": error["type"], "field": field}
     parts = [f"{field}: {msg}"]
     if len(path) >= 2 and path[0] == "shots" and isinstance(path[1], int):
         entry["shot"] = path[1]
         parts[0] = f"shot {path[1]}: {'.'.join(str(p) for p in path[2:]) or 'shot'}: {msg}"
-    value = _plain(error.get("input")) if error["type"] != "missing" else None
+    sent = error.get("input")
+    value = _plain(sent) if error["type"] != "missing" else None
     if value is not None:
         entry["value"] = value
-        parts.append(f"(got {value!r})")
+        parts.append(f"(got {_quoted(sent)!r})" if isinstance(sent, str) else f"(got {value!r})")
     name = path[-1] if path else None
     if isinstance(name, str) and name in ranges and error["type"] != "extra_forbidden":
         entry["allowed"] = ranges[name].describe()

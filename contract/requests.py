@@ -27,6 +27,8 @@ BALL_SPEED_MPH = Range(limits.BALL_SPEED_MPS.low / MPH_TO_MPS, limits.BALL_SPEED
 SIDE_SPIN_RPM = Range(-limits.SPIN_RPM.high, limits.SPIN_RPM.high, "rpm")
 WIND_SPEED_MPH = Range(limits.WIND_SPEED_MPS.low / MPH_TO_MPS, limits.WIND_SPEED_MPS.high / MPH_TO_MPS, "mph")
 GROUND_ELEVATION_FT = Range(limits.GROUND_ELEVATION_M.low / FOOT_M, limits.GROUND_ELEVATION_M.high / FOOT_M, "ft")
+TEMPERATURE_F = Range(limits.TEMPERATURE_C.low * 9 / 5 + 32, limits.TEMPERATURE_C.high * 9 / 5 + 32, "degF")
+ALTITUDE_FT = Range(limits.ALTITUDE_M.low / FOOT_M, limits.ALTITUDE_M.high / FOOT_M, "ft")
 
 RANGES: dict[str, Range] = {
     "ball_speed_mps": limits.BALL_SPEED_MPS,
@@ -38,7 +40,9 @@ RANGES: dict[str, Range] = {
     "back_spin_rpm": limits.SPIN_RPM,
     "side_spin_rpm": SIDE_SPIN_RPM,
     "temperature_c": limits.TEMPERATURE_C,
+    "temperature_f": TEMPERATURE_F,
     "altitude_m": limits.ALTITUDE_M,
+    "altitude_ft": ALTITUDE_FT,
     "pressure_hpa": limits.PRESSURE_HPA,
     "humidity_pct": limits.HUMIDITY_PCT,
     "density_kg_m3": limits.AIR_DENSITY_KG_M3,
@@ -98,26 +102,48 @@ def _exactly_one(model: BaseModel, quantity: str, *names: str) -> None:
         raise ValueError(f"{quantity}: give exactly one of {' or '.join(names)} (got {found})")
 
 
-WEATHER_FIELDS = ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct")
+def _at_most_one(model: BaseModel, quantity: str, *names: str) -> str | None:
+    """The one of `names` that `model` gives, or None when it gives none; ValueError naming both when it gives two."""
+    given = [name for name in names if getattr(model, name) is not None]
+    if len(given) > 1:
+        raise ValueError(f"{quantity}: give {' or '.join(given)}, not both")
+    return given[0] if given else None
+
+
+TEMPERATURE_FIELDS = ("temperature_c", "temperature_f")
+ALTITUDE_FIELDS = ("altitude_m", "altitude_ft")
+WEATHER_FIELDS = (*TEMPERATURE_FIELDS, *ALTITUDE_FIELDS, "pressure_hpa", "humidity_pct")
+"""The weather values an explicit density replaces, every unit form of each."""
 
 
 class AirRequest(Strict):
-    """The air: weather values (altitude or station pressure) or an explicit density; omitted = ICAO standard."""
+    """The air: weather values (altitude or station pressure) or an explicit density; omitted = ICAO standard. The
+    temperature in at most one form, temperature_c or temperature_f, and the altitude in at most one, altitude_m or
+    altitude_ft."""
 
     model_config = ConfigDict(
-        json_schema_extra=_not_together(("altitude_m", "pressure_hpa"), *(("density_kg_m3", w) for w in WEATHER_FIELDS))
+        json_schema_extra=_not_together(
+            TEMPERATURE_FIELDS,
+            ALTITUDE_FIELDS,
+            *((altitude, "pressure_hpa") for altitude in ALTITUDE_FIELDS),
+            *(("density_kg_m3", w) for w in WEATHER_FIELDS),
+        )
     )
 
     temperature_c: _in("temperature_c", "air temperature", True) = None
+    temperature_f: _in("temperature_f", "air temperature, instead of temperature_c", True) = None
     altitude_m: _in("altitude_m", "height above sea level, standard atmosphere", True) = None
+    altitude_ft: _in("altitude_ft", "height above sea level, standard atmosphere, instead of altitude_m", True) = None
     pressure_hpa: _in("pressure_hpa", "station pressure (not reduced to sea level)", True) = None
     humidity_pct: _in("humidity_pct", "relative humidity", True) = None
     density_kg_m3: _in("density_kg_m3", "air density, instead of the weather values", True) = None
 
     @model_validator(mode="after")
     def _one_source(self) -> AirRequest:
-        if self.altitude_m is not None and self.pressure_hpa is not None:
-            raise ValueError("air: give altitude_m or pressure_hpa, not both")
+        _at_most_one(self, "air temperature", *TEMPERATURE_FIELDS)
+        altitude = _at_most_one(self, "altitude", *ALTITUDE_FIELDS)
+        if altitude is not None and self.pressure_hpa is not None:
+            raise ValueError(f"air: give {altitude} or pressure_hpa, not both")
         weather = [n for n in WEATHER_FIELDS if getattr(self, n) is not None]
         if self.density_kg_m3 is not None and weather:
             raise ValueError(f"air: density_kg_m3 replaces the weather values; drop {', '.join(weather)}")
@@ -125,7 +151,9 @@ class AirRequest(Strict):
 
 
 class ReferenceAir(Strict):
-    """Reference air of the normalized flight (calm); omitted fields take TrackMan's 25 degC, sea level."""
+    """Reference air of the normalized flight (calm); omitted fields take TrackMan's 25 degC, sea level. SI only
+    (no temperature_f or altitude_ft, unlike AirRequest): a replay's reference air is a published standard, not a
+    reading in the units at hand."""
 
     model_config = ConfigDict(json_schema_extra=_not_together(("altitude_m", "pressure_hpa")))
 

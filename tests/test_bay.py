@@ -1,4 +1,4 @@
-"""The simulator bay's conditions (contract.bay; the server's store: service.api.bay): a shot without its own flies
+"""The simulator bay's conditions (contract.bay; the server's store: service.runtime.bay): a shot without its own flies
 in the bay's air, wind and ground (over HTTP, in a batch and over GSPro Open Connect's TCP), a shot's own win,
 PUT /v1/bay validates like a shot and is kept in the bay file across restarts, written whole or not at all."""
 

@@ -14,12 +14,12 @@ from functools import partial
 import browser
 import httpx
 import pytest
-from golfflight.contract.flying import fly_shot
+from golfflight.contract.flying import flown_shot
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.app import create_app
 from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.open_connect.server import ConnectAddress
-from golfflight.service.viewer.feed import ShotFeed
+from golfflight.service.runtime.feed import ShotFeed
 from golfflight.service.viewer.stream import KEEPALIVE_FRAME, KEEPALIVE_S, events, serving_server
 from servers import free_port, keyed_service, running
 from test_viewer import DRIVER, KEY, KEYED, WEDGE_BALL, gspro_over_tcp, next_event
@@ -88,8 +88,9 @@ def test_a_quiet_stream_sends_keep_alive_comments(engine):
     async def stream() -> list[str]:
         feed = ShotFeed()
         viewer = feed.subscribe()
-        feed.publish("http", request, fly_shot(engine, request))
-        return [frame async for frame in events(feed, viewer, engine, lifetime_s=0.55, keepalive_s=0.1)]
+        result, flight = flown_shot(engine, request, keep_states=True)
+        feed.publish("http", request, result, flight.states, flight.flight_time_s)
+        return [frame async for frame in events(feed, viewer, lifetime_s=0.55, keepalive_s=0.1)]
 
     frames = asyncio.run(stream())
     assert frames[0].startswith("retry: ") and frames[1].startswith("id: 1\n")
@@ -97,14 +98,14 @@ def test_a_quiet_stream_sends_keep_alive_comments(engine):
     assert KEEPALIVE_S <= 15
 
 
-def test_a_stream_ends_promptly_when_the_server_shuts_down(engine):
+def test_a_stream_ends_promptly_when_the_server_shuts_down():
     told = []  # the server's should_exit, as the stream sees it
 
     async def stream() -> tuple[list[str], float, ShotFeed]:
         feed = ShotFeed()
         asyncio.get_running_loop().call_later(0.3, told.append, True)
         started = time.monotonic()
-        frames = [frame async for frame in events(feed, feed.subscribe(), engine, stopping=lambda: bool(told))]
+        frames = [frame async for frame in events(feed, feed.subscribe(), stopping=lambda: bool(told))]
         return frames, time.monotonic() - started, feed
 
     frames, seconds, feed = asyncio.run(stream())
