@@ -28,7 +28,7 @@ from golfflight.flight.flyer import (
     air_inputs,
     load_flyer,
 )
-from golfflight.flight.ground import GroundSpec, ground_phase, ground_phase_one, putt_phase
+from golfflight.flight.ground import GroundSpec, ground_phase_one, putt_phase
 from golfflight.flight.outcomes import BatchFlights, EulerStates, Rest, ShotFlight, landing_figures, parabola_apex
 from golfflight.flight.physics import euler_step, initial_state, reynolds_scale
 from golfflight.flight.wind import log_profile_factor
@@ -104,7 +104,7 @@ class FlightEngine:
         ground: GroundSpec | None = None,
     ) -> ShotFlight:
         """Fly one shot on Python floats down to its ground and roll it to rest there on floats too
-        (`flight.ground.ground_phase_one`; with states kept, the batch ground phase, which records the path); ground
+        (`flight.ground.ground_phase_one`, which records the ground's path too when states are kept); ground
         None: the flight alone, down to z = 0. Raises FlightError if it has not landed by the Flyer's maximum flight
         time (or, from a broken model, if any number of its flight is not finite)."""
         start = initial_state(*(np.array([value], dtype=float) for value in launch))
@@ -157,18 +157,14 @@ class FlightEngine:
         if not (all(map(math.isfinite, numbers)) and (states is None or states.finite)):
             raise FlightError(NON_FINITE)
         rest = None
-        if ground is not None and states is None:
+        if ground is not None:
             one = ground_phase_one(
                 tuple(land[0:3]), tuple(land[3:6]), tuple(land[6:9]), ground.surface, ground.slope_deg,
-                ground.slope_dir_deg,
+                ground.slope_dir_deg, keep_path=states is not None,
             )
             rest = Rest.at(one.position[0], one.position[1], carry, one.bounces, one.time_s)
-        elif ground is not None:
-            landing = np.array([land[0:3]]), np.array([land[3:6]]), np.array([land[6:9]])
-            phase = ground_phase(*landing, ground.surface, ground.slope_deg, ground.slope_dir_deg, True)
-            x, y, _ = phase.rest_position[0].tolist()
-            rest = Rest.at(x, y, carry, int(phase.bounces[0]), float(phase.time_s[0]))
-            states = states.through_rest(phase, 0, flight_time)
+            if states is not None:
+                states = states.followed_by(one.path, flight_time)
         return ShotFlight(
             landing_x_m=land[0], landing_y_m=land[1], carry_m=carry, lateral_m=land[0], apex_m=apex,
             apex_time_s=apex_time, flight_time_s=flight_time, landing_angle_deg=angle, landing_speed_mps=speed,

@@ -10,7 +10,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 from golfflight.flight.constants import RPM_TO_RADPS
-from golfflight.flight.ground import GroundPhase
+from golfflight.flight.ground import GroundPath, GroundPhase
 from golfflight.flight.physics import State
 
 
@@ -106,7 +106,10 @@ class EulerStates:
 
     def through_rest(self, phase: GroundPhase, i: int, flight_time_s: float) -> EulerStates:
         """These flight states continued through shot i's ground path (its first row, the landing, is their last)."""
-        path = phase.paths[i]
+        return self.followed_by(phase.paths[i], flight_time_s)
+
+    def followed_by(self, path: GroundPath, flight_time_s: float) -> EulerStates:
+        """These flight states continued through a ground path (its first row, the landing, is their last)."""
         return EulerStates(
             times_s=np.append(self.times_s, flight_time_s + path.times_s[1:]),
             positions=np.vstack([self.positions, path.positions[1:]]),

@@ -175,7 +175,8 @@ def test_surface_presets_are_overridable_and_stimp_is_for_greens_only():
 
 
 def test_one_ball_on_plain_floats_is_the_batch():
-    """`ground_phase_one` (the engine's one-shot path) runs the batch's formulas on floats: same rest and hops."""
+    """`ground_phase_one` (the engine's one-shot path) runs the batch's formulas on floats: same rest, hops and
+    recorded path."""
     rng = np.random.default_rng(5)
     for _ in range(200):
         speed, angle, heading = rng.uniform(3, 35), rng.uniform(2, 80), rng.uniform(0, 360)
@@ -186,7 +187,11 @@ def test_one_ball_on_plain_floats_is_the_batch():
         where = SURFACES[rng.choice(list(SURFACES))]
         slope = 0.0 if rng.random() < 0.5 else rng.uniform(0, 0.9) * float(holding_slope_deg(where.rolling_resistance))
         slope_dir = rng.uniform(0, 360)
-        batch = ground_phase(position[None], velocity[None], spin[None], where, slope, slope_dir)
-        one = ground_phase_one(tuple(position), tuple(velocity), tuple(spin), where, slope, slope_dir)
+        batch = ground_phase(position[None], velocity[None], spin[None], where, slope, slope_dir, keep_path=True)
+        one = ground_phase_one(tuple(position), tuple(velocity), tuple(spin), where, slope, slope_dir, keep_path=True)
         np.testing.assert_allclose(one.position, batch.rest_position[0], atol=1e-6)
         assert one.bounces == batch.bounces[0] and one.time_s == pytest.approx(batch.time_s[0], abs=1e-6)
+        path, kept = one.path, batch.paths[0]  # the path a served shot's screen draws: the batch's, state by state
+        for mine, theirs in ((path.times_s, kept.times_s), (path.positions, kept.positions),
+                             (path.velocities, kept.velocities)):
+            np.testing.assert_allclose(mine, theirs, atol=1e-6)

@@ -69,11 +69,12 @@ class GroundPhase:
 
 
 class OneRest(NamedTuple):
-    """Where one ball came to rest: the point (x, y, z), hops, time on the ground."""
+    """Where one ball came to rest: the point (x, y, z), hops, time on the ground and, when kept, its path."""
 
     position: tuple[float, float, float]
     bounces: int
     time_s: float
+    path: GroundPath | None = None
 
 
 def plane_normals(slope_deg: np.ndarray | float, slope_dir_deg: np.ndarray | float, n: int) -> np.ndarray:
@@ -304,13 +305,21 @@ def ground_phase(
 
 
 def ground_phase_one(
-    position: tuple, velocity: tuple, spin: tuple, surface: Surface, slope_deg: float = 0.0, slope_dir_deg: float = 0.0
+    position: tuple,
+    velocity: tuple,
+    spin: tuple,
+    surface: Surface,
+    slope_deg: float = 0.0,
+    slope_dir_deg: float = 0.0,
+    keep_path: bool = False,
 ) -> OneRest:
-    """`ground_phase` of one ball on plain floats (the same formulas; no path): from its landing (x, y, z) tuples
-    to its rest. ValueError if the slope is steeper than the surface holds a ball on."""
+    """`ground_phase` of one ball on plain floats (the same formulas): from its landing (x, y, z) tuples to its
+    rest, with the path `ground_phase` would record when `keep_path` (the served shot a screen draws). ValueError if
+    the slope is steeper than the surface holds a ball on."""
     _check_slopes(np.float64(slope_deg), np.float64(surface.rolling_resistance))
     phi, beta = math.radians(slope_deg), math.radians(slope_dir_deg)
     normal = (math.sin(phi) * math.sin(beta), math.sin(phi) * math.cos(beta), math.cos(phi))
+    path: list[tuple[float, tuple, tuple]] | None = [(0.0, position, velocity)] if keep_path else None
     time, hops = 0.0, 0
     while True:
         velocity, spin = impact_components(velocity, spin, normal, surface)
@@ -318,19 +327,48 @@ def ground_phase_one(
         if not (rebound > MIN_HOP_SPEED_MPS and hops < MAX_BOUNCES):
             break
         duration = 2.0 * rebound / (GRAVITY_MPS2 * normal[2])
+        if path is not None:
+            path.append((time, position, velocity))
         position, velocity = _hop(position, velocity, duration)
         time, hops = time + duration, hops + 1
+        if path is not None:
+            path.append((time, position, velocity))
     rolling = _rolling(velocity, spin, normal)
+    if path is not None and norm(rolling) > 0.0:
+        path.append((time, position, rolling))
+    rest, roll_time = _roll_one(position, rolling, normal, surface, slope_deg, path, time)
+    if path is not None:
+        path.append((time + roll_time, rest, (0.0, 0.0, 0.0)))
+    return OneRest(rest, hops, time + roll_time, None if path is None else _ground_path(path))
+
+
+def _roll_one(position: tuple, rolling: tuple, normal: tuple, surface: Surface, slope_deg: float,
+              path: list | None, start: float) -> tuple[tuple, float]:
+    """One ball's roll from `position` at `rolling` velocity: (rest point, roll time), its states added to `path`
+    as `ground_phase` records them (every ROLL_STEP_S)."""
     drag = float(surface.grass_drag_per_s)
     if slope_deg == 0.0:
         speed = norm(rolling)
         distance, roll_time = _stop(speed, surface.rolling_resistance * GRAVITY_MPS2, drag)
-        rest = add(position, rolling, float(distance) / max(speed, TINY))
-        return OneRest(rest, hops, time + float(roll_time))
+        direction = times(1.0 / max(speed, TINY), rolling)
+        if path is not None:
+            times_s = np.arange(ROLL_STEP_S, float(roll_time) - 1e-9, ROLL_STEP_S)
+            run, now = _level_states(speed, surface.rolling_resistance * GRAVITY_MPS2, drag, times_s)
+            path += [(start + t, add(position, direction, r), times(v, direction))
+                     for t, r, v in zip(times_s.tolist(), run.tolist(), now.tolist(), strict=True)]
+        return add(position, direction, float(distance)), float(roll_time)
     downhill, brake = _downhill(normal), surface.rolling_resistance * GRAVITY_MPS2 * normal[2]
+    elapsed = 0.0
     for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
         stops, taken, stop_at, position, rolling = _slope_step(position, rolling, downhill, brake, drag)
-        time += float(taken)
+        elapsed += float(taken)
         if stops:
-            return OneRest(stop_at, hops, time)
-    return OneRest(position, hops, time)
+            return stop_at, elapsed
+        if path is not None:
+            path.append((start + elapsed, position, rolling))
+    return position, elapsed
+
+
+def _ground_path(rows: list[tuple[float, tuple, tuple]]) -> GroundPath:
+    return GroundPath(np.array([r[0] for r in rows]), np.array([[float(v) for v in r[1]] for r in rows]),
+                      np.array([[float(v) for v in r[2]] for r in rows]))
