@@ -8,7 +8,6 @@ import math
 from golfflight.contract.requests import RANGES
 from golfflight.flight.limits import Range
 
-
 QUOTED_CHARS = 40
 """Most characters of a value (or a field name) a refusal quotes; a longer one is cut, "…" in place of the rest, so
 that a refusal never echoes a whole body."""

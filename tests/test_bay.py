@@ -11,8 +11,8 @@ import pytest
 from golfflight.contract.bay import BayConditions, in_bay
 from golfflight.contract.requests import AirRequest, GroundRequest, ShotRequest, WindRequest
 from golfflight.service.app import create_app
-from golfflight.service.runtime.bay import Bay, BayFileError
 from golfflight.service.open_connect.server import ConnectAddress
+from golfflight.service.runtime.bay import Bay, BayFileError
 
 from tests.servers import free_port, running, shot
 

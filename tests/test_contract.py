@@ -13,8 +13,8 @@ import pytest
 from golfflight.contract.flying import fly_shots
 from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, RANGES, ShotRequest
 from golfflight.flight import limits
-from golfflight.service.app import create_app
 from golfflight.service.api.guards import MAX_BODY_BYTES
+from golfflight.service.app import create_app
 from servers import running
 
 SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}

@@ -11,8 +11,8 @@ from fastapi import APIRouter, Depends, FastAPI, Request
 from fastapi.routing import APIRoute
 from golfflight.contract.gspro import GSProMessage
 from golfflight.contract.requests import BatchRequest, ShotRequest
-from golfflight.service.app import create_app
 from golfflight.service.api.direct import DirectRoute
+from golfflight.service.app import create_app
 from pydantic import ValidationError
 
 from tests.servers import running

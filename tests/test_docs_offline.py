@@ -10,8 +10,8 @@ from urllib.parse import urljoin, urlsplit
 
 import browser
 import pytest
-from golfflight.service.app import create_app
 from golfflight.service.api.routes.docs import ASSETS_DIR
+from golfflight.service.app import create_app
 from servers import running
 
 KEY = "docs-test-key"

@@ -12,8 +12,8 @@ import time
 
 import httpx
 import pytest
-from golfflight.service.app import create_app
 from golfflight.service.api.guards import API_KEY_ENV
+from golfflight.service.app import create_app
 from servers import free_port, running
 
 from golfflight.commands import serve

@@ -16,8 +16,8 @@ from pathlib import Path
 import httpx
 import pytest
 from golfflight.flight.bundle_location import model_dir
-from golfflight.service.app import create_app
 from golfflight.service.api.guards import API_KEY_ENV
+from golfflight.service.app import create_app
 from golfflight.service.runtime.metrics import MULTIPROC_ENV, shared_across_workers
 from golfflight.weights_schema.bundle import load_bundle
 from prometheus_client.multiprocess import MultiProcessCollector

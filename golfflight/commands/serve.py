@@ -7,8 +7,8 @@ GRACEFUL_SHUTDOWN_S) before the workers exit. --connect-port also takes GSPro Op
 process (`service.open_connect`), on loopback unless --connect-host says otherwise: the protocol has no key.
 Several workers share their Prometheus metrics through files in $PROMETHEUS_MULTIPROC_DIR (a temporary directory
 unless set), so GET /metrics answers for the whole server whichever worker takes the scrape. --bay FILE keeps the
-simulator bay's conditions (air, wind, ground, units: GET/PUT /v1/bay, `service.runtime.bay`) there across restarts;
-a file that is not bay conditions stops the start with one line naming it and the field.
+simulator bay's conditions (air, wind, ground, player, units: GET/PUT/PATCH /v1/bay, `service.runtime.bay`) there
+across restarts; a file that is not bay conditions stops the start with one line naming it and the field.
 """
 
 from __future__ import annotations
@@ -53,9 +53,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--bay",
         metavar="FILE",
-        help="the simulator bay's conditions (JSON: air, wind, ground, units as GET /v1/bay shows them): what Open "
-        "Connect shots and shots without conditions of their own fly in; PUT /v1/bay changes them and writes FILE "
-        "(created if missing)",
+        help="the simulator bay's conditions (JSON: air, wind, ground, player, units as GET /v1/bay shows them): what "
+        "Open Connect shots and shots without conditions of their own fly in; PUT and PATCH /v1/bay change them and "
+        "write FILE (created if missing)",
     )
     parser.set_defaults(run=run)
 
@@ -101,10 +101,10 @@ def run(args: argparse.Namespace) -> int:
 
     from golfflight.flight.bundle_check import verify_bundle
     from golfflight.flight.bundle_location import MODEL_ENV, model_dir
-    from golfflight.service.runtime.bay import BAY_FILE_ENV, Bay
     from golfflight.service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
-    from golfflight.service.runtime.metrics import shared_across_workers
     from golfflight.service.open_connect.server import CONNECT_HOST_ENV, CONNECT_PORT_ENV
+    from golfflight.service.runtime.bay import BAY_FILE_ENV, Bay
+    from golfflight.service.runtime.metrics import shared_across_workers
 
     if args.workers < 1:
         raise ValueError(f"--workers must be at least 1, got {args.workers}")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+
 from golfflight.contract.bay import Player
 from golfflight.contract.requests import AirRequest, GroundRequest, WindRequest
 from golfflight.contract.results import ShotResult
