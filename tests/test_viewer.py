@@ -13,8 +13,8 @@ from functools import partial
 
 import browser
 import httpx
-import pytest
 import numpy as np
+import pytest
 from golfflight.contract.flying import flown_shot
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.app import create_app
@@ -41,16 +41,26 @@ def service():
 
 
 def gspro_over_tcp(port: int, number: int, ball: dict) -> dict:
-    """A connector's shot over TCP and its reply."""
+    """A connector's shot over TCP and its reply (the player information GSPro pushes, Code 201, passed over)."""
     with socket.create_connection(("127.0.0.1", port), timeout=5) as connector:
         connector.sendall(json.dumps({"ShotNumber": number, "APIversion": "1", "BallData": ball}).encode())
-        received = b""
+        received, decoder = "", json.JSONDecoder()
         while True:
-            received += connector.recv(65536)
-            try:
-                return json.loads(received)
-            except ValueError:
-                continue
+            received += connector.recv(65536).decode()
+            while received.strip():
+                try:
+                    message, end = decoder.raw_decode(received.lstrip())
+                except ValueError:
+                    break
+                received = received.lstrip()[end:]
+                if message.get("Code") != 201:
+                    return message
+
+
+def pick_club(page, code: str) -> None:
+    """Pick a club in the page's "Club hit now" menu and wait until the bay has it (PATCH /v1/bay answered)."""
+    page.select_option("#club", code)
+    page.wait_for_selector(f"#club[data-saved='{code}']", state="attached", timeout=10_000)
 
 
 def next_event(lines, deadline_s: float = 5.0) -> ShotEvent:
@@ -261,18 +271,18 @@ def test_the_page_in_chromium_draws_shots_from_http_and_open_connect(tmp_path):
             page.wait_for_selector("#status[data-state=live]", timeout=10_000)
             assert "key=" not in page.url  # taken off the address bar
 
-            page.select_option("#club", "Driver")
+            pick_club(page, "DR")
             started = time.perf_counter()
             driver = http.post("/v1/shots?viewer=1", json=DRIVER, headers=KEYED).json()
             page.wait_for_selector("#shots tbody tr[data-shot='1']", timeout=10_000)
             seen_s = time.perf_counter() - started
             assert page.inner_text("#n-carry").startswith(f"{driver['carry_yd']:.1f}")
 
-            page.select_option("#club", "SW")
+            pick_club(page, "SW")
             wedge = gspro_over_tcp(port, 7, WEDGE_BALL)["Flight"]
             page.wait_for_selector("#shots tbody tr[data-shot='2']", timeout=10_000)
             page.wait_for_selector("#side polyline.latest[data-done]", timeout=10_000)
-            assert page.inner_text("#last-source") == "#2 · Open Connect shot 7"
+            assert page.inner_text("#last-source") == "#2 · Open Connect shot 7 · Sand wedge"
             assert page.inner_text("#n-carry").startswith(f"{wedge['carry_yd']:.1f}")
             assert page.inner_text("#n-apex").startswith(f"{wedge['apex_yd']:.1f}")
             assert page.inner_text("#n-landing-angle").startswith(f"{wedge['landing_angle_deg']:.1f}")
@@ -280,15 +290,17 @@ def test_the_page_in_chromium_draws_shots_from_http_and_open_connect(tmp_path):
             assert page.inner_text("#n-total").startswith(f"{wedge['total_yd']:.1f}")
             assert page.inner_text("#n-roll").startswith(f"{wedge['roll_m'] / 0.9144:.1f}")
 
-            for view in ("behind", "side", "top"):
+            for view, across in (("behind", 1), ("side", 0), ("top", 0)):  # behind: the arc rises up the picture
                 for shot in ("1", "2"):
                     points = page.get_attribute(f"#{view} polyline[data-shot='{shot}']", "points").split()
-                    xs = [float(point.split(",")[0]) for point in points]
-                    assert len(points) >= 30 and max(xs) - min(xs) > 20, (view, shot)
+                    spread = [float(point.split(",")[across]) for point in points]
+                    assert len(points) >= 30 and max(spread) - min(spread) > 20, (view, shot)
             assert page.locator("#dispersion circle.dot:not(.rest-dot)").count() == 2
-            assert "Driver: 1 shot" in page.inner_text("#legend") and "SW: 1 shot" in page.inner_text("#legend")
+            legend = page.inner_text("#legend")
+            assert "Driver: 1 shot" in legend and "Sand wedge: 1 shot" in legend
+            assert [page.get_attribute(f"#shots tbody tr[data-shot='{n}']", "data-club") for n in (1, 2)] == ["DR", "SW"]
 
-            page.click(".units button[data-units=metric]")  # the bay's units: shown once PUT /v1/bay answers
+            page.click(".units button[data-units=metric]")  # the bay's units: shown once PATCH /v1/bay answers
             page.wait_for_function("() => !document.querySelector('#n-carry').textContent.endsWith('yd')",
                                    timeout=10_000)
             assert page.inner_text("#n-carry").startswith(f"{wedge['carry_m']:.1f}")

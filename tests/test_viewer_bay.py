@@ -17,12 +17,12 @@ import pytest
 from golfflight.contract.flying import flown_shot
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.app import create_app
-from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.open_connect.server import ConnectAddress
 from golfflight.service.runtime.feed import ShotFeed
+from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.viewer.stream import KEEPALIVE_FRAME, KEEPALIVE_S, events, serving_server
 from servers import free_port, keyed_service, running
-from test_viewer import DRIVER, KEY, KEYED, WEDGE_BALL, gspro_over_tcp, next_event
+from test_viewer import DRIVER, KEY, KEYED, WEDGE_BALL, gspro_over_tcp, next_event, pick_club
 
 STRAIGHT = {"ball_speed_mph": 160.0, "launch_angle_deg": 11.0, "spin_rpm": 2700.0, "spin_axis_deg": 0.0}
 
@@ -146,13 +146,14 @@ def _submit_bay_form(page) -> None:
 def _straight_shot_on_the_centre_line(page, http) -> dict:
     """A batch without the flag never reaches the page; the bay's own straight shot is drawn from the tee at the
     bottom centre up the target line. The behind view's geometry."""
-    page.select_option("#club", "Driver")
+    pick_club(page, "DR")
     assert http.post("/v1/shots/batch", json={"shots": [DRIVER] * 60}, headers=KEYED).status_code == 200
     straight = http.post("/v1/shots?viewer=true", json=STRAIGHT, headers=KEYED).json()
     assert straight["lateral_m"] == pytest.approx(0.0, abs=1e-6)
     path = _latest_path(page)
     assert page.locator("#shots tbody tr").count() == 1 and "Driver: 1 shot" in page.inner_text("#legend")
     behind = page.evaluate("window.golfflightViewer.behind")
+    assert behind["camera"] == {"height_m": 1.6, "back_m": 3, "fov_deg": 55, "pitch_deg": 3.5}
     width, height = behind["width"], behind["height"]
     tee_x, tee_y = behind["tee"]
     assert tee_x == pytest.approx(width / 2) and height - 40 <= tee_y <= height  # bottom centre
@@ -167,28 +168,37 @@ def _straight_shot_on_the_centre_line(page, http) -> dict:
 
 
 def _wedge_right_of_the_line_and_labelled_distances(page, port: int, behind: dict) -> None:
-    """A wedge over Open Connect lands right of the line; every distance line has its label, none overlapping."""
+    """A wedge over Open Connect lands right of the line; the distance lines recede to the horizon, each label at
+    least LABEL_GAP_PX (14 px) above the one below it, none overlapping, all inside the picture."""
     width, tee = behind["width"], tuple(behind["tee"])
     gspro_over_tcp(port, 1, {**WEDGE_BALL, "HLA": 4.0, "SpinAxis": 8.0})
     page.wait_for_selector("#shots tbody tr[data-shot='2']", timeout=10_000)
     wedge = _latest_path(page)
     assert wedge[0] == pytest.approx(tee, abs=1.0) and wedge[-1][0] > width / 2 + 5
-    markers = page.locator("#behind line.marker-line").count()
-    labels = page.locator("#behind text.distance").all_text_contents()
-    assert markers >= 6 and len(labels) == markers and labels[:2] == ["50 yd", "100 yd"]
-    boxes = page.eval_on_selector_all(
-        "#behind text.distance", "els => els.map(e => { const b = e.getBBox(); return [b.x, b.y, b.width, b.height]; })"
-    )
-    for i, a in enumerate(boxes):  # no two labels overlap, and each is inside the picture
-        assert 0 <= a[0] and a[0] + a[2] <= width and a[1] >= 0
-        for b in boxes[i + 1 :]:
-            apart = a[0] + a[2] <= b[0] or b[0] + b[2] <= a[0] or a[1] + a[3] <= b[1] or b[1] + b[3] <= a[1]
-            assert apart, (a, b)
+    behind = page.evaluate("window.golfflightViewer.behind")
+    lines = [float(y) for y in page.eval_on_selector_all("#behind line.marker-line", "els => els.map(e => e.getAttribute('y1'))")]
+    horizon = behind["vanishing"][1]
+    assert len(lines) >= 6 and all(horizon < y < tee[1] for y in lines) and lines == sorted(lines, reverse=True)
+    labels = behind["labels"]
+    assert labels[0]["text"] == "50 yd" and labels == sorted(labels, key=lambda label: -label["line_y"])
+    assert [label["text"] for label in labels] == page.locator("#behind text.distance").all_text_contents()
+    for below, above in zip(labels, labels[1:]):
+        assert below["line_y"] - above["line_y"] >= 14, (below, above)
+    assert_apart([label["box"] for label in labels], width, behind["height"])
     assert page.inner_text("#n-launch") == "24.0°"  # the degree sign on its number (the wedge)
 
 
+def assert_apart(boxes: list[list[float]], width: float, height: float) -> None:
+    """No two boxes (x, y, width, height) overlap, and each is inside the picture."""
+    for i, a in enumerate(boxes):
+        assert 0 <= a[0] and a[0] + a[2] <= width and 0 <= a[1] and a[1] + a[3] <= height, a
+        for b in boxes[i + 1 :]:
+            apart = a[0] + a[2] <= b[0] or b[0] + b[2] <= a[0] or a[1] + a[3] <= b[1] or b[1] + b[3] <= a[1]
+            assert apart, (a, b)
+
+
 def _metric_bay_through_the_form(page, http) -> None:
-    """Metric units, then the issue's bay, PUT through the page and read back by GET /v1/bay."""
+    """Metric units, then the issue's bay, sent through the page and read back by GET /v1/bay."""
     page.click(".units button[data-units=metric]")
     page.wait_for_selector("#bay-message[data-state=saved]", timeout=10_000)
     assert http.get("/v1/bay", headers=KEYED).json()["units"] == "metric"

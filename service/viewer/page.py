@@ -1,26 +1,29 @@
 """The viewer page and its script and style, shipped in `static/` (package data) and read once at import; the page's
-club menu is filled in from the one club-name table (`shots.clubs.CLUB_NAMES`), so it names the clubs as
-`golfflight fly --club` does, and the bay form's ground menu from the surfaces a request may name
-(`flight.ground.SURFACES`)."""
+club menu is filled in from GSPro's club codes (`contract.bay.GSPRO_CLUBS`: the value a code, the label its name), the
+clubs the bay's player can select (`PATCH /v1/bay {"player": {"club": CODE}}`) and each shot's event names, and the
+bay form's ground menu from the surfaces a request may name (`flight.ground.SURFACES`)."""
 
 from __future__ import annotations
 
 from html import escape
 from importlib.resources import files
 
+from golfflight.contract.bay import GSPRO_CLUBS
 from golfflight.flight.ground import SURFACES
-from golfflight.shots.clubs import CLUB_NAMES
 
 PAGE_PATH = "/viewer"
 
-CLUB_OPTIONS_MARKER = b"<!-- club options: shots.clubs.CLUB_NAMES, filled in by service/viewer/page.py -->"
+CLUB_OPTIONS_MARKER = b"<!-- club options: contract.bay.GSPRO_CLUBS, filled in by service/viewer/page.py -->"
 
 
 def with_club_options(page: bytes) -> bytes:
-    """The page with its club menu's options, one per canonical club name."""
+    """The page with its club menu's options, one per GSPro club code in the bag's order: the code the value, the
+    club's name the label."""
     if page.count(CLUB_OPTIONS_MARKER) != 1:
         raise RuntimeError("viewer.html has lost its club options marker")
-    options = "".join(f"<option>{escape(name)}</option>" for name in CLUB_NAMES).encode()
+    options = "".join(
+        f'<option value="{escape(code)}">{escape(name)}</option>' for code, name in GSPRO_CLUBS.items()
+    ).encode()
     return page.replace(CLUB_OPTIONS_MARKER, options)
 
 

@@ -1,25 +1,41 @@
 // golfflight live shot viewer: reads the service's server-sent events (GET /v1/events, one ShotEvent per shot: see
 // service/viewer/event.schema.json) and draws each shot from behind the golfer, from the side and from above, with
-// its numbers, a shot table and the landing dispersion per club. Plain JavaScript and SVG, nothing from elsewhere.
+// its numbers, a shot table and the landing dispersion per club. The bay (GET/PATCH /v1/bay) holds the player's club
+// and the units: the page shows them and changes them there, so every screen of the bay and every shot follow.
+// Plain JavaScript and SVG, nothing from elsewhere.
 "use strict";
 
 const YARD_M = 0.9144;
 const MPH_MPS = 0.44704;
+const FEET_M = 0.3048;
 const KEEP_SHOTS = 50;            // as many as the service keeps
 const PLAY_S = 3;                 // the newest shot plays back in real time, but never longer than this
 const SVG_NS = "http://www.w3.org/2000/svg";
 const KEY_STORE = "golfflight-api-key";
 const SOURCES = { "http": "HTTP", "batch": "batch", "gspro-http": "GSPro (HTTP)", "open-connect": "Open Connect" };
 const CLUB_COLOURS = ["#ffd23f", "#4cd07d", "#5bc0ff", "#ff8a5b", "#c38bff", "#ff5b9a", "#9be15d", "#f2f2f2"];
-const BAY_SOURCES = new Set(["http", "gspro-http", "open-connect"]);  // hit in this bay: tagged with its club
 const STALL_MS = 45_000;          // the service sends a keep-alive comment every 15 s: silence this long is a dead link
-const BAY_POLL_MS = 30_000;       // how often the bay's conditions are read again (another screen may change them)
-const FEET_M = 0.3048;
+const BAY_POLL_MS = 30_000;       // how often the bay is read again (another screen may change it)
+
+// The behind-the-golfer camera: a perspective camera at the golfer's eye, behind the tee on the target line, looking
+// down that line and tilted down just enough to keep the tee in the picture, so the horizon (the target line's
+// vanishing point) is in view and a shot reads as an arc receding to its landing.
+const CAMERA_HEIGHT_M = 1.6;      // above the tee
+const CAMERA_BACK_M = 3;          // behind the tee
+const CAMERA_FOV_DEG = 55;        // vertical field of view: from the tee, 28° below level, to a pitching wedge's 22°
+const CAMERA_PITCH_DEG = 3.5;     // below level: the tee 6 % of the picture above its bottom, the sky up to 24°
+const TEE_Z_M = 0.01;             // the ball on its tee (README: a 1 cm tee)
+const FAIRWAY_HALF_M = 20;
+const FAR_GROUND_M = 5000;        // where the fairway's edges are drawn to: a pixel or two short of the horizon
+const LABEL_GAP_PX = 14;          // a distance label closer than this to the one kept before it is left out
+
+// Every SVG's viewBox is its rendered size in CSS pixels (`frame`), so the labels' font sizes (viewer.css) are the
+// sizes on screen at any width, and margins are worked out from the labels' measured widths.
 
 const state = {
-  shots: [],                       // newest last: {event, club}
+  shots: [],                       // newest last: {event, club}, club the GSPro code of the event's player, or ""
   units: localStorage.getItem("golfflight-units") || "imperial",  // the bay's `units` once read (GET /v1/bay)
-  bay: null,                       // the bay's conditions as the service last gave them
+  bay: null,                       // the bay as the service last gave it
   key: initialKey(),
   lastId: null,
   play: null,                      // {id, started, speed, end}
@@ -29,7 +45,7 @@ const state = {
 /** The newest shot's polyline and ball in each view while it plays: all that an animation frame redraws. */
 const live = [];
 
-// ---- units: SI inside; yards and mph only on screen, by the toggle -------------------------------------------
+// ---- units: SI inside; yards and mph only on screen, by the bay's units --------------------------------------
 
 function imperial() { return state.units === "imperial"; }
 function distUnit() { return imperial() ? "yd" : "m"; }
@@ -58,6 +74,16 @@ function side(value, digits = 1) {
   return [text, Number(text) === 0 ? "" : value > 0 ? "R" : "L"];
 }
 
+// ---- clubs: GSPro's codes, named as the page's club menu names them (filled in from contract.bay.GSPRO_CLUBS) --
+
+/** GSPro club code -> its name, from the club menu's options. */
+const CLUB_NAMES = new Map();
+
+function clubName(code) { return CLUB_NAMES.get(code) || code || "no club"; }
+
+/** The club a shot was hit with: its event's player (the bay's player when it was flown), "" for none. */
+function clubOf(event) { return event.player && event.player.club ? event.player.club : ""; }
+
 // ---- the key ------------------------------------------------------------------------------------------------
 
 /** The API key from the URL fragment (#key=..., never sent to the server; removed from the address bar at once)
@@ -78,6 +104,13 @@ function askForKey(message) {
   document.getElementById("key").focus();
 }
 
+/** The headers of a request to the service: JSON, and the API key when there is one. */
+function keyHeaders(accept = "application/json") {
+  const headers = { "Accept": accept };
+  if (state.key) headers["X-API-Key"] = state.key;
+  return headers;
+}
+
 // ---- the event stream ---------------------------------------------------------------------------------------
 
 function setStatus(kind, text) {
@@ -96,8 +129,7 @@ async function follow() {
   for (;;) {
     let pause = 100;
     try {
-      const headers = { "Accept": "text/event-stream" };
-      if (state.key) headers["X-API-Key"] = state.key;
+      const headers = keyHeaders("text/event-stream");
       if (state.lastId !== null) headers["Last-Event-ID"] = String(state.lastId);
       const abort = new AbortController();
       const response = await fetch("v1/events", { headers, cache: "no-store", signal: abort.signal });
@@ -154,11 +186,13 @@ function onBlock(block) {
   if (kind === "shot" && data.length) addShot(JSON.parse(data.join("\n")));
 }
 
+/** A shot from the stream. Its club is its event's (the bay's player when it was flown, kept by the service, so a
+ * reloaded page tags it alike); a shot hit with another club than the menu shows means the bay's player changed:
+ * the bay is read again. */
 function addShot(event) {
   const seen = state.shots.some((s) => s.event.id === event.id && s.event.received_unix_s === event.received_unix_s);
   if (seen) return;
-  // the bay's own shots get the club picked now; batches (shown only when their request asked) get none
-  const club = BAY_SOURCES.has(event.source) ? document.getElementById("club").value : "";
+  const club = clubOf(event);
   state.shots.push({ event, club });
   if (state.shots.length > KEEP_SHOTS) state.shots.shift();
   const points = event.flight.trajectory;
@@ -169,6 +203,14 @@ function addShot(event) {
     state.ticking = true;
     requestAnimationFrame(tick);
   }
+  if (club && state.bay && state.bay.player && club !== state.bay.player.club) readBaySoon();
+}
+
+let bayRead = null;
+
+/** GET /v1/bay once, shortly (a burst of kept shots on a reload asks once). */
+function readBaySoon() {
+  if (bayRead === null) bayRead = setTimeout(() => { bayRead = null; loadBay(); }, 300);
 }
 
 // ---- drawing ------------------------------------------------------------------------------------------------
@@ -204,23 +246,45 @@ function playing() {
   return play && (performance.now() - play.started) / 1000 * play.speed < play.end;
 }
 
-/** The scene's size in metres: downrange to a round number of the unit shown, height, lateral spread. */
+/** A ground's elevation relative to the tee, metres (`elevation_m`, or `elevation_ft` as the API takes it). */
+function elevationOf(ground) {
+  if (!ground) return 0;
+  if (typeof ground.elevation_m === "number") return ground.elevation_m;
+  if (typeof ground.elevation_ft === "number") return ground.elevation_ft * FEET_M;
+  return 0;
+}
+
+/** The ground the views draw: the bay's (what the next shot lands on), or the newest shot's before the bay is read. */
+function groundElevation() {
+  if (state.bay) return elevationOf(state.bay.ground);
+  const newest = latest();
+  return newest ? elevationOf(newest.event.ground) : 0;
+}
+
+/** The scene's size in metres: downrange to a round number of the unit shown, height (from the lowest point: a
+ * green below the tee), lateral spread, and the ground's elevation. */
 function extent() {
   const step = 50 * (imperial() ? YARD_M : 1);
-  let far = 0, high = 0, wide = 0;
+  const ground = groundElevation();
+  let far = 0, high = 0, low = Math.min(0, ground), wide = 0;
   for (const shot of state.shots) {
     for (const p of shot.event.flight.trajectory) {
-      far = Math.max(far, p.y_m); high = Math.max(high, p.z_m); wide = Math.max(wide, Math.abs(p.x_m));
+      far = Math.max(far, p.y_m); high = Math.max(high, p.z_m); low = Math.min(low, p.z_m); wide = Math.max(wide, Math.abs(p.x_m));
     }
   }
-  return { step, far: Math.max(2, Math.ceil((far * 1.05) / step)) * step, high: Math.max(10, high * 1.15), wide: Math.max(15, wide * 1.2) };
+  return {
+    step, ground, low,
+    far: Math.max(2, Math.ceil((far * 1.05) / step)) * step,
+    high: Math.max(low + 10, high + (high - low) * 0.15),
+    wide: Math.max(15, wide * 1.2),
+  };
 }
 
 function points(list, project) {
   return list.map((p) => project(p).map((v) => v.toFixed(1)).join(",")).join(" ");
 }
 
-/** A whole path's points in a view, worked out once per shot and kept while the view's scale (`scene`) holds. */
+/** A whole path's points in a view, worked out once per shot and kept while the view's projection (`scene`) holds. */
 function pathPoints(shot, svg, scene, project) {
   const kept = (shot.paths ||= {})[svg.id];
   if (kept && kept.scene === scene) return kept.text;
@@ -229,8 +293,19 @@ function pathPoints(shot, svg, scene, project) {
   return text;
 }
 
-/** Every shot as a polyline in one view (`scene`: its scale, for the kept points), the newest highlighted and
- * flown as it plays; its landing and rest points once it has come down. */
+/** Where a flight came down: the trajectory passes exactly through its landing point, at the ground's height there. */
+function landingPoint(flight) {
+  const { x_m, y_m } = flight.landing;
+  let best = null, bestGap = Infinity;
+  for (const p of flight.trajectory) {
+    const gap = (p.x_m - x_m) ** 2 + (p.y_m - y_m) ** 2;
+    if (gap < bestGap) { best = p; bestGap = gap; }
+  }
+  return { x_m, y_m, z_m: best ? best.z_m : 0 };
+}
+
+/** Every shot as a polyline through exactly its trajectory's points in one view (`scene`: its projection, for the
+ * kept points), the newest highlighted and flown as it plays; its landing and rest points once it has come down. */
 function drawShots(svg, project, scene) {
   const newest = latest();
   const moving = playing();
@@ -254,126 +329,180 @@ function drawShots(svg, project, scene) {
     return;
   }
   newestLine.dataset.done = "1";
-  const [lx, ly] = project({ x_m: flight.landing.x_m, y_m: flight.landing.y_m, z_m: 0 });
+  const [lx, ly] = project(landingPoint(flight));
   el(svg, "circle", { class: "landing", cx: lx, cy: ly, r: 6 });
   if (flight.rest) {
-    const [rx, ry] = project({ x_m: flight.rest.x_m, y_m: flight.rest.y_m, z_m: 0 });
+    const [rx, ry] = project(flight.trajectory[flight.trajectory.length - 1]);  // it ends exactly at rest
     el(svg, "circle", { class: "rest", cx: rx, cy: ry, r: 4 });
   }
 }
 
 function unitLabel(metres) { return `${Math.round(metres / (imperial() ? YARD_M : 1))} ${distUnit()}`; }
 
-/** From behind the golfer: a camera 40 m behind the tee and 12 m up, on the target line, looking level down it;
- * zoomed so that every path fits, the tee at the bottom centre and the target line running straight up the middle to
- * the vanishing point (the horizon). A straight shot (direction 0, spin axis 0, no crosswind) stays on that line.
- * Every distance line is labelled, the labels alternating right and left of the fairway so that the far ones, which
- * perspective crowds together, still have room. What was drawn is kept on `window.golfflightViewer.behind`. */
+/** Sets an SVG's viewBox to the size it is drawn at, in CSS pixels (height `aspect` times the width, at least
+ * `minHeight`), so that one unit is one pixel on screen: [width, height]. */
+function frame(svg, aspect, minHeight = 0) {
+  const W = Math.round(svg.getBoundingClientRect().width) || 800;
+  const H = Math.max(Math.round(W * aspect), minHeight);
+  svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+  return [W, H];
+}
+
+/** A label's width as it will be drawn in `svg` (class `cls`), measured. */
+function textWidth(svg, text, cls = "label") {
+  const probe = el(svg, "text", { class: cls, x: 0, y: 0 }, text);
+  const width = probe.getComputedTextLength() || text.length * 7;
+  probe.remove();
+  return width;
+}
+
+function boxesApart(a, b, gap = 2) {
+  return a.x + a.width + gap <= b.x || b.x + b.width + gap <= a.x || a.y + a.height + gap <= b.y || b.y + b.height + gap <= a.y;
+}
+
+/** A label drawn unless it would overlap one already kept (`kept`: their boxes) or leave the picture (W x H):
+ * the text element, or null when it was left out. */
+function placeLabel(svg, kept, W, H, attrs, text) {
+  const label = el(svg, "text", attrs, text);
+  const box = label.getBBox();
+  const inside = box.x >= 0 && box.y >= 0 && box.x + box.width <= W && box.y + box.height <= H;
+  if (!inside || !kept.every((other) => boxesApart(box, other))) {
+    label.remove();
+    return null;
+  }
+  kept.push(box);
+  return label;
+}
+
+/** From behind the golfer: a perspective camera CAMERA_HEIGHT_M above the tee and CAMERA_BACK_M behind it on the
+ * target line, CAMERA_FOV_DEG of vertical view, looking down the line tilted CAMERA_PITCH_DEG down: the tee at the
+ * bottom centre, the target line straight up the middle to its vanishing point on the horizon, so a straight shot
+ * (direction 0, spin axis 0, no crosswind) stays on it, and every shot an arc receding to where it lands. The ground
+ * is a plane at the bay's elevation (the tee at 0); distance lines cross it every 50 yd (or 50 m), receding to the
+ * horizon; a line's label, at the picture's right edge, is left out when it would come closer than LABEL_GAP_PX to the
+ * one kept before it. What was drawn is kept on `window.golfflightViewer.behind`. */
 function drawBehind(svg, box) {
   svg.replaceChildren();
-  const W = 800, H = 800, back = 40, eye = 12, margin = 24;
-  const view = (p) => {
-    const depth = Math.max(p.y_m + back, 0.5);
-    return [p.x_m / depth, (p.z_m - eye) / depth];
-  };
-  const low = view({ x_m: 0, y_m: 0, z_m: 0 })[1];           // the tee, below the horizon
-  let high = 0.05, wide = 0.05;
-  for (const shot of state.shots) {
-    for (const p of shot.event.flight.trajectory) {
-      const [u, v] = view(p);
-      high = Math.max(high, v); wide = Math.max(wide, Math.abs(u));
-    }
-  }
-  const scale = Math.min((H - 2 * margin) / (high - low), (W / 2 - margin) / wide);
-  const bottom = H - margin;
-  const horizon = bottom + low * scale;                        // so that the tee lands on `bottom`
+  const [W, H] = frame(svg, 1);
+  const pitch = (CAMERA_PITCH_DEG * Math.PI) / 180;
+  const focal = H / 2 / Math.tan((CAMERA_FOV_DEG * Math.PI) / 360);
+  const cos = Math.cos(pitch), sin = Math.sin(pitch);
   const project = (p) => {
-    const [u, v] = view(p);
-    return [W / 2 + u * scale, horizon - v * scale];
+    const ahead = p.y_m + CAMERA_BACK_M, up = p.z_m - CAMERA_HEIGHT_M;
+    const depth = Math.max(ahead * cos - up * sin, 0.1);  // along the camera's axis
+    return [W / 2 + (focal * p.x_m) / depth, H / 2 - (focal * (ahead * sin + up * cos)) / depth];
   };
+  const horizon = H / 2 - focal * Math.tan(pitch);
+  const ground = box.ground;
+  const on = (x, y) => ({ x_m: x, y_m: y, z_m: ground });
   const defs = el(svg, "defs");
   const sky = el(defs, "linearGradient", { id: "sky", x1: 0, y1: 0, x2: 0, y2: 1 });
   el(sky, "stop", { offset: "0", "stop-color": "#0f2740" });
   el(sky, "stop", { offset: "1", "stop-color": "#3d6d8f" });
   el(svg, "rect", { class: "sky", x: 0, y: 0, width: W, height: horizon });
   el(svg, "rect", { class: "rough", x: 0, y: horizon, width: W, height: H - horizon });
-  const half = 20;
-  const corners = [[-half, 0], [half, 0], [half, box.far], [-half, box.far]];
-  el(svg, "polygon", { class: "fairway", points: points(corners.map(([x, y]) => ({ x_m: x, y_m: y, z_m: 0 })), project) });
-  const lines = [];
-  for (let y = box.step; y <= box.far + 1e-6; y += box.step) lines.push(y);
-  const ys = lines.map((y) => project({ x_m: 0, y_m: y, z_m: 0 })[1]);
-  const labels = [];
-  lines.forEach((y, n) => {
-    const [x1, y1] = project({ x_m: -half * 1.5, y_m: y, z_m: 0 });
-    const [x2] = project({ x_m: half * 1.5, y_m: y, z_m: 0 });
-    el(svg, "line", { class: "marker-line", x1, y1, x2, y2: y1 });
-    const onLeft = n % 2 === 1;
-    // above its line, as tall as the gap to the next line on the same side allows (that label sits above it)
-    const room = n + 2 < lines.length ? ys[n] - ys[n + 2] - 1 : 20;
-    const size = Math.max(9, Math.min(20, room));
-    const label = el(svg, "text", { class: "label distance", y: y1 - 2, "text-anchor": onLeft ? "end" : "start" }, unitLabel(y));
-    label.style.fontSize = `${size.toFixed(1)}px`;  // CSSOM: the page's CSP allows no inline style attribute
-    const length = label.getComputedTextLength() || 4 * size;  // beside the line's end, always inside the picture
-    label.setAttribute("x", (onLeft ? Math.max(x1 - 6, length + 4) : Math.min(x2 + 6, W - length - 4)).toFixed(1));
-    labels.push({ text: label.textContent, y: y1, size });
-  });
-  const [tx, ty] = project({ x_m: 0, y_m: 0, z_m: 0 });
-  el(svg, "line", { class: "target-line", x1: tx, y1: ty, x2: W / 2, y2: horizon });
+  const fairway = [on(-FAIRWAY_HALF_M, -CAMERA_BACK_M / 2), on(FAIRWAY_HALF_M, -CAMERA_BACK_M / 2), on(FAIRWAY_HALF_M, FAR_GROUND_M), on(-FAIRWAY_HALF_M, FAR_GROUND_M)];
+  el(svg, "polygon", { class: "fairway", points: points(fairway, project) });
+  for (let x = -2 * FAIRWAY_HALF_M; x <= 2 * FAIRWAY_HALF_M; x += FAIRWAY_HALF_M / 2) {  // receding to the horizon
+    if (x === 0) continue;
+    const [x1, y1] = project(on(x, -CAMERA_BACK_M / 2)), [x2, y2] = project(on(x, FAR_GROUND_M));
+    el(svg, "line", { class: Math.abs(x) === FAIRWAY_HALF_M ? "lane edge" : "lane", x1, y1, x2, y2 });
+  }
+  el(svg, "line", { class: "horizon", x1: 0, y1: horizon, x2: W, y2: horizon });
+  const kept = [], labels = [];
+  let lastY = Infinity;
+  for (let y = box.step; y <= box.far + 1e-6; y += box.step) {
+    const [, ly] = project(on(0, y));  // a line across the ground at y: level across the picture
+    el(svg, "line", { class: "marker-line", x1: 0, y1: ly, x2: W, y2: ly, "data-m": y.toFixed(2) });
+    if (lastY - ly < LABEL_GAP_PX) continue;
+    const label = placeLabel(svg, kept, W, H, { class: "label distance", x: W - 6, y: ly - 3, "text-anchor": "end" }, unitLabel(y));
+    if (!label) continue;
+    lastY = ly;
+    const b = label.getBBox();
+    labels.push({ text: label.textContent, line_y: ly, box: [b.x, b.y, b.width, b.height] });
+  }
+  const [tx, ty] = project({ x_m: 0, y_m: 0, z_m: TEE_Z_M });
+  const [gx, gy] = project(on(0, 0));
+  el(svg, "line", { class: "target-line", x1: gx, y1: gy, x2: W / 2, y2: horizon });
   el(svg, "circle", { class: "tee", cx: tx, cy: ty, r: 3 });
-  drawShots(svg, project, `${scale} ${horizon}`);
-  (window.golfflightViewer ||= {}).behind = { width: W, height: H, tee: [tx, ty], vanishing: [W / 2, horizon], labels };
+  drawShots(svg, project, `${W} ${H} ${ground}`);
+  (window.golfflightViewer ||= {}).behind = {
+    width: W, height: H, tee: [tx, ty], vanishing: [W / 2, horizon], labels, ground_m: ground,
+    camera: { height_m: CAMERA_HEIGHT_M, back_m: CAMERA_BACK_M, fov_deg: CAMERA_FOV_DEG, pitch_deg: CAMERA_PITCH_DEG },
+  };
 }
 
-/** From the side: downrange to the right, height up, one scale for both. */
+/** From the side: downrange to the right, height up, one scale for both; the tee at 0 and the ground at its
+ * elevation. The margins are the labels' measured widths, and a distance label is left out where it would touch its
+ * neighbour, so nothing is cut or crammed at any width. */
 function drawSide(svg, box) {
   svg.replaceChildren();
-  const W = 800, H = 250, left = 46, bottom = 22;
-  const scale = Math.min((W - left - 14) / box.far, (H - bottom - 12) / box.high);
-  const project = (p) => [left + p.y_m * scale, H - bottom - p.z_m * scale];
-  for (let y = 0; y <= box.far + 1e-6; y += box.step) {
-    const x = left + y * scale;
-    el(svg, "line", { class: "grid", x1: x, y1: 8, x2: x, y2: H - bottom });
-    el(svg, "text", { class: "label", x: x - 12, y: H - 6 }, unitLabel(y));
-  }
+  const [W, H] = frame(svg, 0.3125, 150);
   const heightStep = imperial() ? 10 * YARD_M : 10;
-  for (let z = heightStep; z * scale < H - bottom - 8; z += heightStep) {
-    el(svg, "text", { class: "label", x: 4, y: H - bottom - z * scale + 4 }, unitLabel(z));
+  const heights = [];
+  for (let k = Math.ceil(box.low / heightStep); k * heightStep <= box.high; k++) if (k !== 0) heights.push(k * heightStep);
+  const lines = [];
+  for (let y = 0; y <= box.far + 1e-6; y += box.step) lines.push(y);
+  const texts = lines.map(unitLabel);
+  const widths = texts.map((text) => textWidth(svg, text));
+  const heightWidth = Math.max(0, ...heights.map((z) => textWidth(svg, unitLabel(z))));
+  const left = Math.max(heightWidth + 10, widths[0] / 2 + 4), right = widths[widths.length - 1] / 2 + 6;
+  const top = 10, bottom = 24;
+  const scale = Math.min((W - left - right) / box.far, (H - top - bottom) / (box.high - box.low));
+  const base = H - bottom + box.low * scale;  // z = 0
+  const project = (p) => [left + p.y_m * scale, base - p.z_m * scale];
+  const kept = [];
+  lines.forEach((y, n) => {
+    const x = left + y * scale;
+    el(svg, "line", { class: "grid", x1: x, y1: top - 2, x2: x, y2: H - bottom });
+    placeLabel(svg, kept, W, H, { class: "label", x, y: H - 7, "text-anchor": "middle" }, texts[n]);
+  });
+  for (const z of heights) {
+    const y = base - z * scale;
+    el(svg, "line", { class: "grid faint", x1: left, y1: y, x2: W - right, y2: y });
+    placeLabel(svg, kept, W, H, { class: "label", x: left - 6, y: y + 4, "text-anchor": "end" }, unitLabel(z));
   }
-  el(svg, "line", { class: "ground-line", x1: left, y1: H - bottom, x2: W, y2: H - bottom });
-  drawShots(svg, project, String(scale));
+  const groundY = base - box.ground * scale;
+  el(svg, "line", { class: "ground-line", x1: left, y1: groundY, x2: W - right, y2: groundY });
+  if (Math.abs(box.ground) * scale >= 1) el(svg, "line", { class: "ground-line tee-box", x1: left - 4, y1: base, x2: left + 6, y2: base });
+  drawShots(svg, project, `${W} ${H} ${scale} ${base}`);
 }
 
 /** From above: downrange to the right, the golfer's right downwards, one scale for both. */
 function drawTop(svg, box) {
   svg.replaceChildren();
-  const W = 800, H = 250, left = 46;
-  const scale = Math.min((W - left - 14) / box.far, (H - 20) / (2 * box.wide));
+  const [W, H] = frame(svg, 0.3125, 150);
+  const left = Math.max(46, Math.max(textWidth(svg, "left"), textWidth(svg, "right")) + 10), right = 14;
+  const scale = Math.min((W - left - right) / box.far, (H - 20) / (2 * box.wide));
   const project = (p) => [left + p.y_m * scale, H / 2 + p.x_m * scale];
-  el(svg, "rect", { class: "fairway", x: left, y: H / 2 - 20 * scale, width: box.far * scale, height: 40 * scale, opacity: 0.5 });
+  el(svg, "rect", { class: "fairway", x: left, y: H / 2 - FAIRWAY_HALF_M * scale, width: box.far * scale, height: 2 * FAIRWAY_HALF_M * scale, opacity: 0.5 });
   for (let y = 0; y <= box.far + 1e-6; y += box.step) {
     const x = left + y * scale;
     el(svg, "line", { class: "grid", x1: x, y1: 0, x2: x, y2: H });
   }
-  el(svg, "line", { class: "target-line", x1: left, y1: H / 2, x2: W, y2: H / 2 });
-  el(svg, "text", { class: "label", x: 4, y: 14 }, "left");
-  el(svg, "text", { class: "label", x: 4, y: H - 6 }, "right");
-  drawShots(svg, project, String(scale));
+  el(svg, "line", { class: "target-line", x1: left, y1: H / 2, x2: W - right, y2: H / 2 });
+  el(svg, "text", { class: "label", x: 4, y: 16 }, "left");
+  el(svg, "text", { class: "label", x: 4, y: H - 7 }, "right");
+  drawShots(svg, project, `${W} ${H} ${scale}`);
 }
 
-/** Landing points (filled) and rest points (rings, once the results carry them) per club, seen from behind. */
+/** Landing points (filled) and rest points (rings) per club, seen from behind; a putt has its rest point only. */
 function drawDispersion(svg, box) {
   svg.replaceChildren();
-  const S = 400, pad = 34;
+  const [S] = frame(svg, 1);
+  const lines = [];
+  for (let y = 0; y <= box.far + 1e-6; y += box.step) lines.push(y);
+  const pad = Math.max(24, ...lines.map((y) => textWidth(svg, unitLabel(y)) + 10));
   const clubs = [...new Set(state.shots.map((s) => s.club))];
   const colour = (club) => CLUB_COLOURS[clubs.indexOf(club) % CLUB_COLOURS.length];
   const wide = Math.max(box.wide, box.far / 8);
   const sx = (S - 2 * pad) / (2 * wide), sy = (S - 2 * pad) / box.far;
   const project = (x, y) => [S / 2 + x * sx, S - pad - y * sy];
-  for (let y = 0; y <= box.far + 1e-6; y += box.step) {
+  const kept = [];
+  for (const y of lines) {
     const [, py] = project(0, y);
     el(svg, "line", { class: "grid", x1: pad, y1: py, x2: S - pad, y2: py });
-    el(svg, "text", { class: "label", x: 2, y: py + 4 }, unitLabel(y));
+    placeLabel(svg, kept, S, S, { class: "label", x: pad - 6, y: py + 4, "text-anchor": "end" }, unitLabel(y));
   }
   el(svg, "line", { class: "target-line", x1: S / 2, y1: pad / 2, x2: S / 2, y2: S - pad });
   // rest rings first and in the club's colour (CSSOM: a stroke attribute loses to the .dot rule, which drew them
@@ -385,6 +514,7 @@ function drawDispersion(svg, box) {
     el(svg, "circle", { class: "dot rest-dot", cx: rx, cy: ry, r: 5 }).style.stroke = colour(shot.club);
   }
   for (const shot of state.shots) {
+    if (shot.event.putt) continue;
     const flight = shot.event.flight;
     const [x, y] = project(flight.landing.x_m, flight.landing.y_m);
     el(svg, "circle", { class: "dot", cx: x, cy: y, r: 5, fill: colour(shot.club), "data-shot": shot.event.id });
@@ -393,11 +523,14 @@ function drawDispersion(svg, box) {
   legend.replaceChildren();
   for (const club of clubs) {
     const group = state.shots.filter((s) => s.club === club);
-    const carries = group.map((s) => distance(s.event.flight, "carry"));
-    const mean = carries.reduce((a, b) => a + b, 0) / carries.length;
+    const putts = group.every((s) => s.event.putt);
+    const figure = putts ? "total" : "carry";
+    const values = group.map((s) => distance(s.event.flight, figure)).filter((v) => v !== null);
+    const mean = values.length ? values.reduce((a, b) => a + b, 0) / values.length : null;
     const item = document.createElement("li");
     item.style.setProperty("--swatch", colour(club));
-    item.textContent = `${club || "no club"}: ${group.length} shot${group.length > 1 ? "s" : ""}, carry ${mean.toFixed(1)} ${distUnit()} on average`;
+    const count = `${group.length} ${putts ? "putt" : "shot"}${group.length > 1 ? "s" : ""}`;
+    item.textContent = `${clubName(club)}: ${count}, ${figure} ${fixed(mean)} ${distUnit()} on average`;
     legend.appendChild(item);
   }
 }
@@ -421,9 +554,62 @@ function spinParts(launch) {
   return { back: launch.spin_rpm * Math.cos(axis), side: launch.spin_rpm * Math.sin(axis) };
 }
 
+/** The connector's ClubData (GSPro Open Connect), in the order a launch monitor shows them: [field, name, kind].
+ * Speeds come in mph, as GSPro's ball speed does (m/s on a metric screen), angles in degrees; the face impact comes
+ * with no unit in Open Connect and is shown as sent. */
+const CLUB_DATA = [
+  ["Speed", "Club speed", "speed"],
+  ["SpeedAtImpact", "Speed at impact", "speed"],
+  ["AngleOfAttack", "Attack angle", "deg"],
+  ["Path", "Club path", "deg"],
+  ["FaceToTarget", "Face to target", "deg"],
+  ["Loft", "Dynamic loft", "deg"],
+  ["Lie", "Lie", "deg"],
+  ["ClosureRate", "Closure rate", "deg/s"],
+  ["HorizontalFaceImpact", "Impact across the face", "raw"],
+  ["VerticalFaceImpact", "Impact up the face", "raw"],
+];
+
+/** The last shot's ClubData as tiles (those it has, in CLUB_DATA's order, then any other field as sent); hidden
+ * when the shot came without any. */
+function showClubData(clubData) {
+  const list = document.getElementById("club-numbers");
+  const title = document.getElementById("club-numbers-title");
+  list.replaceChildren();
+  const entries = clubData ? Object.entries(clubData).filter(([, v]) => v !== null && v !== undefined) : [];
+  const known = new Map(CLUB_DATA.map(([field, name, kind]) => [field, { name, kind }]));
+  entries.sort(([a], [b]) => (known.has(a) ? CLUB_DATA.findIndex(([f]) => f === a) : 99) - (known.has(b) ? CLUB_DATA.findIndex(([f]) => f === b) : 99));
+  for (const [field, value] of entries) {
+    const { name, kind } = known.get(field) || { name: field, kind: "raw" };
+    const tile = document.createElement("div");
+    const dt = document.createElement("dt");
+    dt.textContent = name;
+    const dd = document.createElement("dd");
+    dd.id = `club-${field}`;
+    tile.append(dt, dd);
+    list.appendChild(tile);
+    if (typeof value !== "number") {
+      dd.textContent = String(value);
+    } else if (kind === "speed") {
+      setNumber(dd.id, speedText(value * MPH_MPS), speedUnit());
+    } else if (kind === "deg") {
+      setNumber(dd.id, fixed(value), "°");
+    } else if (kind === "deg/s") {
+      setNumber(dd.id, fixed(value), "°/s");
+    } else {
+      dd.textContent = String(Number(value.toFixed(2)));
+    }
+  }
+  list.hidden = title.hidden = entries.length === 0;
+}
+
 function showNumbers(shot) {
-  document.getElementById("last-source").textContent = shot
-    ? `#${shot.event.id} · ${SOURCES[shot.event.source]}${shot.event.shot_number ? " shot " + shot.event.shot_number : ""}` : "";
+  const source = document.getElementById("last-source");
+  source.textContent = shot
+    ? `#${shot.event.id} · ${SOURCES[shot.event.source]}${shot.event.shot_number ? " shot " + shot.event.shot_number : ""}`
+      + (shot.club ? ` · ${clubName(shot.club)}` : "") + (shot.event.putt ? " putt" : "")
+    : "";
+  showClubData(shot ? shot.event.club_data : null);
   if (!shot) return;
   const { launch, flight } = shot.event;
   const spin = spinParts(launch);
@@ -445,6 +631,20 @@ function showNumbers(shot) {
   setNumber("n-flight-time", fixed(flight.flight_time_s), "s");
 }
 
+/** The club cell: the GSPro code (its name on hover), "putt" after a putter's, "—" for a shot without a player. */
+function clubCell(shot) {
+  const cell = document.createElement("td");
+  cell.textContent = shot.club || "—";
+  if (shot.club) cell.title = clubName(shot.club);
+  if (shot.event.putt) {
+    const mark = document.createElement("span");
+    mark.className = "putt";
+    mark.textContent = "putt";
+    cell.append(" ", mark);
+  }
+  return cell;
+}
+
 function showTable() {
   const body = document.querySelector("#shots tbody");
   body.replaceChildren();
@@ -452,13 +652,19 @@ function showTable() {
     const { launch, flight } = shot.event;
     const row = document.createElement("tr");
     row.dataset.shot = shot.event.id;
+    row.dataset.club = shot.club;
+    if (shot.event.putt) row.dataset.putt = "1";
     const cells = [
-      shot.event.id, SOURCES[shot.event.source], shot.club || "—",
+      shot.event.id, SOURCES[shot.event.source], null,
       `${speedText(launch.ball_speed_mps)} ${speedUnit()}`, `${fixed(launch.launch_angle_deg)}°`, rpm(launch.spin_rpm),
       fixed(distance(flight, "carry")), fixed(distance(flight, "total")), fixed(distance(flight, "apex")),
       `${fixed(flight.landing_angle_deg)}°`, side(distance(flight, "lateral")).join(" ").trim(),
     ];
     for (const text of cells) {
+      if (text === null) {
+        row.appendChild(clubCell(shot));
+        continue;
+      }
       const cell = document.createElement("td");
       cell.textContent = text;
       row.appendChild(cell);
@@ -510,28 +716,62 @@ function tick() {
   requestAnimationFrame(tick);
 }
 
-// ---- the bay's conditions (GET/PUT /v1/bay): shown, changed from the form, its units used for every figure ----
+/** The pictures are drawn at their size on screen: drawn again when a view's width changes. */
+function redrawOnResize() {
+  let pending = false;
+  const widths = new Map();
+  const observer = new ResizeObserver((entries) => {
+    const changed = entries.some((entry) => {
+      const width = Math.round(entry.contentRect.width);
+      const before = widths.get(entry.target);
+      widths.set(entry.target, width);
+      return before !== undefined && before !== width;
+    });
+    if (!changed || pending) return;
+    pending = true;
+    requestAnimationFrame(() => {
+      pending = false;
+      const box = drawViews();
+      drawDispersion(document.getElementById("dispersion"), box);
+    });
+  });
+  for (const id of ["behind", "side", "top", "dispersion"]) observer.observe(document.getElementById(id));
+}
 
-/** The form's fields: the bay's value at `path` in SI, shown in the bay's units (to SI and back). */
+// ---- the bay (GET and PATCH /v1/bay): its conditions shown and changed from the form, its units used for every
+// figure, its player's club in the club menu. A change sends the part it changes only, so nothing another screen
+// or client set is written back, and nothing is rounded through the display units. ---------------------------
+
+/** The form's fields: where each lives in the bay, the field's name in each of the page's units (the API takes
+ * both: temperature_f or temperature_c, altitude_ft or altitude_m, speed_mph or speed_mps, elevation_ft or
+ * elevation_m), and how a value in the other converts. */
 const BAY_FIELDS = [
-  { id: "bay-temperature", path: ["air", "temperature_c"], digits: 1, unit: () => imperial() ? "°F" : "°C",
-    show: (c) => imperial() ? c * 9 / 5 + 32 : c, si: (v) => imperial() ? (v - 32) * 5 / 9 : v },
-  { id: "bay-altitude", path: ["air", "altitude_m"], digits: 0, unit: () => imperial() ? "ft" : "m",
-    show: (m) => imperial() ? m / FEET_M : m, si: (v) => imperial() ? v * FEET_M : v },
-  { id: "bay-humidity", path: ["air", "humidity_pct"], digits: 0, unit: () => "%", show: (v) => v, si: (v) => v },
-  { id: "bay-wind-speed", path: ["wind", "speed_mps"], digits: 1, unit: speedUnit,
-    show: (v) => imperial() ? v / MPH_MPS : v, si: (v) => imperial() ? v * MPH_MPS : v },
-  { id: "bay-wind-from", path: ["wind", "from_deg"], digits: 0, unit: () => "°", show: (v) => v, si: (v) => v },
-  { id: "bay-stimp", path: ["ground", "stimp_ft"], digits: 1, unit: () => "ft", show: (v) => v, si: (v) => v },
+  { id: "bay-temperature", group: "air", imperial: "temperature_f", metric: "temperature_c", digits: 1,
+    units: ["°F", "°C"], toImperial: (c) => c * 9 / 5 + 32, toMetric: (f) => (f - 32) * 5 / 9 },
+  { id: "bay-altitude", group: "air", imperial: "altitude_ft", metric: "altitude_m", digits: 0,
+    units: ["ft", "m"], toImperial: (m) => m / FEET_M, toMetric: (ft) => ft * FEET_M },
+  { id: "bay-humidity", group: "air", imperial: "humidity_pct", metric: "humidity_pct", digits: 0, units: ["%", "%"] },
+  { id: "bay-wind-speed", group: "wind", imperial: "speed_mph", metric: "speed_mps", digits: 1,
+    units: ["mph", "m/s"], toImperial: (mps) => mps / MPH_MPS, toMetric: (mph) => mph * MPH_MPS },
+  { id: "bay-wind-from", group: "wind", imperial: "from_deg", metric: "from_deg", digits: 0, units: ["°", "°"] },
+  { id: "bay-stimp", group: "ground", imperial: "stimp_ft", metric: "stimp_ft", digits: 1, units: ["ft", "ft"] },
+  { id: "bay-elevation", group: "ground", imperial: "elevation_ft", metric: "elevation_m", digits: 1,
+    units: ["ft", "m"], toImperial: (m) => m / FEET_M, toMetric: (ft) => ft * FEET_M },
 ];
 
-function bayValue(bay, [group, name]) { return bay && bay[group] ? bay[group][name] : undefined; }
-
-function bayHeaders() {
-  const headers = { "Accept": "application/json" };
-  if (state.key) headers["X-API-Key"] = state.key;
-  return headers;
+/** A field's value in the bay in `units` ("imperial" or "metric"): as the bay has it in those units, else
+ * converted from the other's; undefined when the bay has neither. */
+function bayValue(bay, field, units = state.units) {
+  const part = bay && bay[field.group];
+  if (!part) return undefined;
+  const wanted = units === "imperial" ? field.imperial : field.metric;
+  const other = units === "imperial" ? field.metric : field.imperial;
+  if (typeof part[wanted] === "number") return part[wanted];
+  if (typeof part[other] === "number") return (units === "imperial" ? field.toImperial : field.toMetric)(part[other]);
+  return undefined;
 }
+
+function fieldUnit(field) { return field.units[imperial() ? 0 : 1]; }
 
 function bayMessage(kind, text) {
   const message = document.getElementById("bay-message");
@@ -546,22 +786,26 @@ function refusal(status, answer) {
   return typeof detail === "string" ? detail : `refused (${status})`;
 }
 
-/** The bay's conditions in a line, in the bay's units. */
+/** The bay's conditions in a line, in the page's units. */
 function baySummary(bay) {
+  const [temperature, altitude, humidity, windSpeed, windFrom, stimp, elevation] = BAY_FIELDS;
   const parts = [];
   const air = bay.air || {};
   if (air.density_kg_m3 !== undefined) parts.push(`air ${air.density_kg_m3} kg/m³`);
   else {
-    const t = BAY_FIELDS[0], a = BAY_FIELDS[1];
-    parts.push(air.temperature_c === undefined ? "15 °C standard air" : `${fixed(t.show(air.temperature_c), 1)}${t.unit()}`);
-    if (air.altitude_m !== undefined) parts.push(`${fixed(a.show(air.altitude_m), 0)} ${a.unit()} up`);
+    const t = bayValue(bay, temperature);
+    parts.push(t === undefined ? "15 °C standard air" : `${fixed(t, 1)}${fieldUnit(temperature)}`);
+    const a = bayValue(bay, altitude);
+    if (a !== undefined) parts.push(`${fixed(a, 0)} ${fieldUnit(altitude)} up`);
     if (air.pressure_hpa !== undefined) parts.push(`${air.pressure_hpa} hPa`);
-    if (air.humidity_pct !== undefined) parts.push(`${air.humidity_pct}% humidity`);
+    if (bayValue(bay, humidity) !== undefined) parts.push(`${bayValue(bay, humidity)}% humidity`);
   }
-  const wind = bay.wind;
-  parts.push(wind && wind.speed_mps ? `wind ${speedText(wind.speed_mps)} ${speedUnit()} from ${Math.round(wind.from_deg || 0)}°` : "calm");
-  const ground = bay.ground || { surface: "fairway" };
-  parts.push(ground.surface.replace("_", " ") + (ground.stimp_ft !== undefined ? `, stimp ${ground.stimp_ft}` : ""));
+  const speed = bayValue(bay, windSpeed);
+  parts.push(speed ? `wind ${fixed(speed)} ${fieldUnit(windSpeed)} from ${Math.round(bayValue(bay, windFrom) || 0)}°` : "calm");
+  const ground = bay.ground || {};
+  const s = bayValue(bay, stimp), e = bayValue(bay, elevation);
+  parts.push((ground.surface || "fairway").replace("_", " ") + (s !== undefined ? `, stimp ${s}` : "")
+    + (e ? `, ${e > 0 ? "+" : "−"}${fixed(Math.abs(e), 1)} ${fieldUnit(elevation)} from the tee` : ""));
   return parts.join(" · ");
 }
 
@@ -572,46 +816,39 @@ function showBay(all = true) {
   document.getElementById("bay-summary").textContent = baySummary(bay);
   for (const field of BAY_FIELDS) {
     const input = document.getElementById(field.id);
-    document.querySelector(`label[for=${field.id}] .unit`).textContent = field.unit();
-    if (!all && input.dataset.dirty) continue;
-    const value = bayValue(bay, field.path);
-    input.value = typeof value === "number" ? String(Number(field.show(value).toFixed(field.digits))) : "";
-    delete input.dataset.dirty;
+    document.querySelector(`label[for=${field.id}] .unit`).textContent = fieldUnit(field);
+    if (!all && changedField(input)) continue;
+    const value = bayValue(bay, field);
+    input.value = typeof value === "number" ? String(Number(value.toFixed(field.digits))) : "";
+    input.dataset.shown = input.value;  // a field is changed when it no longer reads this
   }
   const surface = document.getElementById("bay-surface");
-  if (all || !surface.dataset.dirty) {
+  if (all || !changedField(surface)) {
     surface.value = (bay.ground && bay.ground.surface) || "fairway";
-    delete surface.dataset.dirty;
+    surface.dataset.shown = surface.value;
   }
   document.getElementById("bay-stimp").disabled = surface.value !== "green";
 }
 
-/** Takes the bay the service answered with: its units become the page's. */
-/** The bay with its wind speed in m/s, whichever unit it was set in (`speed_mph` over the API): the form and
- * the summary read `speed_mps`. */
-function windInMps(bay) {
-  const wind = bay.wind;
-  if (wind && wind.speed_mps === undefined && wind.speed_mph !== undefined) {
-    bay.wind = { ...wind, speed_mps: wind.speed_mph * 0.44704 };
-    delete bay.wind.speed_mph;
-  }
-  return bay;
-}
+function changedField(input) { return input.dataset.shown !== undefined && input.value.trim() !== input.dataset.shown; }
 
+/** Takes the bay the service answered with: its units become the page's, its player's club the menu's. */
 function takeBay(bay, all = true) {
-  bay = windInMps(bay);
   state.bay = bay;
+  const club = document.getElementById("club");
+  if (bay.player && bay.player.club && club.value !== bay.player.club) club.value = bay.player.club;
+  if (bay.player) club.dataset.saved = bay.player.club;
   if (bay.units && bay.units !== state.units) {
     state.units = bay.units;
     localStorage.setItem("golfflight-units", state.units);
-    render();
   }
+  render();  // the ground's elevation and the units draw the pictures
   showBay(all);
 }
 
 async function loadBay() {
   try {
-    const response = await fetch("v1/bay", { headers: bayHeaders(), cache: "no-store" });
+    const response = await fetch("v1/bay", { headers: keyHeaders(), cache: "no-store" });
     if (response.ok) {
       const editing = document.getElementById("bay-form").contains(document.activeElement);
       takeBay(await response.json(), !editing);
@@ -619,19 +856,21 @@ async function loadBay() {
   } catch (error) { /* the stream's status says so */ }
 }
 
-/** PUT /v1/bay with `bay`; the service's answer is shown (its message, on a refused value). */
-async function putBay(bay) {
+/** PATCH /v1/bay with `update` (the parts to change, nothing else); the bay the service answers is taken, and a
+ * refusal shown in the service's own words: true when it was saved. */
+async function patchBay(update) {
   bayMessage("saving", "saving…");
   try {
     const response = await fetch("v1/bay", {
-      method: "PUT", headers: { ...bayHeaders(), "Content-Type": "application/json" }, body: JSON.stringify(bay),
+      method: "PATCH", headers: { ...keyHeaders(), "Content-Type": "application/json" }, body: JSON.stringify(update),
     });
     const answer = await response.json().catch(() => null);
     if (!response.ok) {
       bayMessage("refused", refusal(response.status, answer));
       return false;
     }
-    takeBay(answer);
+    if (answer && typeof answer === "object" && answer.units) takeBay(answer);
+    else await loadBay();
     bayMessage("saved", "saved");
     return true;
   } catch (error) {
@@ -640,49 +879,104 @@ async function putBay(bay) {
   }
 }
 
-/** The bay as the form says: the service's last bay with the fields the operator changed (an emptied one
- * removed), so a value nobody touched goes back exactly as it came, never rounded through the display units. */
-function bayFromForm() {
-  const bay = structuredClone(state.bay || {});
+/** The parts of the bay the form changes (PATCH replaces each part it names): a part with a changed field goes as
+ * the bay had it, the changed field set as typed under its name in the page's units (°F, ft, mph when imperial) and
+ * its other spelling dropped; an emptied field is removed, a part left empty (a wind without speed) is cleared
+ * with null. Parts nobody changed are not sent at all, and untouched values go back exactly as they came. */
+function bayUpdate() {
+  const bay = state.bay || {};
+  const parts = {}, changed = new Set();
+  for (const group of ["air", "wind", "ground"]) parts[group] = structuredClone(bay[group] || {});
   for (const field of BAY_FIELDS) {
     const input = document.getElementById(field.id);
-    if (!input.dataset.dirty) continue;
-    const [group, name] = field.path;
+    if (!changedField(input) || input.disabled) continue;
+    const part = parts[field.group];
+    delete part[field.imperial];
+    delete part[field.metric];
     const text = input.value.trim();
-    if (text === "") {
-      if (bay[group]) delete bay[group][name];
-      continue;
+    if (text !== "") {
+      const number = Number(text);
+      part[imperial() ? field.imperial : field.metric] = Number.isFinite(number) ? number : text;
     }
-    bay[group] = bay[group] || {};
-    const number = Number(text);
-    bay[group][name] = Number.isFinite(number) ? Number(field.si(number).toPrecision(12)) : text;
+    changed.add(field.group);
   }
-  const surface = document.getElementById("bay-surface").value;
-  if (surface !== ((bay.ground && bay.ground.surface) || "fairway")) bay.ground = { ...(bay.ground || {}), surface };
-  if (bay.ground && bay.ground.surface !== "green") delete bay.ground.stimp_ft;
-  if (bay.wind && bay.wind.speed_mps === undefined) delete bay.wind;  // no speed: calm
-  for (const group of ["air", "wind", "ground"]) {
-    if (bay[group] && Object.keys(bay[group]).length === 0) delete bay[group];
+  const surface = document.getElementById("bay-surface");
+  if (changedField(surface)) {
+    parts.ground.surface = surface.value;
+    if (surface.value !== "green") delete parts.ground.stimp_ft;
+    changed.add("ground");
   }
-  return bay;
+  const update = {};
+  for (const group of changed) {
+    const part = parts[group];
+    const calm = group === "wind" && part.speed_mps === undefined && part.speed_mph === undefined;
+    update[group] = calm || Object.keys(part).length === 0 ? null : part;
+  }
+  return update;
 }
 
+/** The units button: PATCH {"units": ...} and nothing else; before the bay is read, this screen only. */
 async function setUnits(units) {
   if (state.bay) {
-    await putBay({ ...state.bay, units });
+    await patchBay({ units });
     return;
   }
-  state.units = units;  // no bay read (yet): this screen only
+  state.units = units;
   localStorage.setItem("golfflight-units", state.units);
   render();
+  showBay(true);
+}
+
+/** The club menu: the bay's player's club, PATCH {"player": {"club": CODE}}; the shots hit from now on carry it.
+ * A refused change puts the menu back to the bay's club. */
+async function setClub(code) {
+  const club = document.getElementById("club");
+  delete club.dataset.saved;
+  if (!(await patchBay({ player: { club: code } })) && state.bay && state.bay.player) {
+    club.value = state.bay.player.club;
+    club.dataset.saved = state.bay.player.club;
+  }
+}
+
+// ---- the session's shots as CSV (GET /v1/session.csv): fetched with the key, saved from a blob URL ------------
+
+async function downloadSession() {
+  const message = document.getElementById("download-message");
+  message.dataset.state = "loading";
+  message.textContent = "";
+  try {
+    const response = await fetch("v1/session.csv", { headers: keyHeaders("text/csv"), cache: "no-store" });
+    if (!response.ok) {
+      const answer = await response.json().catch(() => null);
+      message.dataset.state = "refused";
+      message.textContent = refusal(response.status, answer);
+      return;
+    }
+    const url = URL.createObjectURL(await response.blob());
+    const link = document.createElement("a");
+    link.href = url;
+    link.download = "golfflight-session.csv";
+    document.body.appendChild(link);
+    link.click();
+    link.remove();
+    setTimeout(() => URL.revokeObjectURL(url), 60_000);
+    message.dataset.state = "done";
+  } catch (error) {
+    message.dataset.state = "refused";
+    message.textContent = "service unreachable";
+  }
 }
 
 // ---- start --------------------------------------------------------------------------------------------------
 
 document.addEventListener("DOMContentLoaded", () => {
+  const club = document.getElementById("club");
+  for (const option of club.options) CLUB_NAMES.set(option.value, option.textContent);
+  club.addEventListener("change", () => setClub(club.value));
   for (const button of document.querySelectorAll(".units button")) {
     button.addEventListener("click", () => setUnits(button.dataset.units));
   }
+  document.getElementById("download-csv").addEventListener("click", downloadSession);
   document.getElementById("key-form").addEventListener("submit", (event) => {
     event.preventDefault();
     state.key = document.getElementById("key").value;
@@ -693,13 +987,17 @@ document.addEventListener("DOMContentLoaded", () => {
     loadBay();
   });
   const bayForm = document.getElementById("bay-form");
-  bayForm.addEventListener("input", (event) => {
-    event.target.dataset.dirty = "1";
+  bayForm.addEventListener("input", () => {
     document.getElementById("bay-stimp").disabled = document.getElementById("bay-surface").value !== "green";
   });
   bayForm.addEventListener("submit", async (event) => {
     event.preventDefault();
-    await putBay(bayFromForm());
+    const update = bayUpdate();
+    if (Object.keys(update).length === 0) {
+      bayMessage("unchanged", "nothing changed");
+      return;
+    }
+    await patchBay(update);
   });
   bayForm.addEventListener("reset", (event) => {
     event.preventDefault();
@@ -707,6 +1005,7 @@ document.addEventListener("DOMContentLoaded", () => {
     bayMessage("", "");
   });
   render();
+  redrawOnResize();
   follow();
   loadBay();
   setInterval(loadBay, BAY_POLL_MS);
