@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from golfflight.contract.bay import GSPRO_CLUBS
 from golfflight.contract.inputs import air_of
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import MPH_TO_MPS
@@ -180,9 +181,9 @@ def test_the_alias_table_covers_every_club_and_refuses_unknown_names(capsys):
     assert len(err.splitlines()) == 1 and "unknown club 'putter'" in err and "7-iron" in err and "Driver" in err
 
 
-def test_the_viewer_offers_the_canonical_club_names():
+def test_the_viewer_offers_gspros_clubs_by_their_codes():
     page = ASSETS["viewer.html"][0].decode()
-    menu = page[page.index('<select id="club">') : page.index("</select>")]
-    offered = [part.split("</option>")[0] for part in menu.split("<option>")[1:]]
-    assert offered == list(CLUB_NAMES)
-    assert "7 iron" not in page and "<!--" not in menu
+    menu = page[page.index('<select id="club">') : page.index("</select>", page.index('<select id="club">'))]
+    offered = [part.split('"', 1)[0] for part in menu.split('<option value="')[1:]]
+    assert offered == list(GSPRO_CLUBS) and all(name in menu for name in GSPRO_CLUBS.values())
+    assert "<!--" not in menu
