@@ -7,13 +7,17 @@ bottom centre and keeps a straight shot on the target line, labels every distanc
 from __future__ import annotations
 
 import asyncio
+import csv
+import io
 import time
 from contextlib import contextmanager
 from functools import partial
+from pathlib import Path
 
 import browser
 import httpx
 import pytest
+from golfflight.contract.bay import GSPRO_CLUBS
 from golfflight.contract.flying import flown_shot
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.app import create_app
@@ -295,3 +299,182 @@ def test_the_narrow_layout_keeps_the_lateral_column_and_whole_dots():
             assert ring.evaluate("e => getComputedStyle(e).stroke") != "rgb(12, 17, 20)"
         tile = page.locator("#n-landing-angle").bounding_box()
         assert tile["height"] < 40  # number and degree sign on one line
+
+
+# ---- the bay's player and units, the labels at two widths, the session's CSV (issue 30) ----------------------
+
+WITH_BROWSER = pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
+CLUB_DATA = {"Speed": 87.0, "AngleOfAttack": -4.2, "Path": 1.5, "FaceToTarget": -0.8, "Loft": 21.0}
+IRON_BALL = {"Speed": 120.0, "VLA": 16.3, "HLA": 1.0, "TotalSpin": 7000.0, "SpinAxis": 3.0}
+PUTT_BALL = {"Speed": 1.83 / 0.44704, "VLA": 2.0, "HLA": 0.0, "TotalSpin": 150.0, "SpinAxis": 0.0}
+LONG_DRIVE = {"ball_speed_mph": 185.0, "launch_angle_deg": 11.0, "back_spin_rpm": 2300.0, "side_spin_rpm": 300.0}
+
+TEXT_BOXES = """() => [...document.querySelectorAll('svg')].map(svg => {
+  const s = svg.getBoundingClientRect();
+  return {id: svg.id, box: [s.left, s.top, s.right, s.bottom], texts: [...svg.querySelectorAll('text')].map(t => {
+    const b = t.getBoundingClientRect();
+    return {text: t.textContent, box: [b.left, b.top, b.right, b.bottom],
+            px: parseFloat(getComputedStyle(t).fontSize) * svg.getScreenCTM().a};
+  })};
+})"""
+"""Every SVG's box on screen and each of its texts' boxes and rendered font sizes (CSS px)."""
+
+
+def _club_cells(page) -> list[str]:
+    return page.eval_on_selector_all("#shots tbody tr", "rows => rows.map(r => r.cells[2].textContent)")
+
+
+def _bay_loaded(page) -> None:
+    page.wait_for_function("() => document.querySelector('#bay-summary').textContent !== '—'", timeout=10_000)
+
+
+@WITH_BROWSER
+def test_the_club_menu_is_the_bays_player_and_each_shot_keeps_its_club_through_a_reload():
+    with live_viewer(1280, 900) as (page, http, port, errors):
+        page.wait_for_selector("#club[data-saved='DR']", state="attached", timeout=10_000)  # the bay's club at load
+        options = page.eval_on_selector_all("#club option", "os => os.map(o => [o.value, o.textContent])")
+        assert options == [[code, name] for code, name in GSPRO_CLUBS.items()]
+        assert http.patch("/v1/bay", json={"player": {"club": "W3"}}, headers=KEYED).status_code == 200
+        page.evaluate("loadBay()")  # as the page's poll does: the menu follows a change made elsewhere
+        page.wait_for_function("() => document.querySelector('#club').value === 'W3'", timeout=10_000)
+        before = http.get("/v1/bay", headers=KEYED).json()
+        pick_club(page, "I7")
+        after = http.get("/v1/bay", headers=KEYED).json()
+        assert after["player"] == {"club": "I7", "handed": "RH"} and {**after, "player": before["player"]} == before
+
+        gspro_over_tcp(port, 1, IRON_BALL)
+        message = {"ShotNumber": 2, "APIversion": "1", "BallData": IRON_BALL, "ClubData": CLUB_DATA,
+                   "ShotDataOptions": {"ContainsBallData": True, "ContainsClubData": True}}
+        assert http.post("/v1/gspro", json=message, headers=KEYED).json()["Code"] == 200
+        page.wait_for_selector("#shots tbody tr[data-shot='2']", timeout=10_000)
+        assert page.is_visible("#club-numbers") and page.inner_text("#club-Speed").startswith("87.0")
+        assert page.inner_text("#club-Speed").endswith("mph") and page.inner_text("#club-AngleOfAttack") == "-4.2°"
+        assert page.inner_text("#club-numbers-title").startswith("Club")
+        pick_club(page, "PT")
+        gspro_over_tcp(port, 3, PUTT_BALL)
+        assert http.post("/v1/shots/batch?viewer=true", json={"shots": [DRIVER]}, headers=KEYED).status_code == 200
+        page.wait_for_selector("#shots tbody tr[data-shot='4']", timeout=10_000)
+        tags = ["—", "PT putt", "I7", "I7"]  # newest first: the batch has no player
+        assert _club_cells(page) == tags and page.get_attribute("#shots tbody tr[data-shot='3']", "data-putt") == "1"
+        assert not page.is_visible("#club-numbers")  # the last shot came without ClubData
+        assert "Putter: 1 putt" in page.inner_text("#legend") and "7-iron: 2 shots" in page.inner_text("#legend")
+
+        page.reload()  # the tags are the service's, not this page's
+        page.wait_for_selector("#shots tbody tr[data-shot='4']", timeout=10_000)
+        assert _club_cells(page) == tags
+        page.wait_for_function("() => document.querySelector('#club').value === 'PT'", timeout=10_000)
+        assert errors == []
+
+
+BAY_SET_ELSEWHERE = {
+    "air": {"temperature_c": 21.37, "pressure_hpa": 1003.2, "humidity_pct": 55.0},
+    "wind": {"speed_mph": 7.3, "from_deg": 135.0},
+    "ground": {"surface": "green", "stimp_ft": 11.5, "elevation_m": -2.5, "slope_deg": 1.0, "slope_dir_deg": 90.0},
+    "player": {"club": "H4", "handed": "LH"},
+    "units": "imperial",
+}
+"""A bay with values the page's units would round (21.37 °C is 70.466 °F) and forms it does not show (pressure)."""
+
+
+def _without(part: dict, *names: str) -> dict:
+    return {k: v for k, v in part.items() if k not in names}
+
+
+@WITH_BROWSER
+def test_the_units_buttons_and_the_bay_form_send_only_what_they_change():
+    with live_viewer(1280, 900) as (page, http, port, errors):
+        assert http.put("/v1/bay", json=BAY_SET_ELSEWHERE, headers=KEYED).status_code == 200
+        page.evaluate("loadBay()")
+        page.wait_for_function("() => document.querySelector('#club').value === 'H4'", timeout=10_000)
+        before = http.get("/v1/bay", headers=KEYED).json()
+        sent: list = []
+        page.on("request", lambda request: sent.append(request.post_data_json) if request.method == "PATCH" else None)
+        for units in ("metric", "imperial"):
+            page.evaluate("document.querySelector('#bay-message').dataset.state = ''")
+            page.click(f".units button[data-units={units}]")
+            page.wait_for_selector("#bay-message[data-state=saved]", timeout=10_000)
+            assert sent[-1] == {"units": units}
+            assert http.get("/v1/bay", headers=KEYED).json() == {**before, "units": units}
+        assert len(sent) == 2
+
+        page.fill("#bay-temperature", "70")  # imperial: °F, as typed; the air's other values as they came
+        _submit_bay_form(page)
+        air = {"temperature_f": 70, "pressure_hpa": 1003.2, "humidity_pct": 55.0}
+        assert sent[-1] == {"air": air}
+        bay = http.get("/v1/bay", headers=KEYED).json()
+        assert bay == {**before, "air": air}
+
+        page.fill("#bay-wind-speed", "12")
+        page.fill("#bay-elevation", "-10")
+        _submit_bay_form(page)
+        wind = {**_without(before["wind"], "speed_mph"), "speed_mph": 12}
+        ground = {**_without(before["ground"], "elevation_m"), "elevation_ft": -10}
+        assert sent[-1] == {"wind": wind, "ground": ground}
+        assert http.get("/v1/bay", headers=KEYED).json() == {**before, "air": air, "wind": wind, "ground": ground}
+        page.wait_for_function("() => Math.abs(window.golfflightViewer.behind.ground_m + 3.048) < 1e-9", timeout=10_000)
+        assert page.input_value("#bay-elevation") == "-10" and "10.0 ft from the tee" in page.inner_text("#bay-summary")
+
+        page.evaluate("document.querySelector('#bay-message').dataset.state = ''")
+        page.click("#bay-form button[type=submit]")  # nothing changed: nothing sent
+        page.wait_for_selector("#bay-message[data-state=unchanged]", timeout=10_000)
+        assert len(sent) == 4 and errors == []
+
+
+@WITH_BROWSER
+@pytest.mark.parametrize("width", [400, 1280])
+def test_every_label_is_whole_and_at_least_10_px_at_400_and_1280_px(width):
+    with live_viewer(width, 900) as (page, http, port, errors):
+        _bay_loaded(page)
+        assert http.patch("/v1/bay", json={"ground": {"elevation_m": -3.0}}, headers=KEYED).status_code == 200
+        page.evaluate("loadBay()")
+        assert http.post("/v1/shots?viewer=true", json=LONG_DRIVE, headers=KEYED).status_code == 200
+        gspro_over_tcp(port, 2, WEDGE_BALL)
+        gspro_over_tcp(port, 3, IRON_BALL)
+        page.wait_for_selector("#shots tbody tr[data-shot='3']", timeout=10_000)
+        page.wait_for_selector("#side polyline.latest[data-done]", state="attached", timeout=10_000)
+        for units in ("imperial", "metric"):
+            if units == "metric":
+                page.click(".units button[data-units=metric]")
+                page.wait_for_function("() => document.querySelector('#side text').textContent.endsWith(' m')",
+                                       timeout=10_000)
+            views = {view["id"]: view for view in page.evaluate(TEXT_BOXES)}
+            assert set(views) == {"behind", "side", "top", "dispersion"}
+            sizes = []
+            for view in views.values():
+                left, top, right, bottom = view["box"]
+                for text in view["texts"]:
+                    x0, y0, x1, y1 = text["box"]
+                    inside = left - 0.5 <= x0 and x1 <= right + 0.5 and top - 0.5 <= y0 and y1 <= bottom + 0.5
+                    assert inside, (units, view["id"], text, view["box"])
+                    assert text["px"] >= 10, (units, view["id"], text)
+                    sizes.append(text["px"])
+            side = page.locator("#side text.along").all_text_contents()
+            along = [int(text.split()[0]) for text in side]
+            assert len(along) >= 4 and len({b - a for a, b in zip(along, along[1:])}) == 1, side  # evenly spaced
+            assert width == 400 or units == "metric" or "350 yd" in side, side
+            behind = page.evaluate("window.golfflightViewer.behind")
+            assert behind["labels"] and behind["ground_m"] == -3.0
+            assert_apart([label["box"] for label in behind["labels"]], behind["width"], behind["height"])
+            for below, above in zip(behind["labels"], behind["labels"][1:]):
+                assert below["line_y"] - above["line_y"] >= 14
+            print(f"{width} px, {units}: labels {min(sizes):.1f}-{max(sizes):.1f} px, behind labels "
+                  f"{[label['text'] for label in behind['labels']]}, side {side}")
+        assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth") and errors == []
+
+
+@WITH_BROWSER
+def test_the_session_csv_downloads_with_the_key():
+    with live_viewer(1280, 900) as (page, http, port, errors):
+        _bay_loaded(page)
+        gspro_over_tcp(port, 1, WEDGE_BALL)
+        assert http.post("/v1/shots?viewer=true", json=DRIVER, headers=KEYED).status_code == 200
+        page.wait_for_selector("#shots tbody tr[data-shot='2']", timeout=10_000)
+        with page.expect_download(timeout=10_000) as download:
+            page.click("#download-csv")
+        saved = download.value
+        text = Path(saved.path()).read_text()
+        assert saved.suggested_filename == "golfflight-session.csv"
+        assert text == http.get("/v1/session.csv", headers=KEYED).text
+        rows = list(csv.DictReader(io.StringIO(text)))
+        assert [row["session"] for row in rows] == ["open-connect", "http"] and rows[0]["club"] == "DR"
+        assert http.get("/v1/session.csv").status_code == 401 and errors == []  # the page sent the key

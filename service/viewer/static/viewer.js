@@ -433,8 +433,8 @@ function drawBehind(svg, box) {
 }
 
 /** From the side: downrange to the right, height up, one scale for both; the tee at 0 and the ground at its
- * elevation. The margins are the labels' measured widths, and a distance label is left out where it would touch its
- * neighbour, so nothing is cut or crammed at any width. */
+ * elevation. The margins are the labels' measured widths, and the distance lines are labelled every one, every
+ * other one, ... as their labels' widths allow, so nothing is cut or crammed at any width. */
 function drawSide(svg, box) {
   svg.replaceChildren();
   const [W, H] = frame(svg, 0.3125, 150);
@@ -452,15 +452,16 @@ function drawSide(svg, box) {
   const base = H - bottom + box.low * scale;  // z = 0
   const project = (p) => [left + p.y_m * scale, base - p.z_m * scale];
   const kept = [];
+  const stride = Math.max(1, Math.ceil((Math.max(...widths) + 10) / (box.step * scale)));
   lines.forEach((y, n) => {
     const x = left + y * scale;
     el(svg, "line", { class: "grid", x1: x, y1: top - 2, x2: x, y2: H - bottom });
-    placeLabel(svg, kept, W, H, { class: "label", x, y: H - 7, "text-anchor": "middle" }, texts[n]);
+    if (n % stride === 0) placeLabel(svg, kept, W, H, { class: "label along", x, y: H - 7, "text-anchor": "middle" }, texts[n]);
   });
   for (const z of heights) {
     const y = base - z * scale;
     el(svg, "line", { class: "grid faint", x1: left, y1: y, x2: W - right, y2: y });
-    placeLabel(svg, kept, W, H, { class: "label", x: left - 6, y: y + 4, "text-anchor": "end" }, unitLabel(z));
+    placeLabel(svg, kept, W, H, { class: "label height", x: left - 6, y: y + 4, "text-anchor": "end" }, unitLabel(z));
   }
   const groundY = base - box.ground * scale;
   el(svg, "line", { class: "ground-line", x1: left, y1: groundY, x2: W - right, y2: groundY });
