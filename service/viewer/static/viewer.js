@@ -195,8 +195,8 @@ function addShot(event) {
   const club = clubOf(event);
   state.shots.push({ event, club });
   if (state.shots.length > KEEP_SHOTS) state.shots.shift();
-  const points = event.flight.trajectory;
-  const end = points[points.length - 1].t_s;
+  const points = event.flight.trajectory || (event.flight.trajectory = []);
+  const end = points.length ? points[points.length - 1].t_s : 0;
   state.play = { id: event.id, started: performance.now(), speed: Math.max(1, end / PLAY_S), end };
   render();
   if (!state.ticking) {
@@ -319,7 +319,7 @@ function drawShots(svg, project, scene) {
     });
     if (isNew) newestLine = line;
   }
-  if (!newest) return;
+  if (!newest || !newest.event.flight.trajectory.length) return;  // nothing to draw: no path came with it
   const flight = newest.event.flight;
   if (moving) {
     const path = shown(newest);
