@@ -60,6 +60,8 @@ def test_the_schema_covers_every_route(base_url):
         "POST /v1/gspro",
         "GET /v1/bay",
         "PUT /v1/bay",
+        "PATCH /v1/bay",
+        "GET /v1/session.csv",
         "GET /healthz",
         "GET /v1/model",
         "GET /v1/latency",
