@@ -7,6 +7,15 @@ import argparse
 import csv
 import sys
 
+import golfflight
+
+if getattr(golfflight, "__file__", None) is None:  # a namespace package: a folder hides ours (golfflight/__init__.py)
+    raise SystemExit(
+        f"golfflight: Python imported the folder {next(iter(golfflight.__path__))} instead of the installed golfflight "
+        "(a folder called golfflight in the current folder comes first): run `python3 -m golfflight` from any other "
+        "folder, such as the checkout itself, or run the `golfflight` command"
+    )
+
 from golfflight import __version__
 from golfflight.commands import COMMANDS
 

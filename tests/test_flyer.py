@@ -7,7 +7,6 @@ from __future__ import annotations
 import json
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -33,6 +32,7 @@ from golfflight.flight.integrator import (
 from golfflight.flight.physics import initial_state
 from golfflight.shots.ground_fit import RestShots, landings
 from golfflight.weights_schema.bundle import CARD_FILE, BundleError
+from test_readme import venv_with_these_packages
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -135,17 +135,18 @@ for command, bundle in found.items():
 
 
 def test_an_installed_wheel_finds_its_bundle_for_every_command_without_model(tmp_path):
-    """Built and installed into a fresh environment's prefix, run outside the checkout: every command that flies the
-    default bundle finds <prefix>/share/golfflight/models/default."""
+    """Built and installed into a fresh environment's prefix (which sees this interpreter's dependencies, whether it
+    runs from a venv or the system Python), run outside the checkout: every command that flies the default bundle
+    finds <prefix>/share/golfflight/models/default."""
     wheel = build_wheel(tmp_path)
     prefix = tmp_path / "env"
-    subprocess.run([sys.executable, "-m", "venv", "--without-pip", "--system-site-packages", str(prefix)], check=True)
+    python = venv_with_these_packages(prefix)
     # --ignore-installed: with --prefix, pip would otherwise uninstall the golfflight this interpreter has installed
     install = ["install", "--no-deps", "--ignore-installed", "--prefix", str(prefix)]
-    subprocess.run([str(prefix / "bin" / "python"), *PIP[1:], *install, str(wheel)], check=True)
+    subprocess.run([str(python), *PIP[1:], *install, str(wheel)], check=True)
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
-    run = subprocess.run([str(prefix / "bin" / "python"), "-c", INSTALLED_DEFAULTS], cwd=elsewhere, check=False,
+    run = subprocess.run([str(python), "-c", INSTALLED_DEFAULTS], cwd=elsewhere, check=False,
                          env={"PATH": "/usr/bin:/bin"}, capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     shipped = prefix / "share" / "golfflight" / "models" / "default"

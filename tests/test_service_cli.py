@@ -1,9 +1,11 @@
-"""`golfflight simulate` (JSON or CSV in, JSON or CSV out) and `golfflight serve`'s refusal of a bad bundle."""
+"""`golfflight simulate` (JSON or CSV in, JSON or CSV out) and `golfflight serve`'s refusals of a bad bundle and a
+busy port."""
 
 from __future__ import annotations
 
 import csv
 import json
+import socket
 
 from golfflight.cli import main
 
@@ -54,6 +56,17 @@ def test_simulate_names_bad_values_and_unknown_columns(tmp_path, capsys):
 def test_serve_refuses_a_directory_without_a_bundle(tmp_path, capsys):
     assert main(["serve", "--model", str(tmp_path)]) == 2
     assert "not a model bundle" in capsys.readouterr().err
+
+
+def test_serve_refuses_a_busy_http_port_in_one_line_before_saying_it_serves(capsys):
+    """A port another program listens on is refused with what to do (--port), exit 2, and nothing printed about
+    serving there (it printed "... on http://127.0.0.1:PORT ...", then uvicorn's [Errno 98] and exit 3)."""
+    with socket.create_server(("127.0.0.1", 0)) as busy:
+        port = busy.getsockname()[1]
+        assert main(["serve", "--port", str(port)]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err.count("\n") == 1 and f"--port: 127.0.0.1:{port} is in use" in err and "another port with --port" in err
 
 
 def test_serve_names_uvloop_and_httptools_where_they_import_and_falls_back_where_not(monkeypatch):

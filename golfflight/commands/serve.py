@@ -14,6 +14,7 @@ across restarts; a file that is not bay conditions stops the start with one line
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import ipaddress
 import os
@@ -69,14 +70,22 @@ def _loopback(host: str) -> bool:
         return False
 
 
-def _listenable(host: str, port: int) -> None:
-    """Refuse a port that cannot be listened on now with one line saying why, not a traceback at startup."""
+def _listenable(host: str, port: int, option: str) -> None:
+    """Refuse a port that cannot be listened on now with one line saying why and naming the option that sets it, not
+    a traceback at startup (or, for the HTTP port, after the line saying the service is up). The probe binds as uvicorn
+    does (IPv6 when the host has a colon, SO_REUSEADDR), so a port it refuses is one uvicorn could not take either."""
     if not 0 < port < 65536:
-        raise ValueError(f"--connect-port must be 1 to 65535, got {port}")
+        raise ValueError(f"{option} must be 1 to 65535, got {port}")
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
     try:
-        socket.create_server((host, port)).close()
+        socket.create_server((host, port), family=family).close()
     except OSError as error:
-        raise ValueError(f"--connect-port: cannot listen on {host}:{port}: {error.strerror or error}") from None
+        if error.errno == errno.EADDRINUSE:
+            raise ValueError(
+                f"{option}: {host}:{port} is in use (another program, perhaps another golfflight serve, listens "
+                f"there): stop it or choose another port with {option}"
+            ) from None
+        raise ValueError(f"{option}: cannot listen on {host}:{port}: {error.strerror or error}") from None
 
 
 def fast_io() -> dict[str, str]:
@@ -118,9 +127,10 @@ def run(args: argparse.Namespace) -> int:
         os.environ[BAY_FILE_ENV] = os.path.abspath(args.bay)
     if args.cors_origin:
         os.environ[CORS_ORIGINS_ENV] = ",".join(args.cors_origin)
+    _listenable(args.host, args.port, "--port")  # before the line saying it serves there
     connect = "off"
     if args.connect_port is not None:
-        _listenable(args.connect_host, args.connect_port)
+        _listenable(args.connect_host, args.connect_port, "--connect-port")
         os.environ[CONNECT_PORT_ENV], os.environ[CONNECT_HOST_ENV] = str(args.connect_port), args.connect_host
         connect = f"on tcp://{args.connect_host}:{args.connect_port}"
     keyed = bool(os.environ.get(API_KEY_ENV))
