@@ -57,10 +57,15 @@ shot contract on it, the service, sweep, discovery and evaluation above, trainin
 on top. A package imports only from floors below its own, never sideways."""
 
 
+NAMESPACE_ROOT = {"golfflight", "golfflight.__version__"}
+"""The namespace's own `__init__` (imported before any golfflight module anyway) and its version: every floor may
+read them; the command line's modules (`golfflight.cli`, `golfflight.commands`) stay on the top floor."""
+
+
 def _package(name: str) -> str | None:
     """The package folder a golfflight module belongs to (golfflight/ itself for the command line)."""
     parts = name.split(".")
-    if parts[0] != "golfflight":
+    if parts[0] != "golfflight" or name in NAMESPACE_ROOT:
         return None
     return parts[1] if len(parts) > 1 and parts[1] in FLOORS else "golfflight"
 

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from contextlib import AbstractAsyncContextManager
-from importlib.metadata import version
 from typing import Callable
 
 from fastapi import APIRouter, FastAPI
@@ -32,6 +31,8 @@ from golfflight.service.api.routes import bay as bay_routes
 from golfflight.service.api.routes import docs, gspro, metrics, shots, status
 from golfflight.service.runtime import BayRuntime
 from starlette.routing import Mount, Route
+
+from golfflight import __version__
 
 
 def http_app(
@@ -47,7 +48,7 @@ def http_app(
     route but /healthz and `open_paths` when given, CORS for `cors_origins`, `lifespan` run around serving."""
     app = FastAPI(
         title="golfflight",
-        version=version("golfflight"),
+        version=__version__,
         summary="Golf ball flights from launch-monitor data: Phys-NN+ (a network inside the equations of motion).",
         lifespan=lifespan,
         docs_url=None,  # served by service.api.routes.docs from packaged files, not a CDN

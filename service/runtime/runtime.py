@@ -14,7 +14,6 @@ import gc
 import threading
 import time
 from dataclasses import dataclass
-from importlib.metadata import version
 from pathlib import Path
 from typing import Literal
 
@@ -29,6 +28,8 @@ from golfflight.service.runtime.bay import Bay
 from golfflight.service.runtime.feed import Entry, ShotFeed, Source
 from golfflight.service.runtime.latency import Rolling
 from golfflight.service.runtime.metrics import ServiceMetrics
+
+from golfflight import __version__
 
 PLAYER_SOURCES = frozenset({"http", "gspro-http", "open-connect"})
 """Shots hit in this bay, tagged with the bay's player (batches are a studio's files, not the player's swings)."""
@@ -93,7 +94,7 @@ class BayRuntime:
         """The loaded model's variant and ONNX SHA-256 and the package version (/metrics' info labels)."""
         if self.engine is None:
             return None
-        return {"variant": self.engine.variant, "sha256": self.engine.sha256, "version": version("golfflight")}
+        return {"variant": self.engine.variant, "sha256": self.engine.sha256, "version": __version__}
 
     def record_simulation(self, kind: Literal["shot", "batch"], seconds: float) -> None:
         """One simulation's engine time, into /v1/latency's window and /metrics' histogram (its two label sets

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import time
-from importlib.metadata import version
 
 from fastapi import APIRouter, Depends
 from fastapi.responses import JSONResponse, Response
@@ -14,6 +13,8 @@ from golfflight.service.api.dependencies import bay_runtime, ready_engine
 from golfflight.service.api.routes.responses import ERROR_RESPONSES
 from golfflight.service.runtime import BayRuntime
 from golfflight.weights_schema.model_card import ModelCard
+
+from golfflight import __version__
 
 PROBE_SHOT = ShotRequest(ball_speed_mps=55.0, launch_angle_deg=16.0, spin_rpm=7100.0)
 """The shot /v1/latency times on demand: a tour-average 7-iron in standard air."""
@@ -37,7 +38,7 @@ async def healthz(runtime: BayRuntime = Depends(bay_runtime)) -> JSONResponse:
         "load_seconds": engine.load_seconds,
     }
     problems = runtime.problems()
-    answer = {"status": "degraded" if problems else "ready", "model": model, "version": version("golfflight")}
+    answer = {"status": "degraded" if problems else "ready", "model": model, "version": __version__}
     return JSONResponse({**answer, "problems": problems} if problems else answer)
 
 
