@@ -75,18 +75,35 @@ REQUEST_TO_COLUMN = {
 """Request field -> column, to name the column of a refused value."""
 
 
+REQUIRED_COLUMNS = (("ball_speed_mps", "ball_speed_mph"), ("launch_angle_deg",), ("spin_rpm", "back_spin_rpm"))
+"""What every row needs, as columns: a ball speed, a launch angle and a spin, each in one of its forms (a column's
+absence would otherwise surface as one problem a row, or a chunk of rows of which none could fly)."""
+
+
 def unknown_columns(columns: list[str]) -> list[str]:
     return [c for c in columns if c not in KNOWN_COLUMNS]
 
 
+def missing_columns(columns: list[str]) -> list[str]:
+    """Each required launch column that `columns` lacks (`a or b` where either form does)."""
+    return [" or ".join(forms) for forms in REQUIRED_COLUMNS if not any(c in columns for c in forms)]
+
+
 def columns_message(source: str, columns: list[str]) -> str | None:
-    """Why a table with these columns cannot be read (no columns, or unknown ones), or None."""
+    """Why a table with these columns cannot be read, in one line, or None: no columns, or the launch columns it
+    misses and the unknown ones it has. `simulate` and `sweep` check a file's header with it before reading a row."""
     if not columns:
         return f"{source} line 1: no header row; launch columns are {', '.join(LAUNCH_COLUMNS)}"
+    problems = []
+    missing = missing_columns(columns)
+    if missing:
+        problems.append(
+            f"missing columns: {', '.join(missing)} (every row needs a ball speed, a launch angle and a spin)"
+        )
     unknown = unknown_columns(columns)
     if unknown:
-        return f"{source}: unknown columns {unknown}; launch columns are {', '.join(LAUNCH_COLUMNS)}"
-    return None
+        problems.append(f"unknown columns {unknown}; launch columns are {', '.join(LAUNCH_COLUMNS)}")
+    return f"{source}: {'; '.join(problems)}" if problems else None
 
 
 def number_or_text(text: str) -> float | str:
@@ -121,18 +138,45 @@ def request_of_cells(cells: dict) -> dict:
     return shot
 
 
+def _of_cells(message: str) -> str:
+    """A request model's message about the forms of a quantity said of a row's cells, where a blank cell is a value
+    not given: "(got none)" reads "(neither given)"."""
+    return message.replace("(got none)", "(neither given)")
+
+
+QUANTITY = re.compile(r"([a-z ]+): (.*)", re.DOTALL)
+"""A request validator's problem of the shot as a whole: the quantity in lower-case words, then the problem."""
+
+
+def _shot_problem(message: str, csv_columns: bool) -> str:
+    """A problem of the shot as a whole (a quantity given in neither or both of its forms): "spin columns: give
+    exactly one of spin_rpm or back_spin_rpm (neither given)" (CSV), "spin fields: ..." (JSON), or "as a whole: ..." for
+    something that is not a shot at all."""
+    named = QUANTITY.match(message)
+    if not named:
+        return f"as a whole: {message}"
+    quantity, text = named.groups()
+    if csv_columns:
+        return f"{quantity} columns: {_of_cells(text)}"
+    return f"{quantity} fields: {text}"
+
+
 def check(item, csv_columns: bool = True) -> ShotRequest | list[str]:
-    """The validated request, or one problem per invalid value naming its column (or request field) and range."""
+    """The validated request, or one problem per invalid value naming its column (or request field) and range, or
+    the columns (fields) of a quantity given in neither or both forms."""
     try:
         return ShotRequest.model_validate(item)
     except ValidationError as error:
         problems = []
         for detail in describe_errors(error.errors()):
             field, message = detail["field"], detail["message"].split(": ", 1)[-1]
+            if not detail["loc"]:  # about the shot as a whole, not one field of it
+                problems.append(_shot_problem(message, csv_columns))
+                continue
             if csv_columns and field in SECTION_COLUMNS:  # about several fields (two forms given): name the columns
                 columns = {name: column for column, name in SECTION_COLUMNS[field].items()}
                 message = re.sub(r"\b\w+\b", lambda word, named=columns: named.get(word[0], word[0]), message)
-                problems.append(f"{field} columns: {message}")
+                problems.append(f"{field} columns: {_of_cells(message)}")
                 continue
             where = f"column '{REQUEST_TO_COLUMN.get(field, field)}'" if csv_columns else f"field '{field}'"
             problems.append(f"{where}: {message}")

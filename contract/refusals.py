@@ -3,10 +3,11 @@ every 4xx body, the GSPro reply and the command line's messages share."""
 
 from __future__ import annotations
 
+import json
 import math
 
 from golfflight.contract.requests import RANGES
-from golfflight.flight.limits import Range
+from golfflight.flight.limits import Range, limit_text
 
 QUOTED_CHARS = 40
 """Most characters of a value (or a field name) a refusal quotes; a longer one is cut, "…" in place of the rest, so
@@ -42,13 +43,32 @@ def _plain(value):
     return value if isinstance(value, (int, float, bool)) or value is None else None
 
 
+BOUNDS = {
+    "less_than_equal": ("le", "less than or equal to", True),
+    "greater_than_equal": ("ge", "greater than or equal to", False),
+    "less_than": ("lt", "less than", True),
+    "greater_than": ("gt", "greater than", False),
+}
+"""pydantic's error types of a bound passed: (the bound's key in the error's ctx, the words, whether a high end)."""
+
+
+def _msg(error: dict) -> str:
+    """pydantic's `msg`, its "Value error, " prefix dropped and a bound it quotes printed as every limit is
+    (`flight.limits.limit_text`: pydantic prints a converted limit with all its float digits, 223.69362920544023)."""
+    bound = BOUNDS.get(error["type"])
+    limit = (error.get("ctx") or {}).get(bound[0]) if bound else None
+    if isinstance(limit, int | float) and not isinstance(limit, bool):
+        return f"Input should be {bound[1]} {limit_text(limit, high=bound[2])}"
+    return _encodable(error["msg"].removeprefix("Value error, "))
+
+
 def describe_error(error: dict, ranges: dict[str, Range] = RANGES) -> dict:
-    """One 422 detail: FastAPI's own `loc`, `msg` and `type`, plus the field as a dotted path, the value sent, the
-    allowed range (from `ranges`, by field name), the batch index of the shot, and a `message` in plain words that
-    says all of it."""
+    """One 422 detail: FastAPI's own `loc` and `type` and its `msg` (a bound in it printed as every limit is), plus
+    the field as a dotted path, the value sent, the allowed range (from `ranges`, by field name), the batch index of
+    the shot, and a `message` in plain words that says all of it."""
     path = [_shown(p) for p in error["loc"] if p != "body"]
     field = ".".join(str(p) for p in path) or "body"
-    msg = _encodable(error["msg"].removeprefix("Value error, "))
+    msg = _msg(error)
     entry: dict = {"loc": [_shown(p) for p in error["loc"]], "msg": msg, "type": error["type"], "field": field}
     parts = [f"{field}: {msg}"]
     if len(path) >= 2 and path[0] == "shots" and isinstance(path[1], int):
@@ -70,6 +90,16 @@ def describe_error(error: dict, ranges: dict[str, Range] = RANGES) -> dict:
 def body_detail(message: str, kind: str) -> dict:
     """A 422/413 detail about the body as a whole (not one field), shaped like `describe_error`'s."""
     return {"loc": ["body"], "msg": message, "type": kind, "field": "body", "message": message}
+
+
+def not_json(reason: str, text: str, position: int) -> str:
+    """The refusal of a body that does not parse as JSON, saying where (line and column, counted as the JSON
+    decoder counts them, or the end of a body cut short) and what the decoder expected there: FastAPI reports only
+    the character position."""
+    where = json.JSONDecodeError(reason, text, position)
+    place = f"line {where.lineno} column {where.colno}"
+    place = f"the end of the body ({place})" if position >= len(text) else place
+    return f"the body is not valid JSON: {_encodable(reason)} at {place}"
 
 
 def describe_errors(errors, ranges: dict[str, Range] = RANGES) -> list[dict]:

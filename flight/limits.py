@@ -2,7 +2,23 @@
 
 from __future__ import annotations
 
+from decimal import ROUND_CEILING, ROUND_FLOOR, Decimal
 from typing import NamedTuple
+
+SIGNIFICANT_DIGITS = 4
+"""Most significant digits a printed limit has: a limit converted from SI units (100 m/s is 223.69362920544023 mph)
+reads 223.6, not its float's 17 digits."""
+
+
+def limit_text(value: float, high: bool) -> str:
+    """A range's end as every refusal and field description prints it: at most SIGNIFICANT_DIGITS significant digits,
+    no exponent, rounded inwards (a high end down, a low end up) so that every number shown as allowed is accepted."""
+    if value == 0:
+        return "0"
+    exact = Decimal(repr(float(value)))
+    step = Decimal(1).scaleb(exact.adjusted() - SIGNIFICANT_DIGITS + 1)
+    rounded = exact.quantize(step, rounding=ROUND_FLOOR if high else ROUND_CEILING)
+    return f"{rounded.normalize():f}"
 
 
 class Range(NamedTuple):
@@ -13,7 +29,8 @@ class Range(NamedTuple):
     unit: str
 
     def describe(self) -> str:
-        return f"{self.low:g} to {self.high:g} {self.unit}".strip()
+        """The range as refusals and field descriptions quote it: "0.5 to 100 m/s" (ends by `limit_text`)."""
+        return f"{limit_text(self.low, high=False)} to {limit_text(self.high, high=True)} {self.unit}".strip()
 
 
 BALL_SPEED_MPS = Range(0.5, 100.0, "m/s")

@@ -20,21 +20,8 @@ from golfflight.contract.columns import columns_message
 from golfflight.shots.records import reading
 from golfflight.sweep.grid import Grid
 
-REQUIRED_COLUMNS = (("ball_speed_mps", "ball_speed_mph"), ("launch_angle_deg",), ("spin_rpm", "back_spin_rpm"))
-"""What every row needs, as columns: a ball speed, a launch angle and a spin, each in one of its forms (a column's
-absence would otherwise surface as one problem a row, or a chunk of rows of which none could fly)."""
-
 READ_BUFFER_BYTES = 1 << 20
 """Parquet column data is read in buffers of this size, not a column chunk at a time."""
-
-
-def missing_columns(path: str, columns) -> str | None:
-    """Why a file with these columns cannot be swept for want of a launch column, or None: its name and each
-    missing column (`a or b` where either form does)."""
-    missing = [" or ".join(forms) for forms in REQUIRED_COLUMNS if not any(c in columns for c in forms)]
-    if not missing:
-        return None
-    return f"{path}: missing columns: {', '.join(missing)} (every row needs a ball speed, a launch angle and a spin)"
 
 
 def rebatch(batches, rows: int) -> Iterator:
@@ -118,7 +105,7 @@ class CsvSource:
     def open(cls, path: Path, chunk_rows: int) -> CsvSource:
         with reading(path), open(path, newline="") as handle:
             header = next(csv.reader(handle), [])
-        refused = columns_message(str(path), header) or missing_columns(str(path), header)
+        refused = columns_message(str(path), header)
         if refused:
             raise ValueError(refused)
         return cls(str(path), tuple(header), chunk_rows)
@@ -172,9 +159,6 @@ class ParquetSource:
         refused = columns_message(str(path), columns)
         if refused:
             raise ValueError(refused.replace(" line 1: no header row", ": no columns"))
-        refused = missing_columns(str(path), columns)
-        if refused:
-            raise ValueError(refused)
         return cls(str(path), tuple(columns), metadata.num_rows, chunk_rows)
 
     def place(self, row: int) -> str:

@@ -254,7 +254,7 @@ def test_gspro_open_connect_shot_heartbeat_and_error(client):
         "/v1/gspro", json={**GSPRO_SHOT, "BallData": {"Speed": 400.0, "VLA": 12.0, "TotalSpin": 3000.0}}
     )
     assert broken.status_code == 422 and broken.json()["Code"] == 500  # Open Connect's error code, HTTP's status
-    assert "BallData.Speed" in broken.json()["Message"] and "1.11847 to 223.694 mph" in broken.json()["Message"]
+    assert "BallData.Speed" in broken.json()["Message"] and "1.119 to 223.6 mph" in broken.json()["Message"]
     missing = client.post("/v1/gspro", json={**GSPRO_SHOT, "BallData": {"Speed": 150.0}})
     assert missing.status_code == 422 and "VLA" in missing.json()["Message"]
 

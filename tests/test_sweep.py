@@ -111,7 +111,7 @@ def test_grid_axes_ranges_lists_and_single_values():
         (["ball_speed_mps=30:fast:3"], "'fast' is not a number"),
         (["ball_speed_mps=30,30"], "listed twice"),
         (["ball_speed_mps=40", "ball_speed_mps=50", "launch_angle_deg=10", "spin_rpm=3000"], "more than once"),
-        (["launch_angle_deg=10", "spin_rpm=3000"], "ball speed: give exactly one of"),
+        (["launch_angle_deg=10", "spin_rpm=3000"], "ball speed columns: give exactly one of"),
         (["ball_speed_mps=40:120:3", "launch_angle_deg=10", "spin_rpm=3000"],
          ("--grid ball_speed_mps=120.0: column 'ball_speed_mps': Input should be less than or equal to 100 "
           "(got 120.0); allowed 0.5 to 100 m/s")),

@@ -5,12 +5,19 @@ Input: JSON (one shot, a list of shots, or {"shots": [...]}, in the HTTP request
 altitude_m, pressure_hpa, humidity_pct, density_kg_m3, wind_speed_mps or wind_speed_mph, wind_from_deg, wind_profile,
 wind_reference_height_m, normalized, and the ground: ground_surface, stimp_ft, ground_elevation_m or
 ground_elevation_ft, slope_deg, slope_dir_deg). A canonical shot file works as is: its identity and outcome columns are
-passed over, its shot_id echoed. Output: {"results": [...]} as JSON, or a flat CSV when --out ends in .csv: the
-result's fields as columns (`contract.columns.result_columns`), its points flattened (rest_x_m, rest_x_yd, ...), every
-length in metres and yards, the landing speed in m/s and mph.
+passed over, its shot_id echoed. A CSV's header is checked before any row is read: a missing launch column (a ball
+speed, the launch angle, a spin) or an unknown one refuses the file in one line (`contract.columns.columns_message`,
+as `golfflight sweep` does).
+
+Output: {"results": [...]} as JSON, or a flat CSV when --out ends in .csv: the result's fields as columns
+(`contract.columns.result_columns`), its points flattened (rest_x_m, rest_x_yd, ...), every length in metres and
+yards, the landing speed in m/s and mph. Each result starts with what matches it to its input: `row`, the input's
+row number from 0 as in `golfflight sweep`'s results (a CSV's data row: its line number less 2, the header being
+line 1; a JSON shot's index), the shot_id where the CSV has one, and the shot's launch columns as read.
 
 A bad shot (a value out of range or not a number, an extra cell, a shot_id seen before) refuses the file with its
-line (CSV) or index (JSON) and field; --skip-bad-rows flies the rest and lists each one left out on stderr.
+line (CSV) or index (JSON) and field; --skip-bad-rows flies the rest and lists each one left out on stderr, and
+refuses the file still when no shot is left to fly.
 """
 
 from __future__ import annotations
@@ -19,9 +26,17 @@ import argparse
 import csv
 import json
 import sys
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from golfflight.contract.columns import cell_value, check, columns_message, flat_row, request_of_cells
+from golfflight.contract.columns import (
+    LAUNCH_COLUMNS,
+    cell_value,
+    check,
+    columns_message,
+    flat_row,
+    request_of_cells,
+)
 from golfflight.shots.records import reading
 
 
@@ -36,30 +51,49 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(run=run)
 
 
-def shots_from_csv(path: Path) -> tuple[list[dict], list[str | None], list[str], list[str]]:
-    """Request dicts, shot ids (None where the file has none), where each shot is ("FILE line N") and the problems
-    found while reading (extra cells, repeated shot ids) of a launches CSV."""
+@dataclass
+class Input:
+    """The shots of an input as read, before validation: request dicts, each with its input row number (from 0), its
+    place in messages ("FILE line N", "FILE shot N") and its shot id (CSV only: None where the file has none), and
+    the problems found while reading (extra cells, repeated shot ids) of `rows_read` rows in all."""
+
+    shots: list = field(default_factory=list)
+    rows: list[int] = field(default_factory=list)
+    places: list[str] = field(default_factory=list)
+    ids: list[str | None] = field(default_factory=list)
+    problems: list[str] = field(default_factory=list)
+    rows_read: int = 0
+
+
+def shots_from_csv(path: Path) -> Input:
+    """The shots of a launches CSV, its header checked first (`columns_message`): a missing launch column refuses
+    the file in one line instead of one "Field required" a row."""
+    read = Input()
     with reading(path), open(path, newline="") as handle:
         reader = csv.DictReader(handle)
         refused = columns_message(str(path), list(reader.fieldnames or []))
         if refused:
             raise ValueError(refused)
-        shots, ids, places, problems, seen = [], [], [], [], {}
-        for line, row in enumerate(reader, start=2):
+        seen: dict[str, int] = {}
+        for row, cells in enumerate(reader):
+            line, read.rows_read = row + 2, row + 1
             place = f"{path} line {line}"
-            if None in row:
-                problems.append(f"{place}: {len(row[None])} cells beyond the header")
+            if None in cells:
+                read.problems.append(f"{place}: {len(cells[None])} cells beyond the header")
                 continue
-            shot_id = row.get("shot_id")
+            shot_id = cells.get("shot_id")
             if shot_id and shot_id in seen:
-                problems.append(f"{place} column 'shot_id': {shot_id!r} duplicates the shot_id of line {seen[shot_id]}")
+                read.problems.append(
+                    f"{place} column 'shot_id': {shot_id!r} duplicates the shot_id of line {seen[shot_id]}"
+                )
                 continue
             if shot_id:
                 seen[shot_id] = line
-            shots.append(request_of_cells({k: cell_value(v) for k, v in row.items()}))
-            ids.append(shot_id)
-            places.append(place)
-    return shots, ids, places, problems
+            read.shots.append(request_of_cells({k: cell_value(v) for k, v in cells.items()}))
+            read.rows.append(row)
+            read.places.append(place)
+            read.ids.append(shot_id)
+    return read
 
 
 def validate(raw: list, places: list[str], csv_columns: bool) -> tuple[list, list[int], list[str]]:
@@ -75,14 +109,68 @@ def validate(raw: list, places: list[str], csv_columns: bool) -> tuple[list, lis
     return shots, kept, problems
 
 
-def shots_from_json(text: str, source: str) -> list[dict]:
+def shots_from_json(text: str, source: str) -> Input:
+    """The shots of a JSON input (one shot, a list of shots, or {"shots": [...]}), each placed by its index."""
     try:
         data = json.loads(text)
     except json.JSONDecodeError as error:
         raise ValueError(f"{source}: not valid JSON ({error})") from None
     if isinstance(data, dict) and "shots" in data:
         data = data["shots"]
-    return data if isinstance(data, list) else [data]
+    shots = data if isinstance(data, list) else [data]
+    rows = list(range(len(shots)))
+    return Input(shots, rows, [f"{source} shot {i}" for i in rows], rows_read=len(shots))
+
+
+def read_input(name: str) -> tuple[Input, bool]:
+    """The shots of the command's input (`-`: JSON on standard input) and whether it is a CSV."""
+    if name == "-":
+        return shots_from_json(sys.stdin.read(), "standard input"), False
+    path = Path(name)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such file: {path}")
+    if path.suffix.lower() == ".csv":
+        return shots_from_csv(path), True
+    with reading(path):
+        return shots_from_json(path.read_text(), str(path)), False
+
+
+def refuse_or_skip(name: str, problems: list[str], flyable: int, rows_read: int, skip_bad_rows: bool) -> None:
+    """Refuse the input listing its problems, unless `skip_bad_rows` and some shot is left to fly (each problem is
+    then listed as skipped); with none left it is refused either way, rather than answered with no results."""
+    if not problems:
+        return
+    if flyable and skip_bad_rows:
+        for problem in problems:
+            print(f"golfflight simulate: skipped: {problem}", file=sys.stderr)
+        return
+    why = "--skip-bad-rows flies the rest" if flyable else f"none of its {rows_read} shots is valid; nothing written"
+    shown = "\n  ".join(problems[:20]) + (f"\n  ... and {len(problems) - 20} more" if len(problems) > 20 else "")
+    raise ValueError(f"{name}: {len(problems)} invalid values ({why}):\n  {shown}")
+
+
+def matching(read: Input, kept: list[int]) -> list[dict]:
+    """What matches each flown shot to its input, in front of its result: `row`, its shot_id (where it has one) and
+    its launch columns as read."""
+    return [
+        {
+            "row": read.rows[i],
+            **({"shot_id": read.ids[i]} if read.ids and read.ids[i] is not None else {}),
+            **{c: read.shots[i][c] for c in LAUNCH_COLUMNS if read.shots[i].get(c) is not None},
+        }
+        for i in kept
+    ]
+
+
+def write_csv(out: str, fronts: list[dict], results: list[dict]) -> None:
+    """The results as a flat CSV: each row's `matching` columns first, then its result's (`flat_row`)."""
+    flats = [flat_row(r) for r in results]
+    front = [c for c in ("row", "shot_id", *LAUNCH_COLUMNS) if any(c in f for f in fronts)]
+    columns = [*front, *dict.fromkeys(key for flat in flats for key in flat)]
+    with open(out, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, columns)
+        writer.writeheader()
+        writer.writerows({**f, **flat} for f, flat in zip(fronts, flats, strict=True))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -90,49 +178,18 @@ def run(args: argparse.Namespace) -> int:
     from golfflight.flight.bundle_location import model_dir
     from golfflight.flight.engine import FlightEngine
 
-    ids: list[str | None] = []
-    problems: list[str] = []
-    from_csv = False
-    if args.input == "-":
-        raw = shots_from_json(sys.stdin.read(), "standard input")
-        places = [f"standard input shot {i}" for i in range(len(raw))]
-    else:
-        path = Path(args.input)
-        if not path.is_file():
-            raise FileNotFoundError(f"no such file: {path}")
-        from_csv = path.suffix.lower() == ".csv"
-        if from_csv:
-            raw, ids, places, problems = shots_from_csv(path)
-        else:
-            with reading(path):
-                raw = shots_from_json(path.read_text(), str(path))
-            places = [f"{path} shot {i}" for i in range(len(raw))]
-    if not raw and not problems:
+    read, from_csv = read_input(args.input)
+    if not read.shots and not read.problems:
         raise ValueError(f"{args.input}: no shots in it")
-    shots, kept, invalid = validate(raw, places, from_csv)
-    problems += invalid
-    if problems and not args.skip_bad_rows:
-        shown = "\n  ".join(problems[:20]) + (f"\n  ... and {len(problems) - 20} more" if len(problems) > 20 else "")
-        raise ValueError(f"{args.input}: {len(problems)} invalid values (--skip-bad-rows flies the rest):\n  {shown}")
-    for problem in problems:
-        print(f"golfflight simulate: skipped: {problem}", file=sys.stderr)
-    ids = [ids[i] for i in kept] if ids else []
+    shots, kept, invalid = validate(read.shots, read.places, from_csv)
+    refuse_or_skip(args.input, read.problems + invalid, len(shots), read.rows_read, args.skip_bad_rows)
     engine = FlightEngine(model_dir(args.model))
     results = [r.model_dump(exclude_none=True) for r in fly_shots(engine, shots)]
+    fronts = matching(read, kept)
     if args.out and args.out.lower().endswith(".csv"):
-        rows = [
-            {**({"shot_id": i} if i is not None else {}), **flat_row(r)}
-            for i, r in zip(ids or [None] * len(results), results)
-        ]
-        columns = list(dict.fromkeys(key for row in rows for key in row))
-        with open(args.out, "w", newline="") as handle:
-            writer = csv.DictWriter(handle, columns)
-            writer.writeheader()
-            writer.writerows(rows)
+        write_csv(args.out, fronts, results)
         return 0
-    if ids:
-        results = [{"shot_id": i, **r} for i, r in zip(ids, results)]
-    text = json.dumps({"results": results}, indent=2)
+    text = json.dumps({"results": [{**f, **r} for f, r in zip(fronts, results, strict=True)]}, indent=2)
     if args.out:
         Path(args.out).write_text(text + "\n")
     else:

@@ -1,7 +1,8 @@
 """How refusals read: every 4xx body names the field, the value and the allowed range, and POST /v1/gspro answers
-in Open Connect's own form (Code 500, a Message); a body sent without a JSON content type gets 415 saying so (FastAPI
-hands a model the raw bytes then, which read as "Input should be a valid dictionary"); a route called before the
-model is ready gets 503."""
+in Open Connect's own form (Code 500, a Message); a body that is not valid JSON is refused saying where and what the
+decoder expected (FastAPI's own detail is its character position as the field: `"1: JSON decode error"`); a body
+sent without a JSON content type gets 415 saying so (FastAPI hands a model the raw bytes then, which read as "Input
+should be a valid dictionary"); a route called before the model is ready gets 503."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
 from golfflight.contract.gspro import GSProReply, invalid_message
-from golfflight.contract.refusals import body_detail, describe_errors
+from golfflight.contract.refusals import body_detail, describe_errors, not_json
 from golfflight.contract.requests import RANGES
 from golfflight.service.api.paths import GSPRO_PATH
 from golfflight.service.runtime import NotReady
@@ -35,12 +36,27 @@ def _content_type_refusal(request: Request, error: RequestValidationError) -> st
     return f"{JSON_CONTENT_TYPE} ({f'got {sent!r}' if sent else 'none was sent'})"
 
 
+def _json_refusal(error: RequestValidationError) -> str | None:
+    """Why the body is not valid JSON (`not_json`: line, column and what was expected), from FastAPI's one
+    `json_invalid` error (loc ("body", character position), the decoder's reason in ctx, the text as the error's
+    body); None when the body parsed."""
+    for detail in error.errors():
+        if detail["type"] == "json_invalid" and isinstance(error.body, str) and len(detail["loc"]) == 2:
+            return not_json(detail.get("ctx", {}).get("error", detail["msg"]), error.body, detail["loc"][1])
+    return None
+
+
 async def invalid_request(request: Request, error: RequestValidationError) -> JSONResponse:
     unread = _content_type_refusal(request, error)
+    broken = _json_refusal(error)
     if request.url.path == GSPRO_PATH:
-        return _gspro_error(unread, 415) if unread else _gspro_error(invalid_message(error.errors()))
+        if unread:
+            return _gspro_error(unread, 415)
+        return _gspro_error(broken or invalid_message(error.errors()))
     if unread:
         return JSONResponse({"detail": [body_detail(unread, "content_type")]}, 415)
+    if broken:
+        return JSONResponse({"detail": [body_detail(broken, "json_invalid")]}, 422)
     return JSONResponse({"detail": describe_errors(error.errors(), RANGES)}, 422)
 
 
