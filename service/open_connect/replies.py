@@ -1,13 +1,15 @@
-"""What golfflight sends back for each object a connector writes over TCP: a shot's reply, an error, or nothing.
+"""What golfflight writes to a connector over TCP: the reply to each object it sends (a shot's reply, an error, or
+nothing), and the player information pushed to it (Code 201).
 
 Heartbeats and messages without ball data get no reply (GSPro sends none: a connector that waits for one would
 resend). Everything that is not a valid message gets Code 500 with a Message saying what is wrong, as the HTTP
-route's does (`contract.gspro.invalid_message`).
+route's does (`contract.gspro.invalid_message`). Everything goes out as compact JSON with no delimiter.
 """
 
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Callable
 
 from golfflight.contract.gspro import GSProMessage, GSProReply, invalid_message
@@ -16,6 +18,27 @@ from pydantic import ValidationError
 
 Answer = Callable[[GSProMessage], GSProReply]
 """Flies a message that carries BallData: the service's shared GSPro answer (timing, the engine, its readiness)."""
+
+HANDED = ("RH", "LH")
+"""The player's hand as GSPro writes it."""
+CLUB = re.compile(r"[A-Z0-9]{1,4}")
+"""A GSPro club code: DR, W3, H4, I7, PW, GW, SW, LW, PT and the like (connectors switch to putting on PT)."""
+
+
+def encoded(reply: GSProReply) -> bytes:
+    """A reply as it goes on the wire."""
+    return reply.model_dump_json(exclude_none=True).encode()
+
+
+def player_information(club: str, handed: str) -> bytes:
+    """The Code 201 object GSPro pushes when the player or the club changes, as it goes on the wire; ValueError for a
+    hand other than RH or LH or a club that is not a GSPro club code."""
+    if handed not in HANDED:
+        raise ValueError(f"handed must be one of {', '.join(HANDED)}, got {handed!r}")
+    if not isinstance(club, str) or not CLUB.fullmatch(club):
+        raise ValueError(f"club must be a GSPro club code (DR, I7, PW, PT, ...), got {club!r}")
+    player = {"Code": 201, "Message": "GSPro Player Information", "Player": {"Handed": handed, "Club": club}}
+    return json.dumps(player, separators=(",", ":")).encode()
 
 
 def reply_to(item: bytes | Refused, answer: Answer) -> GSProReply | None:

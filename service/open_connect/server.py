@@ -1,12 +1,31 @@
-"""The TCP listener: one protocol object per connector connection, objects framed as they arrive, one reply per shot.
+"""The TCP listener: one protocol object per connector connection, objects framed as they arrive, one reply per shot,
+each connection held to `limits.ConnectorLimits`, and the player information pushed to every connector.
 
 It runs on the HTTP service's event loop, opened and closed by the app's lifespan, not in a process of its own: the
 model is loaded once, TCP shots count in /v1/latency with HTTP's, and whatever the app does with its shots sees
-these too. Shots fly inline on the loop (no thread): one takes about half a millisecond, less than a hop to a
-thread costs, and the replies measured with several connectors sending at once stay in milliseconds
-(docs/service.md), against the 5 s after which a connector sends a shot again. Each connection is an
-`asyncio.Protocol`: bytes are framed and answered in the callback that receives them, with no stream buffer, task
-or wake-up between the socket and the reply (docs/benchmarks.md, issue 25).
+these too. `answer` is called on that loop's thread, as the HTTP routes' own calls are; `send_player` may be called
+from any thread. Each connection is an `asyncio.Protocol`: a shot arriving in one piece is framed and answered in
+the callback that receives it, with no stream buffer, task or wake-up between the socket and the reply
+(docs/benchmarks.md, issue 25).
+
+Isolation from HTTP: Open Connect works in bounded turns. Input is framed PIECE_BYTES at a time, and all connections
+together work (frame, answer) at most TURN_S (plus one piece or one shot) in one turn of the event loop, in round
+robin; what is left waits for the next turn (`loop.call_soon`: behind every callback already ready, HTTP's among
+them) with reading paused, so one read of the socket is the most a connection holds. However many connections
+flood, each of an HTTP request's callbacks waits for one turn at most. Before, one callback framed and answered a
+whole read (256 KiB: 30,000 tiny objects), and a connector writing 20 MB of `{"a":{}}` held HTTP single shots for
+seconds (`benchmarks/bench_hostile.py`: p99 7.7 to 29 s over four runs, a reset connection, /healthz unanswered up
+to 10 s after the flood stopped). The turns bound the time; the token buckets (`limits`: messages and bytes) bound
+the work: a flood is closed once one is empty, whatever it sends next.
+
+Chosen by measurement over a thread with its own event loop (the same connections, turns and limits on uvloop in a
+second thread, `answer` there), on the 2-core machine a minute apart, the same hostile connectors (bench_hostile's
+(b) and (c)): with the thread, HTTP single shots took p99 29 ms, max 142 ms under the flood of empty objects and a
+connector that never reads, and p99 75 ms, max 130 ms under heartbeats, 2,502 and 1,198 of them answered in the
+10 s; in turns on the one loop, p99 5.2 and 4.8 ms, max 10 and 11 ms, 3,681 and 4,759 answered. In one process the
+two loops share the GIL: a thread busy framing holds it for up to the interpreter's switch interval (5 ms) each time
+the HTTP thread, which lets go of it at every system call and every ONNX Runtime call of a flight, wants it back.
+The turns also keep `answer` on the loop the rest of the service runs on, so it need not be thread-safe.
 """
 
 from __future__ import annotations
@@ -14,11 +33,15 @@ from __future__ import annotations
 import asyncio
 import logging
 import os
+import socket
+import time
+from collections import deque
 from dataclasses import dataclass
 
 from golfflight.contract.gspro import GSProReply
 from golfflight.service.open_connect.framing import ObjectFramer, Refused
-from golfflight.service.open_connect.replies import Answer, reply_to
+from golfflight.service.open_connect.limits import ConnectorLimits, TokenBucket
+from golfflight.service.open_connect.replies import Answer, encoded, player_information, reply_to
 
 CONNECT_HOST_ENV = "GOLFFLIGHT_CONNECT_HOST"
 CONNECT_PORT_ENV = "GOLFFLIGHT_CONNECT_PORT"
@@ -27,9 +50,37 @@ PAUSE_S = 2.0
 in one go, so its pieces arrive within milliseconds. Nothing is refused at the pause: what comes next is either the
 rest of the object (answered as usual) or a new object, and then the unfinished one gets one refusal before the new
 one is read."""
+PIECE_BYTES = 1024
+"""Input framed at a time. Framing is pure Python for anything but one whole object in one piece: 1 KiB of the
+cheapest objects to send (`{"a":{}}`, 128 of them) takes about 0.6 ms on the 2-core machine, a connector's shot
+(about 600 bytes, one piece) a few microseconds."""
+TURN_S = 0.001
+"""Open Connect's work (every connection's together) in one turn of the event loop, before everything else that is
+ready runs (HTTP requests among them): a turn lasts TURN_S plus at most one piece's framing or one shot's flight."""
+LOG_EVERY_S = 10.0
+"""Least time between two log lines about one kind of refusal: a hostile program's loop is refused hundreds of
+times a second and would fill the log; each line says how many were not logged since the last."""
 INTERNAL_ERROR = "internal error while answering this message (the server log has the details)"
 
 log = logging.getLogger(__name__)
+
+
+class RefusalLog:
+    """Logs each kind of refusal (its message) at most once per LOG_EVERY_S, with the count of those not logged."""
+
+    def __init__(self):
+        self._last: dict[str, float] = {}
+        self._unlogged: dict[str, int] = {}
+
+    def warning(self, message: str) -> None:
+        now = time.monotonic()
+        if message in self._last and now - self._last[message] < LOG_EVERY_S:
+            self._unlogged[message] = self._unlogged.get(message, 0) + 1
+            return
+        self._last[message] = now
+        unlogged = self._unlogged.pop(message, 0)
+        more = f" ({unlogged:,} more since the last such line)" if unlogged else ""
+        log.warning("GSPro Open Connect: %s%s", message, more)
 
 
 @dataclass(frozen=True)
@@ -49,18 +100,27 @@ class ConnectAddress:
 
 
 class OpenConnectServer:
-    """GSPro Open Connect v1 on a TCP port; `answer` flies each message that carries a shot."""
+    """GSPro Open Connect v1 on a TCP port; `answer` flies each message that carries a shot (called on the event
+    loop's thread that `start` ran on). `limits` bound what each connector may do (default `limits.ConnectorLimits()`:
+    the module's constants)."""
 
-    def __init__(self, answer: Answer):
+    def __init__(self, answer: Answer, limits: ConnectorLimits | None = None):
         self.answer = answer
+        self.limits = limits or ConnectorLimits()
         self._server: asyncio.Server | None = None
-        self.connections: set[Connection] = set()  # open now; each leaves when its connector goes or at `close`
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._player: bytes | None = None  # the last player information sent, for connectors that connect later
+        self.connections: set[Connection] = set()  # served now; each leaves when it closes or is refused
+        self.refused: set[Connection] = set()  # refused (Code 503), their refusal on its way, until closed
+        self.refusals = RefusalLog()
+        self._waiting: deque[Connection] = deque()  # connections with input left, in the order their turns come
+        self._turn: asyncio.Handle | None = None  # the next turn of all Open Connect work, scheduled
 
     async def start(self, address: ConnectAddress, *, listening: bool = True) -> None:
         """Take the port (OSError when it cannot be had) and accept connectors on it, or with `listening` False only
         take it, so that a port that cannot be had stops a startup early, until `listen`."""
-        loop = asyncio.get_running_loop()
-        self._server = await loop.create_server(
+        self._loop = asyncio.get_running_loop()
+        self._server = await self._loop.create_server(
             lambda: Connection(self), address.host, address.port, start_serving=listening
         )
 
@@ -74,11 +134,70 @@ class OpenConnectServer:
         return self._server.sockets[0].getsockname()[1]
 
     async def close(self) -> None:
-        """Stop listening and close every connection (replies already written still go out)."""
+        """Stop listening and close every connection (replies already written still go out, to connectors that
+        read them)."""
         self._server.close()
-        for connection in list(self.connections):
+        for connection in [*self.connections, *self.refused]:
             connection.close()
         await self._server.wait_closed()
+
+    def send_player(self, club: str, handed: str) -> None:
+        """Push GSPro's player information, `{"Code":201,"Message":"GSPro Player Information","Player":{"Handed":
+        handed,"Club":club}}`, to every connector connected now, and to each that connects later right after it
+        connects (the last one sent is kept). `club` is a GSPro club code (DR, I7, PT, ...), `handed` RH or LH;
+        ValueError otherwise. Safe to call from any thread: off the event loop's thread, the push is handed to the
+        loop (`call_soon_threadsafe`) and goes out on its next turn."""
+        data = player_information(club, handed)
+        try:
+            running = asyncio.get_running_loop()
+        except RuntimeError:
+            running = None
+        if self._loop is None or running is self._loop:
+            self._push(data)
+        else:
+            self._loop.call_soon_threadsafe(self._push, data)
+
+    def _push(self, data: bytes) -> None:
+        self._player = data
+        for connection in self.connections:
+            if not connection.transport.is_closing():  # one dropped (`_drop_unread`) leaves at the loop's next turn
+                connection.transport.write(data)
+
+    def admit(self, connection: Connection) -> None:
+        """Serve a new connection (its buffers bounded, the player information sent), or refuse it when
+        MAX_CONNECTIONS are served already."""
+        if len(self.connections) >= self.limits.max_connections:
+            self.refusals.warning(f"a connection refused, {self.limits.max_connections} connected already")
+            connection.refuse(self.limits.too_many_connections())
+            return
+        self.connections.add(connection)
+        transport = connection.transport
+        sock = transport.get_extra_info("socket")
+        if sock is not None:
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, self.limits.send_buffer_bytes)
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, self.limits.receive_buffer_bytes)
+        transport.set_write_buffer_limits(high=self.limits.unread_reply_bytes)
+        if self._player is not None:
+            transport.write(self._player)
+
+    def busy(self) -> bool:
+        """Whether some connection waits for its turn (then a new arrival waits too, behind it)."""
+        return self._turn is not None
+
+    def wait_turn(self, connection: Connection) -> None:
+        """Put `connection`, which has input left, in line for the next turn."""
+        self._waiting.append(connection)
+        if self._turn is None:
+            self._turn = self._loop.call_soon(self._take_turn)
+
+    def _take_turn(self) -> None:
+        """One turn, in the event loop, for all connections together: each in line works, in order, until TURN_S
+        has passed; those with input left go to the back of the line, for the next turn (scheduled once: `_turn`
+        stays set while this one runs)."""
+        deadline = time.perf_counter() + TURN_S
+        while self._waiting and time.perf_counter() < deadline:
+            self._waiting.popleft().work(deadline)
+        self._turn = self._loop.call_soon(self._take_turn) if self._waiting else None
 
     def reply(self, item: bytes | Refused) -> GSProReply | None:
         """`reply_to`, with any unexpected failure answered (and logged) instead of ending the connection."""
@@ -90,40 +209,152 @@ class OpenConnectServer:
 
 
 class Connection(asyncio.Protocol):
-    """One connector's connection: what arrives is framed and answered at once; a pause of PAUSE_S mid-object
-    marks it stalled (`ObjectFramer.stall`). Reading pauses while the connector does not take its replies."""
+    """One connector's connection. What arrives is framed PIECE_BYTES at a time and answered in order: at once while
+    no other connection waits, up to TURN_S, then in the server's turns; while input is left for a later turn, or
+    the connector leaves its replies unread, the socket is not read. A pause of PAUSE_S mid-object marks it stalled
+    (`ObjectFramer.stall`). Refused (too many connections, messages or bytes): one Code 503, then the close
+    (`refuse`); replies left unread UNREAD_LIMIT_S: dropped."""
 
     def __init__(self, server: OpenConnectServer):
         self.server = server
-        self.framer = ObjectFramer()
+        self.limits = server.limits
+        self.framer = ObjectFramer(self.limits.max_message_bytes)
+        self.messages = TokenBucket(self.limits.messages_per_s, self.limits.message_burst)
+        self.bytes = TokenBucket(self.limits.bytes_per_s, self.limits.byte_burst)
         self.transport: asyncio.Transport | None = None
-        self._pause: asyncio.TimerHandle | None = None
+        self._input, self._at = b"", 0  # the last read, framed up to _at
+        self._items: deque[bytes | Refused] = deque()  # framed, not yet answered
+        self._reading = True
+        self._writing = True  # False while the connector leaves its replies unread (pause_writing)
+        self._waiting = False  # in the server's line for a turn
+        self._pause: asyncio.TimerHandle | None = None  # PAUSE_S mid-object
+        self._unread: asyncio.TimerHandle | None = None  # UNREAD_LIMIT_S of replies left unread
+        self._ending: asyncio.TimerHandle | None = None  # LINGER_S after a refusal
+        self._lingered = 0  # bytes dropped since the refusal
 
     def connection_made(self, transport: asyncio.Transport) -> None:
         self.transport = transport
-        self.server.connections.add(self)
+        self.server.admit(self)
 
     def data_received(self, data: bytes) -> None:
+        if self._ending is not None:  # refused: what still comes is dropped, up to LINGER_BYTES
+            self._lingered += len(data)
+            if self._lingered > self.limits.linger_bytes:
+                self.transport.abort()
+            return
         if self._pause is not None:
             self._pause.cancel()
             self._pause = None
-        for item in self.framer.feed(data):
-            reply = self.server.reply(item)
-            if reply is not None:
-                self.transport.write(reply.model_dump_json(exclude_none=True).encode())
-        if self.framer.partial and not self.framer.stalled:
-            self._pause = asyncio.get_running_loop().call_later(PAUSE_S, self.framer.stall)
+        self._input, self._at = self._input[self._at :] + data, 0  # reading pauses while any is left: one read
+        if self.server.busy():
+            self._after_work()  # in line behind the others
+        else:
+            self.work(time.perf_counter() + TURN_S)  # a connector's shot: answered in the callback that got it
 
     def pause_writing(self) -> None:
-        self.transport.pause_reading()
+        self._writing = False
+        self._read(False)
+        self._unread = asyncio.get_running_loop().call_later(self.limits.unread_limit_s, self._drop_unread)
 
     def resume_writing(self) -> None:
-        self.transport.resume_reading()
+        self._writing = True
+        if self._unread is not None:
+            self._unread.cancel()
+            self._unread = None
+        self._after_work()
 
     def connection_lost(self, error: Exception | None) -> None:
-        if self._pause is not None:
-            self._pause.cancel()
+        for timer in (self._pause, self._unread, self._ending):
+            if timer is not None:
+                timer.cancel()
         self.server.connections.discard(self)
+        self.server.refused.discard(self)
 
     def close(self) -> None:
-        self.transport.close()
+        """Close (abort, where the connector leaves its replies unread and the close would wait on it for ever); what
+        it sent and is not answered yet is dropped."""
+        self._items.clear()
+        self._input, self._at = b"", 0
+        if self._writing:
+            self.transport.close()
+        else:
+            self.transport.abort()
+
+    def refuse(self, message: str) -> None:
+        """Answer Code 503 with `message` and close: the connector's side is shut after the reply, and what it still
+        sends is read and dropped for LINGER_S, up to LINGER_BYTES (a close with unread input would reset the
+        connection, and a reset can discard the reply before it is read). With MAX_CONNECTIONS refusals already
+        lingering, it is closed at once."""
+        self.server.connections.discard(self)
+        self._items.clear()
+        self._input, self._at = b"", 0
+        self.transport.write(encoded(GSProReply(Code=503, Message=message)))
+        if len(self.server.refused) >= self.limits.max_connections:
+            self.transport.close()
+            return
+        self.server.refused.add(self)
+        self.transport.write_eof()
+        self._ending = asyncio.get_running_loop().call_later(self.limits.linger_s, self.transport.abort)
+        self._read(True)
+
+    def work(self, deadline: float) -> None:
+        """Frame and answer until `deadline` (`time.perf_counter`), the input is done, or the replies are left
+        unread; then back in line, or reading again."""
+        self._waiting = False
+        while self._ending is None and self._writing and not self.transport.is_closing():
+            if self._items:
+                self._answer(self._items.popleft())
+            elif self._at < len(self._input):
+                piece = self._input[self._at : self._at + PIECE_BYTES]
+                self._at += len(piece)
+                if not self.bytes.take(len(piece)):
+                    self.server.refusals.warning("a connector sent bytes too fast: closed")
+                    self.refuse(self.limits.too_many_bytes())
+                    break
+                self._items.extend(self.framer.feed(piece))
+            else:
+                break
+            if time.perf_counter() >= deadline:
+                break
+        self._after_work()
+
+    def _answer(self, item: bytes | Refused) -> None:
+        if not self.messages.take():
+            self.server.refusals.warning("a connector sent messages too fast: closed")
+            self.refuse(self.limits.too_many_messages())
+            return
+        reply = self.server.reply(item)
+        if reply is not None:
+            self.transport.write(encoded(reply))
+
+    def _backlog(self) -> bool:
+        return bool(self._items) or self._at < len(self._input)
+
+    def _after_work(self) -> None:
+        """In line for the next turn (reading paused meanwhile), or, with nothing left, read again."""
+        if self._ending is not None or self.transport.is_closing():
+            return
+        if self._backlog():
+            self._read(False)
+            if self._writing and not self._waiting:
+                self._waiting = True
+                self.server.wait_turn(self)
+            return
+        self._input, self._at = b"", 0
+        self._read(self._writing)
+        if self.framer.partial and not self.framer.stalled and self._pause is None:
+            self._pause = asyncio.get_running_loop().call_later(PAUSE_S, self._stalled)
+
+    def _stalled(self) -> None:
+        self._pause = None
+        self.framer.stall()
+
+    def _read(self, on: bool) -> None:
+        if on != self._reading:
+            self._reading = on
+            (self.transport.resume_reading if on else self.transport.pause_reading)()
+
+    def _drop_unread(self) -> None:
+        self.server.refusals.warning(f"a connector left its replies unread {self.limits.unread_limit_s:g} s: dropped")
+        self._unread = None
+        self.transport.abort()
