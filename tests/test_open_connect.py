@@ -89,7 +89,7 @@ class Connector:
 
     def reply(self, timeout_s: float = RESEND_S) -> dict | None:
         """The next reply, or None after `timeout_s` of silence (NaN or infinity in it fails the test). Player
-        information (Code 201, pushed on connecting and whenever the player changes) is no reply: it goes to
+        information (Code 201, pushed whenever the player changes) is no reply: it goes to
         `players`, as a connector's own reading loop takes it apart from the replies."""
         deadline = time.monotonic() + timeout_s
         while True:
@@ -283,7 +283,7 @@ def test_malformed_input_gets_a_5xx_with_a_message_and_the_connection_goes_on(co
 
 def test_out_of_range_values_name_the_field_and_its_range(connector):
     for ball, says in (
-        ({"Speed": 400.0}, "(got 400.0); allowed 1.11847 to 223.694 mph"),
+        ({"Speed": 400.0}, "(got 400.0); allowed 1.119 to 223.6 mph"),
         ({"VLA": -45.0}, "BallData.VLA"),
         ({"TotalSpin": 20000.0}, "BallData.TotalSpin"),
         ({"TotalSpin": None, "BackSpin": 14000.0, "SideSpin": 9000.0}, "BackSpin and SideSpin make 16643 rpm"),

@@ -109,7 +109,6 @@ class OpenConnectServer:
         self.limits = limits or ConnectorLimits()
         self._server: asyncio.Server | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._player: bytes | None = None  # the last player information sent, for connectors that connect later
         self.connections: set[Connection] = set()  # served now; each leaves when it closes or is refused
         self.refused: set[Connection] = set()  # refused (Code 503), their refusal on its way, until closed
         self.refusals = RefusalLog()
@@ -143,9 +142,10 @@ class OpenConnectServer:
 
     def send_player(self, club: str, handed: str) -> None:
         """Push GSPro's player information, `{"Code":201,"Message":"GSPro Player Information","Player":{"Handed":
-        handed,"Club":club}}`, to every connector connected now, and to each that connects later right after it
-        connects (the last one sent is kept). `club` is a GSPro club code (DR, I7, PT, ...), `handed` RH or LH;
-        ValueError otherwise. Safe to call from any thread: off the event loop's thread, the push is handed to the
+        handed,"Club":club}}`, to every connector connected now. Nothing is pushed to a connector as it connects: one
+        that reads a single reply after each shot (MLM2PRO-GSPro-Connector's `recv(2048)`) would take an object it
+        did not ask for as its shot's reply if its shot followed at once. `club` is a GSPro club code (DR, I7, PT,
+        ...), `handed` RH or LH; ValueError otherwise. Safe to call from any thread: off the event loop's thread, the push is handed to the
         loop (`call_soon_threadsafe`) and goes out on its next turn."""
         data = player_information(club, handed)
         try:
@@ -158,14 +158,12 @@ class OpenConnectServer:
             self._loop.call_soon_threadsafe(self._push, data)
 
     def _push(self, data: bytes) -> None:
-        self._player = data
         for connection in self.connections:
             if not connection.transport.is_closing():  # one dropped (`_drop_unread`) leaves at the loop's next turn
                 connection.transport.write(data)
 
     def admit(self, connection: Connection) -> None:
-        """Serve a new connection (its buffers bounded, the player information sent), or refuse it when
-        MAX_CONNECTIONS are served already."""
+        """Serve a new connection (its buffers bounded), or refuse it when MAX_CONNECTIONS are served already."""
         if len(self.connections) >= self.limits.max_connections:
             self.refusals.warning(f"a connection refused, {self.limits.max_connections} connected already")
             connection.refuse(self.limits.too_many_connections())
@@ -177,8 +175,6 @@ class OpenConnectServer:
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, self.limits.send_buffer_bytes)
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, self.limits.receive_buffer_bytes)
         transport.set_write_buffer_limits(high=self.limits.unread_reply_bytes)
-        if self._player is not None:
-            transport.write(self._player)
 
     def busy(self) -> bool:
         """Whether some connection waits for its turn (then a new arrival waits too, behind it)."""
