@@ -151,6 +151,18 @@ def launch_from_ball_data(ball: GSProBallData) -> Launch:
     return Launch(ball.Speed * MPH_TO_MPS, ball.VLA, ball.HLA or 0.0, spin, axis)
 
 
+def shot_number_of(data) -> int | None:
+    """The ShotNumber of a message that failed validation, when it carries a valid one (any letter case), so that
+    every refusal of a shot names the shot as a shot's reply does; None otherwise."""
+    if not isinstance(data, dict):
+        return None
+    for key, value in data.items():
+        if isinstance(key, str) and key.casefold() == "shotnumber":
+            valid = isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= 2**31 - 1
+            return value if valid else None
+    return None
+
+
 def invalid_message(errors: list) -> str:
     """The Message of Code 500 for a message that failed validation: each problem with its field, value and range."""
     return "; ".join(detail["message"] for detail in describe_errors(errors, GSPRO_RANGES))

@@ -230,3 +230,14 @@ def test_a_batch_body_in_any_json_encoding_is_flown_as_the_app_read_it(bay_servi
         assert not encoded.startswith(codecs.BOM_UTF16_LE)
     answer = http.post("/v1/shots/batch", content=encoded, headers={"content-type": "application/json"})
     assert answer.status_code == 200 and answer.json() == plain.json()
+
+
+def test_a_refused_connector_message_names_its_shot_over_tcp_and_http(bay_service):
+    http, port = bay_service
+    bad = json.loads(message(42, {**BALLS[0], "Speed": 400.0}))
+    connector = Connector(port)
+    tcp = connector.reply(json.dumps(bad).encode())
+    connector.close()
+    over_http = http.post("/v1/gspro", json=bad).json()
+    for reply in (tcp, over_http):
+        assert reply["Code"] == 500 and reply["ShotNumber"] == 42 and "BallData.Speed" in reply["Message"]

@@ -10,7 +10,7 @@ from fastapi import FastAPI, Request
 from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
-from golfflight.contract.gspro import GSProReply, invalid_message
+from golfflight.contract.gspro import GSProReply, invalid_message, shot_number_of
 from golfflight.contract.refusals import body_detail, describe_errors, not_json
 from golfflight.contract.requests import RANGES
 from golfflight.service.api.paths import GSPRO_PATH
@@ -23,8 +23,9 @@ JSON_CONTENT_TYPE = "the body must be JSON: send content-type: application/json"
 """The refusal (415) of a body sent without a JSON content type, followed by what was sent."""
 
 
-def _gspro_error(message: str, status: int = 422) -> JSONResponse:
-    return JSONResponse(GSProReply(Code=500, Message=message).model_dump(exclude_none=True), status)
+def _gspro_error(message: str, status: int = 422, shot_number: int | None = None) -> JSONResponse:
+    reply = GSProReply(Code=500, Message=message, ShotNumber=shot_number)
+    return JSONResponse(reply.model_dump(exclude_none=True), status)
 
 
 def _content_type_refusal(request: Request, error: RequestValidationError) -> str | None:
@@ -52,7 +53,7 @@ async def invalid_request(request: Request, error: RequestValidationError) -> JS
     if request.url.path == GSPRO_PATH:
         if unread:
             return _gspro_error(unread, 415)
-        return _gspro_error(broken or invalid_message(error.errors()))
+        return _gspro_error(broken or invalid_message(error.errors()), shot_number=shot_number_of(error.body))
     if unread:
         return JSONResponse({"detail": [body_detail(unread, "content_type")]}, 415)
     if broken:

@@ -12,7 +12,7 @@ import json
 import re
 from collections.abc import Callable
 
-from golfflight.contract.gspro import GSProMessage, GSProReply, invalid_message
+from golfflight.contract.gspro import GSProMessage, GSProReply, invalid_message, shot_number_of
 from golfflight.service.open_connect.framing import Refused
 from pydantic import ValidationError
 
@@ -65,5 +65,5 @@ def _read_by_python(item: bytes, answer: Answer) -> GSProReply | None:
     try:
         message = GSProMessage.model_validate(data)
     except ValidationError as error:
-        return GSProReply(Code=500, Message=invalid_message(error.errors()))
+        return GSProReply(Code=500, Message=invalid_message(error.errors()), ShotNumber=shot_number_of(data))
     return None if message.BallData is None else answer(message)
