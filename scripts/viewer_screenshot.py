@@ -111,6 +111,10 @@ def main() -> int:
                 rng, number = random.Random(13), 0
                 for club, how, launch, shots in SESSION:
                     page.select_option("#club", club)
+                    page.wait_for_function(  # the bay's player is saved (PATCH answered) before the club's shots
+                        "() => { const c = document.querySelector('#club'); return c.dataset.saved === c.value; }",
+                        timeout=10_000,
+                    )
                     for _ in range(shots):
                         number += 1
                         sent = time.time()
