@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
-from golfflight.contract.bay import PUTTER, BayConditions, in_bay
+from golfflight.contract.bay import CONDITION_FIELDS, PUTTER, in_bay
 from golfflight.contract.flying import flown_shot
 from golfflight.contract.gspro import GSProMessage, GSProReply, failed_reply, shot_reply, shot_request
 from golfflight.contract.requests import BatchRequest, ShotRequest
@@ -165,17 +165,13 @@ class BayRuntime:
             return failed_reply(message, error)
         return shot_reply(message, flown.result)
 
-    def bay_in_force(self) -> BayConditions:
-        """The bay's conditions and player now."""
-        return self.bay.conditions
-
     async def fly_batch(self, request: BatchRequest, body: bytes, show: bool) -> bytes:
         """A validated batch's encoded BatchResult, flown in the batch process (the bay's conditions filled in
         where a shot gives none); with `show`, its last shots go to the screens with the states they came from.
         BrokenProcessPool when the batch process died under it."""
         self.ready_engine()
         bay = self.bay.conditions
-        if any(getattr(bay, name) is not None for name in ("air", "wind", "ground")):
+        if any(getattr(bay, name) is not None for name in CONDITION_FIELDS):
             request = BatchRequest.model_construct(shots=[in_bay(shot, bay) for shot in request.shots])
             body = request.model_dump_json(exclude_none=True).encode()
         shown = self.feed.history if show else 0
