@@ -25,19 +25,9 @@ from typing import NamedTuple
 
 import numpy as np
 from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
-from golfflight.flight.ground.phase import (
-    MAX_ROLL_TIME_S,
-    ROLL_STEP_S,
-    GroundPath,
-    _check_slopes,
-    _downhill,
-    _level_states,
-    _rolling,
-    _slope_step,
-    _stop,
-)
+from golfflight.flight.ground.phase import GroundPath, _check_slopes, _downhill, _ground_path, _roll_one, _rolling
 from golfflight.flight.ground.surfaces import Surface
-from golfflight.flight.ground.vectors import TINY, add, cross, dot, norm, times
+from golfflight.flight.ground.vectors import add, cross, dot, norm, times
 
 SKID_FRICTION = 0.3
 """Kinetic friction coefficient of a golf ball sliding on a green. It sets only where the skid ends, not the speed
@@ -89,32 +79,9 @@ def putt_phase(
     rolling = add(_rolling(velocity, spin, normal), downhill, skid_time)
     start = add(times(0.5 * skid_time, velocity), rolling, 0.5 * skid_time)
     rows = [(0.0, _ORIGIN, velocity)] + ([(skid_time, start, rolling)] if skid_time > 0.0 else [])
-    drag = float(surface.grass_drag_per_s)
-    if slope_deg == 0.0:
-        speed, deceleration = norm(rolling), float(surface.rolling_resistance) * GRAVITY_MPS2
-        distance, roll_time = _stop(speed, deceleration, drag)
-        direction = times(1.0 / max(speed, TINY), rolling)
-        if keep_path:
-            for t in np.arange(ROLL_STEP_S, roll_time - 1e-9, ROLL_STEP_S).tolist():
-                run, now = _level_states(speed, deceleration, drag, t)
-                rows.append((skid_time + t, add(start, direction, run), times(now, direction)))
-        rest, time = add(start, direction, distance), skid_time + float(roll_time)
-    else:
-        brake = float(surface.rolling_resistance) * GRAVITY_MPS2 * normal[2]
-        position, time = start, skid_time
-        for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
-            stops, taken, rest, position, rolling = _slope_step(position, rolling, downhill, brake, drag)
-            time += float(taken)
-            if stops:
-                break
-            if keep_path:
-                rows.append((time, position, rolling))
-        else:
-            rest = position
-    rest = tuple(float(c) for c in rest)
-    path = None
-    if keep_path:
-        rows.append((time, rest, (0.0, 0.0, 0.0)))
-        path = GroundPath(np.array([r[0] for r in rows]), np.array([r[1] for r in rows], dtype=float),
-                          np.array([r[2] for r in rows], dtype=float))
-    return PuttPhase(rest, time, skid_time, norm(start), path)
+    path = rows if keep_path else None
+    rest, roll_time = _roll_one(start, rolling, normal, surface, slope_deg, path, skid_time)
+    rest, time = tuple(float(c) for c in rest), skid_time + roll_time
+    if path is not None:
+        path.append((time, rest, (0.0, 0.0, 0.0)))
+    return PuttPhase(rest, time, skid_time, norm(start), None if path is None else _ground_path(path))
