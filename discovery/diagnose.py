@@ -51,6 +51,7 @@ from golfflight.discovery.report import MATERIAL, ambiguity, effect_results, ser
 from golfflight.discovery.schema import Candidate, Heldout, Located, ModelInfo, Report, ScatterStat, Unlisted
 from golfflight.discovery.simulator import Flown, Setup
 from golfflight.flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
+from golfflight.shots.progress import progress_bar, progress_step
 from golfflight.shots.synth import MeasurementNoise
 
 OUTLIER_MAD = 8.0
@@ -242,7 +243,8 @@ def candidates(selection: Selection, context: Context) -> list[Candidate]:
 
 class Diagnoser:
     """One diagnosis. Making it flies the model on the recordings (`baseline`) and sets up the problem, folds and fit
-    rows every candidate shares; its methods read only those, and `run` fits, chooses and reports."""
+    rows every candidate shares; its methods read only those, and `run` fits, chooses and reports. With `progress`,
+    each step and a bar over the fits go to standard error (`shots.progress`): a large set takes minutes."""
 
     def __init__(
         self,
@@ -252,11 +254,13 @@ class Diagnoser:
         seed: int = 0,
         with_correction: bool = True,
         estimate_scatter: bool = True,
+        progress: bool = True,
     ):
         self.started = time.perf_counter()
         self.recordings, self.model, self.library = recordings, model, LIBRARY
-        self.with_correction, self.estimate_scatter = with_correction, estimate_scatter
+        self.with_correction, self.estimate_scatter, self.progress = with_correction, estimate_scatter, progress
         self.rng = np.random.default_rng(seed)
+        self.step(f"flying {len(recordings):,} recorded shots through the model and its expected error...")
         self.baseline = baseline(recordings, model, noise, seed, estimate_scatter)
         start = self.baseline
         self.problem = Problem(model, recordings, start.base, start.expected.sigma, start.use, start.offset)
@@ -267,9 +271,11 @@ class Diagnoser:
     def run(self) -> Diagnosis:
         """Locate the mismatch, choose its explanation, and report it with the arrays the plots need."""
         start = self.baseline
+        self.step("locating the mismatch...")
         located = located_mismatch(self.recordings, start)
         selection = self.select(has_structure(located))
         chosen = selection.chosen
+        self.step("the chosen explanation's flights and held-out errors...")
         after = corrected(self.problem, chosen.fit, start.predicted, bool(self.recordings.trajectories))
         heldout_block = self.heldout_summary(selection.null, chosen)
         ambiguities = (
@@ -288,6 +294,10 @@ class Diagnoser:
             after.positions,
             chosen if selection.systematic else None,
         )
+
+    def step(self, message: str) -> None:
+        """Name the step that starts now on standard error, with `progress`."""
+        progress_step(message, self.progress)
 
     def report(
         self, located: Located, selection: Selection, after: Corrected, heldout_block: Heldout, ambiguities: list
@@ -407,14 +417,17 @@ class Diagnoser:
 
     def fit_singles(self) -> list[Scored]:
         """Every library effect alone, from Gauss-Newton starts out of one Jacobian; best score first."""
+        self.step(f"fitting {len(self.library)} effects...")
         starts = linear_starts(self.problem, None, self.library, self.rows)
-        singles = [self.score(fit(self.problem, (e,), start, self.rows)) for e, (start, _) in zip(self.library, starts)]
+        fits = progress_bar(zip(self.library, starts), "effects", total=len(self.library), unit="fit", shown=self.progress)
+        singles = [self.score(fit(self.problem, (e,), start, self.rows)) for e, (start, _) in fits]
         return sorted(singles, key=lambda s: s.score)
 
     def fit_pairs(self, singles: list[Scored]) -> list[Scored]:
         """Each of the best singles with the effects that most reduce its linearised cost; best score first."""
         pairs, tried = [], set()
-        for anchor in singles[:PAIR_ANCHORS]:
+        anchors = singles[:PAIR_ANCHORS]
+        for anchor in progress_bar(anchors, "pairs with the best effects", unit="effect", shown=self.progress):
             others = tuple(e for e in self.library if e not in anchor.fit.effects)
             screened = sorted(
                 zip(others, linear_starts(self.problem, anchor.fit, others, self.rows)), key=lambda item: item[1][1]
@@ -451,6 +464,7 @@ class Diagnoser:
         library effect is kept beside it only if that beats the correction alone beyond doubt: an effect that
         explains the size of the mismatch but not its structure is not named. (choice, corrections tried, the
         systematic test's entries)."""
+        self.step("fitting a learned correction...")
         tolerance, tried, test = self.response_error(chosen), [], {}
         if tolerance:
             test[f"model_response_error_of_{chosen.fit.name}"] = tolerance
@@ -546,9 +560,10 @@ def diagnose(
     seed: int = 0,
     with_correction: bool = True,
     estimate_scatter: bool = True,
+    progress: bool = True,
 ) -> Diagnosis:
-    """Run the whole diagnosis of recordings against a model."""
-    return Diagnoser(recordings, model, noise, seed, with_correction, estimate_scatter).run()
+    """Run the whole diagnosis of recordings against a model (its steps on standard error with `progress`)."""
+    return Diagnoser(recordings, model, noise, seed, with_correction, estimate_scatter, progress).run()
 
 
 def scatter_sentence(scatter: Scatter) -> str:

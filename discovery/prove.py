@@ -31,6 +31,7 @@ from golfflight.flight.reference_aero import CALIBRATED
 from golfflight.flight.wind import wind_vector
 from golfflight.shots.files import write_text_atomic
 from golfflight.shots.markdown import write_generated_section
+from golfflight.shots.progress import progress_bar
 
 COMBINATION = ("wind", "ball_speed_bias")
 """The two-effect case: a carry-alike pair that only the other observables can separate."""
@@ -171,7 +172,7 @@ def run_case(
     concealed = conceal(hidden, n_shots, seed, wind_profile=profile, model=model if truth == "model" else None)
     recordings = from_shot_set(concealed.shots, source=f"concealed {case} seed {seed}")
     started = time.perf_counter()
-    report = diagnose(recordings, model, seed=seed).report
+    report = diagnose(recordings, model, seed=seed, progress=False).report
     seconds = time.perf_counter() - started
     fitted = {e.name: dict(e.parameters) for e in report.effects}
     if profile == "log":
@@ -214,27 +215,32 @@ def prove(
     model: FlightModel,
     seeds: int = 4,
     n_shots: int = 300,
-    progress: Callable[[str], None] | None = None,
+    report: Callable[[str], None] | None = None,
     only: str | None = None,
     truth: Truth = "model",
     clean_sets: int = CLEAN_SETS,
+    progress: bool = True,
 ) -> list[Run]:
     """Every case of the campaign (or those whose name matches the regular expression `only`) at `seeds` seeds,
-    the clean case `clean_sets` times."""
+    the clean case `clean_sets` times; `report` gets a line on each run as it ends, and with `progress` a bar over
+    the runs goes to standard error (`shots.progress`)."""
+    planned = [
+        (case, effects, seed)
+        for case, effects in cases(truth)
+        if only is None or re.search(only, case)
+        for seed in range(seeds if effects else clean_sets)
+    ]
     runs = []
-    for case, effects in cases(truth):
-        if only is not None and not re.search(only, case):
-            continue
-        for seed in range(seeds if effects else clean_sets):
-            run = run_case(model, case, effects, seed, n_shots, truth)
-            runs.append(run)
-            if progress:
-                progress(
-                    f"{case:32s} seed {seed}: named {run.named:28s} systematic {run.systematic!s:5s} "
-                    f"param err {', '.join(f'{v:.1%}' for v in run.parameter_error.values()) or '-':>8s} "
-                    f"explained {'-' if run.explained_fraction is None else f'{run.explained_fraction:.1%}'} "
-                    f"({run.seconds:.1f} s)"
-                )
+    for case, effects, seed in progress_bar(planned, "concealed sets", unit="set", shown=progress):
+        run = run_case(model, case, effects, seed, n_shots, truth)
+        runs.append(run)
+        if report:
+            report(
+                f"{case:32s} seed {seed}: named {run.named:28s} systematic {run.systematic!s:5s} "
+                f"param err {', '.join(f'{v:.1%}' for v in run.parameter_error.values()) or '-':>8s} "
+                f"explained {'-' if run.explained_fraction is None else f'{run.explained_fraction:.1%}'} "
+                f"({run.seconds:.1f} s)"
+            )
     return runs
 
 

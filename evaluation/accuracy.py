@@ -78,6 +78,7 @@ from golfflight.flight.constants import YARD_M
 from golfflight.shots.markdown import table, write_generated_section
 from golfflight.shots.paths import shared_data_dir
 from golfflight.shots.pbp import hole_pars
+from golfflight.shots.progress import progress_step
 from golfflight.shots.records import ShotSet
 from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
 from golfflight.shots.source_air import PGA_2023_TABLE, TOUR_CHAMPIONSHIP_2020
@@ -562,7 +563,7 @@ def _summary_rows(errors: dict[str, np.ndarray]) -> list[tuple[str, ...]]:
 
 
 def _study(data_dir: Path, flyer: ModelFlyer, clubs, epochs: int, finetune: Finetune | None,
-           report: AccuracyReport) -> list[str]:
+           report: AccuracyReport, progress: bool) -> list[str]:
     lines = ["### Fine-tuning on a tour event's early rounds (Sony Open 2022)", ""]
     path = data_dir / SONY_TRAJECTORIES
     if not path.is_file():
@@ -574,7 +575,7 @@ def _study(data_dir: Path, flyer: ModelFlyer, clubs, epochs: int, finetune: Fine
     conversion = load_tourcast(path, None, estimate_spin=True)
     shots = ShotSet(conversion.records)
     try:
-        study = finetune_study(flyer, shots, clubs, finetune, epochs=epochs)
+        study = finetune_study(flyer, shots, clubs, finetune, epochs=epochs, progress=progress)
     except ValueError as error:
         return lines + [f"_Skipped: {error}._"]
     report.study = study
@@ -617,11 +618,12 @@ def run_accuracy(
     finetune_epochs: int = 30,
     synthetic: str | os.PathLike | None = None,
     finetune: Finetune | None = None,
+    progress: bool = True,
 ) -> AccuracyReport:
     """Compare the real-data model `bundle`, the `synthetic` one (default: the same bundle) and Ferguson 2022 on every
     real set found under `data_dir` (default: the shared data folder), run the fine-tuning study with `finetune`
     (`model_export.finetune.finetune`; None skips it), and write OUT's generated section and the path-error figure;
-    missing sets are announced."""
+    missing sets are announced. With `progress`, each set's step goes to standard error as it starts."""
     data_dir = Path(data_dir) if data_dir is not None else shared_data_dir()
     real = ModelFlyer(bundle, "real-data model")
     flyers: list[Flyer] = [
@@ -633,14 +635,20 @@ def run_accuracy(
     lines = _header(flyers, "none of these sets records its weather; the TOUR Championship and the PGA table are "
                             "flown in their own air (`shots.source_air`), every model alike.")
     lines += ["", "## Held-out sets (never trained on, never used to choose a model; `shots.heldout`)", ""]
+    progress_step("the held-out TrackMan drivers...", progress)
     lines += _drivers(data_dir, flyers, report)
+    progress_step("the TOUR Championship 2020...", progress)
     lines += ["", *_tour_championship(data_dir, flyers, report)]
+    progress_step("slow shots...", progress)
     lines += ["", "## Context", "", *_paper(), "", *_slow(flyers, report)]
     lines += ["", "## Training data and studies", ""]
+    progress_step("the PGA TOUR 2023 averages...", progress)
     pga_lines, clubs = _pga(data_dir, flyers, report)
     lines += [*pga_lines, ""]
+    progress_step("the Sentry 2022 paths and each shot's wind...", progress)
     lines += _sentry(data_dir, flyers, Path(out), Path(figures_dir), report)
-    lines += ["", *_study(data_dir, real, clubs, finetune_epochs, finetune, report)]
+    progress_step("the fine-tuning study on the Sony Open 2022...", progress)
+    lines += ["", *_study(data_dir, real, clubs, finetune_epochs, finetune, report, progress)]
     report.markdown = "\n".join(lines) + "\n"
     write_generated_section(out, report.markdown, COMMAND)
     return report

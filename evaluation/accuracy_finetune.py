@@ -17,6 +17,7 @@ from typing import Any, Protocol
 import numpy as np
 from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.evaluation.accuracy_sets import ClubComparison, compare_clubs, outcome_errors
+from golfflight.shots.progress import progress_bar
 from golfflight.shots.records import ShotSet, write_shots
 from golfflight.shots.reference_world import ClubAverage
 from golfflight.shots.source_air import PGA_2023_TABLE
@@ -79,11 +80,13 @@ def finetune_study(
     val_fraction: float = 0.2,
     train_rounds: Sequence[int] = TRAIN_ROUNDS,
     measured_rounds: Sequence[int] = MEASURED_ROUNDS,
+    progress: bool = False,
 ) -> FinetuneStudy:
     """Fine-tune on `train_rounds` at each learning rate (written without a split column, so `golfflight finetune`
     picks its validation shots by its own rule: the latest sessions, i.e. rounds), keep the rate whose best epoch has
     the lowest validation landing error (the measured rounds play no part in any choice), and compare
-    `measured_rounds` before and after. Everything is written to a temporary directory, then deleted."""
+    `measured_rounds` before and after. Everything is written to a temporary directory, then deleted. With `progress`,
+    a bar over the learning rates goes to standard error (the runs' own lines would go to standard output)."""
     train, measured = by_rounds(shots, train_rounds), by_rounds(shots, measured_rounds)
     if not len(train) or not len(measured):
         raise ValueError(f"needs shots in rounds {list(train_rounds)} and {list(measured_rounds)}; "
@@ -94,7 +97,7 @@ def finetune_study(
         train_file = Path(work) / "train_rounds.csv"
         write_shots(train_file, [r.model_copy(update={"split": None}) for r in train.records])
         results = {}
-        for index, lr in enumerate(lrs):
+        for index, lr in enumerate(progress_bar(lrs, "fine-tuning, learning rates", unit="rate", shown=progress)):
             results[lr] = (Path(work) / f"bundle-{index}",
                            finetune(flyer.bundle, train_file, Path(work) / f"bundle-{index}", epochs, lr, batch_size,
                                     val_fraction=val_fraction, progress=False))

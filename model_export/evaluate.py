@@ -35,6 +35,7 @@ from golfflight.model_export.training import (
 from golfflight.model_export.validation import ValidationSet, load_validation
 from golfflight.model_export.variants import PhysNN, PhysQ
 from golfflight.shots.markdown import table, write_generated_section
+from golfflight.shots.progress import progress_bar, progress_step
 from torch import nn
 
 COMMAND = "evaluate"
@@ -448,18 +449,23 @@ def run_evaluation(
     runs: Sequence[str | os.PathLike],
     out_dir: str | os.PathLike,
     bundle: str | os.PathLike | None = None,
+    progress: bool = True,
 ) -> EvaluationReport:
     """Evaluate runs (and a bundle) on the file's validation shots; write OUT/training.md's generated section and
-    OUT/figures/fig6_errors.png, fig7_coefficients.png."""
+    OUT/figures/fig6_errors.png, fig7_coefficients.png. With `progress`, a bar over the runs and each later step go
+    to standard error."""
     torch.set_flush_denormal(True)
     out_dir = Path(out_dir)
     val = load_validation(data)
-    evaluations = [evaluate_run(run, val) for run in runs]
+    evaluations = [evaluate_run(run, val) for run in progress_bar(runs, "runs", unit="run", shown=progress)]
+    progress_step("the reference world's noise floor...", progress)
     air, described = nominal_conditions(val)
     floors = noise_floors(val, air, described)
     for evaluation in evaluations:
         evaluation.world_gap = gap(evaluation.prediction, floors[0].prediction)
+    progress_step(f"the bundle {bundle} through the runtime path...", progress and bundle is not None)
     check = check_bundle(bundle, val) if bundle is not None else None
+    progress_step("figures...", progress)
     written, summary = write_figures(evaluations, floors, val, air, out_dir / "figures")
     markdown = render(evaluations, floors, val, check) + (f"\n{summary}\n" if summary else "")
     write_generated_section(out_dir / "training.md", markdown, COMMAND)

@@ -25,6 +25,7 @@ from golfflight.model_export.training import (
     train,
     validate,
 )
+from golfflight.shots.progress import progress_step
 from golfflight.shots.records import ShotSet, read_shots, write_shots
 from golfflight.weights_schema.bundle import CARD_FILE
 from golfflight.weights_schema.model_card import ModelCard
@@ -126,7 +127,8 @@ def finetune(
     progress: bool = True,
 ) -> FinetuneResult:
     """Fine-tune `model` on `data` for `epochs` and export OUT (model.onnx + model_card.json) from the best epoch,
-    if it beats the base model's validation landing error; the run goes to OUT/finetune-run/."""
+    if it beats the base model's validation landing error; the run goes to OUT/finetune-run/. With `progress`, its
+    steps and epochs go to standard error and a line per epoch to standard output."""
     if epochs < 1:
         raise ValueError(f"epochs must be at least 1, got {epochs}")
     out = Path(out)
@@ -134,9 +136,11 @@ def finetune(
     base = load_base(model)
     config = replace(base.config, epochs=epochs, lr=lr, batch_size=batch_size, seed=seed, limit=None)
     train_file = prepare_data(data, val_fraction, run_dir)
+    progress_step("measuring the starting model on the validation shots...", progress)
     before = _base_metrics(base, config, train_file)
     result = train(train_file, run_dir, config, progress=progress, init_state=base.state)
     improved = result.best is not None and result.best["landing_error_m"] < before["landing_error_m"]
+    progress_step(f"exporting {out}...", progress and improved)
     card = export_checkpoint(run_dir, out) if improved else None
     summary: dict[str, Any] = {
         "base": base.source,

@@ -38,9 +38,9 @@ from golfflight.model_export.observations import (
 from golfflight.model_export.torch_physics import DT_S, T_SIM_S, euler_rollout, hard_landing, positions_at
 from golfflight.model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, load_checkpoint, save_checkpoint
 from golfflight.shots.files import write_text_atomic
+from golfflight.shots.progress import print_line, progress_bar
 from golfflight.shots.source_air import UNKNOWN_AIR_SOURCES
 from torch import nn
-from tqdm import tqdm
 
 HUBER_DELTA = 2.0
 """Residuals beyond 2 sigma count linearly: mishits and gusts do not dominate the fit."""
@@ -360,7 +360,7 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
         order = torch.randperm(len(train), generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch))
         sums, steps = 0.0, 0
         batches = range(0, len(train), config.batch_size)
-        for start in tqdm(batches, desc=f"epoch {epoch}/{config.epochs}", disable=not progress):
+        for start in progress_bar(batches, f"epoch {epoch}/{config.epochs}", unit="batch", shown=progress):
             batch = train.take(order[start:start + config.batch_size])
             optimizer.zero_grad(set_to_none=True)
             losses = shot_losses(fly(model, batch, config, latent), batch, config.huber_delta, noise.factors())
@@ -382,7 +382,7 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
                "source_density": dict(zip(data.sources, source_density.tolist()))}
         history.append(row)
         if progress:
-            tqdm.write(f"epoch {epoch}: train {row['train_loss']:.3f}, felt {row['selection_loss']:.2f} m " + ", ".join(
+            print_line(f"epoch {epoch}: train {row['train_loss']:.3f}, felt {row['selection_loss']:.2f} m " + ", ".join(
                 f"{k} {felt_error_m(v):.2f}" for k, v in metrics["sources"].items()))
         final = _save_run(out_dir, epoch, config, model, latent, noise, data, history, metrics)
     return JointResult(out_dir, history, final)

@@ -20,6 +20,7 @@ from golfflight.model_export.joint import JointConfig, JointResult, soup_runs, t
 from golfflight.model_export.observations import NOISE, OBSERVABLES, PATH_OBSERVATIONS, PATH_SIGMA_M
 from golfflight.model_export.real_data import SourceData, build
 from golfflight.model_export.training import TrainConfig, load_checkpoint
+from golfflight.shots.progress import progress_bar, progress_step
 from golfflight.shots.records import read_shots
 from golfflight.weights_schema.bundle import sha256_of
 from golfflight.weights_schema.model_card import ModelCard
@@ -186,38 +187,54 @@ def train_seed(data_file: Path, run_dir: Path, init: str | os.PathLike, config: 
     return train_joint(data_file, run_dir, config, model, progress)
 
 
+def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig], jobs: int,
+                 threads: int, progress: bool) -> dict[str, JointResult]:
+    """Each seed's joint run (WORK/NAME), by name: one after the other with their epoch bars, or `jobs` at once in
+    processes of their own (silent there) with a bar over the seeds finished."""
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    if jobs <= 1:
+        runs = {}
+        for index, (name, c) in enumerate(configs.items(), start=1):
+            progress_step(f"{name} ({index} of {len(configs)})", progress)
+            runs[name] = train_seed(data_file, work / name, init, c, threads, progress)
+        return runs
+    with ProcessPoolExecutor(jobs) as pool:
+        futures = {pool.submit(train_seed, data_file, work / name, init, c, threads, False): name
+                   for name, c in configs.items()}
+        done = {futures[f]: f.result() for f in progress_bar(as_completed(futures), "seeds", total=len(futures),
+                                                             unit="seed", shown=progress)}
+    return {name: done[name] for name in configs}
+
+
 def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str | os.PathLike,
                config: JointConfig, seeds: tuple[int, ...], out: str | os.PathLike | None,
                source_names: tuple[str, ...] | None = None, progress: bool = True, jobs: int = 1,
                threads: int = 2) -> RealRun:
     """Build WORK/real_flights.csv from DATA_ROOT, train one joint run per seed from the bundle INIT (WORK/seed-S;
     `jobs` seeds at a time, each with `threads` torch threads), average several seeds' weights into a soup
-    (WORK/soup), and export the run with the lowest validation felt error to OUT (if given)."""
-    from concurrent.futures import ProcessPoolExecutor
-
+    (WORK/soup), and export the run with the lowest validation felt error to OUT (if given). With `progress`, each
+    step, and the epochs (one seed at a time) or the seeds (several at once), go to standard error."""
     from golfflight.weights_schema.bundle import load_bundle
 
     started = time.perf_counter()
     work = Path(work)
     work.mkdir(parents=True, exist_ok=True)
     data_file = work / DATA_FILE
+    progress_step(f"building {data_file} from the real sources...", progress)
     sources = build(data_root, data_file, *(() if source_names is None else (source_names,)))
     configs = {f"seed-{seed}": replace(config, seed=seed) for seed in seeds}
-    if jobs > 1:
-        with ProcessPoolExecutor(jobs) as pool:
-            futures = {name: pool.submit(train_seed, data_file, work / name, init, c, threads, False)
-                       for name, c in configs.items()}
-            runs = {name: f.result() for name, f in futures.items()}
-    else:
-        runs = {name: train_seed(data_file, work / name, init, c, threads, progress) for name, c in configs.items()}
+    runs = _train_seeds(data_file, work, init, configs, jobs, threads, progress)
     finished = [run.out_dir for run in runs.values() if run.final]
     if len(finished) > 1:
+        progress_step(f"averaging {len(finished)} seeds' weights (the soup)...", progress)
         runs[SOUP] = soup_runs(data_file, finished, work / SOUP, _network(init))
     chosen = min(runs, key=lambda s: runs[s].final["val_loss"] if runs[s].final else float("inf"))
     exported = None
     if out is not None:
         from golfflight.evaluation.held_out import record_held_out
 
+        progress_step(f"exporting {chosen} to {out} and measuring its held-out errors...", progress)
         card, _ = load_bundle(init)
         export_real(runs[chosen].out_dir, data_file, sources, Path(out), card.variant,
                     tuple(card.architecture.hidden_units))

@@ -29,8 +29,8 @@ from golfflight.model_export.torch_physics import (
 )
 from golfflight.model_export.variants import build_model
 from golfflight.shots.files import write_atomic, write_text_atomic
+from golfflight.shots.progress import print_line, progress_bar
 from torch import nn
-from tqdm import tqdm
 
 CHECKPOINT_FORMAT = 1
 VALIDATION_BATCH = 4096
@@ -195,7 +195,7 @@ def _train_epoch(
     order = torch.randperm(len(shots), generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch))
     sums, steps, skipped = {"lp": 0.0, "lh": 0.0}, 0, 0
     n_batches = math.ceil(len(shots) / config.batch_size)
-    bar = tqdm(range(n_batches), desc=f"epoch {epoch}/{config.epochs}", unit="batch", disable=not progress)
+    bar = progress_bar(range(n_batches), f"epoch {epoch}/{config.epochs}", unit="batch", shown=progress)
     for b in bar:
         batch = shots.take(order[b * config.batch_size : (b + 1) * config.batch_size])
         optimizer.zero_grad(set_to_none=True)
@@ -294,7 +294,7 @@ def _train(
         row |= {"epoch_seconds": time.perf_counter() - started, **{f"val_{k}": v for k, v in metrics.items()}}
         history.append(row)
         if progress:
-            tqdm.write(_epoch_line(row))
+            print_line(_epoch_line(row))
         improved = math.isfinite(metrics["landing_error_m"]) and (
             best is None or metrics["landing_error_m"] < best["landing_error_m"]
         )

@@ -29,6 +29,7 @@ from golfflight.flight.reference_aero import (
 )
 from golfflight.shots.clubs import CLUBS, straight_launches
 from golfflight.shots.markdown import signed
+from golfflight.shots.progress import progress_bar
 from golfflight.shots.records import ShotRecord
 from golfflight.shots.reference_world import CALIBRATION_AIR, ClubAverage, fly_reference
 from scipy.optimize import least_squares
@@ -264,11 +265,12 @@ class Calibration:
 
 def fit_reference(
     cells: list[CalibrationCell], start: ReferenceParameters = CALIBRATED, max_evaluations: int = 200,
-    unknown_air: tuple[str, ...] = (), prior_sd: float = UNKNOWN_AIR_PRIOR_SD,
+    unknown_air: tuple[str, ...] = (), prior_sd: float = UNKNOWN_AIR_PRIOR_SD, progress: bool = True,
 ) -> Calibration:
     """Least-squares fit of FREE_PARAMETERS (each scaled by its start value) inside BOUNDS, together with a log
     density factor per `unknown_air` source (Gaussian prior of `prior_sd` about its cells' air); knobs stay as in
-    start."""
+    start. With `progress`, a count of the cells' flights (each a trial of the parameters, the Jacobian's among
+    them) goes to standard error: a fit takes minutes."""
     scaling = FitScaling(start)
     n = len(FREE_PARAMETERS)
     low, high = scaling.bounds()
@@ -278,12 +280,17 @@ def fit_reference(
     def unpack(x: np.ndarray) -> tuple[ReferenceParameters, dict[str, float]]:
         return scaling.parameters(x[:n]), dict(zip(unknown_air, np.exp(x[n:]).tolist()))
 
+    trials = progress_bar(desc="fitting the reference world", unit="flight", shown=progress)
+
     def misfit(x: np.ndarray) -> np.ndarray:
         params, factors = unpack(x)
-        return np.concatenate([residuals(params, with_air_factors(cells, factors)), x[n:] / prior_sd])
+        misfits = np.concatenate([residuals(params, with_air_factors(cells, factors)), x[n:] / prior_sd])
+        trials.update()
+        return misfits
 
-    solution = least_squares(misfit, np.append(scaling.start_values(), np.zeros(len(unknown_air))),
-                             bounds=(low, high), diff_step=1e-3, max_nfev=max_evaluations)
+    with trials:
+        solution = least_squares(misfit, np.append(scaling.start_values(), np.zeros(len(unknown_air))),
+                                 bounds=(low, high), diff_step=1e-3, max_nfev=max_evaluations)
     params, factors = unpack(solution.x)
     return Calibration(params, factors, float(solution.cost))
 

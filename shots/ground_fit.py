@@ -24,6 +24,7 @@ from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import initial_state
 from golfflight.shots.markdown import table
 from golfflight.shots.pbp import load_pbp, recorded_apex, rest_positions
+from golfflight.shots.progress import progress_bar, progress_step
 from scipy.optimize import minimize
 
 PBP_DIR = Path("real/pga_tourcast_trackman/pbp")
@@ -114,12 +115,14 @@ def fit_fairway(flight: Flight, distance_m: np.ndarray, bounds=BOUNDS) -> tuple[
     return _with(best.x), float(np.mean(np.abs(totals(flight, _with(best.x)) - distance_m)))
 
 
-def resistance_sweep(flight: Flight, distance_m: np.ndarray) -> list[tuple[float, float, float]]:
+def resistance_sweep(
+    flight: Flight, distance_m: np.ndarray, progress: bool = False
+) -> list[tuple[float, float, float]]:
     """(rolling resistance held, grass drag refitted, fit error) over SWEPT_RESISTANCE: how well the rest positions
-    pin the rolling resistance down."""
+    pin the rolling resistance down (a bar over the fits on standard error with `progress`)."""
     rows = []
     index = FITTED.index("rolling_resistance")
-    for value in SWEPT_RESISTANCE:
+    for value in progress_bar(SWEPT_RESISTANCE, "rolling resistance held", unit="fit", shown=progress):
         bounds = tuple((value, value) if i == index else b for i, b in enumerate(BOUNDS))
         fitted, error = fit_fairway(flight, distance_m, bounds)
         rows.append((value, float(fitted.grass_drag_per_s), error))
@@ -165,14 +168,17 @@ class GroundFit:
         return {**asdict(self), "scores": [asdict(s) for s in self.scores]}
 
 
-def run_fit(flyer: Flyer, data_dir: str | os.PathLike) -> GroundFit:
+def run_fit(flyer: Flyer, data_dir: str | os.PathLike, progress: bool = True) -> GroundFit:
     """Fit on THE PLAYERS 2020, check on the TOUR Championship 2020 (files under `data_dir`), flying a bundle's
-    Flyer (`flight.flyer.load_flyer`)."""
+    Flyer (`flight.flyer.load_flyer`); with `progress`, each step goes to standard error."""
     fit_name, fit_path = FIT_EVENT
     check_name, check_path = CHECK_EVENT
+    progress_step(f"flying the fairway tee shots of {fit_name} and {check_name}...", progress)
     fit_shots = fairway_shots(fit_name, Path(data_dir) / fit_path)
     check_shots = fairway_shots(check_name, Path(data_dir) / check_path)
     fit_flight, check_flight = landings(fit_shots, flyer), landings(check_shots, flyer)
+    progress_step(f"fitting the fairway on {len(fit_shots.distance_m)} rest positions ({len(STARTS)} starts)...",
+                  progress)
     fairway, fit_mae = fit_fairway(fit_flight, fit_shots.distance_m)
     fit_carry, check_carry = fit_flight.carry_m, check_flight.carry_m
     constant = float(np.median(fit_shots.distance_m - fit_carry))
@@ -202,7 +208,7 @@ def run_fit(flyer: Flyer, data_dir: str | os.PathLike) -> GroundFit:
                 ("landing spin", flight.landing_spin_rpm),
             )
         }
-    sweep = resistance_sweep(fit_flight, fit_shots.distance_m)
+    sweep = resistance_sweep(fit_flight, fit_shots.distance_m, progress)
     return GroundFit(flyer.card.onnx.sha256, asdict(fairway), fit_mae, constant, scores, carry_check, correlations,
                      sweep)
 

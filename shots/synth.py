@@ -21,6 +21,7 @@ from golfflight.flight.physics import initial_state
 from golfflight.flight.reference_aero import CALIBRATED, ReferenceParameters
 from golfflight.flight.wind import Wind
 from golfflight.shots.clubs import CLUBS, club_weights
+from golfflight.shots.progress import progress_bar, progress_step
 from golfflight.shots.records import LAUNCH_COLUMNS, RANGES, ShotRecord, write_csv_atomic, write_shots
 from golfflight.shots.reference_world import fly_reference
 
@@ -175,19 +176,24 @@ def draw_launches(rng: np.random.Generator, sessions: list[Session]) -> LaunchTa
     return table
 
 
-def fly_sessions(table: LaunchTable, sessions: list[Session], config: SynthConfig, rng: np.random.Generator) -> Flight:
-    """Fly the true launches in each session's air and (gusting, log-profile) wind through the reference world."""
+def fly_sessions(
+    table: LaunchTable, sessions: list[Session], config: SynthConfig, rng: np.random.Generator, progress: bool = False
+) -> Flight:
+    """Fly the true launches in each session's air and (gusting, log-profile) wind through the reference world, BATCH
+    shots at a time (with a bar over the shots when `progress`: the reference world's RK4 takes most of a run)."""
     per_shot = {f.name: np.array([getattr(sessions[i], f.name) for i in table.session_index]) for f in fields(Session)
                 if f.name in ("temperature_c", "altitude_m", "humidity_pct", "wind_speed_mps", "wind_from_deg")}
     gust = np.exp(rng.normal(0, 0.15, size=len(table.session_index)))
     launch = table.launch()
-    parts = []
-    for start in range(0, len(table.session_index), BATCH):
-        chunk = slice(start, start + BATCH)
-        air = Air.from_conditions(per_shot["temperature_c"][chunk], per_shot["altitude_m"][chunk], per_shot["humidity_pct"][chunk])
-        wind = Wind(per_shot["wind_speed_mps"][chunk] * gust[chunk], per_shot["wind_from_deg"][chunk], profile=config.wind_profile)
-        state = initial_state(**{k: v[chunk] for k, v in launch.items()})
-        parts.append(fly_reference(state, air, wind, params=config.world))
+    parts, n = [], len(table.session_index)
+    with progress_bar(desc="flying", total=n, unit="shot", shown=progress) as flown:
+        for start in range(0, n, BATCH):
+            chunk = slice(start, start + BATCH)
+            air = Air.from_conditions(per_shot["temperature_c"][chunk], per_shot["altitude_m"][chunk], per_shot["humidity_pct"][chunk])
+            wind = Wind(per_shot["wind_speed_mps"][chunk] * gust[chunk], per_shot["wind_from_deg"][chunk], profile=config.wind_profile)
+            state = initial_state(**{k: v[chunk] for k, v in launch.items()})
+            parts.append(fly_reference(state, air, wind, params=config.world))
+            flown.update(len(state.position))
     return Flight(*(np.concatenate([getattr(p, name) for p in parts]) for name in
                     ("landed", "landing_position", "landing_velocity", "landing_spin", "flight_time_s", "apex_m", "apex_time_s")))
 
@@ -226,13 +232,16 @@ def validation_sessions(sessions: list[Session], fraction: float) -> set[str]:
     return chosen
 
 
-def generate(config: SynthConfig) -> SyntheticSet:
-    """Draw sessions and launches, fly them through the reference world, record them with noise."""
+def generate(config: SynthConfig, progress: bool = True) -> SyntheticSet:
+    """Draw sessions and launches, fly them through the reference world, record them with noise; with `progress`,
+    what it is doing goes to standard error (`shots.progress`)."""
     started = time.perf_counter()
     rng = np.random.default_rng(config.seed)
+    progress_step(f"drawing {config.n_shots:,} launches...", progress)
     sessions = draw_sessions(rng, config.n_shots, config)
     table = draw_launches(rng, sessions)
-    flight = fly_sessions(table, sessions, config, rng)
+    flight = fly_sessions(table, sessions, config, rng, progress)
+    progress_step(f"recording {len(table.session_index):,} shots with launch-monitor noise...", progress)
     recorded = measure(rng, table, flight, config.noise)
     val = validation_sessions(sessions, config.val_fraction)
 

@@ -31,6 +31,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--figures", help="directory for the path-error PNG (default: figures/ beside --out)")
     parser.add_argument("--data-dir", help="shared data folder (default: $GOLFFLIGHT_SHARED_DATA or ../shared/data)")
     parser.add_argument("--finetune-epochs", type=int, default=30, help="epochs of the fine-tuning study (0 skips it)")
+    parser.add_argument("--quiet", action="store_true", help="no progress on standard error")
     parser.set_defaults(run=run)
 
 
@@ -52,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
         synthetic = DEFAULT_SYNTHETIC if (DEFAULT_SYNTHETIC / "model_card.json").is_file() else args.model
     figures = args.figures or Path(args.out).parent / "figures"
     report = run_accuracy(args.model, args.out, figures, args.data_dir, args.finetune_epochs, synthetic=synthetic,
-                          finetune=finetune)
+                          finetune=finetune, progress=not args.quiet)
     print(report.markdown, end="")
     print(f"wrote {args.out}" + "".join(f", {path}" for path in report.figures))
     return 0

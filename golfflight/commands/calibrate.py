@@ -20,6 +20,7 @@ from golfflight.shots.calibrate_reference import (
 )
 from golfflight.shots.markdown import write_generated_section
 from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.progress import progress_step
 from golfflight.shots.reference_checks import render_checks_markdown
 from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
 from golfflight.shots.source_air import PGA_2023_TABLE, UNKNOWN_AIR_SOURCES
@@ -40,15 +41,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--fit", action="store_true", help="run the least-squares fit first (several minutes)")
     parser.add_argument("--data", type=Path, default=None, help="shared data folder (default: ../shared/data)")
     parser.add_argument("--out", default=None, help="markdown file whose generated section to replace (default: print)")
+    parser.add_argument("--quiet", action="store_true", help="no progress on standard error")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     root = args.data or shared_data_dir()
+    shown = not args.quiet
+    progress_step(f"reading the calibration cells under {root}...", shown)
     cells = calibration_cells(root)
     params, factors = CALIBRATED, FITTED_AIR_FACTORS
     if args.fit:
-        calibration = fit_reference(cells, unknown_air=UNKNOWN_AIR_SOURCES)
+        calibration = fit_reference(cells, unknown_air=UNKNOWN_AIR_SOURCES, progress=shown)
         params, factors = calibration.params, calibration.air_factors
         print("# Paste into flight/reference_aero.py:")
         print(parameters_literal(params))
@@ -57,6 +61,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"# cost {calibration.cost:.2f}\n")
     averages = root / TOUR_AVERAGES_FILE
     check = ferguson = None
+    progress_step("flying the calibration cells, the tour averages and the altitude and wind checks...", shown)
     if averages.exists():
         clubs = read_tour_averages(averages)
         air = PGA_2023_TABLE.air()

@@ -13,6 +13,9 @@ from golfflight.discovery.outputs import write_diagnosis
 from golfflight.discovery.own_error import measure_own_error, write_own_error
 from golfflight.discovery.prove import CLEAN_SETS, cases, command, prove, read_runs, write_tables
 from golfflight.discovery.recordings import read_recordings
+from golfflight.shots.progress import print_line, progress_step
+
+QUIET_HELP = "no progress on standard error"
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -38,6 +41,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="expect only the assumed launch-monitor noise, even where the recordings scatter more than that from "
         "shot to shot (by default their own scatter replaces it there)",
     )
+    parser.add_argument("--quiet", action="store_true", help=QUIET_HELP)
     parser.set_defaults(run=run_diagnose)
 
     prove = subparsers.add_parser("prove", help="hide effects in synthetic recordings, diagnose them blind, score")
@@ -60,6 +64,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--cases", help="only the cases whose name matches this regular expression (e.g. '^clean$' for false alarms)"
     )
     prove.add_argument("--tables-from", help="write the tables of the runs in this --json dump instead of flying")
+    prove.add_argument("--quiet", action="store_true", help=QUIET_HELP)
     prove.set_defaults(run=run_prove)
 
     own = subparsers.add_parser(
@@ -76,7 +81,10 @@ def run_diagnose(args: argparse.Namespace) -> int:
     if len(recordings) < 3:
         raise ValueError(f"{args.recordings}: {len(recordings)} shots with an observed outcome; at least 3 are needed")
     model = load_model(args.model, control=args.reference_control)
-    diagnosis = diagnose(recordings, model, seed=args.seed, estimate_scatter=not args.assumed_noise)
+    diagnosis = diagnose(
+        recordings, model, seed=args.seed, estimate_scatter=not args.assumed_noise, progress=not args.quiet
+    )
+    progress_step(f"writing the report to {args.out}...", not args.quiet)
     paths = write_diagnosis(diagnosis, args.out)
     print(diagnosis.report.statement)
     print(f"wrote {', '.join(str(p) for p in paths)} ({diagnosis.report.seconds:.1f} s)")
@@ -96,7 +104,14 @@ def run_prove(args: argparse.Namespace) -> int:
         results = read_runs(Path(args.tables_from))
     else:
         results = prove(
-            model, args.seeds, args.shots, print, only=args.cases, truth=args.truth, clean_sets=args.clean_sets
+            model,
+            args.seeds,
+            args.shots,
+            print_line,
+            only=args.cases,
+            truth=args.truth,
+            clean_sets=args.clean_sets,
+            progress=not args.quiet,
         )
     if not results:
         names = ", ".join(name for name, _ in cases(args.truth))

@@ -21,6 +21,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "default, `golfflight serve`'s lookup)",
     )
     parser.add_argument("--out", required=True, help="docs directory: OUT/training.md and OUT/figures/ are written")
+    parser.add_argument("--quiet", action="store_true", help="no progress on standard error")
     parser.set_defaults(run=run)
 
 
@@ -31,7 +32,7 @@ def run(args: argparse.Namespace) -> int:
     from golfflight.model_export.evaluate import run_evaluation
 
     torch.set_num_threads(2)
-    report = run_evaluation(args.data, args.runs, args.out, bundle=model_dir(args.bundle))
+    report = run_evaluation(args.data, args.runs, args.out, bundle=model_dir(args.bundle), progress=not args.quiet)
     print(report.markdown, end="")
     for path in report.figures:
         print(f"wrote {path}")

@@ -29,6 +29,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="share of the most recent shots (whole sessions) held out when the file has no split",
     )
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--quiet", action="store_true", help="no progress on standard error and no line per epoch on standard output"
+    )
     parser.set_defaults(run=run)
 
 
@@ -39,7 +42,15 @@ def run(args: argparse.Namespace) -> int:
 
     torch.set_num_threads(1)  # fine-tuning batches are small: a second thread only adds synchronisation
     result = finetune(
-        args.model, args.data, args.out, args.epochs, args.lr, args.batch_size, args.val_fraction, args.seed
+        args.model,
+        args.data,
+        args.out,
+        args.epochs,
+        args.lr,
+        args.batch_size,
+        args.val_fraction,
+        args.seed,
+        progress=not args.quiet,
     )
     data, base = result.run.data, result.base_metrics
     print(f"data: {data.n_train} train, {data.n_val} val shots; left out {data.filters}")

@@ -22,6 +22,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--data-dir", help="shared data folder (default: $GOLFFLIGHT_SHARED_DATA or ../shared/data)")
     parser.add_argument("--out", default="docs/ground.md", help="markdown file whose generated section is replaced")
     parser.add_argument("--results", default="docs/ground_fit.json", help="JSON results file")
+    parser.add_argument("--quiet", action="store_true", help="no progress on standard error")
     parser.set_defaults(run=run)
 
 
@@ -35,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
     data_dir = Path(args.data_dir) if args.data_dir else shared_data_dir()
     flyer = load_flyer(args.model)
     model = args.model or str(flyer.bundle_dir)
-    fit = run_fit(flyer, data_dir)
+    fit = run_fit(flyer, data_dir, progress=not args.quiet)
     section = markdown(fit, model)
     print(section, end="")
     write_generated_section(args.out, section, "ground-fit")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from golfflight.shots.progress import progress_step
 from golfflight.shots.synth import SynthConfig, generate, sessions_path, write_synthetic
 
 
@@ -15,6 +16,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--robot-share", type=float, default=0.3, help="fraction of sessions hit by a robot")
     parser.add_argument("--val-fraction", type=float, default=0.1, help="share of shots, most recent sessions, marked val")
     parser.add_argument("--calm", action="store_true", help="no wind in any session")
+    parser.add_argument("--quiet", action="store_true", help="no progress on standard error")
     parser.set_defaults(run=run)
 
 
@@ -23,7 +25,8 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--shots must be at least 1, got {args.shots}")
     config = SynthConfig(n_shots=args.shots, seed=args.seed, robot_share=args.robot_share,
                          val_fraction=args.val_fraction, calm=args.calm)
-    synthetic = generate(config)
+    synthetic = generate(config, progress=not args.quiet)
+    progress_step(f"writing {args.out}...", not args.quiet)
     write_synthetic(args.out, synthetic)
     n_val = sum(r.split == "val" for r in synthetic.records)
     print(f"wrote {len(synthetic.records)} shots in {len(synthetic.sessions)} sessions to {args.out} "
