@@ -111,7 +111,7 @@ def test_an_http_refusal_prints_a_converted_limit_with_four_digits(http):
 
 def test_a_gspro_refusal_prints_a_converted_limit_with_four_digits(http):
     answer = http.post("/v1/gspro", json={"ShotNumber": 1, "BallData": {"Speed": 600.0, "VLA": 11, "TotalSpin": 2650}})
-    assert answer.json() == {"Code": 500, "Message": f"BallData.Speed: {SPEED_REFUSAL}"}
+    assert answer.json() == {"Code": 500, "Message": f"BallData.Speed: {SPEED_REFUSAL}", "ShotNumber": 1}
 
 
 @pytest.mark.parametrize("command", ["fly", "simulate", "sweep"])
