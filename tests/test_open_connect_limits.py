@@ -245,8 +245,9 @@ PLAYER = b'{"Code":201,"Message":"GSPro Player Information","Player":{"Handed":"
 
 def test_player_information_reaches_every_connector_and_nothing_is_pushed_on_connecting(served):
     first, second = connect(served.port), connect(served.port)
-    first.sendall(encoded(HEARTBEAT))
-    second.sendall(encoded(HEARTBEAT))
+    for number, sock in enumerate((first, second), 1):  # a shot answered: the server has taken the connection
+        sock.sendall(encoded(HEARTBEAT) + encoded(shot(number)))
+        assert objects(sock.recv(2048))[0]["Code"] == 200
     served.call(served.server.send_player, "DR", "RH")  # from the loop's thread, as the service's bay calls it
     for sock in (first, second):
         assert sock.recv(2048) == PLAYER
