@@ -48,8 +48,9 @@ from golfflight.discovery.noise import (
 )
 from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from golfflight.discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
-from golfflight.discovery.schema import Candidate, Heldout, Located, ModelInfo, Report, ScatterStat, Unlisted
+from golfflight.discovery.schema import AirRival, Candidate, Heldout, Located, ModelInfo, Report, ScatterStat, Unlisted
 from golfflight.discovery.simulator import Flown, Setup
+from golfflight.discovery.venue_air import air_rival, air_sentence, with_air
 from golfflight.flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
 from golfflight.shots.progress import progress_bar, progress_step
 from golfflight.shots.synth import MeasurementNoise
@@ -281,7 +282,12 @@ class Diagnoser:
         ambiguities = (
             ambiguity(self.problem, chosen, after.outcomes, selection.scored, self.rng) if selection.systematic else []
         )
-        report = self.report(located, selection, after, heldout_block, ambiguities)
+        rival = (  # recordings without air: the venue's air set against the choice (`discovery.venue_air`)
+            air_rival(self.problem, chosen, after.outcomes, selection.scored, self.score, self.rows, start.expected)
+            if selection.systematic and self.recordings.density_kg_m3 is None
+            else None
+        )
+        report = self.report(located, selection, after, heldout_block, with_air(ambiguities, chosen, rival), rival)
         sigma = start.expected.sigma
         return Diagnosis(
             report,
@@ -300,7 +306,13 @@ class Diagnoser:
         progress_step(message, self.progress)
 
     def report(
-        self, located: Located, selection: Selection, after: Corrected, heldout_block: Heldout, ambiguities: list
+        self,
+        located: Located,
+        selection: Selection,
+        after: Corrected,
+        heldout_block: Heldout,
+        ambiguities: list,
+        rival: AirRival | None = None,
     ) -> Report:
         """The report of a finished selection."""
         recordings, model, chosen = self.recordings, self.model, selection.chosen
@@ -330,8 +342,10 @@ class Diagnoser:
             unlisted=selection.unlisted,
             candidates=candidates(selection, context),
             ambiguities=ambiguities,
+            air_rival=rival,
             heldout=heldout_block,
             statement=words
+            + air_sentence(rival)
             + left_sentence(selection.unexplained)
             + control_sentence(model, self.baseline.offset, self.response_error(chosen))
             + (scatter_sentence(self.baseline.scatter) if self.estimate_scatter else ""),

@@ -1,6 +1,6 @@
 """Diagnose the real data sets (read from the shared folder, never copied) and render a summary for the docs.
 
-python -m golfflight.discovery.real --out runs/discovery-real [--model DIR|reference]
+python -m golfflight.discovery.real --out runs/discovery-real [--model DIR|reference] [--venue-air]
 
 Sets: the outdoor, radar-tracked TrackMan driver shots (all balls, the held-out lines alone, and Premium only), the
 PGA TOUR TrackMan trajectories of the Sentry 2022 (spin from the play-by-play) and the Sony Open 2022 (spin estimated
@@ -9,7 +9,9 @@ apex) of its trainable rounds and of its held-out rounds apart, and TrackMan's P
 club). Each set says whether it is held out (`shots.heldout`: only the driver file's lines from 2943
 and the TOUR Championship's rounds 3-4), trained on by `models/default`, or neither. A set whose source's air is known
 (`shots.source_air`: the PGA table, the Sentry, the TOUR Championship) is flown in that air, as training flew it; the
-others (the range sessions, the Sony Open) in the model's air.
+others (the range sessions, the Sony Open) in the model's air. With --venue-air each set whose air is known is
+diagnosed a second time with its air concealed (as `golfflight convert pbp`, which records no air, gives it), and
+venue_air.md tabulates what each run says about air (`discovery.venue_air`).
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +29,7 @@ from golfflight.discovery.locate import binned_means
 from golfflight.discovery.model import FlightModel, load_model
 from golfflight.discovery.outputs import write_diagnosis
 from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings, from_shot_set
+from golfflight.flight.air import STANDARD_TEMPERATURE_C, Air
 from golfflight.shots.files import write_text_atomic
 from golfflight.shots.heldout import held_out_rounds, held_out_set, shot_round
 from golfflight.shots.markdown import table
@@ -266,6 +269,65 @@ def summary_row(item: RealSet, diagnosis: Diagnosis) -> list[str]:
     ]
 
 
+NO_AIR = "_no_air"
+"""Key suffix of a set diagnosed with its known air concealed."""
+
+
+def venue_ratio(recordings: Recordings) -> float | None:
+    """The recordings' median air density over ICAO standard density (None where they carry no air)."""
+    if recordings.density_kg_m3 is None:
+        return None
+    return float(np.median(recordings.density_kg_m3) / Air.standard().density_kg_m3)
+
+
+def with_and_without_air(sets: list[RealSet]) -> list[RealSet]:
+    """Each set, followed, where its air is known, by the same shots carrying no air (flown in the model's air)."""
+    out = []
+    for item in sets:
+        out.append(item)
+        if item.recordings.density_kg_m3 is not None:
+            concealed = replace(item.recordings, density_kg_m3=None)
+            title, caveat = f"{item.title}, air concealed", f"{item.caveat}; its air concealed"
+            out.append(RealSet(item.key + NO_AIR, title, concealed, caveat, item.use))
+    return out
+
+
+def venue_air_row(item: RealSet, diagnosis: Diagnosis, venue: float | None) -> list[str]:
+    """What one run says about air: whether the recordings carry it (and the venue's, `venue` x ICAO, where known),
+    what is named, and air density against it where they carry none."""
+    report, rival = diagnosis.report, diagnosis.report.air_rival
+    given = venue_ratio(item.recordings)
+    air = (
+        f"given ({given:.3f} × ICAO)"
+        if given is not None
+        else f"not given (venue {venue:.3f} × ICAO)"
+        if venue is not None
+        else "not known"
+    )
+    named = summary_row(item, diagnosis)[5] if report.systematic else "– (not systematic)"
+    if rival is None:
+        against, verdict, separate = "–", "not compared (air given)" if given is not None else "not compared", "–"
+    else:
+        interval = f"{rival.difference_ci[0]:+.3f} to {rival.difference_ci[1]:+.3f}"
+        against = (
+            f"{rival.explanation}: {rival.ratio:.3f} ± {rival.ratio_sd:.3f} (as at {rival.equivalent_altitude_m:.0f} m "
+            f"at {STANDARD_TEMPERATURE_C:.0f} °C)"
+            + ("" if rival.named else f"; held-out {rival.heldout_error:.3f} vs {report.heldout.after_error:.3f}")
+            + ("" if rival.named else f" ({interval})")
+        )
+        verdict = "named" if rival.named else "ruled out" if rival.separable else "inseparable rival"
+        separate = "–" if rival.named else LABELS[rival.separating_measurement].split(" (")[0]
+    return [
+        f"{item.title} ({item.use})" if item.use else item.title,
+        str(report.n_shots),
+        air,
+        named,
+        against,
+        verdict,
+        separate,
+    ]
+
+
 def figures(diagnosis: Diagnosis) -> dict[str, str]:
     """Aggregate plots only (binned means, histograms: no individual shot of the real data): name -> SVG."""
     rec = diagnosis.recordings
@@ -297,11 +359,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--model", help="bundle directory or 'reference' (default: models/default)")
     parser.add_argument("--only", help="regular expression on the set keys")
     parser.add_argument("--figures", help="folder for aggregate SVG figures of each set (e.g. docs/discovery)")
+    parser.add_argument(
+        "--venue-air", action="store_true", help="also diagnose each set of known air without it; venue_air.md"
+    )
     args = parser.parse_args(argv)
     model: FlightModel = load_model(args.model)
     out = Path(args.out)
-    rows, details = [], {}
-    for item in real_sets(shared_data_dir()):
+    rows, details, air_rows = [], {}, []
+    sets = real_sets(shared_data_dir())
+    venue = {item.key + NO_AIR: venue_ratio(item.recordings) for item in sets}
+    for item in with_and_without_air(sets) if args.venue_air else sets:
         if args.only and not re.search(args.only, item.key):
             continue
         diagnosis = diagnose(item.recordings, model)
@@ -310,6 +377,8 @@ def main(argv: list[str] | None = None) -> int:
             for name, text in figures(diagnosis).items():
                 write_text_atomic(Path(args.figures) / f"{item.key}_{name}.svg", text)
         rows.append(summary_row(item, diagnosis))
+        air_rows.append(venue_air_row(item, diagnosis, venue.get(item.key)))
+        rival = diagnosis.report.air_rival
         details[item.key] = {
             "title": item.title,
             "use": item.use,
@@ -317,6 +386,7 @@ def main(argv: list[str] | None = None) -> int:
             "statement": diagnosis.report.statement,
             "located": diagnosis.report.located.summary,
             "ambiguities": [a.note for a in diagnosis.report.ambiguities],
+            "air_rival": None if rival is None else rival.model_dump(),
         }
         print(f"{item.key}: {diagnosis.report.statement}", flush=True)
     header = [
@@ -333,6 +403,10 @@ def main(argv: list[str] | None = None) -> int:
     lines = table(header, rows, align="l" * len(header))
     write_text_atomic(out / "summary.md", f"Model: {model.name}\n\n" + "\n".join(lines) + "\n")
     write_text_atomic(out / "details.json", json.dumps(details, indent=1) + "\n")
+    if args.venue_air:
+        header = ["set", "shots", "air", "named", "air density against it", "air is", "would separate them"]
+        lines = table(header, air_rows, align="l" * len(header))
+        write_text_atomic(out / "venue_air.md", f"Model: {model.name}\n\n" + "\n".join(lines) + "\n")
     return 0
 
 

@@ -139,6 +139,31 @@ class Ambiguity(_Strict):
     note: str
 
 
+class AirRival(_Strict):
+    """Air density set against the chosen explanation of recordings that carry no air (`discovery.venue_air`)."""
+
+    explanation: str = Field(
+        description="the candidate with air density: the chosen one, or it with air density in place of its main "
+        "library effect (air alone for a single effect)"
+    )
+    named: bool = Field(description="air density is part of the chosen explanation")
+    ratio: float = Field(description="fitted density / the density the model assumed")
+    ratio_sd: float
+    equivalent_altitude_m: float = Field(description="standard-atmosphere height of that density in dry air at 15 degC")
+    heldout_error: float
+    difference_ci: tuple[float, float] = Field(
+        description="95 % session-bootstrap interval of its held-out error minus the chosen one's"
+    )
+    separable: bool = Field(
+        description="worse than the chosen explanation beyond doubt (the interval above zero) and apart from it by "
+        "more than the model's own error in some recorded observable"
+    )
+    separating_measurement: str | None = Field(
+        description="the observable where the two differ most, unrecorded first (None where air is named)"
+    )
+    note: str
+
+
 class Unlisted(_Strict):
     """A learned extra acceleration, summarised as a readable expression, when no library effect explains enough."""
 
@@ -236,6 +261,9 @@ class Report(_Strict):
     unlisted: Unlisted | None
     candidates: list[Candidate]
     ambiguities: list[Ambiguity]
+    air_rival: AirRival | None = Field(
+        default=None, description="air density against the chosen explanation, where the recordings carry no air"
+    )
     heldout: Heldout
     statement: str
     service_settings: ServiceSettings

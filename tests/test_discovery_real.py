@@ -55,3 +55,18 @@ def test_only_what_shots_heldout_holds_out_is_labelled_held_out():
     assert sets["tour_championship_trained"].use == sets["pga_2023_averages"].use == TRAINED_ON
     table = sets["pga_2023_averages"].recordings.density_kg_m3
     assert table is not None and table == pytest.approx(KNOWN_AIR["pga-2023-table"].air().density_kg_m3)
+
+
+def test_venue_air_runs_each_set_of_known_air_with_and_without_it(tmp_path):
+    """--venue-air: a set whose air is known is diagnosed as it is and with its air concealed, and venue_air.md says
+    for each run whether the air was given and what air density does against the explanation."""
+    if not (shared_data_dir() / TRACKMAN).is_file():
+        pytest.skip("needs the shared real data")
+    args = ["--out", str(tmp_path), "--model", "reference", "--only", "pga_2023_averages", "--venue-air"]
+    assert main(args) == 0
+    rows = (tmp_path / "venue_air.md").read_text().splitlines()[4:]
+    assert len(rows) == 2 and "given (0.990 × ICAO)" in rows[0] and "not given (venue 0.990 × ICAO)" in rows[1]
+    assert "not compared (air given)" in rows[0] and "air concealed" in rows[1]
+    details = json.loads((tmp_path / "details.json").read_text())
+    assert set(details) == {"pga_2023_averages", "pga_2023_averages_no_air"}
+    assert details["pga_2023_averages"]["air_rival"] is None
