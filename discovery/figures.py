@@ -13,6 +13,7 @@ import numpy as np
 import plotly.graph_objects as go
 from golfflight.discovery.locate import binned_means, trajectory_residuals
 from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
+from golfflight.discovery.words import OBSERVABLE_WORDS, UNITS, covariate_label, effect_words
 from plotly.subplots import make_subplots
 
 SHOT_FIELDS = ("shot", "session", "club")
@@ -21,7 +22,8 @@ SHOT_FIELDS = ("shot", "session", "club")
 BEFORE, AFTER = "#888888", "#1f77b4"
 """Colours of the model as is and of the corrected model, in every figure."""
 
-SIZE = {"width": 620, "height": 400}
+SIZE = {"width": 570, "height": 400}
+"""A figure's size in pixels: two side by side in the page's 76rem column."""
 
 
 def _shots(recordings: Recordings, index: np.ndarray | None = None) -> np.ndarray:
@@ -67,7 +69,7 @@ def covariate_figures(diagnosis, count: int = 4) -> list[go.Figure]:
     for item in ranked[:count]:
         j = OBSERVABLES.index(item.observable)
         x = rec.covariate(item.covariate)
-        y_label = f"recorded - model, {LABELS[item.observable]}"
+        y_label = f"recorded − model, {LABELS[item.observable]}"
         series = [("model as is", diagnosis.before, BEFORE)]
         if diagnosis.chosen is not None:
             series.append(("corrected", diagnosis.after, AFTER))
@@ -86,8 +88,10 @@ def covariate_figures(diagnosis, count: int = 4) -> list[go.Figure]:
                     hovertemplate="binned mean %{y:.4g}<extra></extra>",
                 )
             )
-        title = f"{item.observable} residual vs {item.covariate} (t = {item.t:.1f})"
-        out.append(_layout(figure, title, item.covariate, y_label))
+        title = (
+            f"{OBSERVABLE_WORDS[item.observable]} difference vs {covariate_label(item.covariate)} (t = {item.t:.1f})"
+        )
+        out.append(_layout(figure, title, covariate_label(item.covariate), y_label))
     return out
 
 
@@ -128,7 +132,7 @@ def session_figure(diagnosis) -> go.Figure:
                 row=row,
                 col=1,
             )
-        figure.update_yaxes(title_text="mean residual", row=row, col=1)
+        figure.update_yaxes(title_text=f"mean residual ({UNITS[name]})", row=row, col=1)
     figure.update_layout(
         title={"text": "mean residual per session (± 1 standard error)"},
         hovermode="closest",
@@ -164,7 +168,7 @@ def phase_figure(diagnosis) -> go.Figure | None:
             trace.update(legendgroup=label, showlegend=row == 1)
             figure.add_trace(trace, row=row, col=1)
     figure.update_xaxes(title_text="share of the recorded flight (0 = launch, 1 = last sample)", row=2, col=1)
-    figure.update_yaxes(title_text="recorded - model (m)")
+    figure.update_yaxes(title_text="recorded − model (m)")
     figure.update_layout(
         title={"text": "trajectory residuals along the flight"},
         hovermode="closest",
@@ -187,7 +191,8 @@ def heldout_figures(diagnosis) -> list[go.Figure]:
             after = diagnosis.heldout_after[:, j]
             figure.add_trace(go.Histogram(x=after, name="held out, corrected", marker_color=AFTER, opacity=0.6))
         figure.update_layout(barmode="overlay")
-        out.append(_layout(figure, f"held-out residual: {name}", LABELS[name], "shots"))
+        title = f"held-out difference: {OBSERVABLE_WORDS[name]}"
+        out.append(_layout(figure, title, f"recorded − model, {LABELS[name]}", "shots (count)"))
     return out
 
 
@@ -237,14 +242,14 @@ def candidates_figure(diagnosis, count: int = 15) -> go.Figure:
     figure = go.Figure(
         go.Bar(
             x=[c.score for c in scored],
-            y=[c.name for c in scored],
+            y=[effect_words(c.name) for c in scored],
             orientation="h",
             marker_color=AFTER,
             hovertemplate="%{y}: score %{x:.4g}<extra></extra>",
         )
     )
     figure.update_yaxes(autorange="reversed")
-    _layout(figure, "held-out score (lower is better)", "score", "")
+    _layout(figure, "held-out score (lower is better)", "score (mean z², 1 = as large as expected)", "")
     return figure.update_layout(height=120 + 22 * len(scored), margin={"l": 220})
 
 

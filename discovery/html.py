@@ -1,25 +1,24 @@
-"""report.html: the statement, the tables and the interactive figures an engineer looks at first (`discovery.figures`:
-residuals against the covariates that matter and along the flight, per-session means, held-out residuals and
-trajectories before and after the correction, the candidates' scores).
+"""report.html, written for a reader: the verdict first in plain words (`discovery.verdict`: what differs, which
+physics explains it, the rivals, how sure, what to record next), then numbered sections of evidence, each table
+with its units in the headers, and the interactive figures (`discovery.figures`: residuals against the launch
+values that matter and along the flight, per-session means, held-out residuals and trajectories before and after the
+correction, the candidates' scores); report.json itself only in a folded "raw" section at the end.
 
-One self-contained file: plotly.js is embedded once in the page, nothing is fetched, so the report opens offline.
+One self-contained file: the stylesheet (`discovery.style`) and plotly.js are embedded once in the page, nothing is
+fetched, so the report opens offline and prints as a report.
 The figures need plotly, the optional extra `report`; without it the page keeps every table and the statement and
 says which extra to install (`PLOTS_MISSING`): diagnose works without it.
 """
 
 from __future__ import annotations
 
-import json
 from html import escape
 
-from golfflight.discovery.recordings import OBSERVABLES
+from golfflight.discovery import tables
 from golfflight.discovery.schema import Report
-
-STYLE = """body{font-family:sans-serif;max-width:1280px;margin:1em auto;color:#222}
-table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}
-th{background:#f2f2f2}td:first-child{text-align:left}.plots{display:flex;flex-wrap:wrap;gap:6px}
-.plots>div{border:1px solid #eee}.missing{background:#fff4e5;padding:.6em;border-left:4px solid #ff7f0e}
-.statement{font-size:1.1em;background:#f7f7f0;padding:.6em;border-left:4px solid #1f77b4}"""
+from golfflight.discovery.style import STYLE
+from golfflight.discovery.verdict import Verdict, verdict
+from golfflight.discovery.words import OBSERVABLE_WORDS
 
 PLOTS_MISSING = (
     "The interactive figures need plotly, which is not installed: pip install 'golfflight[report]' (the tables and "
@@ -72,176 +71,155 @@ class Plots:
         return "" if self.bundle else f"<p class='missing'>{escape(PLOTS_MISSING)}</p>"
 
 
-def _table(header: list[str], rows: list[list[object]]) -> str:
-    def cell(v: object) -> str:
-        return f"{v:.4g}" if isinstance(v, float) else escape(str(v))
+VERDICT_ROWS = (
+    ("differs", "What differs"),
+    ("physics", "Which physics"),
+    ("rivals", "Rivals"),
+    ("sure", "How sure"),
+    ("record_next", "Record next"),
+)
+"""The verdict's questions in the order a reader asks them: its fields and their titles."""
 
-    head = "".join(f"<th>{escape(h)}</th>" for h in header)
-    body = "".join("<tr>" + "".join(f"<td>{cell(v)}</td>" for v in row) + "</tr>" for row in rows)
-    return f"<table><tr>{head}</tr>{body}</table>"
+KNOWN_FIELDS = {
+    "schema_version",
+    "recordings",
+    "n_shots",
+    "n_sessions",
+    "fit_shots",
+    "scored_shots",
+    "observables",
+    "trajectories",
+    "model",
+    "systematic",
+    "systematic_test",
+    "located",
+    "effects",
+    "unlisted",
+    "candidates",
+    "ambiguities",
+    "air_rival",
+    "heldout",
+    "statement",
+    "service_settings",
+    "seconds",
+}
+"""report.json's fields this page has a place for; any other (added since) is shown in words under "Further
+findings", so a new finding is never lost between the JSON and the page."""
 
 
-def _mismatch_table(report: Report) -> str:
-    """Per observable: the located bias and scatter against the expected, and the held-out RMS before and after."""
-    held = report.heldout
-    stats = {o.name: o for o in report.located.observables}
-    rows = [
-        [
-            n,
-            stats[n].bias,
-            stats[n].bias_se,
-            stats[n].rms,
-            stats[n].expected,
-            stats[n].rms_ratio,
-            "yes" if stats[n].significant else "",
-            held.before[n],
-            held.after[n],
-            "{:.3g} [{:.3g}, {:.3g}]".format(*held.improvement_by_observable[n]),
-        ]
-        for n in OBSERVABLES
-        if n in held.before and n in stats
-    ]
-    header = ["observable", "bias", "bias SE", "RMS", "expected", "RMS/expected", "significant"]
-    return _table(header + ["held-out RMS before", "held-out RMS after", "improvement of mean z² [95 %]"], rows)
+def _items(lines: list[str]) -> str:
+    return "<ul>" + "".join(f"<li>{escape(line[0].upper() + line[1:])}</li>" for line in lines) + "</ul>"
 
 
-def _heldout_line(report: Report) -> str:
-    """The held-out errors before and after in one sentence, with the explained share where there is one."""
-    held = report.heldout
-    fraction = (
-        ""
-        if held.explained_fraction is None
-        else f"; explained share of the excess error {100 * held.explained_fraction:.0f} % "
-        f"(95 % interval {100 * held.explained_fraction_ci[0]:.0f}–{100 * held.explained_fraction_ci[1]:.0f} %)"
+def verdict_section(report: Report, found: Verdict) -> str:
+    """The verdict: the answer in one sentence, one list per question, and the report's own paragraph."""
+    rows = "".join(
+        f"<dt>{title}</dt><dd>{_items(getattr(found, field))}</dd>"
+        for field, title in VERDICT_ROWS
+        if getattr(found, field)
     )
     return (
-        f"<p>Held-out ({escape(held.grouping)}): mean squared standardized error {held.before_error:.3g} → "
-        f"{held.after_error:.3g}, improvement {held.improvement:.3g} (95 % interval {held.improvement_ci[0]:.3g} to "
-        f"{held.improvement_ci[1]:.3g}){fraction}.</p>"
+        f"<section class=verdict id=verdict aria-labelledby=verdict-title><h2 id=verdict-title>Verdict</h2>"
+        f"<p class=headline>{escape(found.headline)}</p><dl>{rows}</dl>"
+        f"<p class=paragraph>In one paragraph (report.json's statement): {escape(report.statement)}</p></section>"
     )
 
 
-def _trajectory_section(report: Report, plots: Plots) -> list[str]:
-    """The mismatch along the recorded flights (none without trajectories)."""
-    rows = [
-        [t.phase, t.height_band, t.n_samples, t.n_shots, t.across_m, t.along_m, t.height_m, t.rms_m]
-        for t in report.located.trajectory
-    ]
-    if not rows and not plots.div("along"):
+def title_block(report: Report) -> str:
+    """What was diagnosed against what: the recordings, their size and outcomes, the model, the run time."""
+    fields = report.model_dump()
+    subsample = ", ".join(
+        f"{what} {fields[key]:,}"
+        for key, what in (("fit_shots", "fitted on"), ("scored_shots", "scored on"))
+        if isinstance(fields.get(key), int) and fields[key] < report.n_shots
+    )
+    facts = {
+        "Shots": f"{report.n_shots:,} in {report.n_sessions:,} sessions"
+        + (f" (candidates {subsample})" if subsample else ""),
+        "Recorded": ", ".join(OBSERVABLE_WORDS.get(n, n) for n in report.observables)
+        + (f"; {report.trajectories:,} trajectories" if report.trajectories else ""),
+        "Model": f"{report.model.name}, assumed air {report.model.density_kg_m3:.3f} kg/m³",
+        "Run": f"{report.seconds:.1f} s",
+    }
+    items = "".join(f"<div><dt>{k}</dt><dd>{escape(v)}</dd></div>" for k, v in facts.items())
+    return (
+        "<header class=title><p class=kicker>golfflight diagnose · recordings against the model</p>"
+        f"<h1>{escape(report.recordings or 'Recordings')}</h1><dl class=meta>{items}</dl></header>"
+    )
+
+
+def _further(report: Report) -> list[str]:
+    """Fields of report.json this page has no section for (added since), in words."""
+    extra = {k: v for k, v in report.model_dump().items() if k not in KNOWN_FIELDS and v not in (None, [], {})}
+    if not extra:
         return []
-    header = ["phase", "height band", "samples", "shots", "across (m)", "along (m)", "height (m)", "RMS (m)"]
-    return ["<h2>Along the flight</h2>" + _table(header, rows) + plots.div("along")]
-
-
-def _candidates_table(report: Report) -> str:
-    """Every candidate with its fitted parameters (± 1 sigma) and its held-out score."""
-    rows = [
-        [
-            c.name,
-            "; ".join(
-                f"{e.name}: "
-                + ", ".join(f"{k} {v:.4g} ± {e.uncertainty.get(k, float('nan')):.2g}" for k, v in e.parameters.items())
-                for e in c.effects
-            ),
-            c.n_parameters,
-            c.heldout_error,
-            c.penalty,
-            c.score,
-        ]
-        for c in report.candidates
+    rows = []
+    for key, value in extra.items():
+        for item in value if isinstance(value, list) else [value]:
+            rows += (
+                tables.flat_rows(item, f"{key.replace('_', ' ')}: ")
+                if isinstance(item, dict)
+                else [[key.replace("_", " "), tables.flat_text(item), ""]]
+            )
+    columns = [
+        tables.Column("finding", "", False),
+        tables.Column("value", "in the unit beside it"),
+        tables.Column("unit", "", False),
     ]
-    return _table(["candidate", "fitted parameters", "k", "held-out error", "penalty", "score"], rows)
+    return ["<h2>Further findings</h2>" + tables.table(columns, rows)]
 
 
-def _named_sections(report: Report) -> list[str]:
-    """The ambiguities and the unlisted effect, where the report has them."""
-    sections = []
-    if report.ambiguities:
-        items = "".join(
-            f"<li>{escape(a.effects[0])} vs {escape(a.effects[1])}: {escape(a.note)}</li>" for a in report.ambiguities
-        )
-        sections.append(f"<h2>What the data cannot separate</h2><ul>{items}</ul>")
-    if report.unlisted is not None:
-        items = "".join(f"<li>{escape(k)}: {escape(v)}</li>" for k, v in report.unlisted.meaning.items())
-        sections.append(f"<h2>Unlisted effect</h2><p>{escape(report.unlisted.expression)}</p><ul>{items}</ul>")
-    return sections
-
-
-def _groups_table(report: Report) -> str:
-    """The differences between clubs and sessions the systematic test measured."""
-    rows = [
-        [
-            g.observable,
-            g.grouping,
-            g.n_groups,
-            g.f,
-            g.p,
-            "yes" if g.significant else "",
-            ", ".join(f"{k} {v:+.2f}" for k, v in g.extremes.items()),
-        ]
-        for g in report.located.groups
-    ]
-    return _table(["observable", "grouping", "groups", "F", "p", "significant", "extreme groups (mean residual)"], rows)
-
-
-def _expected_table(report: Report) -> str:
-    """The error each observable was expected to have, by part, and where the recordings' own scatter replaced it."""
-    model = report.model
-    rows = [
-        [
-            n,
-            model.model_error[n],
-            model.model_error_source.get(n, ""),
-            model.outcome_noise[n],
-            model.launch_noise[n],
-            model.scatter[n].ratio if n in model.scatter else "",
-            model.scatter[n].applied if n in model.scatter else "",
-        ]
-        for n in OBSERVABLES
-    ]
-    header = ["observable", "model error", "source", "outcome noise", "launch noise"]
-    return _table(header + ["recordings' scatter (x expected)", "scatter used"], rows)
-
-
-def _opening(report: Report, plots: Plots) -> list[str]:
-    """What was diagnosed against what, the statement, the systematic test and where the mismatch is."""
+def _sections(report: Report, plots: Plots) -> list[str]:
+    """The numbered evidence after the verdict."""
+    trajectory = tables.trajectory_table(report) + plots.div("along")
+    rivals = tables.rivals_table(report)
     return [
-        (
-            f"<h1>Mismatch diagnosis</h1><p>{escape(report.recordings)}: {report.n_shots} shots, {report.n_sessions} "
-            f"sessions, observed {', '.join(report.observables)}, {report.trajectories} trajectories. Model: "
-            f"{escape(report.model.name)}. {report.seconds:.1f} s.</p>"
-        ),
-        plots.notice(),
-        f"<p class='statement'>{escape(report.statement)}</p>",
-        f"<p><b>Systematic:</b> {report.systematic}. Test: "
-        f"{escape(json.dumps(report.systematic_test, default=str))}</p>",
-        "<h2>Where the mismatch is</h2><ul>"
-        + "".join(f"<li>{escape(s)}</li>" for s in report.located.summary)
-        + "</ul>",
+        "<h2>1. What differs</h2>"
+        + tables.observables_table(report)
+        + tables.trends_table(report)
+        + plots.div("residuals"),
+        *(["<h2>Along the flight</h2>" + trajectory] if trajectory else []),
+        "<h2>2. Which physics: the candidates</h2>"
+        "<p class=note>Each explanation fitted through the simulator and scored on shots held out of its fit.</p>"
+        + tables.SCORE_NOTE
+        + tables.candidates_table(report)
+        + plots.div("candidates"),
+        *(["<h2>3. Rivals and what would separate them</h2>" + rivals] if rivals else []),
+        *_unlisted(report),
+        "<h2>4. Held-out shots, before and after</h2>" + tables.heldout_table(report) + plots.div("heldout"),
+        "<h2>5. How the tool decided</h2>" + tables.decision_table(report),
+        "<h2>Differences between groups</h2>" + tables.groups_table(report),
+        "<h2>Service settings</h2><p class=note>The correction as the service's request options "
+        "(service_settings.json).</p>" + tables.settings_table(report),
+        "<h2>Expected error</h2>" + tables.expected_table(report),
+        *_further(report),
     ]
+
+
+def _unlisted(report: Report) -> list[str]:
+    """The learned extra acceleration, where the report has one."""
+    if report.unlisted is None:
+        return []
+    items = "".join(f"<li>{escape(k)}: {escape(v)}</li>" for k, v in report.unlisted.meaning.items())
+    return [f"<h2>Unlisted effect</h2><p>{escape(report.unlisted.expression)}</p><ul>{items}</ul>"]
 
 
 def render(diagnosis) -> str:
     """The whole HTML page of a diagnosis."""
     report: Report = diagnosis.report
     plots = Plots(diagnosis)
-    sections = [
-        *_opening(report, plots),
-        _mismatch_table(report),
-        _heldout_line(report),
-        plots.div("residuals"),
-        "<h2>Before and after, held-out shots</h2>" + plots.div("heldout"),
-        *_trajectory_section(report, plots),
-        "<h2>Candidates</h2>" + plots.div("candidates"),
-        _candidates_table(report),
-        *_named_sections(report),
-        "<h2>Differences between groups</h2>" + _groups_table(report),
-        "<h2>Service settings</h2><pre>"
-        + escape(report.service_settings.model_dump_json(indent=2, exclude_none=True))
-        + "</pre>",
-        "<h2>Expected error</h2>" + _expected_table(report),
+    found = verdict(report, diagnosis.recordings.observed - diagnosis.before)
+    raw = escape(report.model_dump_json(indent=2))
+    main = [
+        verdict_section(report, found),
+        plots.notice(),
+        *_sections(report, plots),
+        f"<details class=raw><summary>Raw report.json</summary><pre>{raw}</pre></details>",
     ]
     return (
-        f"<!doctype html><html><head><meta charset='utf-8'><title>golfflight diagnose</title><style>{STYLE}</style>"
-        f"{plots.head()}</head><body>{''.join(sections)}</body></html>"
+        "<!doctype html><html lang=en><head><meta charset=utf-8>"
+        "<meta name=viewport content='width=device-width, initial-scale=1'>"
+        f"<title>golfflight diagnose: {escape(report.recordings)}</title><style>{STYLE}</style>{plots.head()}</head>"
+        f"<body>{title_block(report)}<main>{''.join(main)}</main>"
+        f"<footer>golfflight diagnose · report.json schema {report.schema_version}</footer></body></html>"
     )

@@ -7,7 +7,7 @@ import numpy as np
 from golfflight.discovery.effects import Context
 from golfflight.discovery.fit import Fit, Problem, Scored, cluster_bootstrap, per_shot
 from golfflight.discovery.locate import has_structure
-from golfflight.discovery.recordings import LABELS, OBSERVABLES
+from golfflight.discovery.recordings import OBSERVABLES
 from golfflight.discovery.schema import (
     AirAltitude,
     AirDensity,
@@ -19,6 +19,7 @@ from golfflight.discovery.schema import (
     Unlisted,
     WindSetting,
 )
+from golfflight.discovery.words import OBSERVABLE_WORDS, UNITS, effect_words, key_words, quantity, unit_of, with_unit
 from golfflight.flight.wind import STATION_HEIGHT_M
 
 MATERIAL = 0.05
@@ -116,7 +117,7 @@ def ambiguity(
             continue
         observable, rms, in_sigma = _separation(problem, predicted, other.fit)
         recorded = observable in problem.recordings.observed_names
-        label = LABELS[observable]
+        label, apart = OBSERVABLE_WORDS[observable], with_unit(f"{rms:.2g}", UNITS[observable])
         if in_sigma < 0.5:
             note = (
                 f"the two explanations predict nearly the same for every outcome of these launches (at most "
@@ -125,12 +126,12 @@ def ambiguity(
             )
         elif recorded:
             note = (
-                f"on these shots the two explanations differ most in {label}, by {rms:.2g} RMS "
+                f"on these shots the two explanations differ most in {label}, by {apart} RMS "
                 f"({in_sigma:.2g} expected sigma per shot): more shots, or clubs with other launches, would separate them"
             )
         else:
             note = (
-                f"{label} is not recorded; the two explanations predict it {rms:.2g} apart RMS "
+                f"{label} is not recorded; the two explanations predict it {apart} apart RMS "
                 f"({in_sigma:.2g} expected sigma per shot): recording it would separate them"
             )
         out.append(
@@ -153,7 +154,9 @@ def plus_minus(value: float, sd: float, unit: str = "") -> str:
     return f"{value:.{decimals}f} ± {sd:.{decimals}f}{unit}"
 
 
-def _phrase(effect: EffectResult) -> str:
+def effect_phrase(effect: EffectResult) -> str:
+    """The fitted effect in words with its size ± 1 sigma and units ('air 0.914 ± 0.002 times as dense as assumed
+    (as at about 755 ± 12 m)'); an effect this module has no words for lists its parameters."""
     p, u = effect.parameters, effect.uncertainty
     name = effect.name
     if name == "wind":
@@ -189,7 +192,10 @@ def _phrase(effect: EffectResult) -> str:
         "lift_scale": "lift scaled by",
         "ball_speed_bias": "true/recorded ball speed of",
         "spin_bias": "true/recorded spin of",
-    }[name]
+    }.get(name)
+    if what is None or "scale" not in p:
+        sizes = ", ".join(f"{key_words(k)} {quantity(v, u.get(k), unit_of(k))}" for k, v in p.items())
+        return f"{effect_words(name)} ({sizes})"
     return f"{what} {plus_minus(p['scale'], u['scale'])}"
 
 
@@ -288,7 +294,7 @@ def statement(
         )
     sentences = [_mismatch(located) + "."]
     contrast = _contrast(chosen, scored, {a.effects[1] for a in ambiguities})
-    named = [_phrase(e) for e in effects if e.name != "unlisted"]
+    named = [effect_phrase(e) for e in effects if e.name != "unlisted"]
     explains = ""
     if heldout.explained_fraction is not None:
         low, high = heldout.explained_fraction_ci or (np.nan, np.nan)

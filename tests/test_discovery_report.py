@@ -1,12 +1,17 @@
-"""report.html (issue 14, item 7): plotly figures in one self-contained file that opens offline (plotly.js inline
-once, no CDN), every shot-level point carrying its shot id, session and club for hover; the tables alone, naming
-the extra to install, without plotly; and the page in a real headless Chromium: no console errors, every figure
-drawn, a hover shows a shot id (skipped where chromium or Playwright is missing)."""
+"""report.html (issue 14, item 7; issue 32, item 3): plotly figures in one self-contained file that opens offline
+(plotly.js and the stylesheet inline once, no CDN), every shot-level point carrying its shot id, session and club for
+hover; the tables alone, naming the extra to install, without plotly; the verdict first, in plain words (what
+differs with its unit, sign and share of shots, which physics with its size, the rivals and why, how sure, what to
+record next); and the page in a real headless Chromium: no console errors, every figure drawn, a hover shows a shot
+id, the verdict is the first thing in the main content, no JSON in the prose, a unit under every numeric header,
+and a screenshot (skipped where chromium or Playwright is missing)."""
 
 from __future__ import annotations
 
+import importlib.util
 import re
 import sys
+from pathlib import Path
 
 import browser
 import numpy as np
@@ -14,9 +19,12 @@ import pytest
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import Diagnosis, diagnose
 from golfflight.discovery.html import PLOTS_MISSING, render
+from golfflight.discovery.locate import holm
 from golfflight.discovery.model import reference
 from golfflight.discovery.outputs import write_diagnosis
 from golfflight.discovery.recordings import from_shot_set
+from golfflight.discovery.schema import Report
+from golfflight.discovery.verdict import holm_adjusted, verdict
 
 plotly = pytest.importorskip("plotly", reason="report.html's figures need the extra 'report'")
 
@@ -36,6 +44,24 @@ def diagnosis() -> Diagnosis:
 @pytest.fixture(scope="module")
 def page_file(diagnosis, tmp_path_factory):
     return write_diagnosis(diagnosis, tmp_path_factory.mktemp("report"))[1]
+
+
+SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "discovery_report_screenshot.py"
+
+
+@pytest.fixture(scope="module")
+def screenshot_script():
+    """scripts/discovery_report_screenshot.py as a module: the docs' synthetic report and its screenshot."""
+    spec = importlib.util.spec_from_file_location("discovery_report_screenshot", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def apex_only(screenshot_script) -> Diagnosis:
+    """The docs' screenshot case: drivers in air 0.912 times as dense as assumed, only the apex recorded."""
+    return screenshot_script.synthetic_diagnosis()
 
 
 def _shot_traces(diagnosis: Diagnosis) -> list:
@@ -81,7 +107,8 @@ def test_without_plotly_the_page_keeps_its_tables_and_names_the_extra(diagnosis,
     html = render(diagnosis)
     assert "pip install &#x27;golfflight[report]&#x27;" in html and PLOTS_MISSING.startswith("The interactive")
     assert "plotly-graph-div" not in html and "<script" not in html
-    assert "Expected error" in html and "Candidates" in html
+    assert "Expected error" in html and "Which physics" in html and html.count("<table>") >= 6
+    assert html.index("id=verdict") < html.index("class='missing'"), "the verdict comes first, then the notice"
 
 
 @pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
@@ -114,3 +141,97 @@ def test_the_report_in_chromium_draws_every_figure_and_hovers_a_shot_id(diagnosi
         shown = [shot for shot in diagnosis.recordings.shot_id if f"shot {shot}" in text]
         assert len(shown) == 1 and "session" in text and "club" in text, text
         assert errors == [] and fetched == []
+
+
+def test_the_verdict_says_what_differs_which_physics_and_how_sure(diagnosis):
+    report = diagnosis.report
+    found = verdict(report, diagnosis.recordings.observed - diagnosis.before)
+    assert found.headline.endswith(": wind explains it.")
+    assert re.fullmatch(
+        r"carry across the line \d+\.\d+ ± \d\.\d+ m further left than the model, on \d+ % of shots", found.differs[0]
+    ), found.differs
+    assert any(re.match(r"apex [\d.]+ ± [\d.]+ m higher than the model", line) for line in found.differs)
+    assert "m/s wind from" in found.physics[0] and "explains 10" in found.physics[1]
+    tests = 2 * 5 + len(report.located.covariates) + len(report.located.groups)
+    assert f"after Holm correction over {tests} tests" in found.sure[0] and "clear of zero" in found.sure[1]
+    assert found.rivals[0].startswith("None") and found.rivals[1].startswith(("Ruled out:", "Venue air ruled out:"))
+    assert found.record_next[0].startswith("Nothing more")
+
+
+def test_the_verdict_names_the_rivals_apex_alone_cannot_separate_and_what_to_record(apex_only):
+    report = apex_only.report
+    found = verdict(report)
+    assert report.effects[0].name == "air_density"
+    assert report.effects[0].parameters["ratio"] == pytest.approx(0.912, abs=0.02)
+    assert re.match(r"Apex [\d.]+ ± [\d.]+ m lower than the model: air density explains it, though", found.headline)
+    assert len(found.rivals) == len(report.ambiguities) >= 1
+    assert all("not recorded" in line and "m apart" in line for line in found.rivals)
+    rivals = ", ".join(line.split(" (")[0].lower() for line in found.rivals)
+    assert found.record_next == [f"Record carry along the line (m): it would separate air density from {rivals}."]
+
+
+def test_a_clean_set_reads_as_no_mismatch():
+    clean = diagnose(from_shot_set(conceal({}, 150, seed=2).shots), reference(), seed=0, with_correction=False)
+    found = verdict(clean.report)
+    assert found.headline.startswith("No systematic mismatch")
+    assert found.differs[0].startswith("nothing beyond the expected error") and found.rivals == []
+    assert found.physics[0].startswith("None needed") and found.record_next == []
+    assert "None of the" in found.sure[0] and "no explanation is claimed" in found.sure[1]
+
+
+def test_holm_adjusted_p_values_decide_as_the_systematic_test_does():
+    rng = np.random.default_rng(0)
+    for _ in range(50):
+        p = rng.uniform(0, 0.05, 30) ** rng.uniform(1, 3)
+        assert list(holm_adjusted(p) <= 0.01) == holm(list(p), 0.01)
+
+
+VISIBLE_PROSE = """() => [...document.querySelectorAll('main > *:not(details.raw)')]
+    .map(e => e.innerText).join('\\n')"""
+"""The page's visible text outside the folded raw report.json."""
+
+
+@pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
+def test_the_report_reads_verdict_first_offline_in_chromium(apex_only, tmp_path):
+    page_file = write_diagnosis(apex_only, tmp_path)[1]
+    with browser.headless_page(1280, 1000) as page:
+        errors: list[str] = []
+        fetched: list[str] = []
+        page.on("pageerror", lambda error: errors.append(str(error)))
+        page.on("console", lambda message: errors.append(message.text) if message.type == "error" else None)
+        page.on("request", lambda request: fetched.append(request.url) if request.url.startswith("http") else None)
+        page.goto(page_file.as_uri())
+        page.wait_for_function(
+            "[...document.querySelectorAll('.plotly-graph-div')].every(d => d.querySelector('.main-svg'))",
+            timeout=20_000,
+        )
+        first = page.evaluate("() => document.querySelector('main').firstElementChild.id")
+        headline = page.text_content("#verdict .headline") or ""
+        prose = page.evaluate(VISIBLE_PROSE)
+        bare = page.eval_on_selector_all("th.num", "ths => ths.filter(t => !t.querySelector('.unit')).length")
+        raw_open = page.evaluate("() => document.querySelector('details.raw').open")
+        png = page.screenshot(full_page=False)
+    assert errors == [] and fetched == []
+    assert first == "verdict" and headline.startswith("Apex") and "air density explains it" in headline
+    for question in ("What differs", "Which physics", "Rivals", "How sure", "Record next"):
+        assert question in prose
+    assert '{"' not in prose and "':" not in prose, "no JSON or Python mapping in the visible text"
+    assert bare == 0, "every numeric column has its unit under its header"
+    assert raw_open is False
+    assert len(png) > 50_000, "the screenshot shows a page, not a blank window"
+
+
+def test_a_field_the_page_has_no_place_for_is_shown_in_words(diagnosis, monkeypatch):
+    from golfflight.discovery import html as page
+
+    monkeypatch.setattr(page, "KNOWN_FIELDS", page.KNOWN_FIELDS - {"heldout"})
+    further = render(diagnosis).split("<h2>Further findings</h2>")[1].split("</table>")[0]
+    assert "heldout: noise floor" in further and '{"' not in further and "{&quot;" not in further
+
+
+@pytest.mark.skipif("air_rival" not in Report.model_fields, reason="report.json has no venue-air comparison yet")
+@pytest.mark.filterwarnings("ignore:Pydantic serializer warnings")
+def test_venue_air_ruled_out_is_said_among_the_rivals(diagnosis):
+    rival = {"separable": True, "named": False, "note": "air 0.95 ± 0.01 times as dense fits clearly worse"}
+    found = verdict(diagnosis.report.model_copy(update={"air_rival": rival}))
+    assert "Venue air ruled out: air 0.95 ± 0.01 times as dense fits clearly worse." in found.rivals
