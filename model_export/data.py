@@ -41,6 +41,10 @@ class ShotTensors:
         """The shots at `index` (a batch)."""
         return ShotTensors(*(getattr(self, name)[index] for name in self.__dataclass_fields__))
 
+    def to(self, device: torch.device) -> ShotTensors:
+        """The same shots on `device` (themselves where they are there already)."""
+        return ShotTensors(*(getattr(self, name).to(device) for name in self.__dataclass_fields__))
+
 
 @dataclass
 class DataSummary:

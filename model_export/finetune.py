@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import torch
 from golfflight.model_export.data import load_training_data
+from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.export import export_checkpoint
 from golfflight.model_export.training import (
     RunResult,
@@ -109,10 +110,10 @@ class FinetuneResult:
         return self.card is not None
 
 
-def _base_metrics(base: BaseModel, config: TrainConfig, data: Path) -> dict[str, float]:
+def _base_metrics(base: BaseModel, config: TrainConfig, data: Path, device: torch.device) -> dict[str, float]:
     _, val, _ = load_training_data(data, None, config.min_apex_m)
     model: nn.Module = model_from_checkpoint({"config": config.as_dict(), "model": base.state})[0]
-    return validate(model, val, config)
+    return validate(model.to(device), val.to(device), config)
 
 
 def finetune(
@@ -125,20 +126,22 @@ def finetune(
     val_fraction: float = 0.2,
     seed: int = 0,
     progress: bool = True,
+    device: str = DEFAULT_DEVICE,
 ) -> FinetuneResult:
     """Fine-tune `model` on `data` for `epochs` and export OUT (model.onnx + model_card.json) from the best epoch,
     if it beats the base model's validation landing error; the run goes to OUT/finetune-run/. With `progress`, its
-    steps and epochs go to standard error and a line per epoch to standard output."""
+    steps and epochs go to standard error and a line per epoch to standard output; `device` as `training.train`'s."""
     if epochs < 1:
         raise ValueError(f"epochs must be at least 1, got {epochs}")
+    where = resolve_device(device)
     out = Path(out)
     run_dir = out / RUN_DIR
     base = load_base(model)
     config = replace(base.config, epochs=epochs, lr=lr, batch_size=batch_size, seed=seed, limit=None)
     train_file = prepare_data(data, val_fraction, run_dir)
     progress_step("measuring the starting model on the validation shots...", progress)
-    before = _base_metrics(base, config, train_file)
-    result = train(train_file, run_dir, config, progress=progress, init_state=base.state)
+    before = _base_metrics(base, config, train_file, where)
+    result = train(train_file, run_dir, config, progress=progress, init_state=base.state, device=device)
     improved = result.best is not None and result.best["landing_error_m"] < before["landing_error_m"]
     progress_step(f"exporting {out}...", progress and improved)
     card = export_checkpoint(run_dir, out) if improved else None

@@ -20,13 +20,14 @@ import json
 import math
 import os
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import torch
 from golfflight.discovery.effects import EFFECTS
 from golfflight.flight.wind import Wind
+from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.observations import (
     OBSERVABLES,
     PATH_OBSERVATIONS,
@@ -155,7 +156,7 @@ class LatentConditions(nn.Module):
                                ) -> torch.Tensor:
         """Per source [n_sources]: the fitted mean density factor of an unknown-air source, 1 for every other: the
         air a validation shot of a range session is flown in (its source's, not one block's)."""
-        factors = torch.ones(len(sources))
+        factors = torch.ones(len(sources), device=self.log_density.device)
         for s in air_source.unique():
             if sources[int(s)] in config.unknown_air_sources:
                 factors[int(s)] = self.log_density[air_source == s].mean().exp()
@@ -214,7 +215,8 @@ def shot_losses(predicted: Predicted, shots: ObservedShots, delta: float, scales
     (3-D distance over the path noise) scaled to count as PATH_OBSERVATIONS observations in all. With `scales`
     (`NoiseScales.factors()`, [sources, 6]) each sigma is widened by its source's factor and log sigma is added
     (the negative log likelihood, so the factors are fitted too)."""
-    factor = torch.ones(len(shots), len(OBSERVABLES) + 1) if scales is None else scales[shots.source]
+    factor = torch.ones(len(shots), len(OBSERVABLES) + 1, device=shots.sigma.device) if scales is None else (
+        scales[shots.source])
     mask = shots.target_mask & predicted.landed[:, None]
     sigma = shots.sigma * factor[:, :-1]
     residual = torch.where(mask, (predicted.observables - shots.targets) / sigma, 0.0)
@@ -232,7 +234,7 @@ def spread_heavy_rows(shots: ObservedShots) -> ObservedShots:
     otherwise each land in one batch an epoch, where gradient clipping and Adam's normalisation cap their pull
     whatever their weight (measured: table weights 5 and 150 trained the same network)."""
     copies = torch.ceil(shots.weight.clamp_min(1.0)).long()
-    spread = shots.take(torch.repeat_interleave(torch.arange(len(shots)), copies))
+    spread = shots.take(torch.repeat_interleave(torch.arange(len(shots), device=copies.device), copies))
     spread.weight = spread.weight / torch.repeat_interleave(copies, copies).float()
     return spread
 
@@ -304,7 +306,7 @@ def conditions_report(latent: LatentConditions, data: ObservedData, train: Obser
 
 def _group_sources(group: torch.Tensor, source: torch.Tensor, n_groups: int) -> torch.Tensor:
     """The source index of each latent group [n_groups] (a group never spans two sources)."""
-    out = torch.full((n_groups,), -1, dtype=torch.long)
+    out = torch.full((n_groups,), -1, dtype=torch.long, device=group.device)
     has = group >= 0
     out[group[has]] = source[has]
     return out
@@ -326,23 +328,26 @@ class JointResult:
 
 
 def train_joint(data_path: str | os.PathLike, out_dir: str | os.PathLike, config: JointConfig,
-                init: nn.Module, progress: bool = True) -> JointResult:
-    """Train `init` (a coefficient module, changed in place) jointly with the latent conditions on a merged file;
-    writes OUT/last.pt (the `model_export.training` checkpoint format), history.json and conditions.json (the
-    latent conditions and noise factors), all of the last epoch finished."""
+                init: nn.Module, progress: bool = True, device: str = DEFAULT_DEVICE) -> JointResult:
+    """Train `init` (a coefficient module, changed in place and moved to `device`) jointly with the latent
+    conditions on a merged file; writes OUT/last.pt (the `model_export.training` checkpoint format), history.json
+    and conditions.json (the latent conditions and noise factors), all of the last epoch finished. The latent
+    conditions are initialised and the batches drawn on the CPU whatever the device."""
+    where = resolve_device(device)
     torch.set_flush_denormal(True)
     try:
-        return _train_joint(Path(data_path), Path(out_dir), config, init, progress)
+        return _train_joint(Path(data_path), Path(out_dir), config, init.to(where), progress, where)
     finally:
         torch.set_flush_denormal(False)
 
 
 def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.Module,
-                 progress: bool) -> JointResult:
+                 progress: bool, device: torch.device) -> JointResult:
     out_dir.mkdir(parents=True, exist_ok=True)
     data = load_observed(data_path, config.weights)
+    data = replace(data, train=data.train.to(device), val=data.val.to(device))
     torch.manual_seed(config.seed)
-    latent, noise = LatentConditions(data), NoiseScales(len(data.sources))
+    latent, noise = LatentConditions(data).to(device), NoiseScales(len(data.sources)).to(device)
     wind_source = _group_sources(data.train.wind_group, data.train.source, len(data.wind_groups))
     air_source = _group_sources(data.train.air_group, data.train.source, len(data.air_groups))
     optimizer = torch.optim.Adam([{"params": model.parameters(), "lr": config.lr},
@@ -358,6 +363,7 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
     for epoch in range(1, config.epochs + 1):
         started = time.perf_counter()
         order = torch.randperm(len(train), generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch))
+        order = order.to(device)
         sums, steps = 0.0, 0
         batches = range(0, len(train), config.batch_size)
         for start in progress_bar(batches, f"epoch {epoch}/{config.epochs}", unit="batch", shown=progress):

@@ -81,6 +81,10 @@ class ObservedShots:
     def take(self, index: torch.Tensor) -> ObservedShots:
         return ObservedShots(*(getattr(self, name)[index] for name in self.__dataclass_fields__))
 
+    def to(self, device: torch.device) -> ObservedShots:
+        """The same shots on `device` (themselves where they are there already)."""
+        return ObservedShots(*(getattr(self, name).to(device) for name in self.__dataclass_fields__))
+
 
 @dataclass
 class ObservedData:

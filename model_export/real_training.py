@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from golfflight.flight.constants import YARD_M
+from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.export import export_bundle
 from golfflight.model_export.joint import JointConfig, JointResult, soup_runs, train_joint
 from golfflight.model_export.observations import NOISE, OBSERVABLES, PATH_OBSERVATIONS, PATH_SIGMA_M
@@ -177,18 +178,18 @@ def _network(init: str | os.PathLike) -> nn.Module:
 
 
 def train_seed(data_file: Path, run_dir: Path, init: str | os.PathLike, config: JointConfig, threads: int,
-               progress: bool) -> JointResult:
-    """One seed's joint run from the bundle `init` (a process of its own when seeds run in parallel)."""
+               progress: bool, device: str = DEFAULT_DEVICE) -> JointResult:
+    """One seed's joint run from the bundle `init` on `device` (a process of its own when seeds run in parallel)."""
     import torch
 
     torch.set_num_threads(threads)
     model = _network(init)
     model.train()
-    return train_joint(data_file, run_dir, config, model, progress)
+    return train_joint(data_file, run_dir, config, model, progress, device)
 
 
 def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig], jobs: int,
-                 threads: int, progress: bool) -> dict[str, JointResult]:
+                 threads: int, progress: bool, device: str) -> dict[str, JointResult]:
     """Each seed's joint run (WORK/NAME), by name: one after the other with their epoch bars, or `jobs` at once in
     processes of their own (silent there) with a bar over the seeds finished."""
     from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -197,10 +198,10 @@ def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: 
         runs = {}
         for index, (name, c) in enumerate(configs.items(), start=1):
             progress_step(f"{name} ({index} of {len(configs)})", progress)
-            runs[name] = train_seed(data_file, work / name, init, c, threads, progress)
+            runs[name] = train_seed(data_file, work / name, init, c, threads, progress, device)
         return runs
     with ProcessPoolExecutor(jobs) as pool:
-        futures = {pool.submit(train_seed, data_file, work / name, init, c, threads, False): name
+        futures = {pool.submit(train_seed, data_file, work / name, init, c, threads, False, device): name
                    for name, c in configs.items()}
         done = {futures[f]: f.result() for f in progress_bar(as_completed(futures), "seeds", total=len(futures),
                                                              unit="seed", shown=progress)}
@@ -210,12 +211,16 @@ def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: 
 def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str | os.PathLike,
                config: JointConfig, seeds: tuple[int, ...], out: str | os.PathLike | None,
                source_names: tuple[str, ...] | None = None, progress: bool = True, jobs: int = 1,
-               threads: int = 2) -> RealRun:
+               threads: int = 2, device: str = DEFAULT_DEVICE) -> RealRun:
     """Build WORK/real_flights.csv from DATA_ROOT, train one joint run per seed from the bundle INIT (WORK/seed-S;
-    `jobs` seeds at a time, each with `threads` torch threads), average several seeds' weights into a soup
-    (WORK/soup), and export the run with the lowest validation felt error to OUT (if given). With `progress`, each
-    step, and the epochs (one seed at a time) or the seeds (several at once), go to standard error."""
+    `jobs` seeds at a time, each with `threads` torch threads, on `device`), average several seeds' weights into a
+    soup (WORK/soup, scored on the CPU), and export the run with the lowest validation felt error to OUT (if given).
+    With `progress`, each step, and the epochs (one seed at a time) or the seeds (several at once), go to standard
+    error. On a GPU the seeds run one after another (`jobs` 1): processes of their own would share the one device."""
     from golfflight.weights_schema.bundle import load_bundle
+
+    if resolve_device(device).type != "cpu" and jobs > 1:
+        raise ValueError(f"--jobs {jobs} goes with --device cpu: on {device} the seeds run one after another")
 
     started = time.perf_counter()
     work = Path(work)
@@ -224,7 +229,7 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     progress_step(f"building {data_file} from the real sources...", progress)
     sources = build(data_root, data_file, *(() if source_names is None else (source_names,)))
     configs = {f"seed-{seed}": replace(config, seed=seed) for seed in seeds}
-    runs = _train_seeds(data_file, work, init, configs, jobs, threads, progress)
+    runs = _train_seeds(data_file, work, init, configs, jobs, threads, progress, device)
     finished = [run.out_dir for run in runs.values() if run.final]
     if len(finished) > 1:
         progress_step(f"averaging {len(finished)} seeds' weights (the soup)...", progress)

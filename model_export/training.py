@@ -19,6 +19,7 @@ import torch
 from golfflight.flight.constants import YARD_M
 from golfflight.model_export import DEFAULT_HIDDEN, VARIANTS
 from golfflight.model_export.data import MIN_APEX_M, DataSummary, ShotTensors, load_training_data
+from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.torch_physics import (
     DT_S,
     SOFT_ARGMAX_TEMPERATURE_M,
@@ -126,7 +127,8 @@ def validate(model: nn.Module, shots: ShotTensors, config: TrainConfig) -> dict[
     model.eval()
     sums = {"landing": 0.0, "apex": 0.0}
     for start in range(0, len(shots), VALIDATION_BATCH):
-        batch = shots.take(torch.arange(start, min(start + VALIDATION_BATCH, len(shots))))
+        stop = min(start + VALIDATION_BATCH, len(shots))
+        batch = shots.take(torch.arange(start, stop, device=shots.position.device))
         landing, apex = predict(model, batch, config, soft=False)
         l_p, l_h = errors(landing, apex, batch)
         sums["landing"] += float(l_p) * int(batch.landing_mask.sum())
@@ -190,9 +192,11 @@ def _train_epoch(
     epoch: int,
     progress: bool,
 ) -> dict[str, Any]:
-    """One pass over the training shots in a seeded order; a batch whose loss or gradient is not finite is
-    skipped (no optimiser step) and counted. Returns the mean L_p, L_h of the steps taken (None if none)."""
+    """One pass over the training shots in a seeded order (drawn on the CPU, so every device takes the same); a
+    batch whose loss or gradient is not finite is skipped (no optimiser step) and counted. Returns the mean L_p, L_h
+    of the steps taken (None if none)."""
     order = torch.randperm(len(shots), generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch))
+    order = order.to(shots.position.device)
     sums, steps, skipped = {"lp": 0.0, "lh": 0.0}, 0, 0
     n_batches = math.ceil(len(shots) / config.batch_size)
     bar = progress_bar(range(n_batches), f"epoch {epoch}/{config.epochs}", unit="batch", shown=progress)
@@ -240,19 +244,22 @@ def train(
     progress: bool = True,
     init_state: dict[str, torch.Tensor] | None = None,
     skip_bad_rows: bool = False,
+    device: str = DEFAULT_DEVICE,
 ) -> RunResult:
     """Train `config.variant` on the file's train split, validating on its val split after every epoch.
 
     `init_state` starts from these weights instead of a fresh initialisation (fine-tuning; with `resume`, the run's
     own last.pt wins); `skip_bad_rows` leaves malformed rows of the data file out (listed in the result's data
-    summary) instead of refusing it.
+    summary) instead of refusing it; `device` is where the model and the shots live ("cpu", "cuda"; the model is
+    initialised and the batches drawn on the CPU either way, `devices.DeviceError` where it is missing).
     Denormal floats are flushed to zero while training (without it the first backward passes through the rollout
     hit denormals and a CPU batch runs 20-100x slower), and the CPU's normal mode is restored afterwards."""
     if config.loss == "observables":
         raise ValueError("the 'observables' loss is trained by model_export.joint (golfflight train-real)")
+    where = resolve_device(device)
     torch.set_flush_denormal(True)
     try:
-        return _train(data_path, out_dir, config, resume, progress, init_state, skip_bad_rows)
+        return _train(data_path, out_dir, config, resume, progress, init_state, skip_bad_rows, where)
     finally:
         torch.set_flush_denormal(False)
 
@@ -265,16 +272,19 @@ def _train(
     progress: bool,
     init_state: dict[str, torch.Tensor] | None,
     skip_bad_rows: bool,
+    device: torch.device,
 ) -> RunResult:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     train_set, val_set, data = load_training_data(
         data_path, config.limit, config.min_apex_m, skip_bad_rows=skip_bad_rows
     )
+    train_set, val_set = train_set.to(device), val_set.to(device)
     torch.manual_seed(config.seed)
     model = build_model(config.variant, config.hidden)
     if init_state is not None:
         model.load_state_dict(init_state)
+    model.to(device)
     optimizer = torch.optim.Adam(model.parameters(), lr=config.lr)
     history: list[dict[str, Any]] = []
     best: dict[str, Any] | None = None

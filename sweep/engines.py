@@ -1,7 +1,8 @@
-"""The two ways a sweep's pieces are flown, each a generator of result tables in input order: `local_tables` (a pool
-of processes on this machine) and `ray_tables` (Ray Data on a local Ray instance or an existing cluster). Either
-way each worker holds one `sweep.flyer.Flyer`, and at most a few pieces per worker are in flight, so memory stays
-bounded however long the input is.
+"""The ways a sweep's pieces are flown, each a generator of result tables in input order: `local_tables` (a pool
+of processes on this machine), `ray_tables` (Ray Data on a local Ray instance or an existing cluster) and
+`in_process_tables` (one engine in this process, whose parallelism is its device's: the torch engine). Each worker
+holds one `sweep.flyer.Flyer`, and at most a few pieces per worker are in flight, so memory stays bounded however
+long the input is.
 """
 
 from __future__ import annotations
@@ -58,6 +59,13 @@ def local_tables(source, bundle_dir: str, sha256: str, workers: int) -> Iterator
             yield pending.popleft().result()
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def in_process_tables(source, flyer: Flyer) -> Iterator:
+    """Result tables of `source`'s pieces flown one after another by `flyer` in this process (an engine that has
+    the device to itself: a pool of processes would only share it)."""
+    for piece in source.pieces():
+        yield flyer(piece)
 
 
 RAY_NOISE = (b"has constructor arguments in the object store and max_restarts > 0",)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING, Protocol
 
 from golfflight.contract.columns import (
     ELEVATION_COLUMNS,
@@ -24,6 +25,9 @@ from golfflight.contract.columns import (
     request_of_cells,
     result_columns,
 )
+
+if TYPE_CHECKING:
+    from golfflight.flight.outcomes import BatchFlights
 
 PROBLEM = "problem"
 """Column of a worker's table: why the request model refused the row (lines), null for a row that flew."""
@@ -101,15 +105,25 @@ def echo(column: str, value):
     return _number(value)
 
 
+class ColumnsEngine(Protocol):
+    """What a worker flies its rows with: `FlightEngine`, or another engine with its batch path (`fly_columns`) and the
+    SHA-256 of the bundle's graph (`model_export.torch_engine.TorchEngine`, given by the command line)."""
+
+    sha256: str
+
+    def fly_columns(self, launches, conditions, grounds) -> BatchFlights: ...
+
+
 class Flyer:
     """A flight engine for one worker: `flyer(piece)` flies a piece of a source (module docstring)."""
 
-    def __init__(self, bundle_dir: str, sha256: str, source):
-        """Load the bundle at `bundle_dir` (its own path on each node of a cluster) and refuse it unless its ONNX
-        graph is the one the driver checked (`sha256`); `source` (`sweep.sources`) turns pieces into rows."""
+    def __init__(self, bundle_dir: str, sha256: str, source, engine: ColumnsEngine | None = None):
+        """Load the bundle at `bundle_dir` (its own path on each node of a cluster), or take `engine` already loaded,
+        and refuse it unless its ONNX graph is the one the driver checked (`sha256`); `source` (`sweep.sources`)
+        turns pieces into rows."""
         from golfflight.flight.engine import FlightEngine
 
-        self.engine = FlightEngine(bundle_dir, batch_threads=1)
+        self.engine = FlightEngine(bundle_dir, batch_threads=1) if engine is None else engine
         if self.engine.sha256 != sha256:
             raise ValueError(f"{bundle_dir}: this worker's model ({self.engine.sha256[:12]}) is not the driver's "
                              f"({sha256[:12]}); every node needs the same bundle at the same path")

@@ -18,13 +18,14 @@ from typing import Literal
 
 from golfflight.flight.bundle_location import model_dir
 from golfflight.shots.files import write_atomic
-from golfflight.sweep.flyer import PROBLEM, ROW, Layout
+from golfflight.sweep.flyer import PROBLEM, ROW, ColumnsEngine, Flyer, Layout
 from golfflight.sweep.sources import Source
 
 SHOWN_PROBLEMS = 20
 """Problems listed when a sweep is refused (the rest are counted)."""
 
-Engine = Literal["local", "ray"]
+Engine = Literal["local", "ray", "torch"]
+"""Where the pieces fly: a pool of processes here, Ray, or the torch engine the command line hands `run_sweep`."""
 
 
 @dataclass(frozen=True)
@@ -45,13 +46,19 @@ class Summary:
         return self.rows / self.seconds if self.seconds > 0 else 0.0
 
 
-def _tables(source: Source, engine: Engine, workers: int, model: str | None, ray_address: str | None) -> Iterator:
-    """Result tables from the chosen engine, its workers loading the bundle the driver verified here."""
+def _tables(source: Source, engine: Engine, workers: int, model: str | None, ray_address: str | None,
+            in_process: ColumnsEngine | None) -> Iterator:
+    """Result tables from the chosen engine, its workers loading the bundle the driver verified here (or flying
+    with `in_process`, an engine already loaded from it)."""
     from golfflight.flight.bundle_check import verify_bundle
-    from golfflight.sweep.engines import local_tables, ray_tables
+    from golfflight.sweep.engines import in_process_tables, local_tables, ray_tables
 
     bundle = model_dir(model).resolve()
     sha256 = verify_bundle(bundle).onnx.sha256
+    if engine == "torch":
+        if in_process is None:
+            raise ValueError("the torch engine is flown in this process: pass it as in_process")
+        return in_process_tables(source, Flyer(str(bundle), sha256, source, engine=in_process))
     if engine == "ray":
         return ray_tables(source, str(bundle), sha256, workers, ray_address)
     return local_tables(source, str(bundle), sha256, workers)
@@ -76,9 +83,11 @@ def run_sweep(
     skip_bad_rows: bool = False,
     progress: bool = True,
     skipped: Callable[[str], None] = print,
+    in_process: ColumnsEngine | None = None,
 ) -> Summary:
     """Fly every row of `source` on `engine` and write `out` (Parquet): the input row's number, its columns, its
-    flight (module docstring). `skipped` gets each problem of a row left out under `skip_bad_rows`."""
+    flight (module docstring). `skipped` gets each problem of a row left out under `skip_bad_rows`; `in_process` is
+    the engine `engine="torch"` flies with (`model_export.torch_engine.TorchEngine`, loaded from `model`)."""
     import pyarrow as pa
     import pyarrow.compute as pc
     import pyarrow.parquet as pq
@@ -89,7 +98,7 @@ def run_sweep(
     counts = {"rows": 0, "written": 0, "skipped": 0, "chunks": 0, "chunks_skipped": 0, "failed": 0}
 
     def write(path: str) -> None:
-        tables = _tables(source, engine, workers, model, ray_address)
+        tables = _tables(source, engine, workers, model, ray_address, in_process)
         bar = tqdm(total=source.total_rows, unit="shot", unit_scale=True, disable=not progress, desc="sweep")
         with closing(tables), bar, pq.ParquetWriter(path, schema) as writer:
             for table in tables:

@@ -29,6 +29,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="share of the most recent shots (whole sessions) held out when the file has no split",
     )
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--device", default="cpu", help="where to train: cpu (default) or cuda[:N]")
     parser.add_argument(
         "--quiet", action="store_true", help="no progress on standard error and no line per epoch on standard output"
     )
@@ -51,6 +52,7 @@ def run(args: argparse.Namespace) -> int:
         args.val_fraction,
         args.seed,
         progress=not args.quiet,
+        device=args.device,
     )
     data, base = result.run.data, result.base_metrics
     print(f"data: {data.n_train} train, {data.n_val} val shots; left out {data.filters}")

@@ -3,8 +3,10 @@
 Input: a CSV or Parquet file with `golfflight simulate`'s CSV columns, or `--grid COLUMN=SPEC ...` (a cartesian
 product: START:STOP:COUNT, V1,V2,... or V per column, `sweep.grid`). Output: one row per input row, its number
 (`row`), its columns and its flight, the same numbers as `golfflight simulate`. `--engine local` flies on a pool of
-processes here, `--engine ray` through Ray Data (a local Ray instance, or a cluster's with `--ray-address`).
-Needs the `sweep` extra (pyarrow, tqdm), and the `ray` extra for `--engine ray`.
+processes here, `--engine ray` through Ray Data (a local Ray instance, or a cluster's with `--ray-address`),
+`--engine torch` in this process on `--device cpu` or `cuda` (the bundle rebuilt in torch,
+`model_export.torch_engine`). Needs the `sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray` and the
+`train` extra (torch) for `--engine torch`.
 """
 
 from __future__ import annotations
@@ -14,15 +16,19 @@ import importlib
 import os
 import sys
 
-EXTRAS = {"sweep": ("pyarrow", "tqdm"), "ray": ("ray.data",)}
+EXTRAS = {"sweep": ("pyarrow", "tqdm"), "ray": ("ray.data",), "train": ("torch",)}
 """The modules each extra brings: the serving install (`pip install .`, the Docker image) has none of them."""
 
 CHUNK_ROWS = 8192
 """Shots a worker flies in one engine batch: large enough that the per-step ONNX call is spread over many shots."""
 
+TORCH_CHUNK_ROWS = 65_536
+"""Shots the torch engine flies in one batch by default: a device's per-step kernel launches spread over many more
+shots (the engine splits a batch further where the device's memory needs it)."""
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser("sweep", help="fly a file or grid of launches into a Parquet file (local or Ray)")
+    parser = subparsers.add_parser("sweep", help="fly a file or grid of launches into a Parquet file (local, Ray or torch)")
     parser.add_argument("launches", nargs="?", help="CSV or Parquet file of launches (simulate's CSV columns)")
     parser.add_argument(
         "--grid", nargs="+", metavar="COLUMN=SPEC",
@@ -30,10 +36,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--out", required=True, help="the results' Parquet file (written whole or not at all)")
     parser.add_argument("--model", help="model bundle directory (default: the shipped models/default)")
-    parser.add_argument("--engine", choices=("local", "ray"), default="local", help="local processes or Ray Data")
-    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="processes or Ray actors (default: "
-                        "this machine's cores)")
-    parser.add_argument("--chunk-rows", type=int, default=CHUNK_ROWS, help=f"shots a batch (default {CHUNK_ROWS})")
+    parser.add_argument("--engine", choices=("local", "ray", "torch"), default="local",
+                        help="local processes, Ray Data, or the model in torch in this process (--device)")
+    parser.add_argument("--workers", type=int, help="processes or Ray actors (default: this machine's cores)")
+    parser.add_argument("--chunk-rows", type=int, help=f"shots a batch (default {CHUNK_ROWS}; {TORCH_CHUNK_ROWS} "
+                        "with --engine torch)")
+    parser.add_argument("--device", help="--engine torch: cpu (default), cuda or cuda:N")
+    parser.add_argument("--dtype", choices=("float32", "float64"),
+                        help="--engine torch: the physics' precision (default float32; the network is float32)")
+    parser.add_argument("--threads", type=int, help="--engine torch on the CPU: torch's threads (default: torch's, "
+                        "one a core; 1 where other work shares the cores)")
     parser.add_argument("--ray-address", help="an existing Ray cluster (e.g. ray://head:10001 or auto); default: a "
                         "local Ray instance, stopped after")
     parser.add_argument(
@@ -51,11 +63,39 @@ def require_extras(*extras: str) -> None:
             try:
                 importlib.import_module(module)
             except ImportError as missing:
-                who = "--engine ray needs" if extra == "ray" else "needs"
+                who = {"ray": "--engine ray needs", "train": "--engine torch needs"}.get(extra, "needs")
                 raise ValueError(
                     f"{who} the {extra} extra, which is not installed (no {missing.name or module}): "
                     f"pip install 'golfflight[{extra}]'"
                 ) from None
+
+
+def _check_options(args: argparse.Namespace) -> None:
+    """Refuse options that do not go with the chosen engine, or numbers below 1."""
+    if (args.workers is not None and args.workers < 1) or (args.chunk_rows is not None and args.chunk_rows < 1):
+        raise ValueError("--workers and --chunk-rows take a whole number of at least 1")
+    if args.ray_address and args.engine != "ray":
+        raise ValueError("--ray-address goes with --engine ray")
+    if args.engine == "torch" and args.workers is not None:
+        raise ValueError("--workers goes with --engine local or ray (--engine torch flies in this process, on its "
+                         "--device)")
+    if args.threads is not None and args.threads < 1:
+        raise ValueError("--threads takes a whole number of at least 1")
+    torch_only = [name for name in ("device", "dtype", "threads") if getattr(args, name) is not None]
+    if torch_only and args.engine != "torch":
+        raise ValueError(f"--{torch_only[0]} goes with --engine torch")
+
+
+def _torch_engine(args: argparse.Namespace):
+    """The bundle rebuilt in torch on the asked device (`model_export.torch_engine.TorchEngine`)."""
+    import torch
+
+    from golfflight.flight.bundle_location import model_dir
+    from golfflight.model_export.torch_engine import TorchEngine
+
+    if args.threads is not None:
+        torch.set_num_threads(args.threads)
+    return TorchEngine(model_dir(args.model).resolve(), args.device or "cpu", args.dtype or "float32")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -64,32 +104,38 @@ def run(args: argparse.Namespace) -> int:
         from golfflight.sweep.sources import open_source
     except ImportError as missing:  # an install without the sweep package
         raise ValueError(f"needs the sweep extra: pip install 'golfflight[sweep]' ({missing})") from None
-    require_extras("sweep", *(["ray"] if args.engine == "ray" else []))
-
-    if args.workers < 1 or args.chunk_rows < 1:
-        raise ValueError("--workers and --chunk-rows take a whole number of at least 1")
-    if args.ray_address and args.engine != "ray":
-        raise ValueError("--ray-address goes with --engine ray")
-    source = open_source(args.launches, args.grid, args.chunk_rows)
+    require_extras("sweep", *({"ray": ["ray"], "torch": ["train"]}.get(args.engine, [])))
+    _check_options(args)
+    chunk_rows = args.chunk_rows or (TORCH_CHUNK_ROWS if args.engine == "torch" else CHUNK_ROWS)
+    source = open_source(args.launches, args.grid, chunk_rows)
+    torch_engine = _torch_engine(args) if args.engine == "torch" else None
+    workers = 1 if torch_engine is not None else args.workers or os.cpu_count() or 1
     summary = run_sweep(
         source,
         args.out,
         args.engine,
-        args.workers,
+        workers,
         args.model,
         args.ray_address,
         args.skip_bad_rows,
         progress=not args.no_progress,
         skipped=lambda problem: print(f"golfflight sweep: skipped: {problem}", file=sys.stderr),
+        in_process=torch_engine,
     )
     whole = (
         f", {summary.chunks_skipped:,} of {summary.chunks:,} chunks skipped whole for want of a valid row"
         if summary.chunks_skipped
         else ""
     )
+    where = f"with {workers} workers" if torch_engine is None else f"({torch_engine.device}, {args.dtype or 'float32'})"
     print(
         f"golfflight sweep: {summary.written:,} shots written to {args.out} ({summary.skipped:,} rows skipped{whole}, "
         f"{summary.failed:,} could not be flown) in {summary.seconds:.1f} s: {summary.shots_per_second:,.0f} shots/s "
-        f"on {args.engine} with {args.workers} workers"
+        f"on {args.engine} {where}"
     )
+    if torch_engine is not None:
+        flight, ground = torch_engine.seconds["flight"], torch_engine.seconds["ground"]
+        print(f"golfflight sweep: torch flight {flight:.2f} s on {torch_engine.device}, ground phase {ground:.2f} s on "
+              f"the CPU (NumPy), the rest ({max(summary.seconds - flight - ground, 0.0):.2f} s) reading, validating "
+              f"and writing rows")
     return 0

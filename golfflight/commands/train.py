@@ -44,6 +44,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="leave out malformed rows of --data (each listed) instead of refusing the file",
     )
     parser.add_argument("--threads", type=int, default=2, help="torch CPU threads (1 is faster on a busy machine)")
+    parser.add_argument("--device", default="cpu", help="where to train: cpu (default) or cuda[:N]")
     parser.add_argument(
         "--quiet", action="store_true", help="no progress on standard error and no line per epoch on standard output"
     )
@@ -67,7 +68,8 @@ def run(args: argparse.Namespace) -> int:
         limit=args.limit,
     )
     result = train(
-        args.data, args.out, config, resume=args.resume, progress=not args.quiet, skip_bad_rows=args.skip_bad_rows
+        args.data, args.out, config, resume=args.resume, progress=not args.quiet, skip_bad_rows=args.skip_bad_rows,
+        device=args.device,
     )
     data = result.data
     for problem in data.bad_rows:

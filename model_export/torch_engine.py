@@ -1,0 +1,308 @@
+"""A bundle flown in torch, on a CPU or a GPU: `TorchEngine`, the served engine's batch path (`FlightEngine.fly_columns`)
+rebuilt on training's physics, for `golfflight sweep --engine torch`.
+
+The coefficient network is the bundle's ONNX graph's weights in the training code's model class
+(`bundle_model.model_from_bundle`, checked against ONNX Runtime on probe inputs), run in float32 as the graph runs;
+the equations of motion are training's (`torch_physics.derivatives`, one forward-Euler step as `euler_rollout` takes
+it), in float32 or float64. What the engine takes, this takes: every shot's air (density, and its kinematic viscosity
+as the Reynolds scale of the network's inputs), its wind (uniform, or the log profile evaluated at the ball's height
+each step) and its ground's elevation, down to the engine's maximum flight time. The landing and apex are
+training's `hard_landing` and `apex`, which hold the integrator's rules (the state interpolated linearly to the
+ground's plane between the two steps around the first downward crossing; the parabola through the highest state and
+its neighbours), on heights measured from each shot's ground. Each shot is flown for the whole batch's steps (fixed
+shapes), a part stopping once every shot of it has come down; a shot never down by the maximum flight time, or whose
+figures are not finite, fails with the engine's message (the batch is flown in parts that fit the device).
+
+The ground phase (bounce and roll) is the engine's own NumPy code (`flight.ground.ground_phase`) on the CPU, fed the
+landing states in float64; `seconds` splits the time between the device's flight and that ground phase. A part's
+size is `part_shots`. Torch is imported here only: nothing of the serving install or the sweep package imports this
+module (`golfflight sweep --engine torch` does, from the command line).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from golfflight.flight.conditions import STANDARD, Conditions
+from golfflight.flight.flyer import LAUNCH_WIDTH, NON_FINITE, Launch, air_inputs, load_flyer
+from golfflight.flight.ground import GroundSpec, Surface, ground_phase
+from golfflight.flight.outcomes import BatchFlights, Rest, landing_figures
+from golfflight.flight.physics import initial_state, reynolds_scale
+from golfflight.model_export.bundle_model import model_from_bundle
+from golfflight.model_export.devices import resolve_device
+from golfflight.model_export.torch_physics import Trajectory, apex, derivatives, hard_landing
+
+DTYPES = {"float32": torch.float32, "float64": torch.float64}
+"""The physics' precisions by name (the network always runs in float32, as the bundle's graph does)."""
+
+CPU_PART_SHOTS = 16_384
+"""Shots flown at once on a CPU: about 120 MB of states at the engine's 200 steps in float32 (the network's step
+costs about 2 us a shot at 4,096 shots and 2.6 at 65,536 on one core: larger parts only leave the caches)."""
+
+DEVICE_MEMORY_SHARE = 0.5
+"""Share of a GPU's free memory one part's states may take (the network's activations and the landing's gathers
+need the rest)."""
+
+STATE_COPIES = 3
+"""Each part keeps every step's positions, velocities and spins ([steps + 1, N, 3] each)."""
+
+WORKING_BYTES_PER_SHOT = 4096
+"""A step's transient memory a shot, beside the kept states, as estimated: the network's two 256-wide and two
+128-wide float32 activations (3 kB) and the equations' temporaries (`bench_gpu.py` measures the peak on a GPU)."""
+
+LANDING_CHECK_STEPS = 10
+"""Steps between the checks whether every shot of a part has come down (each check waits for the device)."""
+
+
+@dataclass(frozen=True)
+class ShotInputs:
+    """A batch's shots in the equations' terms, NumPy [N] or [N,3] arrays: the launch state, each shot's air
+    density, Reynolds scale, wind at its reference height and log profile (flag, reference height, roughness),
+    and ground elevation."""
+
+    position: np.ndarray
+    velocity: np.ndarray
+    spin: np.ndarray
+    density: np.ndarray
+    reynolds_scale: np.ndarray
+    wind: np.ndarray
+    log_profile: np.ndarray
+    reference_height_m: np.ndarray
+    roughness_m: np.ndarray
+    ground_m: np.ndarray
+
+    def part(self, start: int, stop: int) -> ShotInputs:
+        """The shots start..stop-1."""
+        return ShotInputs(*(getattr(self, name)[start:stop] for name in self.__dataclass_fields__))
+
+
+@dataclass(frozen=True)
+class Landings:
+    """What the flight hands the ground phase and the figures, float64 NumPy: the landing states [N,3], the flight
+    and apex times and the apex height [N], and whether each shot came down."""
+
+    position: np.ndarray
+    velocity: np.ndarray
+    spin: np.ndarray
+    flight_time_s: np.ndarray
+    apex_m: np.ndarray
+    apex_time_s: np.ndarray
+    landed: np.ndarray
+
+
+class TorchEngine:
+    """A bundle's coefficient network on a torch device, flying batches as `FlightEngine.fly_columns` does
+    (module docstring)."""
+
+    def __init__(self, bundle_dir: str | os.PathLike, device: str = "cpu", dtype: str = "float32",
+                 part_shots: int | None = None) -> None:
+        """Load and verify the bundle (`flight.flyer.load_flyer`, the engine's checks: its step, maximum flight time,
+        nominal air and error messages are this engine's) and rebuild its network in torch on `device`; `dtype`
+        is the physics' precision; `part_shots` caps the shots flown at once (default: what the device's memory
+        holds). `devices.DeviceError` for a device this machine lacks, ValueError for a dtype it does not know."""
+        if dtype not in DTYPES:
+            raise ValueError(f"dtype {dtype!r}: choose from {', '.join(DTYPES)}")
+        self.device, self.dtype = resolve_device(device), DTYPES[dtype]
+        self.flyer = load_flyer(bundle_dir)
+        self.card, self.sha256 = self.flyer.card, self.flyer.card.onnx.sha256
+        model, _ = model_from_bundle(self.flyer.bundle_dir)
+        self.model = model.to(self.device)
+        self.part_limit = part_shots
+        self.seconds = {"flight": 0.0, "ground": 0.0}
+
+    def coefficients(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
+        """C_L, C_D, C_M, C_Q [N,4] in the physics' dtype from the network run in float32, as the graph runs."""
+        return self.model(v_rel.float(), omega.float()).to(v_rel.dtype)
+
+    def part_shots(self) -> int:
+        """Shots flown at once: `part_shots` if given, else what the device's free memory holds (a GPU), or
+        CPU_PART_SHOTS."""
+        if self.part_limit is not None:
+            return self.part_limit
+        if self.device.type == "cpu":
+            return CPU_PART_SHOTS
+        free, _ = torch.cuda.mem_get_info(self.device)
+        itemsize = torch.finfo(self.dtype).bits // 8
+        per_shot = (self.flyer.max_steps + 1) * 3 * STATE_COPIES * itemsize + WORKING_BYTES_PER_SHOT
+        return max(1024, int(free * DEVICE_MEMORY_SHARE / per_shot))
+
+    def fly_columns(
+        self,
+        launches: Sequence[Launch] | np.ndarray,
+        conditions: Sequence[Conditions] | Conditions = STANDARD,
+        grounds: Sequence[GroundSpec | None] | GroundSpec | None = None,
+    ) -> BatchFlights:
+        """Shots (an [N, LAUNCH_WIDTH] array or Launches), each in its conditions, down to its ground and rolled to
+        rest there (grounds None: down to z = 0, the flight alone), as `FlightEngine.fly_columns` gives them. One
+        Conditions or GroundSpec for every shot is spread without a Python step a shot (a benchmark's millions)."""
+        n = len(launches)
+        if n == 0:
+            raise ValueError("no shots to fly")
+        for given, name in ((conditions, "conditions"), (grounds, "grounds")):
+            if isinstance(given, Sequence) and len(given) != n:
+                raise ValueError(f"{len(given)} {name} for {n} launches")
+        started = time.perf_counter()
+        shot_grounds = Grounds.of(grounds, n)
+        inputs = self._inputs(np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH), conditions, shot_grounds)
+        size = self.part_shots()
+        parts = [self._fly_part(inputs.part(start, min(start + size, n))) for start in range(0, n, size)]
+        landings = Landings(*(np.concatenate([getattr(p, name) for p in parts]) for name in Landings.__dataclass_fields__))
+        flown = time.perf_counter()
+        columns = self._columns(landings, shot_grounds)
+        self.seconds["flight"] += flown - started
+        self.seconds["ground"] += time.perf_counter() - flown
+        return columns
+
+    def _inputs(self, launches: np.ndarray, conditions: Sequence[Conditions] | Conditions,
+                grounds: Grounds) -> ShotInputs:
+        """The shots' launch states, air, wind and grounds as the engine's Flyer takes them (`air_inputs`)."""
+        n = len(launches)
+        start = initial_state(*launches.T)
+        air = [air_inputs(conditions)] if isinstance(conditions, Conditions) else [air_inputs(c) for c in conditions]
+
+        def column(values: list, dtype: type = float) -> np.ndarray:
+            array = np.array(values, dtype=dtype)
+            return np.repeat(array, n, axis=0) if len(array) == 1 else array
+
+        nominal = self.flyer.kinematic_viscosity_m2_s
+        return ShotInputs(
+            start.position, start.velocity, start.spin,
+            density=column([a.density_kg_m3 for a in air]),
+            reynolds_scale=reynolds_scale(column([a.kinematic_viscosity_m2_s for a in air]), nominal),
+            wind=column([(a.wind_x_mps, a.wind_y_mps, 0.0) for a in air]),
+            log_profile=column([a.log_profile for a in air], bool),
+            reference_height_m=column([a.reference_height_m for a in air]),
+            roughness_m=column([a.roughness_m for a in air]),
+            ground_m=grounds.elevation_m,
+        )
+
+    @torch.no_grad()
+    def _fly_part(self, shots: ShotInputs) -> Landings:
+        """One part's flights on the device: forward Euler from the launch until every shot has come down through its
+        ground's plane or the maximum flight time has passed, then training's landing and apex."""
+        def tensor(array: np.ndarray) -> torch.Tensor:
+            return torch.as_tensor(array, dtype=self.dtype, device=self.device)
+
+        position, velocity, spin = tensor(shots.position), tensor(shots.velocity), tensor(shots.spin)
+        density, scale, ground = tensor(shots.density), tensor(shots.reynolds_scale)[:, None], tensor(shots.ground_m)
+        wind_at = _wind(tensor(shots.wind), torch.as_tensor(shots.log_profile, device=self.device),
+                        tensor(shots.reference_height_m), tensor(shots.roughness_m))
+        steps, dt = self.flyer.max_steps, self.flyer.dt_s
+        states = [torch.empty((steps + 1, *position.shape), dtype=self.dtype, device=self.device) for _ in range(3)]
+        for kept, now in zip(states, (position, velocity, spin), strict=True):
+            kept[0] = now
+        down = torch.zeros(len(position), dtype=torch.bool, device=self.device)
+        last = steps
+        for step in range(1, steps + 1):
+            d_position, d_velocity, d_spin = derivatives(
+                position, velocity, spin, self.coefficients, density, scale, wind_at(position[:, 2])
+            )
+            height_before = position[:, 2]
+            position, velocity, spin = position + dt * d_position, velocity + dt * d_velocity, spin + dt * d_spin
+            for kept, now in zip(states, (position, velocity, spin), strict=True):
+                kept[step] = now
+            down |= (height_before > ground) & (position[:, 2] <= ground)
+            if step % LANDING_CHECK_STEPS == 0 and bool(down.all()):
+                last = step
+                break
+        positions = states[0][: last + 1]
+        positions[:, :, 2] -= ground  # heights above each shot's ground: its plane is the landing's z = 0
+        trajectory = Trajectory(positions, states[1][: last + 1], states[2][: last + 1], dt)
+        landing, peak = hard_landing(trajectory), apex(trajectory)
+        landing.position[:, 2] += ground
+
+        def array(values: torch.Tensor) -> np.ndarray:
+            return values.to(device="cpu", dtype=torch.float64).numpy()
+
+        return Landings(
+            array(landing.position), array(landing.velocity), array(landing.spin), array(landing.time_s),
+            array(peak.height_m + ground), array(peak.time_s), landing.landed.cpu().numpy(),
+        )
+
+    def _columns(self, flight: Landings, grounds: Grounds) -> BatchFlights:
+        """The batch's figures, errors and rests from its landings (as `flight.flyer.Flyer` makes them from the
+        integrator's), the landed shots with a ground bounced and rolled to rest on the CPU."""
+        n = len(flight.landed)
+        x, y = flight.position[:, 0], flight.position[:, 1]
+        carry, angle, speed, spin = landing_figures(x, y, *flight.velocity.T, *flight.spin.T)
+        numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
+        finite = np.isfinite(np.stack(numbers)).all(axis=0)
+        errors = {}
+        for i in np.flatnonzero(~(flight.landed & finite)).tolist():
+            unlanded = not flight.landed[i]
+            errors[i] = (self.flyer.unlanded_message(float(flight.apex_m[i]), float(grounds.elevation_m[i]))
+                         if unlanded else NON_FINITE)
+        rolled = flight.landed & finite & grounds.present
+        shots = np.flatnonzero(rolled)
+        phase = None
+        if shots.size:
+            phase = ground_phase(flight.position[shots], flight.velocity[shots], flight.spin[shots],
+                                 grounds.surface_of(shots), grounds.slope_deg[shots], grounds.slope_dir_deg[shots])
+        # a shot that never came down has no landing: NaN figures, as the integrator leaves them
+        x, y, carry, angle, speed, spin, flight_time = (
+            np.where(flight.landed, v, math.nan) for v in (x, y, carry, angle, speed, spin, flight.flight_time_s)
+        )
+        return BatchFlights(
+            landing_x_m=x, landing_y_m=y, carry_m=carry, lateral_m=x, apex_m=flight.apex_m,
+            apex_time_s=flight.apex_time_s, flight_time_s=flight_time, landing_angle_deg=angle,
+            landing_speed_mps=speed, landing_spin_rpm=spin, rest=Rest.of_batch(phase, shots, n, carry),
+            rolled=rolled, errors=errors,
+        )
+
+
+@dataclass(frozen=True)
+class Grounds:
+    """A batch's grounds as [N] arrays: whether a shot has one (None: the flight alone, down to z = 0), its
+    elevation, slope and slope direction, and its surface (one for all, or one a shot)."""
+
+    present: np.ndarray
+    elevation_m: np.ndarray
+    slope_deg: np.ndarray
+    slope_dir_deg: np.ndarray
+    surfaces: Surface | list[Surface | None]
+
+    @classmethod
+    def of(cls, grounds: Sequence[GroundSpec | None] | GroundSpec | None, n: int) -> Grounds:
+        """One ground for every shot (or none), or one a shot."""
+        if grounds is None or isinstance(grounds, GroundSpec):
+            one = GroundSpec() if grounds is None else grounds
+            values = (grounds is not None, one.elevation_m, one.slope_deg, one.slope_dir_deg)
+            return cls(*(np.full(n, v) for v in values), surfaces=one.surface)
+        return cls(
+            np.array([g is not None for g in grounds], dtype=bool),
+            *(np.array([0.0 if g is None else getattr(g, name) for g in grounds], dtype=float)
+              for name in ("elevation_m", "slope_deg", "slope_dir_deg")),
+            surfaces=[None if g is None else g.surface for g in grounds],
+        )
+
+    def surface_of(self, shots: np.ndarray) -> Surface:
+        """The surface of these shots (all with a ground): the one surface, or their surfaces stacked."""
+        if isinstance(self.surfaces, Surface):
+            return self.surfaces
+        chosen = [self.surfaces[i] for i in shots.tolist()]
+        distinct = {id(s): s for s in chosen}
+        return next(iter(distinct.values())) if len(distinct) == 1 else Surface.stack(chosen)
+
+
+def _wind(at_reference: torch.Tensor, log_profile: torch.Tensor, reference_height_m: torch.Tensor,
+          roughness_m: torch.Tensor):
+    """The air's velocity [N,3] at the balls' heights [N], as `flight.wind.Wind.velocity` gives it: the wind at its
+    reference height, times V(h)/V(h_ref) of the log profile for the shots that follow it (zero at and below the
+    roughness length); None in calm air."""
+    if not bool(at_reference.any()):
+        return lambda height_m: None
+    if not bool(log_profile.any()):
+        return lambda height_m: at_reference
+    reference_log = torch.log(reference_height_m / roughness_m)
+
+    def velocity(height_m: torch.Tensor) -> torch.Tensor:
+        factor = torch.log(torch.maximum(height_m, roughness_m) / roughness_m) / reference_log
+        return at_reference * torch.where(log_profile, factor, torch.ones_like(factor))[:, None]
+
+    return velocity

@@ -1,0 +1,246 @@
+"""The torch engine (`model_export.torch_engine`, `golfflight sweep --engine torch`) flies the shipped bundle as the
+ONNX engine does: the same figures, errors and rests for mixed shots (air, uniform and log winds, grounds above and
+below the tee, sloped surfaces), the engine's landing and apex rules to float64 rounding, the same sweep columns;
+a device this machine lacks, a missing torch and options of other engines are refused in one line; training's
+`--device` left out is the CPU, bit for bit. CPU only (CI has no GPU); `benchmarks/bench_gpu.py` measures a GPU."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+import torch
+from conftest import random_launches
+from golfflight.flight.air import Air
+from golfflight.flight.conditions import Conditions
+from golfflight.flight.flyer import Flyer, load_flyer
+from golfflight.flight.ground import SURFACES, GroundSpec
+from golfflight.flight.physics import reynolds_scale
+from golfflight.flight.wind import Wind
+from golfflight.model_export.devices import DeviceError, resolve_device
+from golfflight.model_export.torch_engine import TorchEngine
+from golfflight.model_export.training import TrainConfig, load_checkpoint, train
+
+from golfflight.cli import main
+
+pq = pytest.importorskip("pyarrow.parquet")
+
+SHOTS = 300
+FIGURES = ("landing_x_m", "landing_y_m", "carry_m", "apex_m", "apex_time_s", "flight_time_s", "landing_angle_deg",
+           "landing_speed_mps", "landing_spin_rpm")
+
+
+@pytest.fixture(scope="module", autouse=True)
+def one_thread():
+    """One torch thread: the 2-core test machines run other work, where a second thread waits more than it helps."""
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(threads)
+
+
+def mixed_shots(n: int, seed: int = 0) -> tuple[np.ndarray, list[Conditions], list[GroundSpec | None]]:
+    """Wedges to drivers in air from sea level to 2,000 m, -5 to 40 degC; calm, uniform and log-profile winds from
+    every side; no ground (the flight alone), level and sloped grounds 4 m below to 6 m above the tee, on four
+    surfaces; and two shots whose ground is higher than they rise (they cannot land)."""
+    rng = np.random.default_rng(seed)
+    launches = np.stack(list(random_launches(n, seed).values()), axis=-1)
+    conditions, grounds = [], []
+    for i in range(n):
+        air = Air.from_conditions(float(rng.uniform(-5, 40)), float(rng.choice([0.0, 800.0, 2000.0])))
+        wind = Wind(float(rng.uniform(0, 12)), float(rng.uniform(0, 360)), str(rng.choice(["uniform", "log"])),
+                    float(rng.choice([2.0, 10.0])))
+        conditions.append(Conditions(air, wind if i % 4 else Wind()))
+        surface = SURFACES[str(rng.choice(["fairway", "green", "rough", "firm_fairway"]))]
+        ground = GroundSpec(surface, float(rng.choice([-4.0, 0.0, 6.0])), float(rng.choice([0.0, 0.0, 2.0])),
+                            float(rng.uniform(0, 360)))
+        grounds.append(None if i % 5 == 0 else ground)
+    grounds[1] = grounds[2] = GroundSpec(SURFACES["fairway"], 90.0)
+    return launches, conditions, grounds
+
+
+@pytest.fixture(scope="module")
+def shots():
+    return mixed_shots(SHOTS)
+
+
+@pytest.fixture(scope="module")
+def onnx_flights(shots):
+    return load_flyer(None).fly_columns(*shots)
+
+
+@pytest.fixture(scope="module")
+def engines() -> dict[str, TorchEngine]:
+    return {dtype: TorchEngine(load_flyer(None).bundle_dir, "cpu", dtype) for dtype in ("float32", "float64")}
+
+
+def _deviation(got, want, name: str, landed: np.ndarray) -> float:
+    return float(np.max(np.abs(getattr(got, name)[landed] - getattr(want, name)[landed])))
+
+
+@pytest.mark.parametrize("dtype, carry_m, figures", [("float32", 1e-3, 2e-2), ("float64", 2e-5, 2e-4)])
+def test_the_torch_engine_flies_mixed_shots_as_the_onnx_engine(engines, shots, onnx_flights, dtype, carry_m, figures):
+    """Carries within 1 mm in float32. In float64 the physics agree to rounding and what is left is the network's
+    float32 arithmetic (torch's and ONNX Runtime's sums differ by an ulp: about 1e-7 in a coefficient), some 10 um
+    of carry (the rules themselves are held to 1e-6 m below). The other figures (degrees, rpm, s) and the rests
+    after the ground phase follow."""
+    got = engines[dtype].fly_columns(*shots)
+    assert got.errors == onnx_flights.errors and {1, 2} <= set(got.errors)
+    assert "never rose to its landing ground" in got.errors[1]
+    np.testing.assert_array_equal(got.rolled, onnx_flights.rolled)
+    landed = np.array([i not in got.errors for i in range(SHOTS)])
+    assert _deviation(got, onnx_flights, "carry_m", landed) < carry_m
+    for name in FIGURES:
+        assert _deviation(got, onnx_flights, name, landed) < figures, name
+    rolled = got.rolled
+    np.testing.assert_array_equal(got.rest.bounces[rolled], onnx_flights.rest.bounces[rolled])
+    assert np.max(np.abs(got.rest.total_m[rolled] - onnx_flights.rest.total_m[rolled])) < 20 * carry_m
+
+
+class TorchNetwork:
+    """The torch engine's own network (float32, as it runs it) as a NumPy coefficient model for the Flyer, so that
+    the NumPy integrator and the torch engine fly the same coefficients and differ only in their arithmetic."""
+
+    def __init__(self, engine: TorchEngine, scale: float | np.ndarray = 1.0) -> None:
+        self.engine, self.scale = engine, scale
+
+    def in_air(self, kinematic_viscosity_m2_s: float | np.ndarray) -> TorchNetwork:
+        scale = reynolds_scale(np.asarray(kinematic_viscosity_m2_s), self.engine.flyer.kinematic_viscosity_m2_s)
+        return TorchNetwork(self.engine, scale[:, None] if scale.ndim else float(scale))
+
+    def take(self, index: np.ndarray) -> TorchNetwork:
+        return TorchNetwork(self.engine, self.scale[index] if isinstance(self.scale, np.ndarray) else self.scale)
+
+    @torch.no_grad()
+    def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
+        inputs = (torch.as_tensor(a * self.scale, dtype=torch.float64) for a in (v_rel, omega))
+        return self.engine.coefficients(*inputs).numpy()
+
+
+def test_in_float64_the_landing_and_apex_rules_are_the_integrators(engines, shots):
+    """The same network flown by the NumPy integrator (the engine's Flyer) and by the torch engine in float64: every
+    figure within 1e-6 (m, s, deg; the landing spin within 1e-5 rpm): the landing interpolated into the crossing
+    step, the apex's parabola, each shot's ground, its air's Reynolds scale, the log profile at the ball's height,
+    the failures. (An input a float64 rounding away from a float32 boundary can still move a coefficient by an ulp.)"""
+    engine = engines["float64"]
+    onnx = engine.flyer
+    numpy_flyer = Flyer(TorchNetwork(engine), onnx.dt_s, onnx.max_flight_time_s, onnx.density_kg_m3,
+                        onnx.kinematic_viscosity_m2_s)
+    want, got = numpy_flyer.fly_columns(*shots), engine.fly_columns(*shots)
+    assert got.errors == want.errors
+    landed = np.array([i not in got.errors for i in range(SHOTS)])
+    for name in FIGURES:
+        assert _deviation(got, want, name, landed) < (1e-5 if name == "landing_spin_rpm" else 1e-6), name
+    rolled = got.rolled
+    assert np.max(np.abs(got.rest.total_m[rolled] - want.rest.total_m[rolled])) < 1e-6
+
+
+def test_a_batch_split_into_parts_flies_the_same_numbers(shots):
+    """Parts of a batch (the device's memory) are flown apart and joined in order: the same figures."""
+    small = TorchEngine(load_flyer(None).bundle_dir, "cpu", "float64", part_shots=64)
+    whole = TorchEngine(load_flyer(None).bundle_dir, "cpu", "float64")
+    launches, conditions, grounds = (part[:150] for part in shots)
+    split, joined = small.fly_columns(launches, conditions, grounds), whole.fly_columns(launches, conditions, grounds)
+    assert split.errors == joined.errors
+    for name in FIGURES:
+        np.testing.assert_allclose(getattr(split, name), getattr(joined, name), rtol=0, atol=1e-9)
+    assert small.seconds["flight"] > 0 and small.seconds["ground"] > 0
+
+
+def sweep(*argv) -> int:
+    return main(["sweep", *map(str, argv), "--no-progress"])
+
+
+GRID = ["--grid", "ball_speed_mps=35:75:5", "launch_angle_deg=10,16", "spin_rpm=2500,6000",
+        "wind_speed_mps=0,7", "wind_profile=uniform,log", "ground_elevation_m=0,-3", "normalized=true"]
+
+
+def test_the_sweep_on_torch_writes_the_local_engines_columns_and_numbers(tmp_path, capsys):
+    """A tiny grid (normalized replays and flat flights riding along) through both engines: the same schema, the
+    same rows, errors and bounces, lengths within 2 mm and the other figures within 0.02 (deg, s, m/s, mph, rpm)."""
+    local, flown = tmp_path / "local.parquet", tmp_path / "torch.parquet"
+    assert sweep(*GRID, "--out", local, "--workers", 1) == 0
+    assert sweep(*GRID, "--out", flown, "--engine", "torch", "--device", "cpu", "--threads", 1) == 0
+    out = capsys.readouterr().out
+    assert "160 shots written" in out and "on torch (cpu, float32)" in out
+    assert "ground phase" in out and "on the CPU (NumPy)" in out
+    want, got = pq.read_table(local), pq.read_table(flown)
+    assert got.schema == want.schema
+    for name, field in zip(want.column_names, want.schema, strict=True):
+        if field.type == "double":
+            tolerance = 2e-3 if name.endswith(("_m", "_yd")) else 2e-2
+            np.testing.assert_allclose(got[name].to_numpy(), want[name].to_numpy(), rtol=0, atol=tolerance,
+                                       err_msg=name)
+        else:
+            assert got[name].to_pylist() == want[name].to_pylist(), name
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--engine", "torch", "--workers", "2"], "--workers goes with --engine local or ray"),
+    (["--device", "cpu"], "--device goes with --engine torch"),
+    (["--threads", "1"], "--threads goes with --engine torch"),
+    (["--engine", "torch", "--device", "tpu"], "--device 'tpu': not a device name"),
+    (["--engine", "torch", "--device", "meta"], "only cpu and cuda are supported"),
+])
+def test_options_of_other_engines_and_unknown_devices_are_refused(tmp_path, capsys, argv, message):
+    out = tmp_path / "out.parquet"
+    assert sweep("--grid", "ball_speed_mps=50", "launch_angle_deg=12", "spin_rpm=3000", "--out", out, *argv) == 2
+    assert message in capsys.readouterr().err and not out.exists()
+
+
+@pytest.mark.skipif(torch.cuda.is_available(), reason="this machine has a GPU")
+def test_cuda_without_a_gpu_is_refused_in_one_line(tmp_path, capsys):
+    """By the sweep, and by train, train-real and finetune before they read anything."""
+    with pytest.raises(DeviceError, match="no CUDA GPU"):
+        resolve_device("cuda")
+    out = tmp_path / "out.parquet"
+    assert sweep("--grid", "ball_speed_mps=50", "launch_angle_deg=12", "spin_rpm=3000", "--out", out,
+                 "--engine", "torch", "--device", "cuda") == 2
+    assert capsys.readouterr().err.splitlines() == [
+        (f"golfflight sweep: error: --device cuda: this machine has no CUDA GPU that torch {torch.__version__} can use "
+         "(torch.cuda.is_available() is False); use --device cpu")
+    ]
+    assert not out.exists()
+    missing = str(tmp_path / "missing.csv")
+    for command in (["train", "--data", missing, "--out", str(tmp_path / "run")],
+                    ["train-real", "--work", str(tmp_path / "work"), "--data-root", str(tmp_path)],
+                    ["finetune", "--model", "models/default", "--data", missing, "--out", str(tmp_path / "ft")]):
+        assert main([*command, "--device", "cuda", "--quiet"]) == 2, command
+        assert "--device cuda: this machine has no CUDA GPU" in capsys.readouterr().err, command
+
+
+class NoTorch:
+    """An import finder that finds no torch, as in an install without the train extra."""
+
+    def find_spec(self, name: str, path=None, target=None) -> None:
+        if name == "torch" or name.startswith("torch."):
+            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+
+
+def test_the_torch_engine_without_torch_names_the_extra(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(sys, "meta_path", [NoTorch(), *sys.meta_path])
+    monkeypatch.delitem(sys.modules, "torch")
+    out = tmp_path / "out.parquet"
+    assert sweep("--grid", "ball_speed_mps=50", "launch_angle_deg=12", "spin_rpm=3000", "--out", out,
+                 "--engine", "torch") == 2
+    assert capsys.readouterr().err.splitlines() == [
+        ("golfflight sweep: error: --engine torch needs the train extra, which is not installed (no torch): "
+         "pip install 'golfflight[train]'")
+    ]
+
+
+def test_training_on_the_default_device_is_training_on_the_cpu_bit_for_bit(tiny_shots, tmp_path):
+    """`--device` left out (train, finetune and train-real's joint training) is the CPU, and a CPU run moved through
+    the device plumbing gives the same history and weights, bit for bit (the numbers from before the option)."""
+    config = TrainConfig(variant="phys-nn+", hidden=(16,), epochs=1, batch_size=32, limit=64)
+    default = train(tiny_shots, tmp_path / "default", config, progress=False)
+    on_cpu = train(tiny_shots, tmp_path / "cpu", config, progress=False, device="cpu")
+    assert [_numbers(row) for row in default.history] == [_numbers(row) for row in on_cpu.history]
+    weights = [load_checkpoint(run / "last.pt")["model"] for run in (tmp_path / "default", tmp_path / "cpu")]
+    assert all(torch.equal(weights[0][name], weights[1][name]) for name in weights[0])
+
+
+def _numbers(row: dict) -> dict:
+    """An epoch's history row less its timings."""
+    return {k: v for k, v in row.items() if "seconds" not in k}
