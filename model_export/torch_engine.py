@@ -41,9 +41,9 @@ from golfflight.model_export.torch_physics import Trajectory, apex, derivatives,
 DTYPES = {"float32": torch.float32, "float64": torch.float64}
 """The physics' precisions by name (the network always runs in float32, as the bundle's graph does)."""
 
-CPU_PART_SHOTS = 16_384
-"""Shots flown at once on a CPU: about 120 MB of states at the engine's 200 steps in float32 (the network's step
-costs about 2 us a shot at 4,096 shots and 2.6 at 65,536 on one core: larger parts only leave the caches)."""
+CPU_PART_SHOTS = 4096
+"""Shots flown at once on a CPU: about 30 MB of states at the engine's 200 steps in float32 (on the project's shared
+2-core machine parts of 16,384 flew slower a shot than parts of 4,096: their states leave the caches)."""
 
 DEVICE_MEMORY_SHARE = 0.5
 """Share of a GPU's free memory one part's states may take (the network's activations and the landing's gathers
