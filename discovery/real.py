@@ -293,8 +293,8 @@ def with_and_without_air(sets: list[RealSet]) -> list[RealSet]:
 
 
 def venue_air_row(item: RealSet, diagnosis: Diagnosis, venue: float | None) -> list[str]:
-    """What one run says about air: whether the recordings carry it (and the venue's, `venue` x ICAO, where known),
-    what is named, and air density against it where they carry none."""
+    """What one run says about air, as markdown cells: whether the recordings carry it (and the venue's, `venue` x
+    ICAO, where known), what is named, and air density against it where they carry none."""
     report, rival = diagnosis.report, diagnosis.report.air_rival
     given = venue_ratio(item.recordings)
     air = (
@@ -317,15 +317,8 @@ def venue_air_row(item: RealSet, diagnosis: Diagnosis, venue: float | None) -> l
         )
         verdict = "named" if rival.named else "ruled out" if rival.separable else "inseparable rival"
         separate = "–" if rival.named else LABELS[rival.separating_measurement].split(" (")[0]
-    return [
-        f"{item.title} ({item.use})" if item.use else item.title,
-        str(report.n_shots),
-        air,
-        named,
-        against,
-        verdict,
-        separate,
-    ]
+    cells = [f"{item.title} ({item.use})" if item.use else item.title, str(report.n_shots), air, named, against]
+    return [cell.replace("|", "\\|") for cell in cells + [verdict, separate]]  # |v| in a learned term
 
 
 def figures(diagnosis: Diagnosis) -> dict[str, str]:
