@@ -20,6 +20,7 @@ from golfflight.discovery.words import (
     effect_words,
     p_value,
     quantity,
+    signed,
 )
 
 
@@ -120,8 +121,8 @@ def differences(report: Report, residual: np.ndarray | None = None) -> list[str]
             f"the difference in {OBSERVABLE_WORDS[c.observable]} {way} by {size} per standard deviation of {words}"
         )
     for g in sorted((g for g in located.groups if g.significant), key=lambda g: g.p)[:1]:
-        extremes = ", ".join(f"{k} {v:+.2g} {UNITS[g.observable]}" for k, v in g.extremes.items())
-        out.append(f"{OBSERVABLE_WORDS[g.observable]} differs between {g.grouping}s (most: {extremes})")
+        extremes = ", ".join(f"{k} {signed(v, UNITS[g.observable])}" for k, v in g.extremes.items())
+        out.append(f"{OBSERVABLE_WORDS[g.observable]} differs between {g.grouping}s ({g.grouping} means: {extremes})")
     return out
 
 
@@ -179,7 +180,33 @@ def _physics(report: Report) -> list[str]:
         if held.absorbs_noise:
             share += ", more than the noise allows: part of what it removes is noise"
         out.append(share + ".")
+    air = venue_air(report)
+    if air and air.get("named") and isinstance(air.get("ratio"), float):
+        density = air["ratio"] * report.model.density_kg_m3
+        out.append(f"The recordings carry no air, so this is the venue's: {density:.3f} kg/m³.")
     return out
+
+
+def venue_air(report: Report) -> dict | None:
+    """The comparison with the venue's air (`discovery.venue_air`: report.json's `air_rival`) as a mapping, where
+    the report has one; read by name so the page works with and without it."""
+    return report.model_dump().get("air_rival") or None
+
+
+def _venue_air_words(report: Report, air: dict) -> str:
+    """'air 0.899 ± 0.015 times as dense as assumed (1.101 kg/m³, as at about 888 m)' from the comparison."""
+    ratio, sd, altitude = air.get("ratio"), air.get("ratio_sd"), air.get("equivalent_altitude_m")
+    if not isinstance(ratio, float):
+        return air.get("note", "air density")
+    density = f"{ratio * report.model.density_kg_m3:.3f} kg/m³"
+    where = f", as at about {altitude:.0f} m in the standard atmosphere" if isinstance(altitude, float) else ""
+    return f"air {quantity(ratio, sd)} times as dense as assumed ({density}{where})"
+
+
+def _worse(report: Report, air: dict) -> str:
+    """' (held-out error 1.64 against 0.83)' where the comparison has its held-out error."""
+    error = air.get("heldout_error")
+    return f" (held-out error {error:.2f} against {report.heldout.after_error:.2f})" if isinstance(error, float) else ""
 
 
 def _candidate(report: Report, name: str) -> Candidate | None:
@@ -209,9 +236,11 @@ def rivals(report: Report) -> list[str]:
         for c in report.candidates
         if c.name not in ambiguous and len(c.effects) == len(named) and not named & {e.name for e in c.effects}
     ]
-    air = report.model_dump().get("air_rival")  # venue air (`discovery.venue_air`), where the schema has it
+    air = venue_air(report)
     if air and air.get("separable"):
-        out.append(f"Venue air ruled out: {air.get('note', '')}.")
+        out.append(
+            f"Venue air ruled out: {_venue_air_words(report, air)} fits held-out shots worse beyond doubt{_worse(report, air)}."
+        )
         others = [c for c in others if "air_density" not in {e.name for e in c.effects}]
     if others and not report.ambiguities:
         ruled = min(others, key=lambda c: c.score)

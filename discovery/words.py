@@ -117,6 +117,19 @@ def quantity(value: float, sd: float | None = None, unit: str = "") -> str:
     return with_unit(f"{value:.{places}f} ± {sd:.{places}f}", unit)
 
 
+SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
 def p_value(p: float) -> str:
-    """'p = 0.003', or 'p < 10⁻⁶' where the number itself says nothing more."""
-    return "p < 10⁻⁶" if p < 1e-6 else f"p = {p:.2g}"
+    """'p = 0.003', 'p = 3.2 × 10⁻⁵', or 'p < 10⁻⁶' where the number itself says nothing more."""
+    if p < 1e-6:
+        return "p < 10⁻⁶"
+    if p < 1e-3:
+        exponent = int(np.floor(np.log10(p)))
+        return f"p = {p / 10.0**exponent:.2g} × 10{str(exponent).translate(SUPERSCRIPT)}"
+    return f"p = {p:.2g}"
+
+
+def signed(value: float, unit: str = "") -> str:
+    """'−0.38 m', '+1.2 m': two significant digits, a true minus sign."""
+    return with_unit(f"{value:+.2g}".replace("-", "−"), unit)

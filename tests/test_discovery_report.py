@@ -230,8 +230,27 @@ def test_a_field_the_page_has_no_place_for_is_shown_in_words(diagnosis, monkeypa
 
 
 @pytest.mark.skipif("air_rival" not in Report.model_fields, reason="report.json has no venue-air comparison yet")
-@pytest.mark.filterwarnings("ignore:Pydantic serializer warnings")
-def test_venue_air_ruled_out_is_said_among_the_rivals(diagnosis):
-    rival = {"separable": True, "named": False, "note": "air 0.95 ± 0.01 times as dense fits clearly worse"}
+@pytest.mark.parametrize("named", [False, True])
+def test_the_venue_air_is_said_where_the_report_compares_it(diagnosis, named):
+    from golfflight.discovery.schema import AirRival
+
+    rival = AirRival(
+        explanation="air_density",
+        named=named,
+        ratio=0.899,
+        ratio_sd=0.015,
+        equivalent_altitude_m=888.0,
+        heldout_error=1.64,
+        difference_ci=(0.33, 1.38),
+        separable=not named,
+        separating_measurement=None if named else "carry_y_m",
+        note="in words",
+    )
     found = verdict(diagnosis.report.model_copy(update={"air_rival": rival}))
-    assert "Venue air ruled out: air 0.95 ± 0.01 times as dense fits clearly worse." in found.rivals
+    air = "air 0.899 ± 0.015 times as dense as assumed (1.101 kg/m³, as at about 888 m in the standard atmosphere)"
+    if named:
+        assert found.physics[-1] == "The recordings carry no air, so this is the venue's: 1.101 kg/m³."
+    else:
+        assert f"Venue air ruled out: {air} fits held-out shots worse beyond doubt (held-out error 1.64 against" in (
+            " ".join(found.rivals)
+        )
