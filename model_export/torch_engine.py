@@ -121,13 +121,14 @@ class TorchEngine:
         return self.model(v_rel.float(), omega.float()).to(v_rel.dtype)
 
     def part_shots(self) -> int:
-        """Shots flown at once: `part_shots` if given, else what the device's free memory holds (a GPU), or
-        CPU_PART_SHOTS."""
+        """Shots flown at once: `part_shots` if given, else what the device's free memory holds (a GPU: free to the
+        driver, or held in torch's cache unused, so that the last part's cached blocks count), or CPU_PART_SHOTS."""
         if self.part_limit is not None:
             return self.part_limit
         if self.device.type == "cpu":
             return CPU_PART_SHOTS
         free, _ = torch.cuda.mem_get_info(self.device)
+        free += torch.cuda.memory_reserved(self.device) - torch.cuda.memory_allocated(self.device)  # torch's own cache
         itemsize = torch.finfo(self.dtype).bits // 8
         per_shot = (self.flyer.max_steps + 1) * 3 * STATE_COPIES * itemsize + WORKING_BYTES_PER_SHOT
         return max(1024, int(free * DEVICE_MEMORY_SHARE / per_shot))
