@@ -199,7 +199,11 @@ def _venue_air_words(report: Report, air: dict) -> str:
     if not isinstance(ratio, float):
         return air.get("note", "air density")
     density = f"{ratio * report.model.density_kg_m3:.3f} kg/m³"
-    where = f", as at about {altitude:.0f} m in the standard atmosphere" if isinstance(altitude, float) else ""
+    where = (
+        f", as at about {altitude:.0f} m in the standard atmosphere".replace("-", "−")
+        if isinstance(altitude, float)
+        else ""
+    )
     return f"air {quantity(ratio, sd)} times as dense as assumed ({density}{where})"
 
 

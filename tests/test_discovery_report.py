@@ -254,3 +254,20 @@ def test_the_venue_air_is_said_where_the_report_compares_it(diagnosis, named):
         assert f"Venue air ruled out: {air} fits held-out shots worse beyond doubt (held-out error 1.64 against" in (
             " ".join(found.rivals)
         )
+
+
+def test_a_learned_term_is_said_when_no_library_effect_explains(diagnosis):
+    from golfflight.discovery.schema import Unlisted
+
+    learned = Unlisted(
+        expression="a = -0.0012 |v| v (a drag that grows with speed)",
+        terms={"drag_v": -0.0012},
+        uncertainty={"drag_v": 0.0001},
+        meaning={"drag_v": "drag proportional to |v|"},
+        heldout_error=1.02,
+        library_heldout_error=1.6,
+    )
+    found = verdict(diagnosis.report.model_copy(update={"unlisted": learned}))
+    assert found.headline.endswith("no library effect explains it, a learned extra acceleration does.")
+    assert found.physics[0].startswith("No library effect explains it (best: a steady")
+    assert found.physics[1] == "A learned extra acceleration does: a = -0.0012 |v| v (a drag that grows with speed)."
