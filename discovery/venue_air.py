@@ -145,6 +145,7 @@ def _in_place_of_main(
 
 
 def _blocks(result: Fit) -> list[tuple[Effect, slice]]:
+    """Each effect of a fit with its parameters' place in the fit's parameter vector."""
     out, start = [], 0
     for effect in result.effects:
         out.append((effect, slice(start, start + effect.size)))
