@@ -24,16 +24,20 @@ import numpy as np
 from golfflight.discovery import correction as learned
 from golfflight.discovery.effects import LIBRARY, Context
 from golfflight.discovery.fit import (
+    MAX_FIT_SHOTS,
+    SCORED_SHOTS,
     Fit,
     Problem,
     Scored,
     cluster_bootstrap,
     fit,
     fit_rows,
+    fold_thetas,
     folds,
     heldout,
     linear_starts,
     per_shot,
+    stratified_rows,
 )
 from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
 from golfflight.discovery.model import FlightModel
@@ -190,11 +194,14 @@ def located_mismatch(recordings: Recordings, start: Baseline) -> Located:
     return locate(recordings, start.residual, start.expected.sigma, start.use, along, outliers, start.expected.dilution)
 
 
-def corrected(problem: Problem, chosen: Fit, predicted: np.ndarray, keep_trajectories: bool) -> Corrected:
-    """Fly every recorded shot with the chosen effects (the model's own `predicted` when none)."""
+def corrected(
+    problem: Problem, chosen: Fit, predicted: np.ndarray, keep_trajectories: bool, wind_factor: bool = True
+) -> Corrected:
+    """Fly every shot of the problem with the chosen effects (the model's own `predicted` when none); for a wind,
+    with `wind_factor`, the flights' positions give the log profile's uniform-equivalent factor."""
     if not chosen.k:
         return Corrected(predicted, None, None)
-    has_wind = any(e.name == "wind" for e in chosen.effects)
+    has_wind = wind_factor and any(e.name == "wind" for e in chosen.effects)
     everyone = np.arange(len(problem.recordings))
     theta_rows = np.repeat(chosen.theta[None], len(everyone), 0)
     flown = problem.outcomes(chosen.effects, theta_rows, everyone, keep_positions=keep_trajectories or has_wind)
@@ -245,7 +252,12 @@ def candidates(selection: Selection, context: Context) -> list[Candidate]:
 class Diagnoser:
     """One diagnosis. Making it flies the model on the recordings (`baseline`) and sets up the problem, folds and fit
     rows every candidate shares; its methods read only those, and `run` fits, chooses and reports. With `progress`,
-    each step and a bar over the fits go to standard error (`shots.progress`): a large set takes minutes."""
+    each step and a bar over the fits go to standard error (`shots.progress`): a large set takes minutes.
+
+    The baseline, the systematic test and the chosen explanation's held-out errors use every shot (`everyone`);
+    candidates are fitted and scored on `problem`: every shot up to `scored_shots`, above that a stratified
+    subsample of that many (`scored`, by session and club), with the least-squares fits on at most MAX_FIT_SHOTS of
+    those (`rows`); the report says how many."""
 
     def __init__(
         self,
@@ -256,6 +268,7 @@ class Diagnoser:
         with_correction: bool = True,
         estimate_scatter: bool = True,
         progress: bool = True,
+        scored_shots: int = SCORED_SHOTS,
     ):
         self.started = time.perf_counter()
         self.recordings, self.model, self.library = recordings, model, LIBRARY
@@ -264,9 +277,15 @@ class Diagnoser:
         self.step(f"flying {len(recordings):,} recorded shots through the model and its expected error...")
         self.baseline = baseline(recordings, model, noise, seed, estimate_scatter)
         start = self.baseline
-        self.problem = Problem(model, recordings, start.base, start.expected.sigma, start.use, start.offset)
+        self.everyone = Problem(model, recordings, start.base, start.expected.sigma, start.use, start.offset)
         self.fold, self.grouping = folds(recordings.session)
-        self.rows = fit_rows(recordings, self.rng)
+        self.scored = stratified_rows(recordings, scored_shots, np.random.default_rng([seed, 2]))
+        if len(self.scored) == len(recordings):
+            self.problem, self.rows = self.everyone, fit_rows(recordings, self.rng)
+        else:  # a large set: its own stratified fit rows among the scored ones
+            self.problem = self.everyone.subset(self.scored)
+            self.rows = stratified_rows(self.problem.recordings, MAX_FIT_SHOTS, self.rng)
+        self.scored_fold = self.fold[self.scored]
         self._response_errors: dict[tuple[str, bytes], float] = {}  # memo: asked up to three times
 
     def run(self) -> Diagnosis:
@@ -277,8 +296,15 @@ class Diagnoser:
         selection = self.select(has_structure(located))
         chosen = selection.chosen
         self.step("the chosen explanation's flights and held-out errors...")
-        after = corrected(self.problem, chosen.fit, start.predicted, bool(self.recordings.trajectories))
-        heldout_block = self.heldout_summary(selection.null, chosen)
+        trajectories = bool(self.recordings.trajectories)
+        after = corrected(self.problem, chosen.fit, start.predicted[self.scored], trajectories)
+        everywhere = (
+            after
+            if self.problem is self.everyone
+            else corrected(self.everyone, chosen.fit, start.predicted, trajectories, wind_factor=False)
+        )
+        null_everywhere, chosen_everywhere = self.everywhere(selection.null), self.everywhere(chosen)
+        heldout_block = self.heldout_summary(null_everywhere, chosen_everywhere)
         ambiguities = (
             ambiguity(self.problem, chosen, after.outcomes, selection.scored, self.rng) if selection.systematic else []
         )
@@ -293,11 +319,11 @@ class Diagnoser:
             report,
             self.recordings,
             start.predicted,
-            after.outcomes,
-            selection.null.heldout_z * sigma,
-            chosen.heldout_z * sigma,
+            everywhere.outcomes,
+            null_everywhere.heldout_z * sigma,
+            chosen_everywhere.heldout_z * sigma,
             start.flown.positions,
-            after.positions,
+            everywhere.positions,
             chosen if selection.systematic else None,
         )
 
@@ -332,6 +358,8 @@ class Diagnoser:
             recordings=recordings.source,
             n_shots=len(recordings),
             n_sessions=recordings.n_sessions,
+            fit_shots=len(self.rows),
+            scored_shots=len(self.scored),
             observables=list(recordings.observed_names),
             trajectories=len(recordings.trajectories),
             model=model_info(model, context, self.baseline, self.estimate_scatter),
@@ -348,16 +376,30 @@ class Diagnoser:
             + air_sentence(rival)
             + left_sentence(selection.unexplained)
             + control_sentence(model, self.baseline.offset, self.response_error(chosen))
-            + (scatter_sentence(self.baseline.scatter) if self.estimate_scatter else ""),
+            + (scatter_sentence(self.baseline.scatter) if self.estimate_scatter else "")
+            + sampling_sentence(len(recordings), len(self.scored), len(self.rows)),
             service_settings=service_settings(effects, context, after.wind_factor),
             seconds=time.perf_counter() - self.started,
         )
 
     def null_candidate(self) -> Scored:
         """The model as is, scored like any candidate (no parameters, no penalty)."""
-        null_z = self.problem.standardize(self.baseline.predicted, np.arange(len(self.recordings)))
+        null_z = self.problem.standardize(self.baseline.predicted[self.scored], np.arange(len(self.scored)))
         empty = Fit((), np.zeros(0), null_z, np.zeros(null_z.shape + (0,)), np.zeros((0, 0)))
         return Scored(empty, null_z, _mean_sq(null_z), 0.0)
+
+    def everywhere(self, candidate: Scored) -> Scored:
+        """A candidate scored on the shots it was chosen on, scored on every shot: each fold flown with the
+        parameters its scored shots gave without it (the candidate itself where every shot was scored)."""
+        if self.problem is self.everyone:
+            return candidate
+        result, n = candidate.fit, len(self.recordings)
+        if result.k == 0:
+            z = self.everyone.standardize(self.baseline.predicted, np.arange(n))
+        else:
+            z = heldout(self.everyone, result, self.fold, fold_thetas(result, self.scored_fold))
+        error = _mean_sq(z)
+        return Scored(result, z, error, error * result.k * np.log(n) / n)
 
     def select(self, structure: bool) -> Selection:
         """Fit the singles and pairs, choose among them, try the learned correction where structure is left, and
@@ -387,8 +429,8 @@ class Diagnoser:
         return Selection(null, scored, chosen, True, test, unlisted, unexplained)
 
     def score(self, result: Fit) -> Scored:
-        z = heldout(self.problem, result, self.fold)
-        n = len(self.recordings)
+        z = heldout(self.problem, result, self.scored_fold)
+        n = len(self.scored)
         error = _mean_sq(z)
         return Scored(result, z, error, error * result.k * np.log(n) / n)
 
@@ -400,7 +442,7 @@ class Diagnoser:
         `response_error`); (flag, gain, low, high)."""
         a, count = per_shot(simple.heldout_z)
         b, _ = per_shot(rich.heldout_z)
-        draws = cluster_bootstrap(a - b, count, self.recordings.session, self.rng)
+        draws = cluster_bootstrap(a - b, count, self.problem.recordings.session, self.rng)
         gain = float((a - b).sum() / count.sum())
         low, high = np.quantile(draws, [1 - level, level])
         against = simple.error if against is None else against
@@ -421,7 +463,7 @@ class Diagnoser:
             return 0.0
         key = (result.name, result.theta.tobytes())
         if key not in self._response_errors:
-            everyone = np.arange(len(self.recordings))
+            everyone = np.arange(len(self.scored))
             theta_rows = np.repeat(result.theta[None], len(everyone), 0)
             truth = self.problem.outcomes(result.effects, theta_rows, everyone, model=control).outcomes()
             model = self.problem.predict(result.effects, result.theta, everyone)[0]
@@ -510,11 +552,12 @@ class Diagnoser:
         when nothing is left; "the whole mismatch" for no explanation)."""
         if explanation.fit.k == 0:
             return ["the whole mismatch"]
-        everyone = np.arange(len(self.recordings))
-        after = self.problem.predict(explanation.fit.effects, explanation.fit.theta, everyone)[0]
-        residual = self.recordings.observed - after
-        use = self.problem.use & np.isfinite(after)
-        left = locate(self.recordings, residual, self.problem.sigma, use, [], {}, self.baseline.expected.dilution)
+        problem = self.problem
+        after = problem.predict(explanation.fit.effects, explanation.fit.theta, np.arange(len(self.scored)))[0]
+        residual = problem.observed - after
+        use = problem.use & np.isfinite(after)
+        dilution = {name: slopes[self.scored] for name, slopes in self.baseline.expected.dilution.items()}
+        left = locate(problem.recordings, residual, problem.sigma, use, [], {}, dilution)
         return left.summary if has_structure(left) else []
 
     def heldout_summary(self, null: Scored, chosen: Scored) -> Heldout:
@@ -589,6 +632,19 @@ def scatter_sentence(scatter: Scatter) -> str:
         f" The recordings scatter more from shot to shot than the assumed launch-monitor noise ({parts}, about a "
         "linear trend in the launch within each session and club), so that scatter is what they are expected to "
         "miss by."
+    )
+
+
+def sampling_sentence(n_shots: int, scored: int, fitted: int) -> str:
+    """How many shots the candidates were fitted and scored on and what that does to the quoted uncertainties, in
+    words (empty where every shot was scored)."""
+    if scored == n_shots:
+        return ""
+    return (
+        f" The candidates were fitted on {fitted:,} and scored on {scored:,} of the {n_shots:,} shots (a subsample "
+        "stratified by session and club); the ± quoted are from those shots: the whole set would narrow them by up to "
+        f"{np.sqrt(n_shots / scored):.1f}x where its shots scatter independently, by much less where each session's "
+        "own conditions dominate. The systematic test and the chosen explanation's held-out errors use every shot."
     )
 
 

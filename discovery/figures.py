@@ -100,7 +100,10 @@ def session_figure(diagnosis) -> go.Figure:
     shift shared by a session (its weather) stands out from the rest."""
     rec = diagnosis.recordings
     names = [(j, n) for j, n in enumerate(OBSERVABLES) if n in rec.observed_names]
-    sessions = np.unique(rec.session)
+    sessions, codes = np.unique(rec.session, return_inverse=True)
+    # each session's shots in recorded order, found once (a season has a thousand sessions and 100,000 shots)
+    members = np.split(np.argsort(codes, kind="stable"), np.cumsum(np.bincount(codes))[:-1])
+    clubs = [", ".join(np.unique(rec.club[rows]).astype(str)) for rows in members]
     figure = make_subplots(rows=len(names), cols=1, shared_xaxes=True, subplot_titles=[LABELS[n] for _, n in names])
     series = [("model as is", diagnosis.before, BEFORE)]
     if diagnosis.chosen is not None:
@@ -108,13 +111,12 @@ def session_figure(diagnosis) -> go.Figure:
     for row, (j, name) in enumerate(names, start=1):
         for label, predicted, color in series:
             means, errors, details = [], [], []
-            for session in sessions:
-                residual = (rec.observed[:, j] - predicted[:, j])[rec.session == session]
+            for session, rows, played in zip(sessions, members, clubs):
+                residual = rec.observed[rows, j] - predicted[rows, j]
                 residual = residual[np.isfinite(residual)]
                 means.append(residual.mean() if residual.size else np.nan)
                 errors.append(residual.std(ddof=1) / np.sqrt(residual.size) if residual.size > 1 else np.nan)
-                clubs = ", ".join(np.unique(rec.club[rec.session == session]).astype(str))
-                details.append([str(session), residual.size, clubs, errors[-1]])
+                details.append([str(session), residual.size, played, errors[-1]])
             figure.add_trace(
                 go.Scatter(
                     x=sessions.astype(str),

@@ -24,6 +24,13 @@ MISSED_LANDING_Z = 10.0
 MAX_FIT_SHOTS = 600
 """Effects are fitted on at most this many shots (spread over sessions); held-out scoring uses every shot."""
 
+SCORED_SHOTS = 5_000
+"""Candidates are scored (Jacobian, covariance, held-out error) on at most this many shots, a stratified subsample of
+larger sets (`stratified_rows`); the systematic test and the chosen explanation's held-out errors use every shot.
+Each candidate costs about (2 + k) flights of its scored shots, so this bounds a 100,000-shot diagnosis; with every
+session represented the session-clustered uncertainties grow by far less than sqrt(N / SCORED_SHOTS)
+(docs/discovery.md, "Scale")."""
+
 MAX_EVALUATIONS = 12
 
 
@@ -63,6 +70,17 @@ class Problem:
         theta_rows = np.repeat(thetas, len(rows), axis=0)
         flown = self.outcomes(effects, theta_rows, np.tile(rows, len(thetas)))
         return flown.outcomes().reshape(len(thetas), len(rows), len(OBSERVABLES)) + self.offset[rows]
+
+    def subset(self, rows: np.ndarray) -> Problem:
+        """The same problem restricted to the shots at `rows`."""
+        return Problem(
+            self.model,
+            self.recordings.subset(rows),
+            self.base.take(rows),
+            self.sigma[rows],
+            self.use[rows],
+            self.offset[rows],
+        )
 
     def standardize(self, predicted: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """(recorded - predicted) / sigma [..., len(rows), 5]; NaN where unused, a large value where not landed."""
@@ -190,6 +208,19 @@ def fit_rows(recordings: Recordings, rng: np.random.Generator, limit: int = MAX_
     return np.sort(rng.choice(n, size=limit, replace=False))
 
 
+def stratified_rows(recordings: Recordings, size: int, rng: np.random.Generator) -> np.ndarray:
+    """`size` shots (all of them if there are no more) spread over every session and club in proportion: a systematic
+    sample, from a random start, through the shots ordered by session, club and a random key, so each session-club
+    stratum of n shots gets n x size / N of them (rounded one way or the other) and no session is left out whose
+    shots number at least N / size. Sorted indices."""
+    n = len(recordings)
+    if n <= size:
+        return np.arange(n)
+    order = np.lexsort((rng.random(n), recordings.club, recordings.session))
+    picks = np.floor(rng.random() * n / size + np.arange(size) * n / size).astype(int)
+    return np.sort(order[np.minimum(picks, n - 1)])
+
+
 def fit(problem: Problem, effects: tuple[Effect, ...], start: np.ndarray, rows: np.ndarray) -> Fit:
     """Least-squares fit of the effects' parameters on `rows`, then residuals and Jacobian on every shot."""
     low, high, typical, _ = _bounds(effects)
@@ -239,18 +270,29 @@ def folds(groups: np.ndarray, n_folds: int = 5) -> tuple[np.ndarray, str]:
     return (np.arange(n) * k // n), ("shot blocks in recorded order" if k < n else "leave one shot out")
 
 
-def heldout(problem: Problem, result: Fit, fold: np.ndarray) -> np.ndarray:
-    """Held-out standardized residuals [N, 5]: each fold flown with parameters fitted without it."""
-    if result.k == 0:
-        return result.z
+def fold_thetas(result: Fit, fold: np.ndarray) -> dict[int, np.ndarray]:
+    """Each fold's parameters: one Gauss-Newton step from the fit using only the other folds' residuals and Jacobian
+    (`fold` gives the fold of each shot the fit's residuals are on)."""
     low, high, _, _ = _bounds(result.effects)
     used = np.isfinite(result.z)
-    theta_rows = np.empty((len(fold), result.k))
+    thetas = {}
     for f in np.unique(fold):
         train = used & (fold != f)[:, None]
         J, r = result.jacobian[train], result.z[train]
         step = np.linalg.lstsq(J, -r, rcond=None)[0] if len(r) > result.k else np.zeros(result.k)
-        theta_rows[fold == f] = np.clip(result.theta + step, low, high)
+        thetas[int(f)] = np.clip(result.theta + step, low, high)
+    return thetas
+
+
+def heldout(problem: Problem, result: Fit, fold: np.ndarray, thetas: dict[int, np.ndarray] | None = None) -> np.ndarray:
+    """Held-out standardized residuals [N, 5]: each fold flown with parameters fitted without it (`thetas`, by
+    default `fold_thetas` of the fit itself; a fold without any keeps the fit's parameters, which never saw it)."""
+    if result.k == 0:
+        return result.z
+    thetas = fold_thetas(result, fold) if thetas is None else thetas
+    theta_rows = np.repeat(result.theta[None], len(fold), axis=0)
+    for f, theta in thetas.items():
+        theta_rows[fold == f] = theta
     everyone = np.arange(len(fold))
     predicted = problem.outcomes(result.effects, theta_rows, everyone).outcomes() + problem.offset
     return problem.standardize(predicted, everyone)

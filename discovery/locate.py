@@ -85,6 +85,21 @@ def holm(pvalues: list[float], alpha: float = ALPHA) -> list[bool]:
     return reject
 
 
+def group_codes(recordings: Recordings) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """(sorted names, each shot's index among them) of the clubs and of the sessions: the same groups as the names,
+    without comparing strings shot by shot on a large set."""
+    return {grouping: np.unique(getattr(recordings, grouping), return_inverse=True) for grouping in ("club", "session")}
+
+
+def group_means(values: np.ndarray, codes: np.ndarray, names: np.ndarray) -> dict[str, float]:
+    """The mean of `values` in each group present (`codes` index `names`), keyed by name in code order; each mean is
+    taken over its members in their order, as `values[codes == g].mean()` would, in one sort instead of a pass per
+    group."""
+    order = np.argsort(codes, kind="stable")
+    present, starts = np.unique(codes[order], return_index=True)
+    return {str(names[g]): float(part.mean()) for g, part in zip(present, np.split(values[order], starts[1:]))}
+
+
 def binned_means(x: np.ndarray, y: np.ndarray, bins: int = 8) -> tuple[np.ndarray, np.ndarray]:
     """Means of y in quantile bins of x (the trend line drawn over a scatter)."""
     keep = np.isfinite(x) & np.isfinite(y)
@@ -162,6 +177,7 @@ def locate(
     trend is tested after taking out the trend its own recording noise makes (`discovery.noise.dilution_slopes`)."""
     pending: list[tuple[type, dict, list[int]]] = []
     pvalues: list[float] = []
+    codes = group_codes(recordings)
 
     def add(kind: type, item: dict, *p: float) -> None:
         pending.append((kind, item, list(range(len(pvalues), len(pvalues) + len(p)))))
@@ -171,7 +187,7 @@ def locate(
         rows = use[:, j]
         if rows.sum() < 3:
             continue
-        r, s, sessions = residual[rows, j], sigma[rows, j], recordings.session[rows]
+        r, s, sessions = residual[rows, j], sigma[rows, j], codes["session"][1][rows]
         z = r / s
         bias, se, p_bias = mean_test(r, sessions)
         _, _, p_excess = mean_test(z**2, sessions, null=1.0)
@@ -201,11 +217,12 @@ def locate(
             slope, t, p = slope_test(r - expected, x, sessions)
             add(CovariateStat, {"observable": name, "covariate": covariate, "slope_per_sd": slope, "t": t, "p": p}, p)
         for grouping in ("club", "session"):
-            labels = getattr(recordings, grouping)[rows]
+            names, every = codes[grouping]
+            labels = every[rows]
             f, p, k = group_test(z, labels)
             if k < 2:
                 continue
-            means = {str(g): float(r[labels == g].mean()) for g in np.unique(labels)}
+            means = group_means(r, labels, names)
             extremes = dict(sorted(means.items(), key=lambda kv: -abs(kv[1] - bias))[:3])
             add(
                 GroupStat,

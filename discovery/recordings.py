@@ -86,12 +86,13 @@ def _text(values: np.ndarray, fallback: str) -> np.ndarray:
 
 def _shot_order(session: np.ndarray, timestamp: np.ndarray) -> np.ndarray:
     """0, 1, 2, ... within each session, by timestamp where recorded, else by file order."""
-    order = np.zeros(len(session), dtype=int)
     keys = np.array(["" if t is None else str(t) for t in timestamp], dtype=object)
-    for name in np.unique(session):
-        rows = np.flatnonzero(session == name)
-        rows = rows[np.argsort(keys[rows], kind="stable")]
-        order[rows] = np.arange(len(rows))
+    sessions = np.unique(session, return_inverse=True)[1]
+    times = np.unique(keys, return_inverse=True)[1]
+    rows = np.lexsort((np.arange(len(session)), times, sessions))  # by session, then time, then file order
+    starts = np.flatnonzero(np.r_[True, np.diff(sessions[rows]) != 0])
+    order = np.empty(len(session), dtype=int)
+    order[rows] = np.arange(len(rows)) - np.repeat(starts, np.diff(np.r_[starts, len(rows)]))
     return order
 
 

@@ -251,6 +251,14 @@ class Report(_Strict):
     recordings: str
     n_shots: int
     n_sessions: int
+    fit_shots: int = Field(
+        description="shots the candidates' least-squares fits used (a subsample spread over sessions above 600)"
+    )
+    scored_shots: int = Field(
+        description="shots the candidates were scored on (their residuals, Jacobian, the quoted ± and the held-out "
+        "comparisons): every shot up to 5,000, above that a subsample stratified by session and club; the systematic "
+        "test and the chosen explanation's held-out errors use every shot"
+    )
     observables: list[str]
     trajectories: int = Field(description="shots with a recorded trajectory")
     model: ModelInfo

@@ -17,6 +17,11 @@ from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import CoefficientModel, initial_state
 from golfflight.flight.wind import Wind
 
+CHUNK_SHOTS = 25_000
+"""Batches larger than this are flown in chunks of it when no positions are kept: the flight of each shot is its own,
+so the outcomes are the same, and the memory a batch needs stays bounded (a 100,000-shot diagnosis flies batches of
+up to five times its shots at once)."""
+
 CoefficientsFor = Callable[[np.ndarray], CoefficientModel]
 """Builds the model's coefficient function for shots whose air density is `ratio` x the assumed one (per shot)."""
 
@@ -91,6 +96,10 @@ class Flown:
         )
 
 
+FLOWN_OUTCOMES = ("landing_xy", "apex_m", "flight_time_s", "landing_angle_deg")
+"""The per-shot fields of a `Flown` batch, in order."""
+
+
 def fly_setup(
     setup: Setup,
     coefficients_for: CoefficientsFor,
@@ -129,6 +138,14 @@ def simulate_setup(
 
     A parameter set far outside reality may make a ball diverge; its outcome is then NaN (not landed), silently.
     """
+    if not keep_positions and len(setup) > CHUNK_SHOTS:
+        settings = (coefficients_for, dt_s, t_max_s, method, correction)
+        chunks = [
+            simulate_setup(setup.take(np.arange(start, min(start + CHUNK_SHOTS, len(setup)))), *settings)
+            for start in range(0, len(setup), CHUNK_SHOTS)
+        ]
+        values = [np.concatenate([getattr(c, name) for c in chunks]) for name in FLOWN_OUTCOMES]
+        return Flown(*values, dt_s=dt_s)
     flight = fly_setup(setup, coefficients_for, dt_s, t_max_s, method, correction, keep_positions)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         landing_angle = flight.landing_angle_deg
