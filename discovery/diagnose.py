@@ -161,12 +161,19 @@ def outlier_mask(residual: np.ndarray) -> np.ndarray:
 
 
 def baseline(
-    recordings: Recordings, model: FlightModel, noise: MeasurementNoise, seed: int, estimate_scatter: bool
+    recordings: Recordings,
+    model: FlightModel,
+    noise: MeasurementNoise,
+    seed: int,
+    estimate_scatter: bool,
+    progress: bool = False,
 ) -> Baseline:
-    """Fly the recorded launches through the model (and its control), and measure how far off it is expected to be."""
+    """Fly the recorded launches through the model (and its control), and measure how far off it is expected to be
+    (with `progress`, the expected error's flights, five times the model's, are named as they start)."""
     base = base_conditions(recordings, model)
     flown = model.simulate(base, keep_positions=bool(recordings.trajectories))
     predicted = flown.outcomes()
+    progress_step("the model's response to the launch monitor's noise (five more flights of every shot)...", progress)
     expected = expected_error(model, recordings, base, predicted, noise)
     offset = np.zeros_like(predicted)
     if model.control is not None:  # the model's known error on these launches, taken out of every prediction
@@ -275,7 +282,7 @@ class Diagnoser:
         self.with_correction, self.estimate_scatter, self.progress = with_correction, estimate_scatter, progress
         self.rng = np.random.default_rng(seed)
         self.step(f"flying {len(recordings):,} recorded shots through the model and its expected error...")
-        self.baseline = baseline(recordings, model, noise, seed, estimate_scatter)
+        self.baseline = baseline(recordings, model, noise, seed, estimate_scatter, progress)
         start = self.baseline
         self.everyone = Problem(model, recordings, start.base, start.expected.sigma, start.use, start.offset)
         self.fold, self.grouping = folds(recordings.session)
