@@ -174,14 +174,15 @@ class FlightEngine:
     def putt(self, launch: Launch, ground: GroundSpec, keep_states: bool = False) -> ShotFlight:
         """Skid and roll one putt to rest on `ground` (`flight.ground.putt_phase`): the ball never leaves it, so the
         flight's figures are its start's (landing at the tee, carry, apex, times and landing angle 0, the launch's
-        speed and spin). A putt is played on that ground itself from the origin: its states lie on the ground's plane
-        through (0, 0, 0) (z = 0 when level), and `ground.elevation_m`, the height a flight comes down to, plays no
-        part. ValueError for a slope steeper than the surface holds a ball on."""
+        speed and spin). A putt is played on that ground itself, from the point below the tee: its states lie on the
+        ground's plane through (0, 0, ground.elevation_m), so a screen draws it on the green it rolls on. ValueError
+        for a slope steeper than the surface holds a ball on."""
         rolled = putt_phase(*launch, ground.surface, ground.slope_deg, ground.slope_dir_deg, keep_states)
         states = None
         if rolled.path is not None:
             path = rolled.path
-            states = EulerStates(times_s=path.times_s, positions=path.positions, velocities=path.velocities)
+            positions = path.positions + np.array([0.0, 0.0, ground.elevation_m])
+            states = EulerStates(times_s=path.times_s, positions=positions, velocities=path.velocities)
         x, y, _ = rolled.position
         return ShotFlight(
             landing_x_m=0.0, landing_y_m=0.0, carry_m=0.0, lateral_m=0.0, apex_m=0.0, apex_time_s=0.0,

@@ -111,3 +111,13 @@ def test_a_slope_steeper_than_the_green_holds_is_refused():
         GroundSpec(surface=green, slope_deg=holding + 0.5)
     held = putt_phase(1.83, 2.0, 0.0, 0.0, 0.0, green, slope_deg=holding - 0.5, slope_dir_deg=90.0)
     assert held.time_s < MAX_ROLL_TIME_S and held.position[0] > 0.0
+
+
+def test_a_putt_rolls_on_its_green_where_that_green_lies(engine: FlightEngine):
+    """A bay's green 3 m below the tee: the putt's states lie on it (z = -3 m), the same roll as on a green at 0."""
+    level = engine.putt(Launch(1.83, 2.0, 0.0, 100.0, 0.0), GroundSpec(surface=surface("green", 11.0)), True)
+    below = engine.putt(Launch(1.83, 2.0, 0.0, 100.0, 0.0),
+                        GroundSpec(surface=surface("green", 11.0), elevation_m=-3.0), True)
+    np.testing.assert_allclose(below.states.positions[:, 2], -3.0)
+    np.testing.assert_allclose(below.states.positions[:, :2], level.states.positions[:, :2])
+    assert below.rest == level.rest

@@ -131,7 +131,7 @@ def test_the_drawn_path_is_the_answered_flight_through_its_landing_to_its_rest(e
     assert flight.carry_m == answered.carry_m and flight.rest == answered.rest
     assert 2 <= len(flight.trajectory) <= MAX_POINTS
     points = np.array([(p.x_m, p.y_m, p.z_m) for p in flight.trajectory])
-    floor = request.ground.elevation_m if request.ground is not None and not putt else 0.0
+    floor = request.ground.elevation_m if request.ground is not None else 0.0  # a putt rolls on that green too
     assert points[-1] == pytest.approx((answered.rest.x_m, answered.rest.y_m, floor), abs=1e-9)
     landing = (answered.landing.x_m, answered.landing.y_m, floor)
     assert np.min(np.linalg.norm(points - landing, axis=1)) < 1e-9  # the landing itself, not a chord beside it
