@@ -7,7 +7,8 @@ them in the reference world's flights (the model-form campaign: what the diagnos
 that physics adds). Scores: detection rate (and false alarms on at least CLEAN_SETS clean sets), which effect was
 named against which was hidden (confusion), the fitted parameters' error relative to the hidden effect's size, and
 the share of the excess held-out error removed. Every case uses several seeds: new sessions, launches, noise and
-effect size each time.
+effect size each time. `campaign="triples"` hides three library effects at once (`TRIPLES`) beside clean sets, and
+scores whether all three are named and all three fitted within 10 % of their sizes.
 """
 
 from __future__ import annotations
@@ -36,6 +37,14 @@ from golfflight.shots.progress import progress_bar
 COMBINATION = ("wind", "ball_speed_bias")
 """The two-effect case: a carry-alike pair that only the other observables can separate."""
 
+TRIPLES = (
+    ("wind", "ball_speed_bias", "spin_axis_bias"),
+    ("air_density", "launch_angle_bias", "spin_bias"),
+    ("landing_elevation", "lift_scale", "launch_direction_bias"),
+)
+"""The three-effect cases of the `triples` campaign: a condition, a launch bias and a third effect of another kind
+in each, so every library effect family is hidden beside two others."""
+
 LOG_WIND = "wind, log profile"
 """A wind stated at 10 m that follows the log profile (slower low down, faster high up): `wind` must be named with
 its uniform-equivalent speed (the stated speed x the profile's mean factor along the flights), and the service
@@ -45,12 +54,22 @@ CLEAN_SETS = 40
 """Clean sets per campaign, whatever the seeds per case: false alarms are counted on at least this many."""
 
 Truth = Literal["model", "reference"]
+Campaign = Literal["library", "triples"]
+CAMPAIGNS: tuple[Campaign, ...] = ("library", "triples")
 
 
-def command(model_spec: str, truth: Truth, only: str | None = None, seeds: int | None = None) -> str:
+def command(
+    model_spec: str,
+    truth: Truth,
+    only: str | None = None,
+    seeds: int | None = None,
+    campaign: Campaign = "library",
+) -> str:
     """The `golfflight` command whose generated section the tables go to: one per model and campaign (and case
     filter), so such sections coexist."""
-    extra = "" if only is None else f" --cases '{only}' --seeds {seeds}"
+    extra = "" if campaign == "library" else f" --campaign {campaign}"
+    extra += "" if only is None else f" --cases '{only}'"
+    extra += f" --seeds {seeds}" if extra else ""
     return f"prove --model {model_spec} --truth {truth}{extra}"
 
 
@@ -93,10 +112,13 @@ def draw_effect(name: str, rng: np.random.Generator) -> dict[str, float]:
     return {key: float(centre + _sign(rng) * rng.uniform(low, high))}
 
 
-def cases(truth: Truth = "model") -> list[tuple[str, tuple[str, ...]]]:
+def cases(truth: Truth = "model", campaign: Campaign = "library") -> list[tuple[str, tuple[str, ...]]]:
     """(case name, hidden effects): clean, every library effect, the combination, the effects outside the library
     (the reference world takes the moved drag crisis and the gust that grows with height; the model's own flights
-    every one of `discovery.outside.OUTSIDE`) and, in the reference world, a log-profile wind."""
+    every one of `discovery.outside.OUTSIDE`) and, in the reference world, a log-profile wind; or, in the `triples`
+    campaign, clean and the three-effect cases `TRIPLES`."""
+    if campaign == "triples":
+        return [("clean", ())] + [("+".join(triple), triple) for triple in TRIPLES]
     library = [(e.name, (e.name,)) for e in LIBRARY]
     if truth == "reference":
         library.append((LOG_WIND, ("wind",)))
@@ -220,13 +242,14 @@ def prove(
     truth: Truth = "model",
     clean_sets: int = CLEAN_SETS,
     progress: bool = True,
+    campaign: Campaign = "library",
 ) -> list[Run]:
     """Every case of the campaign (or those whose name matches the regular expression `only`) at `seeds` seeds,
     the clean case `clean_sets` times; `report` gets a line on each run as it ends, and with `progress` a bar over
     the runs goes to standard error (`shots.progress`)."""
     planned = [
         (case, effects, seed)
-        for case, effects in cases(truth)
+        for case, effects in cases(truth, campaign)
         if only is None or re.search(only, case)
         for seed in range(seeds if effects else clean_sets)
     ]
@@ -258,6 +281,11 @@ def _among(run: Run) -> bool:
     return bool(hidden) and hidden <= named
 
 
+def _within(run: Run, tolerance: float = 0.1) -> bool:
+    """Every hidden effect was fitted with its parameters within `tolerance` of its size (a missed effect is not)."""
+    return set(run.parameter_error) == set(run.hidden) and all(e <= tolerance for e in run.parameter_error.values())
+
+
 def _share(flags: list[bool]) -> str:
     return f"{sum(flags)} of {len(flags)} ({np.mean(flags):.0%})"
 
@@ -268,6 +296,7 @@ def _measure_rows(runs: list[Run], truth: Truth) -> list[str]:
     hidden = [r for r in runs if r.case != "clean"]
     library = [r for r in hidden if r.case in EFFECTS]
     outside = [r for r in hidden if _outside(r.hidden)]
+    triples = [r for r in hidden if len(r.hidden) == 3]
     errors = [e for r in hidden for e in r.parameter_error.values()]
     fractions = [r.explained_fraction for r in hidden if r.explained_fraction is not None]
     rows = []
@@ -294,6 +323,15 @@ def _measure_rows(runs: list[Run], truth: Truth) -> list[str]:
         )
     if outside:
         rows.append(f"| outside effects reported as unlisted | {_share([r.correct for r in outside])} | ≥ 80 % |")
+    if triples:
+        rows += [
+            f"| three effects: all three among those named | {_share([_among(r) for r in triples])} | ≥ 80 % |",
+            f"| three effects: exactly these three named | {_share([r.correct for r in triples])} | - |",
+            (
+                "| three effects: all three fitted within 10 % of their sizes | "
+                f"{_share([_within(r) for r in triples])} | ≥ 60 % |"
+            ),
+        ]
     if hidden:
         rows.append(
             "| fits flagged as absorbing noise (over 100 % beyond doubt, error 25 % below the noise floor) | "
@@ -380,7 +418,7 @@ def _every_run(runs: list[Run]) -> list[str]:
     return lines
 
 
-def tables(runs: list[Run], model_name: str, truth: Truth = "model") -> str:
+def tables(runs: list[Run], model_name: str, truth: Truth = "model", campaign: Campaign = "library") -> str:
     """The markdown tables of a prove run."""
     flown = "the diagnosed model's own flights" if truth == "model" else "the reference world's flights"
     opening = (
@@ -388,7 +426,7 @@ def tables(runs: list[Run], model_name: str, truth: Truth = "model") -> str:
         f"{int(np.mean([r.n_shots for r in runs]))} shots and {np.mean([r.n_sessions for r in runs]):.1f} sessions "
         f"each on average; diagnose took {np.median([r.seconds for r in runs]):.1f} s per set (median)."
     )
-    present = [(case, effects) for case, effects in cases(truth) if any(r.case == case for r in runs)]
+    present = [(case, effects) for case, effects in cases(truth, campaign) if any(r.case == case for r in runs)]
     lines = [opening, "", "| measure | reached | target |", "|---|---:|---:|", *_measure_rows(runs, truth), ""]
     lines += [*_confusion(runs, present), "", *_per_case(runs, present), "", *_every_run(runs)]
     return "\n".join(lines) + "\n"
@@ -400,9 +438,15 @@ def read_runs(path: Path) -> list[Run]:
 
 
 def write_tables(
-    runs: list[Run], markdown: Path, json_path: Path | None, model_name: str, command: str, truth: Truth = "model"
+    runs: list[Run],
+    markdown: Path,
+    json_path: Path | None,
+    model_name: str,
+    command: str,
+    truth: Truth = "model",
+    campaign: Campaign = "library",
 ) -> None:
     """Put the tables into the markdown file's section of `command`; optionally dump every run as JSON."""
-    write_generated_section(markdown, tables(runs, model_name, truth), command)
+    write_generated_section(markdown, tables(runs, model_name, truth, campaign), command)
     if json_path is not None:
         write_text_atomic(json_path, json.dumps([asdict(r) for r in runs], indent=1) + "\n")

@@ -3,6 +3,8 @@ the proof's bookkeeping."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from golfflight.discovery.conceal import conceal
@@ -18,7 +20,16 @@ from golfflight.discovery.correction import (
 from golfflight.discovery.effects import EFFECTS, Context, equivalent_altitude_m
 from golfflight.discovery.model import reference
 from golfflight.discovery.outside import HEIGHT_GUST, OUTSIDE, HeightGust, air_motion
-from golfflight.discovery.prove import Run, cases, draw_effect, expected_label, relative_error, tables
+from golfflight.discovery.prove import (
+    TRIPLES,
+    Run,
+    cases,
+    draw_effect,
+    expected_label,
+    read_runs,
+    relative_error,
+    tables,
+)
 from golfflight.discovery.report import plus_minus, service_settings, share_interval
 from golfflight.discovery.schema import EffectResult
 from golfflight.flight.air import pressure_at_altitude
@@ -230,3 +241,27 @@ def test_prove_runs_only_the_cases_asked_for_into_their_own_section(tmp_path):
     assert again.read_text() == written, "the tables of a dump are the tables of its run"
     assert main(["prove", "--cases", "^nothing$", "--out", str(out)]) == 2
     assert main(["prove", "--cases", "clean(", "--out", str(out)]) == 2
+
+
+def test_prove_triples_conceals_three_effects_and_scores_them(tmp_path):
+    """`prove --campaign triples` hides three library effects at once beside clean sets and scores whether all three
+    are named and fitted within tolerance, in a section of its own."""
+    from golfflight.cli import main
+
+    out, dump = tmp_path / "discovery.md", tmp_path / "runs.json"
+    args = ["prove", "--model", "reference", "--campaign", "triples", "--cases", "^clean$|^wind", "--seeds", "1"]
+    assert main([*args, "--clean-sets", "1", "--shots", "40", "--out", str(out), "--json", str(dump)]) == 0
+    runs = read_runs(dump)
+    assert [(r.case, len(r.hidden)) for r in runs] == [("clean", 0), ("+".join(TRIPLES[0]), 3)]
+    assert set(runs[1].hidden) == set(TRIPLES[0])
+    page = out.read_text()
+    assert "--campaign triples --cases '^clean$|^wind' --seeds 1" in page
+    assert "| false alarms on clean sets | 0 of 1 | 0 |" in page and "| three effects: all three among" in page
+    hidden = {name: {} for name in TRIPLES[0]}
+    errors = {name: 0.05 for name in TRIPLES[0]}
+    label = "+".join(sorted(TRIPLES[0]))
+    named = Run("x", 0, hidden, 300, 4, True, label, True, hidden, {}, errors, 2.0, 1.0, 1.0, False, {}, {}, [], 1.0)
+    missed = replace(named, fitted={"wind": {}, "unlisted": {}}, parameter_error={"wind": 0.05}, correct=False)
+    text = tables([named, missed], "test model", campaign="triples")
+    assert "| three effects: all three among those named | 1 of 2 (50%) | ≥ 80 % |" in text
+    assert "| three effects: all three fitted within 10 % of their sizes | 1 of 2 (50%) | ≥ 60 % |" in text

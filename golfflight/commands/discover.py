@@ -11,7 +11,7 @@ from golfflight.discovery.html import PLOTS_MISSING, plots_available
 from golfflight.discovery.model import REFERENCE, load_model
 from golfflight.discovery.outputs import write_diagnosis
 from golfflight.discovery.own_error import measure_own_error, write_own_error
-from golfflight.discovery.prove import CLEAN_SETS, cases, command, prove, read_runs, write_tables
+from golfflight.discovery.prove import CAMPAIGNS, CLEAN_SETS, cases, command, prove, read_runs, write_tables
 from golfflight.discovery.recordings import read_recordings
 from golfflight.shots.progress import print_line, progress_step
 
@@ -54,6 +54,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default="model",
         help="hide the effects in the diagnosed model's own flights (default) or in the reference world's (the "
         "model-form campaign: what the model's own difference from that physics adds)",
+    )
+    prove.add_argument(
+        "--campaign",
+        choices=CAMPAIGNS,
+        default="library",
+        help="every library effect, the pair and the effects outside the library (default), or three effects at once",
     )
     prove.add_argument("--seeds", type=int, default=4, help="concealed sets per case")
     prove.add_argument("--clean-sets", type=int, default=CLEAN_SETS, help="clean sets (false-alarm count)")
@@ -112,14 +118,15 @@ def run_prove(args: argparse.Namespace) -> int:
             truth=args.truth,
             clean_sets=args.clean_sets,
             progress=not args.quiet,
+            campaign=args.campaign,
         )
     if not results:
-        names = ", ".join(name for name, _ in cases(args.truth))
+        names = ", ".join(name for name, _ in cases(args.truth, args.campaign))
         raise ValueError(f"--cases {args.cases!r} matches none of: {names}")
     spec = args.model or "models/default"
-    section = command(spec, args.truth, args.cases, args.seeds if args.cases else None)
+    section = command(spec, args.truth, args.cases, args.seeds, args.campaign)
     json_path = Path(args.json) if args.json else None
-    write_tables(results, Path(args.out), json_path, model.name, section, args.truth)
+    write_tables(results, Path(args.out), json_path, model.name, section, args.truth, args.campaign)
     print(f"wrote the tables to {args.out}")
     return 0
 
