@@ -304,6 +304,14 @@ def ground_phase(
     return GroundPhase(rest, hops, total, record.paths())
 
 
+def plane_normal_one(surface: Surface, slope_deg: float, slope_dir_deg: float) -> tuple[float, float, float]:
+    """One plane's unit normal on floats (`plane_normals`' formula), after refusing a slope steeper than `surface`
+    holds a ball on (ValueError): where every one-ball phase on a plane starts."""
+    _check_slopes(np.float64(slope_deg), np.float64(surface.rolling_resistance))
+    phi, beta = math.radians(slope_deg), math.radians(slope_dir_deg)
+    return math.sin(phi) * math.sin(beta), math.sin(phi) * math.cos(beta), math.cos(phi)
+
+
 def ground_phase_one(
     position: tuple,
     velocity: tuple,
@@ -316,9 +324,7 @@ def ground_phase_one(
     """`ground_phase` of one ball on plain floats (the same formulas): from its landing (x, y, z) tuples to its
     rest, with the path `ground_phase` would record when `keep_path` (the served shot a screen draws). ValueError if
     the slope is steeper than the surface holds a ball on."""
-    _check_slopes(np.float64(slope_deg), np.float64(surface.rolling_resistance))
-    phi, beta = math.radians(slope_deg), math.radians(slope_dir_deg)
-    normal = (math.sin(phi) * math.sin(beta), math.sin(phi) * math.cos(beta), math.cos(phi))
+    normal = plane_normal_one(surface, slope_deg, slope_dir_deg)
     path: list[tuple[float, tuple, tuple]] | None = [(0.0, position, velocity)] if keep_path else None
     time, hops = 0.0, 0
     while True:

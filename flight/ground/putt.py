@@ -23,9 +23,8 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-import numpy as np
 from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
-from golfflight.flight.ground.phase import GroundPath, _check_slopes, _downhill, _ground_path, _roll_one, _rolling
+from golfflight.flight.ground.phase import GroundPath, _downhill, _ground_path, _roll_one, _rolling, plane_normal_one
 from golfflight.flight.ground.surfaces import Surface
 from golfflight.flight.ground.vectors import add, cross, dot, norm, times
 
@@ -64,9 +63,7 @@ def putt_phase(
 ) -> PuttPhase:
     """Skid and roll a putt launched from the origin to rest on a plane sloped by `slope_deg` towards `slope_dir_deg`
     (`phase.plane_normals`), on plain floats. ValueError if the slope is steeper than the surface holds a ball on."""
-    _check_slopes(np.float64(slope_deg), np.float64(surface.rolling_resistance))
-    phi, beta = math.radians(slope_deg), math.radians(slope_dir_deg)
-    normal = (math.sin(phi) * math.sin(beta), math.sin(phi) * math.cos(beta), math.cos(phi))
+    normal = plane_normal_one(surface, slope_deg, slope_dir_deg)
     gamma, heading, psi = (math.radians(a) for a in (launch_angle_deg, launch_direction_deg, spin_axis_deg))
     launch = times(ball_speed_mps, (math.cos(gamma) * math.sin(heading), math.cos(gamma) * math.cos(heading),
                                     math.sin(gamma)))
