@@ -7,11 +7,12 @@ and shot order, differences between clubs and sessions, scatter beyond the expec
 correction removes a material share of the excess on held-out sessions beyond doubt. Noise alone passes neither;
 a consistent shift fails the first however large the expected per-shot error is.
 
-Selection: every single effect is fitted (from a Gauss-Newton start); the best is combined with the other effects
-that most reduce the linearised cost. A candidate replaces a simpler one only if its held-out error is lower beyond
-doubt (the lower end of a session-bootstrap interval of the improvement is above zero) and by a material share, and,
-against a controlled model, by more than the model's own error of response to the simpler explanation
-(`Diagnoser.response_error`). Structure the library explanation leaves (the test run again on its residuals) leads
+Selection: every single effect is fitted (from a Gauss-Newton start); once the best beats the model as is, each of
+the best singles is combined with the other effects that most reduce its linearised cost (pairs), and once the best
+pair beats the best single, each of the best pairs with a third (triples). A candidate replaces a simpler one only if
+its held-out error is lower beyond doubt (the lower end of a session-bootstrap interval of the improvement is above
+zero) and by a material share, and, against a controlled model, by more than the model's own error of response to
+the simpler explanation (`Diagnoser.response_error`). Structure the library explanation leaves (the test run again on its residuals) leads
 to the learned correction; a library effect stays beside it only if it beats the correction alone beyond doubt.
 """
 
@@ -79,8 +80,11 @@ said to absorb noise."""
 PAIR_ANCHORS = 3
 """Pairs are built on the best three single effects (greedy selection on the best one alone can be misled)."""
 
-PAIR_FITS = 2
-"""Pairs per anchor fitted through the simulator: the most promising by linearised cost."""
+TRIPLE_ANCHORS = 2
+"""Triples are built on the best two pairs, once a pair has beaten the best single."""
+
+EXTENSION_FITS = 2
+"""Effects added to each anchor and fitted through the simulator: the most promising by linearised cost."""
 
 
 @dataclass
@@ -413,9 +417,8 @@ class Diagnoser:
         call the mismatch systematic only if the test found `structure` and something beat the null."""
         null = self.null_candidate()
         singles = self.fit_singles()
-        pairs = self.fit_pairs(singles)
-        scored = singles + pairs
-        chosen, test = self.choose(null, singles, pairs)
+        chosen, richer, test = self.choose(null, singles)
+        scored = singles + richer
         unlisted, left = None, self.structure_left(chosen) if structure and self.with_correction else []
         if left:
             library_best = chosen
@@ -482,45 +485,56 @@ class Diagnoser:
         """Every library effect alone, from Gauss-Newton starts out of one Jacobian; best score first."""
         self.step(f"fitting {len(self.library)} effects...")
         starts = linear_starts(self.problem, None, self.library, self.rows)
-        fits = progress_bar(zip(self.library, starts), "effects", total=len(self.library), unit="fit", shown=self.progress)
+        fits = progress_bar(
+            zip(self.library, starts), "effects", total=len(self.library), unit="fit", shown=self.progress
+        )
         singles = [self.score(fit(self.problem, (e,), start, self.rows)) for e, (start, _) in fits]
         return sorted(singles, key=lambda s: s.score)
 
-    def fit_pairs(self, singles: list[Scored]) -> list[Scored]:
-        """Each of the best singles with the effects that most reduce its linearised cost; best score first."""
-        pairs, tried = [], set()
-        anchors = singles[:PAIR_ANCHORS]
-        for anchor in progress_bar(anchors, "pairs with the best effects", unit="effect", shown=self.progress):
-            others = tuple(e for e in self.library if e not in anchor.fit.effects)
+    def fit_extensions(self, bases: list[Scored], anchors: int, label: str) -> list[Scored]:
+        """Each of the best `anchors` candidates with the EXTENSION_FITS effects that most reduce its linearised
+        cost (one Jacobian per candidate), fitted through the simulator; best score first."""
+        extended, tried = [], set()
+        for base in progress_bar(bases[:anchors], label, unit="candidate", shown=self.progress):
+            others = tuple(e for e in self.library if e not in base.fit.effects)
             screened = sorted(
-                zip(others, linear_starts(self.problem, anchor.fit, others, self.rows)), key=lambda item: item[1][1]
+                zip(others, linear_starts(self.problem, base.fit, others, self.rows)), key=lambda item: item[1][1]
             )
-            fresh = [(o, start) for o, (start, _) in screened if frozenset((anchor.fit.name, o.name)) not in tried]
-            for other, start in fresh[:PAIR_FITS]:
-                tried.add(frozenset((anchor.fit.name, other.name)))
-                pairs.append(self.score(fit(self.problem, anchor.fit.effects + (other,), start, self.rows)))
-        return sorted(pairs, key=lambda s: s.score)
+            names = frozenset(e.name for e in base.fit.effects)
+            fresh = [(o, start) for o, (start, _) in screened if names | {o.name} not in tried]
+            for other, start in fresh[:EXTENSION_FITS]:
+                tried.add(names | {other.name})
+                extended.append(self.score(fit(self.problem, base.fit.effects + (other,), start, self.rows)))
+        return sorted(extended, key=lambda s: s.score)
 
-    def choose(self, null: Scored, singles: list[Scored], pairs: list[Scored]) -> tuple[Scored, dict]:
-        """No effect, the best single, or the best pair: each step only when it beats the simpler one (the first
-        by a material share of the excess over the expected error: a shift hides in a large expected error)."""
+    def choose(self, null: Scored, singles: list[Scored]) -> tuple[Scored, list[Scored], dict]:
+        """No effect, the best single, the best pair or the best triple: each step only when it beats the simpler
+        one (the first by a material share of the excess over the expected error: a shift hides in a large expected
+        error), and the next step's candidates fitted only on a choice that passed. (choice, the pairs and triples
+        fitted, the systematic test's entries)."""
         chosen, test = null, {}
         flag, gain, low, _ = self.better(singles[0], null, SINGLE_LEVEL, against=max(null.error - 1.0, 0.0))
         test.update(best_single=singles[0].fit.name, best_single_gain=gain, best_single_gain_low=low)
-        if flag:
-            chosen = singles[0]
-            if pairs:
-                tolerance = self.response_error(chosen)
-                flag, gain, low, _ = self.better(pairs[0], chosen, COMBINATION_LEVEL, tolerance)
-                test.update(
-                    best_pair=pairs[0].fit.name,
-                    best_pair_gain_over_single=gain,
-                    best_pair_gain_low=low,
-                    **{f"model_response_error_of_{chosen.fit.name}": tolerance},
-                )
-                if flag:
-                    chosen = pairs[0]
-        return chosen, test
+        if not flag:
+            return chosen, [], test
+        chosen, richer, bases = singles[0], [], singles
+        for step, simpler, anchors in (("pair", "single", PAIR_ANCHORS), ("triple", "pair", TRIPLE_ANCHORS)):
+            extended = self.fit_extensions(bases, anchors, f"{step}s on the best {simpler}s")
+            richer += extended
+            tolerance = self.response_error(chosen)
+            flag, gain, low, _ = self.better(extended[0], chosen, COMBINATION_LEVEL, tolerance)
+            test.update(
+                {
+                    f"best_{step}": extended[0].fit.name,
+                    f"best_{step}_gain_over_{simpler}": gain,
+                    f"best_{step}_gain_low": low,
+                    f"model_response_error_of_{chosen.fit.name}": tolerance,
+                }
+            )
+            if not flag:
+                break
+            chosen, bases = extended[0], extended
+        return chosen, richer, test
 
     def try_correction(self, null: Scored, chosen: Scored) -> tuple[Scored, list[Scored], dict]:
         """The learned correction on top of the chosen explanation and alone; it replaces the choice if better. A
