@@ -4,13 +4,17 @@ before and after the suggested correction, and the candidates' scores.
 
 Every point that is one shot carries its shot id, session and club in `customdata` (`SHOT_FIELDS`), shown on
 hover, so a reader goes from an odd point straight to the shot in the recordings. Plain SVG scatter traces (not
-WebGL): they render in any browser, headless ones included, and a few thousand points stay quick.
+WebGL): they render in any browser, headless ones included, and a few thousand points stay quick. Above
+PLOTTED_SHOTS shots the scatter plots show a subsample stratified by session and club (their titles say so) and
+every statistic drawn over them (binned means, histograms, session means) uses every shot, so a season's report
+stays a few megabytes.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import plotly.graph_objects as go
+from golfflight.discovery.fit import stratified_rows
 from golfflight.discovery.locate import binned_means, trajectory_residuals
 from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from golfflight.discovery.words import OBSERVABLE_WORDS, UNITS, covariate_label, effect_words
@@ -24,6 +28,24 @@ BEFORE, AFTER = "#888888", "#1f77b4"
 
 SIZE = {"width": 570, "height": 400}
 """A figure's size in pixels: two side by side in the page's 76rem column."""
+
+PLOTTED_SHOTS = 5_000
+"""Shots drawn as points in a scatter plot at most (a stratified subsample above it)."""
+
+HISTOGRAM_BINS = 40
+"""Bins of the held-out histograms, counted here so the page holds counts, not every shot's value."""
+
+
+def plotted_shots(recordings: Recordings) -> np.ndarray:
+    """The shots a scatter plot draws: all up to PLOTTED_SHOTS, above it that many spread over every session and club
+    in proportion (the same shots in every figure and every run)."""
+    return stratified_rows(recordings, PLOTTED_SHOTS, np.random.default_rng(0))
+
+
+def _shown(recordings: Recordings, shown: np.ndarray) -> str:
+    """A title's note of how many shots its points are (empty where every shot is drawn)."""
+    n = len(recordings)
+    return "" if len(shown) == n else f" ({len(shown):,} of {n:,} shots shown)"
 
 
 def _shots(recordings: Recordings, index: np.ndarray | None = None) -> np.ndarray:
@@ -64,7 +86,8 @@ def covariate_figures(diagnosis, count: int = 4) -> list[go.Figure]:
     each with its binned means."""
     report, rec = diagnosis.report, diagnosis.recordings
     ranked = sorted(report.located.covariates, key=lambda c: (not c.significant, -abs(c.t)))
-    shots = _shots(rec)
+    shown = plotted_shots(rec)
+    shots = _shots(rec, shown)
     out = []
     for item in ranked[:count]:
         j = OBSERVABLES.index(item.observable)
@@ -76,7 +99,8 @@ def covariate_figures(diagnosis, count: int = 4) -> list[go.Figure]:
         figure = go.Figure()
         for name, predicted, color in series:
             residual = rec.observed[:, j] - predicted[:, j]
-            figure.add_trace(_points(x, residual, shots, name, color, _hover(item.covariate, "residual")))
+            hover = _hover(item.covariate, "residual")
+            figure.add_trace(_points(x[shown], residual[shown], shots, name, color, hover))
             centres, means = binned_means(x, residual)
             figure.add_trace(
                 go.Scatter(
@@ -90,6 +114,7 @@ def covariate_figures(diagnosis, count: int = 4) -> list[go.Figure]:
             )
         title = (
             f"{OBSERVABLE_WORDS[item.observable]} difference vs {covariate_label(item.covariate)} (t = {item.t:.1f})"
+            + _shown(rec, shown)
         )
         out.append(_layout(figure, title, covariate_label(item.covariate), y_label))
     return out
@@ -151,7 +176,8 @@ def phase_figure(diagnosis) -> go.Figure | None:
     rec = diagnosis.recordings
     if not rec.trajectories or diagnosis.positions_before is None:
         return None
-    index = {shot: i for i, shot in enumerate(rec.shot_id)}
+    shown = plotted_shots(rec)
+    index = {rec.shot_id[i]: i for i in shown}
     shots = _shots(rec)
     series = [("model as is", diagnosis.positions_before, BEFORE)]
     if diagnosis.positions_after is not None:
@@ -159,7 +185,7 @@ def phase_figure(diagnosis) -> go.Figure | None:
     figure = make_subplots(rows=2, cols=1, shared_xaxes=True, subplot_titles=["height", "across the line (+ right)"])
     dt_s = diagnosis.report.model.dt_s
     for label, positions, color in series:
-        residuals = trajectory_residuals(rec, positions, dt_s)
+        residuals = {shot: r for shot, r in trajectory_residuals(rec, positions, dt_s).items() if shot in index}
         if not residuals:
             continue
         share = np.concatenate([r[:, 0] / r[-1, 0] for r in residuals.values()])
@@ -172,7 +198,7 @@ def phase_figure(diagnosis) -> go.Figure | None:
     figure.update_xaxes(title_text="share of the recorded flight (0 = launch, 1 = last sample)", row=2, col=1)
     figure.update_yaxes(title_text="recorded − model (m)")
     figure.update_layout(
-        title={"text": "trajectory residuals along the flight"},
+        title={"text": "trajectory residuals along the flight" + _shown(rec, shown)},
         hovermode="closest",
         width=SIZE["width"],
         height=560,
@@ -188,11 +214,27 @@ def heldout_figures(diagnosis) -> list[go.Figure]:
         before = diagnosis.heldout_before[:, j]
         if not np.isfinite(before).any():
             continue
-        figure = go.Figure(go.Histogram(x=before, name="held out, model as is", marker_color=BEFORE, opacity=0.6))
+        series = [("held out, model as is", before, BEFORE)]
         if diagnosis.chosen is not None:
-            after = diagnosis.heldout_after[:, j]
-            figure.add_trace(go.Histogram(x=after, name="held out, corrected", marker_color=AFTER, opacity=0.6))
-        figure.update_layout(barmode="overlay")
+            series.append(("held out, corrected", diagnosis.heldout_after[:, j], AFTER))
+        finite = np.concatenate([values[np.isfinite(values)] for _, values, _ in series])
+        edges = np.histogram_bin_edges(finite, bins=HISTOGRAM_BINS)
+        centres, widths = (edges[1:] + edges[:-1]) / 2, np.diff(edges)
+        figure = go.Figure()
+        for label, values, color in series:
+            counts = np.histogram(values[np.isfinite(values)], bins=edges)[0]
+            figure.add_trace(
+                go.Bar(
+                    x=centres,
+                    y=counts,
+                    width=widths,
+                    name=label,
+                    marker_color=color,
+                    opacity=0.6,
+                    hovertemplate="%{x:.4g}: %{y} shots<extra>%{fullData.name}</extra>",
+                )
+            )
+        figure.update_layout(barmode="overlay", bargap=0)
         title = f"held-out difference: {OBSERVABLE_WORDS[name]}"
         out.append(_layout(figure, title, f"recorded − model, {LABELS[name]}", "shots (count)"))
     return out

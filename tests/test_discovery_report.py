@@ -102,6 +102,26 @@ def test_every_shot_level_point_carries_its_shot_session_and_club(diagnosis, pag
     assert all(f'"{shot}"' in html for shot in rec.shot_id) and all(f'"{s}"' in html for s in set(rec.session))
 
 
+def test_a_large_set_draws_a_stratified_share_of_its_shots_and_counts_every_one(diagnosis, monkeypatch):
+    """Above PLOTTED_SHOTS the scatter plots draw that many shots from every session (the title says how many) and
+    the histograms count every held-out residual, so a season's page stays small."""
+    from golfflight.discovery import figures
+
+    monkeypatch.setattr(figures, "PLOTTED_SHOTS", 40)
+    rec = diagnosis.recordings
+    drawn = report_figures(diagnosis)
+    for figure in drawn["residuals"][:-1]:
+        assert f"(40 of {len(rec):,} shots shown)" in figure.layout.title.text
+        points = [t for t in figure.data if t.mode == "markers"]
+        assert points and all(len(t.x) <= 40 for t in points)
+        shown = {shot for t in points for shot in np.asarray(t.customdata)[:, 0]}
+        assert {rec.session[list(rec.shot_id).index(s)] for s in shown} == set(rec.session), "every session drawn"
+    observed = np.flatnonzero(np.isfinite(diagnosis.heldout_before).any(axis=0))
+    for column, figure in zip(observed, drawn["heldout"], strict=True):
+        assert all(trace.type == "bar" for trace in figure.data)
+        assert sum(figure.data[0].y) == np.isfinite(diagnosis.heldout_before[:, column]).sum(), "every shot counted"
+
+
 def test_without_plotly_the_page_keeps_its_tables_and_names_the_extra(diagnosis, monkeypatch):
     monkeypatch.setitem(sys.modules, "plotly", None)  # import plotly now raises ModuleNotFoundError
     html = render(diagnosis)
