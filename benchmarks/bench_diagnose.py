@@ -3,7 +3,12 @@ served default model), each diagnosed in its own process as a user runs it; wall
 process, the time to its first progress line, how many shots the fits used and the verdict. Prints a table, writes
 its section of results.json (issue 32: 100,000 shots in at most 150 s and 1.5 GB, progress within 10 s).
 
-python benchmarks/bench_diagnose.py [--shots 1000 10000 100000] [--seed 7] [--data CSV] [--work DIR] [--uncertainty]
+python benchmarks/bench_diagnose.py [--shots 1000 10000 100000] [--seed 7] [--data CSV] [--hidden EFFECTS] [--work DIR]
+                                   [--uncertainty]
+
+--hidden (e.g. wind+ball_speed_bias+spin_axis_bias) diagnoses sets with those library effects hidden in the served
+model's own flights instead (`discovery.conceal`, sizes drawn as `golfflight prove` draws them): the costliest
+diagnosis, where singles, pairs and triples are all fitted.
 
 --uncertainty also measures, on the largest set, what fitting on the stratified subsample does to the quoted ±: for
 a few single effects, the standard deviation from the scored subsample over the one from every shot's Jacobian.
@@ -23,10 +28,12 @@ from pathlib import Path
 
 import numpy as np
 from common import REPO, write_results
+from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import Diagnoser
 from golfflight.discovery.effects import EFFECTS
 from golfflight.discovery.fit import covariance, fit, linear_starts, residuals_and_jacobian
 from golfflight.discovery.model import load_model
+from golfflight.discovery.prove import draw_effect
 from golfflight.discovery.recordings import read_recordings
 from golfflight.shots.records import write_shots
 from golfflight.shots.synth import SynthConfig, generate
@@ -52,6 +59,17 @@ def synthetic_set(n: int, seed: int, folder: Path) -> Path:
     return path
 
 
+def concealed_set(n: int, seed: int, hidden: str, model: str | None, folder: Path) -> Path:
+    """`n` shots with the library effects `hidden` ('+'-joined) concealed in the model's own flights, as a
+    canonical CSV in `folder`."""
+    path = folder / f"concealed_{hidden}_{n}_seed{seed}.csv"
+    if not path.is_file():
+        rng = np.random.default_rng(10_000 + seed)
+        effects = {name: draw_effect(name, rng) for name in hidden.split("+")}
+        write_shots(path, conceal(effects, n, seed, model=load_model(model)).shots.records)
+    return path
+
+
 def diagnosed(csv: Path, out: Path, model: str | None) -> dict:
     """Run `golfflight diagnose` on `csv` in a child process: wall s, its peak RSS, the first progress line's time."""
     command = [sys.executable, "-m", "golfflight", "diagnose", str(csv), "--out", str(out)]
@@ -74,7 +92,12 @@ def diagnosed(csv: Path, out: Path, model: str | None) -> dict:
     watcher.join()
     if child.returncode:
         raise RuntimeError(f"diagnose {csv} exited {child.returncode}:\n{stdout}")
-    return {"wall_s": wall, "peak_rss_mb": usage.ru_maxrss / 1024, "first_progress_s": first[0] if first else None}
+    return {
+        "wall_s": wall,
+        "peak_rss_mb": usage.ru_maxrss / 1024,
+        "first_progress_s": first[0] if first else None,
+        "report_html_mb": (out / "report.html").stat().st_size / 1e6,
+    }
 
 
 def verdict(report: dict) -> str:
@@ -88,7 +111,12 @@ def verdict(report: dict) -> str:
 
 def measure(n: int, args: argparse.Namespace, folder: Path) -> dict:
     """One set of `n` shots generated (or --data, whatever its size) and diagnosed."""
-    csv = Path(args.data) if args.data else synthetic_set(n, args.seed, folder)
+    if args.data:
+        csv = Path(args.data)
+    elif args.hidden:
+        csv = concealed_set(n, args.seed, args.hidden, args.model, folder)
+    else:
+        csv = synthetic_set(n, args.seed, folder)
     out = folder / f"diagnose_{n}"
     row = {"data": str(csv), **diagnosed(csv, out, args.model)}
     report = json.loads((out / "report.json").read_text())
@@ -135,13 +163,14 @@ def uncertainty_ratios(csv: Path, model: str | None) -> list[dict]:
 
 
 def print_rows(rows: list[dict]) -> None:
-    """| shots | sessions | wall s | peak RSS MB | first progress s | fitted / scored shots | verdict |."""
-    print("\n| shots | sessions | wall | peak RSS | first progress | fits on / scored on | verdict |")
-    print("|---:|---:|---:|---:|---:|---:|---|")
+    """| shots | sessions | wall s | peak RSS MB | first progress s | report.html MB | fitted / scored shots | verdict |."""
+    print("\n| shots | sessions | wall | peak RSS | first progress | report.html | fits on / scored on | verdict |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---|")
     for r in rows:
         first = f"{r['first_progress_s']:.1f} s" if r["first_progress_s"] is not None else "–"
         print(
             f"| {r['shots']:,} | {r['sessions']:,} | {r['wall_s']:.0f} s | {r['peak_rss_mb']:.0f} MB | {first} "
+            f"| {r['report_html_mb']:.1f} MB "
             f"| {r['fit_shots']:,} / {r['scored_shots']:,} | {r['verdict']} |"
         )
 
@@ -151,6 +180,7 @@ def main() -> None:
     parser.add_argument("--shots", type=int, nargs="+", default=[1000, 10_000, 100_000], help="set sizes")
     parser.add_argument("--seed", type=int, default=7, help="the generator's seed")
     parser.add_argument("--data", help="diagnose this canonical CSV instead of generating (one size: its own)")
+    parser.add_argument("--hidden", help="hide these '+'-joined library effects in the model's flights instead")
     parser.add_argument("--model", help="model bundle (default: the served default)")
     parser.add_argument("--work", help="folder for the sets and reports (default: a temporary one)")
     parser.add_argument("--uncertainty", action="store_true", help="also compare the ± on the largest set")
@@ -176,7 +206,8 @@ def main() -> None:
     )
     print(f"\ntarget {TARGET}: {'met' if met else 'NOT met'} by the {largest['shots']:,}-shot set")
     if not args.no_write:
-        write_results("diagnose", [*rows, {"name": "target", **TARGET, "met": met}, *ratios])
+        section = "diagnose" if not args.hidden else f"diagnose_hidden_{args.hidden}"
+        write_results(section, [*rows, {"name": "target", **TARGET, "met": met}, *ratios])
 
 
 if __name__ == "__main__":
