@@ -1,12 +1,11 @@
 """The worker side of a sweep: a table of input rows in, a table of the same rows with their flights out.
 
 One `Flyer` holds one FlightEngine (ONNX Runtime on one thread: the workers are the parallelism) and is what every
-engine runs: called in each process of the local pool, and as Ray Data's callable class (one per actor). Each row
-goes through the request model and the batch `golfflight simulate` flies (`contract.flying.fly_columns`: the
-same engine batch as `fly_shots`, its numbers straight into columns, no result object a shot), so the numbers are
-the same; a row the request model refuses keeps its place with the reason in `problem` and no flight,
-for the driver to report with the row's place in the input (only the driver knows it).
-"""
+engine runs: called in each process of the local pool, and as Ray Data's callable class (one per actor). A piece's
+rows are checked against the request model and flown a column at a time (`sweep.rows`: the verdicts, problem lines
+and numbers of each row through the request model and the batch `golfflight simulate` flies, `contract.flying`,
+without a request object a row); a row the request model refuses keeps its place with the reason in `problem` and no
+flight, for the driver to report with the row's place in the input (only the driver knows it)."""
 
 from __future__ import annotations
 
@@ -134,39 +133,33 @@ class Flyer:
         return self.fly_table(self.source.expand(piece))
 
     def fly_table(self, table):
-        """The rows of `table` (the layout's input columns) with their flights, in order (a pyarrow.Table)."""
+        """The rows of `table` (the layout's input columns) with their flights, in order (a pyarrow.Table): checked
+        and flown a column at a time (`sweep.rows`), each refused row with the request model's own problem lines."""
         import numpy as np
         import pyarrow as pa
-        from golfflight.contract.flying import fly_columns
+        from golfflight.sweep.rows import check_rows, fly_checked
 
         layout = self.layout
         table = table.select(list(layout.columns))
-        columns = table.to_pydict()
         n = table.num_rows
+        checked = check_rows(table, problems_of)
+        flew = checked.valid
+        flown = np.flatnonzero(flew)
         problems: list[str | None] = [None] * n
-        shots, flown = [], []
-        for i, values in enumerate(zip(*columns.values(), strict=True)):
-            cells = {column: cell_value(value) for column, value in zip(layout.columns, values, strict=True)}
-            checked = problems_of(cells)
-            if isinstance(checked, list):
-                problems[i] = "\n".join(checked)
-            else:
-                shots.append(checked)
-                flown.append(i)
-        flew = np.zeros(n, dtype=bool)
-        flew[flown] = True
+        for i, lines in checked.problems.items():
+            problems[i] = "\n".join(lines)
         schema = layout.schema(with_problem=True)
         out = {}
         for name, column in zip(layout.echoed, layout.columns, strict=True):
-            out[name] = _echoed(table[column], columns[column], column, flew, schema.field(name).type)
-        flights = fly_columns(self.engine, shots) if shots else None  # a chunk of invalid rows only flies nothing
+            out[name] = _echoed(table[column], column, flew, schema.field(name).type, checked.columns.get(column))
+        flights = fly_checked(self.engine, checked) if len(flown) else None  # a chunk of invalid rows flies nothing
         for name in layout.results:
             if flights is None:
                 out[name] = pa.nulls(n, schema.field(name).type)
                 continue
             if name == "error":
                 errors: list[str | None] = [None] * n
-                for i, error in zip(flown, flights.errors, strict=True):
+                for i, error in zip(flown.tolist(), flights.errors, strict=True):
                     errors[i] = error
                 out[name] = pa.array(errors, pa.string())
                 continue
@@ -178,14 +171,22 @@ class Flyer:
         return pa.table(out, schema=schema)
 
 
-def _echoed(array, cells: list, column: str, flew, kind):
+def _echoed(array, column: str, flew, kind, checked=None):
     """An input column as the results hold it (`echo`), null where the row did not fly: a numeric Arrow column as it
-    is (cast to float64), any other cell by cell."""
+    is (cast to float64), a number column already read (`checked`, a `sweep.rows.Column`: a flown row's cells are
+    numbers or blank) from its numbers, any other each distinct cell once."""
+    import numpy as np
     import pyarrow as pa
     import pyarrow.compute as pc
+    from golfflight.sweep.rows import distinct
 
     if column not in TEXT_COLUMNS and column != "normalized" and (
         pa.types.is_floating(array.type) or pa.types.is_integer(array.type)
     ):
         return pc.if_else(pa.array(flew), array.cast(pa.float64()), pa.scalar(None, pa.float64())).combine_chunks()
-    return pa.array([echo(column, value) if ok else None for value, ok in zip(cells, flew.tolist(), strict=True)], kind)
+    if checked is not None and checked.numbers is not None:
+        return pa.array(checked.numbers, pa.float64(), mask=~(flew & checked.given))
+    cells, codes = distinct(array)
+    echoed = [echo(column, cell) for cell in cells] + [None]
+    codes = np.where(flew, codes, -1)
+    return pa.array([echoed[code] for code in codes.tolist()], kind)

@@ -228,3 +228,66 @@ def test_ray_sweep_with_two_actors_equals_simulate(launches, tmp_path, capfd, re
     assert "core_worker" not in err and "max_restarts" not in err, err
     assert not [w for w in recwarn if "ray_remote_args" in str(w.message)]
     assert_same_as_simulate(pq.read_table(out).to_pylist(), expected)
+
+
+def assert_columnar_flights_equal_fly_columns(table) -> int:
+    """The columnar path (`sweep.rows`: checked in bulk, launches in arrays, conditions once each) flies a chunk's
+    valid rows to the very numbers `fly_columns` gives for their requests made one by one: bit for bit, each column
+    present where it was, the same errors. Returns the rows flown."""
+    from golfflight.contract.columns import cell_value
+    from golfflight.contract.flying import fly_columns
+    from golfflight.flight.bundle_location import model_dir
+    from golfflight.flight.engine import FlightEngine
+    from golfflight.sweep.flyer import problems_of
+    from golfflight.sweep.rows import check_rows, fly_checked
+
+    shots = [problems_of({k: cell_value(v) for k, v in row.items()}) for row in table.to_pylist()]
+    shots = [shot for shot in shots if not isinstance(shot, list)]
+    engine = FlightEngine(model_dir(None), batch_threads=1)
+    want, got = fly_columns(engine, shots), fly_checked(engine, check_rows(table, problems_of))
+    assert got.errors == want.errors
+    assert got.values.keys() == want.values.keys()
+    for name, values in want.values.items():
+        assert np.array_equal(got.present[name], want.present[name]), name
+        assert got.values[name].dtype == values.dtype and np.array_equal(got.values[name], values, equal_nan=True), name
+    return len(shots)
+
+
+def test_the_columnar_path_flies_every_valid_row_as_its_request():
+    """Launch-monitor forms (mph, back and side spin, a -0.0 axis), random winds, airs, grounds off the tee's height
+    (their flat flights), normalized replays, a shot that never reaches its ground, text cells as a CSV reads them
+    and numbers typed as Parquet holds them (integers among them), invalid rows among the valid; and a grid, whose
+    rows share one condition."""
+    rows = launch_rows(300, seed=4)
+    rows[5].update(ground_elevation_m=90.0)
+    rows[10].update(spin_axis_deg=-0.0, launch_direction_deg="", normalized="yes")
+    rows[7].update(ball_speed_mps="", ball_speed_mph=140.0, spin_rpm="", spin_axis_deg="", back_spin_rpm=2500.0,
+                   side_spin_rpm=-0.0)
+    rows[8].update(spin_rpm=99999)  # refused: not flown, and not in the requests flown one by one
+    text = pa.table({k: [None if r[k] == "" else str(r[k]) for r in rows] for k in rows[0]})
+    assert assert_columnar_flights_equal_fly_columns(text) == 299
+    typed = pa.Table.from_pylist([{k: None if v == "" else v for k, v in r.items()} for r in rows])
+    typed = typed.set_column(typed.column_names.index("spin_rpm"), "spin_rpm",
+                             pa.array([None if r["spin_rpm"] == "" else int(r["spin_rpm"]) for r in rows], pa.int64()))
+    assert assert_columnar_flights_equal_fly_columns(typed) == 299
+    grid = Grid.parse(["ball_speed_mps=40:70:8", "launch_angle_deg=8:20:4", "spin_rpm=2500,5000", "altitude_m=1600",
+                       "wind_speed_mps=5", "ground_elevation_m=-2"])
+    assert assert_columnar_flights_equal_fly_columns(pa.table(grid.rows(0, len(grid)))) == 64
+
+
+def test_a_grid_sweep_equals_simulate_row_for_row(tmp_path):
+    """Every row of a grid with conditions swept (columnar checking and flying) against `golfflight simulate` on the
+    same rows written as a CSV."""
+    axes = ["ball_speed_mps=40:70:4", "launch_angle_deg=8,16", "spin_rpm=2500,6000", "wind_speed_mph=0,12",
+            "wind_from_deg=90", "temperature_f=50,95", "ground_surface=green,rough", "ground_elevation_ft=0,-10",
+            "normalized=true,false"]
+    grid = Grid.parse(axes)
+    rows = grid.rows(0, len(grid))
+    source = write_csv(tmp_path / "grid.csv", [{"shot_id": f"s{i}", **{k: v[i] for k, v in rows.items()}}
+                                                for i in range(len(grid))])
+    out = tmp_path / "grid.parquet"
+    assert sweep("--grid", *axes, "--out", out, "--workers", 1, "--chunk-rows", 100) == 0
+    swept = pq.read_table(out).to_pylist()
+    for i, row in enumerate(swept):
+        row["shot_id"] = f"s{i}"
+    assert_same_as_simulate(swept, simulated(tmp_path, source), sample=len(grid))

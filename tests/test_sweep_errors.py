@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import sys
 
+import numpy as np
 import pytest
 
 from golfflight.cli import main
@@ -128,3 +129,122 @@ def test_the_ray_noise_filter_drops_only_its_line(capfd):
     assert capfd.readouterr().err == f"\rsweep: 10% [00:01<00:09]\rsweep: 50% [00:05<00:05]{real}a line\n"
     os.write(2, noise.encode())
     assert capfd.readouterr().err == noise
+
+
+def per_row(table) -> list:
+    """Each row of `table` through the request model on its own (`problems_of`): its request, or its problem lines."""
+    from golfflight.contract.columns import cell_value
+    from golfflight.sweep.flyer import problems_of
+
+    return [problems_of({k: cell_value(v) for k, v in row.items()}) for row in table.to_pylist()]
+
+
+def assert_checked_as_per_row(table) -> None:
+    """The columnar check (`sweep.rows.check_rows`) gives every row the per-row verdict and, for a refused row, the
+    same problem lines (each naming its column and range)."""
+    from golfflight.sweep.flyer import problems_of
+    from golfflight.sweep.rows import check_rows
+
+    checked = check_rows(table, problems_of)
+    for i, want in enumerate(per_row(table)):
+        assert bool(checked.valid[i]) == (not isinstance(want, list)), (i, table.slice(i, 1).to_pylist(), want)
+        assert checked.problems.get(i) == (want if isinstance(want, list) else None), i
+
+
+POOLS = {
+    "ball_speed_mps": ["55", "0.5", "100", "100.00001", "0.49", "NaN", "nan", "inf", "-inf", "fast", "", " 60 ", "1_0"],
+    "ball_speed_mph": ["", "", "", "120", "300", "1e9"],
+    "launch_angle_deg": ["12", "-0", "-0.0", "", "90", "91", "-91", "abc"],
+    "launch_direction_deg": ["", "3", "-46", "45"],
+    "spin_rpm": ["3000", "", "15000", "15001", "-1", "NaN"],
+    "spin_axis_deg": ["", "-0.0", "10", "90", "91"],
+    "back_spin_rpm": ["", "", "14000", "3000", "15000"],
+    "side_spin_rpm": ["", "", "9000", "-400", "-0.0"],
+    "altitude_m": ["", "1600", "-600", "6000", "x"],
+    "altitude_ft": ["", "", "5000"],
+    "pressure_hpa": ["", "", "850"],
+    "density_kg_m3": ["", "", "", "1.1", "9"],
+    "temperature_c": ["", "31", "-60"],
+    "wind_speed_mps": ["", "4", "30", "31"],
+    "wind_speed_mph": ["", "", "10"],
+    "wind_from_deg": ["", "90", "361"],
+    "wind_profile": ["", "log", " log ", "uniform", "gusty", "1"],
+    "ground_surface": ["", "green", "fairway", "bunker", "sand", " rough"],
+    "stimp_ft": ["", "", "12", "30"],
+    "ground_elevation_m": ["", "-3", "0", "90"],
+    "ground_elevation_ft": ["", "", "10"],
+    "slope_deg": ["", "0", "2", "5", "45"],
+    "slope_dir_deg": ["", "90"],
+    "normalized": ["", "true", "1", "no", "YES"],
+    "shot_id": ["a", ""],
+}
+"""Cells of a launches CSV, valid and not, for every request column: the edges of each range and just past them,
+NaN, infinities, words, blanks, whitespace, both forms of a quantity at once, cross-field rules (back and side spin
+over the total, a stimp reading off the green, a slope steeper than its surface holds, density with weather)."""
+
+
+@pytest.mark.parametrize("form", ["text", "typed"])
+def test_the_columnar_check_gives_every_row_the_models_verdict_and_lines(form):
+    """2,000 random rows drawn from POOLS, as a CSV reads them (text) and as a Parquet file holds them (numbers typed,
+    a few words left in number columns, booleans and integers): the same verdict and problem lines as the request
+    model on each row alone. Most rows are refused, for one reason or several."""
+    from golfflight.contract.columns import TEXT_COLUMNS, cell_value
+
+    rng = np.random.default_rng(7)
+    rows = [{column: str(rng.choice(cells)) for column, cells in POOLS.items()} for _ in range(2000)]
+    for row in rows[::2]:  # half the rows valid but for three cells drawn from the pools
+        drawn = {c: row[c] for c in rng.choice(list(POOLS), 3, replace=False)}
+        row.update({c: "" for c in POOLS})
+        row.update(ball_speed_mps=str(rng.uniform(1, 99)), launch_angle_deg="11", spin_rpm=str(rng.uniform(0, 15000)))
+        row.update(drawn)
+    if form == "text":
+        table = pa.table({c: [None if r[c] == "" else r[c] for r in rows] for c in POOLS})
+    else:
+        def typed(column, cell):
+            value = cell_value(cell)
+            if column in TEXT_COLUMNS or value is None or column == "normalized":
+                return None if value is None else cell
+            return float(value) if isinstance(value, float) else None
+        columns = {c: [typed(c, r[c]) for r in rows] for c in POOLS}
+        columns["launch_direction_deg"] = [None if v is None else int(v) for v in columns["launch_direction_deg"]]
+        table = pa.table(columns)
+        table = table.append_column("wind_reference_height_m", pa.array([True if i % 50 == 0 else None for i in range(2000)]))
+    assert_checked_as_per_row(table)
+    from golfflight.sweep.flyer import problems_of
+    from golfflight.sweep.rows import check_rows
+
+    valid = check_rows(table, problems_of).valid
+    assert 100 < valid.sum() < 1900  # both verdicts well represented
+
+
+def test_the_cross_field_rules_read_only_presence_and_the_value_rule_columns():
+    """The columnar check groups rows by which columns they give and by VALUE_RULE_COLUMNS' values, and lets one row a
+    group decide for it: that holds while the request models' validators read no other field's value. Read from
+    their source: a field read as `self.NAME` other than `is (not) None` must be a value-rule column; helpers called
+    with the model, and a before-validator's data, test presence only."""
+    import inspect
+    import re
+
+    from golfflight.contract import requests
+    from golfflight.contract.columns import SECTION_COLUMNS
+    from golfflight.sweep.rows import VALUE_RULE_COLUMNS
+
+    def column(model, field: str) -> str:
+        for section, columns in SECTION_COLUMNS.items():
+            if model is getattr(requests, f"{section.capitalize()}Request", None):
+                return {name: c for c, name in columns.items()}[field]
+        return field
+
+    models = [requests.ShotRequest, requests.AirRequest, requests.WindRequest, requests.GroundRequest]
+    for model in models:
+        for decorator in model.__pydantic_decorators__.model_validators.values():
+            source = inspect.getsource(decorator.func)
+            for name in re.findall(r"self\.(\w+)\b(?! is (?:not )?None)", source):
+                assert column(model, name) in VALUE_RULE_COLUMNS, (model.__name__, name)
+            assert re.findall(r"getattr\(self, \w+\)(?! is not None)", source) == [], model.__name__
+            for helper in set(re.findall(r"(?<!def )\b(\w+)\(self\b", source)) - {"getattr"}:
+                body = inspect.getsource(getattr(requests, helper))
+                assert re.findall(r"getattr\(model, \w+\)(?! is not None)", body) == [], helper
+                assert "model." not in body, helper
+            for read in re.findall(r"data(?:\.get\([^)]*\)|\[[^]]*\])( is not None)?", source):
+                assert read, (model.__name__, source)
