@@ -258,6 +258,23 @@ class TorchEngine:
 
 
 @dataclass(frozen=True)
+class TorchEngineMaker:
+    """How a sweep's worker builds its own TorchEngine from a bundle path: `golfflight sweep --engine torch` in its
+    process, and each Ray actor of `--engine ray --device ...` on its node, on the GPU Ray gave it ("cuda" is that
+    actor's one visible GPU). Picklable, so that Ray sends it to the actors; `threads` sets torch's CPU threads first
+    (an actor has one CPU)."""
+
+    device: str = "cpu"
+    dtype: str = "float32"
+    threads: int | None = None
+
+    def __call__(self, bundle_dir: str | os.PathLike) -> TorchEngine:
+        if self.threads is not None:
+            torch.set_num_threads(self.threads)
+        return TorchEngine(bundle_dir, self.device, self.dtype)
+
+
+@dataclass(frozen=True)
 class Grounds:
     """A batch's grounds as [N] arrays: whether a shot has one (None: the flight alone, down to z = 0), its
     elevation, slope and slope direction, and its surface (one for all, or one a shot)."""

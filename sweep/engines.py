@@ -13,7 +13,7 @@ import re
 import sys
 import threading
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 
@@ -145,11 +145,15 @@ def ray_noise_filtered(noise: tuple[bytes, ...] = RAY_NOISE):
             os.close(original)
 
 
-def ray_tables(source, bundle_dir: str, sha256: str, workers: int, address: str | None) -> Iterator:
+def ray_tables(source, bundle_dir: str, sha256: str, workers: int | None, address: str | None,
+               make_engine: Callable | None = None, gpus_per_actor: int = 0) -> Iterator:
     """Result tables of `source`'s pieces through Ray Data: `map_batches` with `Flyer` as a callable class on a pool
-    of `workers` actors of one CPU each, order preserved. Connects to the cluster at `address` if given (and leaves
-    it running), else starts a local Ray instance with a CPU for each worker and one for reading, and stops it
-    after."""
+    of `workers` actors of one CPU each, order preserved. Each actor flies with ONNX Runtime, or with the engine
+    `make_engine` builds on its node (the torch engine), asking Ray for `gpus_per_actor` GPUs besides: then
+    `workers` None is one actor for each GPU the cluster lists (`gpu_actors`), and one actor's engine is built on a
+    GPU of the cluster before the sweep starts, so that a node without torch or CUDA is refused in one line.
+    Connects to the cluster at `address` if given (and leaves it running), else starts a local Ray instance with a
+    CPU for each worker and one for reading (every CPU and GPU of this machine for GPU actors), and stops it after."""
     import logging
 
     import ray
@@ -159,21 +163,65 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int, address: str 
         logging.getLogger("ray.data").setLevel(logging.WARNING)
         logging.getLogger("ray.data._internal.progress").setLevel(logging.ERROR)
     with ray_noise_filtered():
-        yield from _ray_tables(ray, source, bundle_dir, sha256, workers, address)
+        yield from _ray_tables(ray, source, bundle_dir, sha256, workers, address, make_engine, gpus_per_actor)
 
 
-def _ray_tables(ray, source, bundle_dir: str, sha256: str, workers: int, address: str | None) -> Iterator:
+def gpu_actors(resources: dict, workers: int | None, gpus_per_actor: int) -> int:
+    """The actors of a sweep on GPUs: `workers`, or one for each GPU of `resources` (`ray.cluster_resources()`);
+    ValueError where the cluster lists no GPU or fewer than the actors need (an actor Ray cannot place would wait for
+    ever)."""
+    gpus = int(resources.get("GPU", 0))
+    if gpus < gpus_per_actor:
+        raise ValueError(
+            "--engine ray --device cuda: the Ray cluster lists no GPU (ray.cluster_resources() has none); start its "
+            "nodes with their GPUs (ray start --num-gpus N, or a KubeRay worker group with nvidia.com/gpu), or sweep "
+            "on CPUs without --device"
+        )
+    most = gpus // gpus_per_actor
+    if workers is not None and workers > most:
+        raise ValueError(f"--workers {workers}: the Ray cluster lists {gpus} GPUs, and each actor takes "
+                         f"{gpus_per_actor} (leave --workers out for one actor a GPU)")
+    return most if workers is None else workers
+
+
+def _engine_problem(make_engine: Callable, bundle_dir: str) -> str | None:
+    """Why `make_engine` cannot build an engine here (a Ray task on a GPU node, as an actor would), or None."""
+    try:
+        make_engine(bundle_dir)
+    except Exception as error:  # noqa: BLE001 - whatever stops an actor: no torch, no CUDA device, no bundle
+        return f"{type(error).__name__}: {error}"
+    return None
+
+
+def check_actor_engine(ray, make_engine: Callable, bundle_dir: str, gpus: int) -> None:
+    """Build one engine as an actor would, in a Ray task asking for `gpus` GPUs, before any actor starts; ValueError
+    saying why where it fails (a node without torch fails before the task runs: the error's last line says so)."""
+    task = ray.remote(num_cpus=1, num_gpus=gpus, max_retries=0)(_engine_problem)
+    try:
+        problem = ray.get(task.remote(make_engine, bundle_dir))
+    except Exception as error:  # noqa: BLE001 - Ray's own types: the task could not run (a module it lacks)
+        problem = str(error).strip().splitlines()[-1]
+    if problem:
+        raise ValueError(f"--engine ray: a worker of the Ray cluster cannot build the torch engine ({problem}); "
+                         f"every node needs the train extra (torch), and a GPU node its CUDA driver")
+
+
+def _ray_tables(ray, source, bundle_dir: str, sha256: str, workers: int | None, address: str | None,
+                make_engine: Callable | None, gpus_per_actor: int) -> Iterator:
     from golfflight.sweep.ray_input import PiecesDatasource
 
     started = not ray.is_initialized()
     if started:
         ray.init(
             address=address,
-            num_cpus=None if address else workers + 1,
+            num_cpus=None if address or workers is None else workers + 1,
             include_dashboard=False,
             logging_level="WARNING",
         )
     try:
+        if gpus_per_actor:
+            workers = gpu_actors(ray.cluster_resources(), workers, gpus_per_actor)
+            check_actor_engine(ray, make_engine, bundle_dir, gpus_per_actor)
         context = ray.data.DataContext.get_current()
         context.execution_options.preserve_order = True
         context.enable_progress_bars = False
@@ -183,11 +231,12 @@ def _ray_tables(ray, source, bundle_dir: str, sha256: str, workers: int, address
         read = ray.data.read_datasource(PiecesDatasource(source), max_calls=1)
         dataset = read.map_batches(
             Flyer,
-            fn_constructor_args=(bundle_dir, sha256, source),
+            fn_constructor_args=(bundle_dir, sha256, source, None, make_engine),
             compute=ray.data.ActorPoolStrategy(size=workers),
             batch_size=1,  # one piece (one row) a call: one engine batch of --chunk-rows shots
             batch_format="pyarrow",
             num_cpus=1,
+            num_gpus=gpus_per_actor,
         )
         yield from dataset.iter_batches(batch_size=None, batch_format="pyarrow")
     finally:

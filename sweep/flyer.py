@@ -10,6 +10,7 @@ flight, for the driver to report with the row's place in the input (only the dri
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING, Protocol
@@ -116,13 +117,17 @@ class ColumnsEngine(Protocol):
 class Flyer:
     """A flight engine for one worker: `flyer(piece)` flies a piece of a source (module docstring)."""
 
-    def __init__(self, bundle_dir: str, sha256: str, source, engine: ColumnsEngine | None = None):
-        """Load the bundle at `bundle_dir` (its own path on each node of a cluster), or take `engine` already loaded,
-        and refuse it unless its ONNX graph is the one the driver checked (`sha256`); `source` (`sweep.sources`)
-        turns pieces into rows."""
+    def __init__(self, bundle_dir: str, sha256: str, source, engine: ColumnsEngine | None = None,
+                 make_engine: Callable[[str], ColumnsEngine] | None = None):
+        """Load the bundle at `bundle_dir` (its own path on each node of a cluster) with ONNX Runtime, or with
+        `make_engine` (a Ray actor's torch engine, `model_export.torch_engine.TorchEngineMaker`), or take `engine`
+        already loaded, and refuse it unless its ONNX graph is the one the driver checked (`sha256`); `source`
+        (`sweep.sources`) turns pieces into rows."""
         from golfflight.flight.engine import FlightEngine
 
-        self.engine = FlightEngine(bundle_dir, batch_threads=1) if engine is None else engine
+        if engine is None:
+            engine = FlightEngine(bundle_dir, batch_threads=1) if make_engine is None else make_engine(bundle_dir)
+        self.engine = engine
         if self.engine.sha256 != sha256:
             raise ValueError(f"{bundle_dir}: this worker's model ({self.engine.sha256[:12]}) is not the driver's "
                              f"({sha256[:12]}); every node needs the same bundle at the same path")

@@ -29,6 +29,15 @@ Engine = Literal["local", "ray", "torch"]
 
 
 @dataclass(frozen=True)
+class RayEngine:
+    """What each Ray actor flies with: ONNX Runtime on its CPU (`make` None), or the engine `make` builds from the
+    bundle's path on the actor's node (`model_export.torch_engine.TorchEngineMaker`), with `gpus` GPUs of its own."""
+
+    make: Callable[[str], ColumnsEngine] | None = None
+    gpus: int = 0
+
+
+@dataclass(frozen=True)
 class Summary:
     rows: int
     written: int
@@ -46,10 +55,10 @@ class Summary:
         return self.rows / self.seconds if self.seconds > 0 else 0.0
 
 
-def _tables(source: Source, engine: Engine, workers: int, model: str | None, ray_address: str | None,
-            in_process: ColumnsEngine | None) -> Iterator:
+def _tables(source: Source, engine: Engine, workers: int | None, model: str | None, ray_address: str | None,
+            in_process: ColumnsEngine | None, ray_engine: RayEngine) -> Iterator:
     """Result tables from the chosen engine, its workers loading the bundle the driver verified here (or flying
-    with `in_process`, an engine already loaded from it)."""
+    with `in_process`, an engine already loaded from it, or each Ray actor with the engine `ray_engine` makes)."""
     from golfflight.flight.bundle_check import verify_bundle
     from golfflight.sweep.engines import in_process_tables, local_tables, ray_tables
 
@@ -60,7 +69,7 @@ def _tables(source: Source, engine: Engine, workers: int, model: str | None, ray
             raise ValueError("the torch engine is flown in this process: pass it as in_process")
         return in_process_tables(source, Flyer(str(bundle), sha256, source, engine=in_process))
     if engine == "ray":
-        return ray_tables(source, str(bundle), sha256, workers, ray_address)
+        return ray_tables(source, str(bundle), sha256, workers, ray_address, ray_engine.make, ray_engine.gpus)
     return local_tables(source, str(bundle), sha256, workers)
 
 
@@ -77,17 +86,19 @@ def run_sweep(
     source: Source,
     out: str,
     engine: Engine = "local",
-    workers: int = 2,
+    workers: int | None = 2,
     model: str | None = None,
     ray_address: str | None = None,
     skip_bad_rows: bool = False,
     progress: bool = True,
     skipped: Callable[[str], None] = print,
     in_process: ColumnsEngine | None = None,
+    ray_engine: RayEngine = RayEngine(),
 ) -> Summary:
     """Fly every row of `source` on `engine` and write `out` (Parquet): the input row's number, its columns, its
     flight (module docstring). `skipped` gets each problem of a row left out under `skip_bad_rows`; `in_process` is
-    the engine `engine="torch"` flies with (`model_export.torch_engine.TorchEngine`, loaded from `model`)."""
+    the engine `engine="torch"` flies with (`model_export.torch_engine.TorchEngine`, loaded from `model`),
+    `ray_engine` what each actor of `engine="ray"` flies with (`workers` None: one actor a GPU)."""
     import pyarrow as pa
     import pyarrow.compute as pc
     import pyarrow.parquet as pq
@@ -98,7 +109,7 @@ def run_sweep(
     counts = {"rows": 0, "written": 0, "skipped": 0, "chunks": 0, "chunks_skipped": 0, "failed": 0}
 
     def write(path: str) -> None:
-        tables = _tables(source, engine, workers, model, ray_address, in_process)
+        tables = _tables(source, engine, workers, model, ray_address, in_process, ray_engine)
         bar = tqdm(total=source.total_rows, unit="shot", unit_scale=True, disable=not progress, desc="sweep")
         with closing(tables), bar, pq.ParquetWriter(path, schema) as writer:
             for table in tables:

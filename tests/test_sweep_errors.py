@@ -248,3 +248,50 @@ def test_the_cross_field_rules_read_only_presence_and_the_value_rule_columns():
                 assert "model." not in body, helper
             for read in re.findall(r"data(?:\.get\([^)]*\)|\[[^]]*\])( is not None)?", source):
                 assert read, (model.__name__, source)
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (
+            ["--engine", "ray", "--device", "cuda:1"],
+            "--device cuda:1: with --engine ray, Ray gives each actor its own GPU; give --device cuda (or cpu)",
+        ),
+        (
+            ["--engine", "ray", "--threads", "2"],
+            "--threads goes with --engine ray only beside --device (cuda or cpu): the torch engine",
+        ),
+        (["--engine", "local", "--device", "cuda"], "--device goes with --engine torch, or --engine ray with --device"),
+    ],
+)
+def test_torch_options_that_do_not_go_with_the_engine_are_refused(tmp_path, capsys, options, message):
+    pytest.importorskip("ray")
+    assert sweep(*GRID, "--out", tmp_path / "out.parquet", *options) == 2
+    err = capsys.readouterr().err
+    assert err.splitlines() == [f"golfflight sweep: error: {message}"], err
+
+
+def test_ray_on_gpus_without_torch_is_refused_in_one_line(tmp_path, capfd, monkeypatch):
+    """The driver needs torch to send the actors their engine: without the train extra, one line saying so."""
+    pytest.importorskip("ray")
+    for name in [m for m in sys.modules if m == "torch" or m.startswith("torch.")]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.setitem(sys.modules, "torch", None)
+    assert sweep(*GRID, "--out", tmp_path / "out.parquet", "--engine", "ray", "--device", "cuda") == 2
+    assert capfd.readouterr().err.splitlines() == [
+        (
+            "golfflight sweep: error: --engine ray --device needs the train extra, which is not installed (no torch): "
+            "pip install 'golfflight[train]'"
+        )
+    ]
+
+
+def test_gpu_actors_are_one_a_gpu_and_never_more_than_the_cluster_lists():
+    from golfflight.sweep.engines import gpu_actors
+
+    assert gpu_actors({"CPU": 16.0, "GPU": 4.0}, None, 1) == 4
+    assert gpu_actors({"CPU": 16.0, "GPU": 4.0}, 2, 1) == 2
+    with pytest.raises(ValueError, match=r"--workers 5: the Ray cluster lists 4 GPUs, and each actor takes 1"):
+        gpu_actors({"GPU": 4.0}, 5, 1)
+    with pytest.raises(ValueError, match=r"the Ray cluster lists no GPU \(ray.cluster_resources\(\) has none\)"):
+        gpu_actors({"CPU": 16.0}, None, 1)

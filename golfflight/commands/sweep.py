@@ -5,8 +5,11 @@ product: START:STOP:COUNT, V1,V2,... or V per column, `sweep.grid`). Output: one
 (`row`), its columns and its flight, the same numbers as `golfflight simulate`. `--engine local` flies on a pool of
 processes here, `--engine ray` through Ray Data (a local Ray instance, or a cluster's with `--ray-address`),
 `--engine torch` in this process on `--device cpu` or `cuda` (the bundle rebuilt in torch,
-`model_export.torch_engine`). Needs the `sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray` and the
-`train` extra (torch) for `--engine torch`.
+`model_export.torch_engine`). `--engine ray --device cuda` flies the torch engine in each Ray actor on a GPU of its
+own (one actor a GPU: the engine sizes its batches to the GPU's free memory, so two on one GPU would only contend;
+`--workers` left out is one actor for each GPU the cluster lists); `--device cpu` there flies it on each actor's CPU,
+the numbers of `--engine torch`. Needs the `sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray` and the
+`train` extra (torch) for `--engine torch` and `--device`.
 """
 
 from __future__ import annotations
@@ -38,14 +41,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--model", help="model bundle directory (default: the shipped models/default)")
     parser.add_argument("--engine", choices=("local", "ray", "torch"), default="local",
                         help="local processes, Ray Data, or the model in torch in this process (--device)")
-    parser.add_argument("--workers", type=int, help="processes or Ray actors (default: this machine's cores)")
+    parser.add_argument("--workers", type=int, help="processes or Ray actors (default: this machine's cores; with "
+                        "--engine ray --device cuda, one actor for each GPU of the Ray cluster)")
     parser.add_argument("--chunk-rows", type=int, help=f"shots a batch (default {CHUNK_ROWS}; {TORCH_CHUNK_ROWS} "
-                        "with --engine torch)")
-    parser.add_argument("--device", help="--engine torch: cpu (default), cuda or cuda:N")
+                        "with the torch engine)")
+    parser.add_argument("--device", help="the torch engine's device: --engine torch: cpu (default), cuda or cuda:N; "
+                        "--engine ray: cuda (each actor on a GPU of its own that Ray gives it) or cpu")
     parser.add_argument("--dtype", choices=("float32", "float64"),
-                        help="--engine torch: the physics' precision (default float32; the network is float32)")
-    parser.add_argument("--threads", type=int, help="--engine torch on the CPU: torch's threads (default: torch's, "
-                        "one a core; 1 where other work shares the cores)")
+                        help="the torch engine's physics' precision (default float32; the network is float32)")
+    parser.add_argument("--threads", type=int, help="the torch engine on a CPU: torch's threads (default: torch's, "
+                        "one a core, with --engine torch; 1 in each Ray actor; 1 where other work shares the cores)")
     parser.add_argument("--ray-address", help="an existing Ray cluster (e.g. ray://head:10001 or auto); default: a "
                         "local Ray instance, stopped after")
     parser.add_argument(
@@ -55,19 +60,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(run=run)
 
 
-def require_extras(*extras: str) -> None:
-    """Refuse in one line, naming the extra to install, unless every module of `extras` imports (a missing one would
-    otherwise surface as a ModuleNotFoundError's traceback in the middle of the sweep)."""
+def require_extras(*extras: str, who: str | None = None) -> None:
+    """Refuse in one line, naming the extra to install (and `who` needs it, where given), unless every module of
+    `extras` imports (a missing one would otherwise surface as a ModuleNotFoundError's traceback in the middle of the
+    sweep)."""
     for extra in extras:
         for module in EXTRAS[extra]:
             try:
                 importlib.import_module(module)
             except ImportError as missing:
-                who = {"ray": "--engine ray needs", "train": "--engine torch needs"}.get(extra, "needs")
+                needs = who or {"ray": "--engine ray needs", "train": "--engine torch needs"}.get(extra, "needs")
                 raise ValueError(
-                    f"{who} the {extra} extra, which is not installed (no {missing.name or module}): "
+                    f"{needs} the {extra} extra, which is not installed (no {missing.name or module}): "
                     f"pip install 'golfflight[{extra}]'"
                 ) from None
+
+
+def _torch_on_ray(args: argparse.Namespace) -> bool:
+    """Whether each Ray actor flies the torch engine (`--engine ray --device ...`)."""
+    return args.engine == "ray" and args.device is not None
 
 
 def _check_options(args: argparse.Namespace) -> None:
@@ -82,20 +93,33 @@ def _check_options(args: argparse.Namespace) -> None:
     if args.threads is not None and args.threads < 1:
         raise ValueError("--threads takes a whole number of at least 1")
     torch_only = [name for name in ("device", "dtype", "threads") if getattr(args, name) is not None]
-    if torch_only and args.engine != "torch":
-        raise ValueError(f"--{torch_only[0]} goes with --engine torch")
+    if torch_only and args.engine == "local":
+        raise ValueError(f"--{torch_only[0]} goes with --engine torch, or --engine ray with --device")
+    if torch_only and args.engine == "ray" and args.device is None:
+        raise ValueError(f"--{torch_only[0]} goes with --engine ray only beside --device (cuda or cpu): the torch engine")
+    if _torch_on_ray(args) and args.device not in ("cuda", "cpu"):
+        raise ValueError(f"--device {args.device}: with --engine ray, Ray gives each actor its own GPU; give --device "
+                         "cuda (or cpu)")
 
 
-def _torch_engine(args: argparse.Namespace):
-    """The bundle rebuilt in torch on the asked device (`model_export.torch_engine.TorchEngine`)."""
-    import torch
+def _torch_maker(args: argparse.Namespace, threads: int | None):
+    """How the torch engine is built on the asked device (`model_export.torch_engine.TorchEngineMaker`)."""
+    from golfflight.model_export.torch_engine import TorchEngineMaker
 
+    return TorchEngineMaker(args.device or "cpu", args.dtype or "float32", threads)
+
+
+def _engines(args: argparse.Namespace):
+    """The torch engine `--engine torch` flies in this process (the bundle rebuilt in torch), or None; and what each
+    Ray actor flies with (`sweep.run.RayEngine`: the torch engine on a GPU of its own with `--device cuda`)."""
     from golfflight.flight.bundle_location import model_dir
-    from golfflight.model_export.torch_engine import TorchEngine
+    from golfflight.sweep.run import RayEngine
 
-    if args.threads is not None:
-        torch.set_num_threads(args.threads)
-    return TorchEngine(model_dir(args.model).resolve(), args.device or "cpu", args.dtype or "float32")
+    if args.engine == "torch":
+        return _torch_maker(args, args.threads)(model_dir(args.model).resolve()), RayEngine()
+    if _torch_on_ray(args):
+        return None, RayEngine(_torch_maker(args, args.threads or 1), int(args.device == "cuda"))
+    return None, RayEngine()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -106,10 +130,13 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"needs the sweep extra: pip install 'golfflight[sweep]' ({missing})") from None
     require_extras("sweep", *({"ray": ["ray"], "torch": ["train"]}.get(args.engine, [])))
     _check_options(args)
-    chunk_rows = args.chunk_rows or (TORCH_CHUNK_ROWS if args.engine == "torch" else CHUNK_ROWS)
+    if _torch_on_ray(args):
+        require_extras("train", who="--engine ray --device needs")
+    torch_anywhere = args.engine == "torch" or _torch_on_ray(args)
+    chunk_rows = args.chunk_rows or (TORCH_CHUNK_ROWS if torch_anywhere else CHUNK_ROWS)
     source = open_source(args.launches, args.grid, chunk_rows)
-    torch_engine = _torch_engine(args) if args.engine == "torch" else None
-    workers = 1 if torch_engine is not None else args.workers or os.cpu_count() or 1
+    torch_engine, ray_engine = _engines(args)
+    workers = 1 if torch_engine is not None else args.workers or (None if ray_engine.gpus else os.cpu_count() or 1)
     summary = run_sweep(
         source,
         args.out,
@@ -121,13 +148,19 @@ def run(args: argparse.Namespace) -> int:
         progress=not args.no_progress,
         skipped=lambda problem: print(f"golfflight sweep: skipped: {problem}", file=sys.stderr),
         in_process=torch_engine,
+        ray_engine=ray_engine,
     )
     whole = (
         f", {summary.chunks_skipped:,} of {summary.chunks:,} chunks skipped whole for want of a valid row"
         if summary.chunks_skipped
         else ""
     )
-    where = f"with {workers} workers" if torch_engine is None else f"({torch_engine.device}, {args.dtype or 'float32'})"
+    dtype = args.dtype or "float32"
+    if torch_engine is not None:
+        where = f"({torch_engine.device}, {dtype})"
+    else:
+        where = f"with {workers} workers" if workers else "with one actor a GPU"
+        where += f" (torch on {args.device}, {dtype})" if ray_engine.make else ""
     print(
         f"golfflight sweep: {summary.written:,} shots written to {args.out} ({summary.skipped:,} rows skipped{whole}, "
         f"{summary.failed:,} could not be flown) in {summary.seconds:.1f} s: {summary.shots_per_second:,.0f} shots/s "
