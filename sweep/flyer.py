@@ -150,9 +150,8 @@ class Flyer:
         checked = check_rows(table, problems_of)
         flew = checked.valid
         flown = np.flatnonzero(flew)
-        problems: list[str | None] = [None] * n
-        for i, lines in checked.problems.items():
-            problems[i] = "\n".join(lines)
+        problems = np.full(n, None, dtype=object)
+        problems[list(checked.problems)] = ["\n".join(lines) for lines in checked.problems.values()]
         schema = layout.schema(with_problem=True)
         out = {}
         for name, column in zip(layout.echoed, layout.columns, strict=True):
@@ -163,9 +162,8 @@ class Flyer:
                 out[name] = pa.nulls(n, schema.field(name).type)
                 continue
             if name == "error":
-                errors: list[str | None] = [None] * n
-                for i, error in zip(flown.tolist(), flights.errors, strict=True):
-                    errors[i] = error
+                errors = np.full(n, None, dtype=object)
+                errors[flown] = flights.errors
                 out[name] = pa.array(errors, pa.string())
                 continue
             values, present = flights.values[name], flights.present[name]

@@ -99,6 +99,16 @@ class Grid:
         index = np.unravel_index(np.arange(start, stop), self.counts)
         return {axis.column: [axis.values[i] for i in at.tolist()] for axis, at in zip(self.axes, index, strict=True)}
 
+    def arrays(self, start: int, stop: int) -> dict:
+        """Rows start..stop-1 as columns, as `rows` gives them: a NumPy float64 array for an axis of numbers (as
+        Arrow reads Python floats), a list for any other."""
+        index = np.unravel_index(np.arange(start, stop), self.counts)
+        columns = {}
+        for axis, at in zip(self.axes, index, strict=True):
+            numbers = all(type(value) is float for value in axis.values)
+            columns[axis.column] = np.array(axis.values)[at] if numbers else [axis.values[i] for i in at.tolist()]
+        return columns
+
     def check_values(self) -> None:
         """Refuse the grid before anything flies if the request model refuses row 0 or any axis value in it (each
         value is tried in row 0 with the others fixed), naming the axis, the value and the allowed range."""

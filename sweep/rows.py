@@ -387,16 +387,13 @@ def _columns(flights, n: int, replays: np.ndarray, flats: np.ndarray) -> ShotCol
     `flats`: a shot fails with the first error of its own flight, its replay, its flat flight."""
     replay_rows = np.arange(n, n + len(replays))
     flat_rows = np.arange(n + len(replays), n + len(replays) + len(flats))
+    owner = np.concatenate([np.arange(n), replays, flats]).tolist()
     errors: list[str | None] = [None] * n
-    for shot, rows in (
-        (range(n), range(n)),
-        (replays.tolist(), replay_rows.tolist()),
-        (flats.tolist(), flat_rows.tolist()),
-    ):
-        for i, row in zip(shot, rows, strict=True):
-            if errors[i] is None and row in flights.errors:
-                errors[i] = flights.errors[row]
-    flew = np.array([e is None for e in errors], dtype=bool)
+    for row in sorted(flights.errors):  # a shot's own row comes before its replay's, which comes before its flat's
+        if errors[owner[row]] is None:
+            errors[owner[row]] = flights.errors[row]
+    flew = np.ones(n, dtype=bool)
+    flew[[owner[row] for row in flights.errors]] = False
     values, present = {}, {}
     for prefix, numbers, rows, own in (
         ("", flight_numbers, np.arange(n), np.arange(n)),
@@ -406,7 +403,8 @@ def _columns(flights, n: int, replays: np.ndarray, flats: np.ndarray) -> ShotCol
         mask = np.zeros(n, dtype=bool)
         mask[own] = True
         mask &= flew
-        for name, column in numbers(flights.take(rows)).items():
+        taken = flights if len(rows) == len(owner) else flights.take(rows)  # the whole batch: its own shots alone
+        for name, column in numbers(taken).items():
             full = np.zeros(n, dtype=column.dtype)
             full[own] = column
             values[prefix + name], present[prefix + name] = full, mask

@@ -76,6 +76,8 @@ def _tables(source: Source, engine: Engine, workers: int | None, model: str | No
 def _refused(source: Source, table, start: int) -> list[str]:
     """One line per problem of the refused rows of `table`, whose first row is input row `start`."""
     lines = []
+    if table[PROBLEM].null_count == table.num_rows:
+        return lines
     for i, problem in enumerate(table[PROBLEM].to_pylist()):
         if problem is not None:
             lines += [f"{source.place(start + i)} {line}" for line in problem.split("\n")]

@@ -88,7 +88,7 @@ class GridSource:
         import pyarrow as pa
 
         ranges = zip(piece["start"].to_pylist(), piece["stop"].to_pylist(), strict=True)
-        return pa.concat_tables([pa.table(self.grid.rows(start, stop)) for start, stop in ranges])
+        return pa.concat_tables([pa.table(self.grid.arrays(start, stop)) for start, stop in ranges])
 
 
 @dataclass(frozen=True)

@@ -99,6 +99,8 @@ def test_grid_axes_ranges_lists_and_single_values():
     assert rows["ball_speed_mps"] == [40.0, 40.0, 50.0, 50.0, 60.0, 60.0]  # the first axis varies slowest
     assert rows["launch_angle_deg"] == [10.0, 14.0] * 3
     assert grid.rows(3, 5) == {k: v[3:5] for k, v in rows.items()}
+    worded = Grid.parse(["ball_speed_mps=40:60:3", "launch_angle_deg=10,14", "spin_rpm=3000", "ground_surface=green,rough"])
+    assert pa.table(worded.arrays(2, 11)).equals(pa.table(worded.rows(2, 11)))  # what a sweep reads, as Arrow reads rows
 
 
 @pytest.mark.parametrize(
