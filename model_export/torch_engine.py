@@ -16,7 +16,8 @@ figures are not finite, fails with the engine's message (the batch is flown in p
 The ground phase (bounce and roll) is the engine's own NumPy code (`flight.ground.ground_phase`) on the CPU, fed the
 landing states in float64; `seconds` splits the time between the device's flight and that ground phase. A part's
 size is `part_shots`. Torch is imported here only: nothing of the serving install or the sweep package imports this
-module (`golfflight sweep --engine torch` does, from the command line).
+module (`golfflight sweep --engine torch` and `--engine ray --device` do, from the command line, and each Ray actor
+of the latter when it unpickles the `TorchEngineMaker` it is sent).
 """
 
 from __future__ import annotations
