@@ -4,9 +4,10 @@ without a request object a valid row.
 
 Checking. The request model (`contract.requests.ShotRequest`) stays the one contract: this reads its rules, it does
 not restate them.
-- A number column is checked in bulk against its own field's bounds, read from the pydantic field's metadata (`ge`,
-  `le`; finite; a number, as the strict model takes numbers); a text or flag column's distinct cells go through
-  their field itself (a pydantic TypeAdapter of the field), each once.
+- A number column of Arrow numbers (a grid, a Parquet file) is checked in bulk against its own field's bounds, read
+  from the pydantic field's metadata (`ge`, `le`; finite); every other column (a CSV's text, words, flags, Arrow
+  types such as decimals) has its distinct cells read as `simulate` reads a cell and put through their field itself
+  (a pydantic TypeAdapter of the field), each once.
 - The model's cross-field rules (one form of each quantity, back and side spin within the spin range, a slope its
   surface holds, ...) read which columns a row gives and the values of VALUE_RULE_COLUMNS only
   (`tests/test_sweep_errors.py` reads the validators to hold this): the rows whose every cell passes are grouped by
@@ -16,8 +17,8 @@ not restate them.
 
 Flying. The valid rows' launches are converted as `contract.inputs.launch_of` converts them, in arrays (back and side
 spin by `spin_from_components` itself); their conditions, grounds and normalized replays come from the contract's own
-functions (`conditions_of`, `ground_of`, `reference_of`, `lands_off_the_flat`) on one validated request for each
-distinct combination of those columns' cells. The batch (the rows, their normalized replays, then their flat flights)
+functions (`air_of`, `wind_of`, `ground_of`, `reference_of`, `lands_off_the_flat`) on one validated request part for
+each distinct combination of those columns' cells. The batch (the rows, their normalized replays, then their flat flights)
 and its columns are `contract.flying.fly_columns`'s.
 """
 
@@ -150,60 +151,80 @@ def distinct(array) -> tuple[list, np.ndarray]:
     return encoded.dictionary.to_pylist(), codes
 
 
-def _number_column(column: str, array) -> Column:
-    import pyarrow as pa
-
-    kind, n = array.type, len(array)
-    if pa.types.is_floating(kind) or pa.types.is_integer(kind):
-        numbers = array.cast(pa.float64(), safe=False).to_numpy(zero_copy_only=False)
-        given = ~array.is_null().to_numpy(zero_copy_only=False)
-        checked = given
-    elif pa.types.is_string(kind) or pa.types.is_large_string(kind):  # a CSV: each distinct text read as simulate does
-        cells, codes = distinct(array)
-        read = [cell_value(cell) for cell in cells]
-        value = np.array([v if isinstance(v, float) else math.nan for v in read] + [math.nan])
-        is_number = np.array([isinstance(v, float) for v in read] + [False])
-        is_given = np.array([v is not None for v in read] + [False])
-        numbers, given, checked = value[codes], is_given[codes], is_number[codes]
-    elif pa.types.is_null(kind):
-        numbers, given = np.full(n, math.nan), np.zeros(n, dtype=bool)
-        checked = given
-    else:  # booleans, dates, ...: the model refuses them (strict numbers); each row says so itself
-        numbers, given = np.full(n, math.nan), ~array.is_null().to_numpy(zero_copy_only=False)
-        checked = np.zeros(n, dtype=bool)
+def _in_bounds(column: str, numbers: np.ndarray) -> np.ndarray:
+    """Where floats are what the column's field takes: finite (unless its model takes non-finite numbers) and within
+    the bounds of its metadata."""
     bounds, non_finite = number_bounds(column)
     with np.errstate(invalid="ignore"):
-        ok = checked.copy() if non_finite else checked & np.isfinite(numbers)
+        ok = np.ones(len(numbers), dtype=bool) if non_finite else np.isfinite(numbers)
         for compare, bound in bounds:
             ok &= compare(numbers, bound)
-    return Column(given, ok | ~given, numbers.view(np.int64), numbers)
+    return ok
 
 
-def _value_column(column: str, array) -> Column:
-    """A text or flag column: each distinct cell through the request's reading and the field's validator, once."""
+def _number_column(column: str, array) -> Column:
+    """A number column of Arrow numbers (a grid, a Parquet file), in bulk (the strict model takes integers as
+    floats)."""
+    import pyarrow as pa
+
+    numbers = array.cast(pa.float64(), safe=False).to_numpy(zero_copy_only=False)
+    given = ~array.is_null().to_numpy(zero_copy_only=False)
+    return Column(given, _in_bounds(column, numbers) | ~given, numbers.view(np.int64), numbers)
+
+
+def _number_cells(column: str, array) -> Column:
+    """A number column of other cells (a CSV's text, decimals, booleans, ...): each distinct cell read as `simulate`
+    reads it (`cell_value`); a float is checked in bulk as above, anything else through the field's own validator."""
+    cells, codes = distinct(array)
+    value, bulk, taken, given = [], [], [], []
+    for cell in cells:
+        read = cell_value(cell)
+        validated, ok = math.nan, read is not None
+        if read is not None and type(read) is not float:
+            try:
+                validated = float(field_adapter(column).validate_python(read))
+            except ValidationError:
+                ok = False
+        value.append(read if type(read) is float else validated)
+        bulk.append(type(read) is float)
+        taken.append(ok)
+        given.append(read is not None)
+    numbers = np.array([*value, math.nan])[codes]
+    given_rows = np.array([*given, False])[codes]
+    ok = np.where(np.array([*bulk, False])[codes], _in_bounds(column, numbers), np.array([*taken, False])[codes])
+    return Column(given_rows, ok | ~given_rows, numbers.view(np.int64), numbers)
+
+
+def _value_cells(column: str, array) -> Column:
+    """A text or flag column: each distinct cell read as `simulate` reads it (`cell_value`, `request_of_cells`) and
+    put through the field's own validator; the key is the validated value's index."""
     cells, codes = distinct(array)
     known: dict = {}
-    index, accepted, is_given = [], [], []
+    key, taken, given = [], [], []
     for cell in cells:
-        value = cell_value(cell)
-        if value is None:
-            index.append(-1), accepted.append(True), is_given.append(False)
-            continue
-        value = request_value(column, value)
-        try:
-            validated = field_adapter(column).validate_python(value)
-        except ValidationError:
-            index.append(-2), accepted.append(False), is_given.append(True)
-            continue
-        index.append(known.setdefault((type(validated), validated), len(known)))
-        accepted.append(True), is_given.append(True)
-    pick = np.array([*index, -1], dtype=np.int64)
-    return Column(np.array([*is_given, False])[codes], np.array([*accepted, True])[codes], pick[codes])
+        read = cell_value(cell)
+        index, ok = -1, True
+        if read is not None:
+            try:
+                validated = field_adapter(column).validate_python(request_value(column, read))
+                index = known.setdefault((type(validated), validated), len(known))
+            except ValidationError:
+                ok = False
+        key.append(index)
+        taken.append(ok)
+        given.append(read is not None)
+    return Column(np.array([*given, False])[codes], np.array([*taken, True])[codes], np.array([*key, -1])[codes])
 
 
 def read_column(column: str, array) -> Column:
     """One request column of a chunk (an Arrow array), checked against its field (module docstring)."""
-    return _number_column(column, array) if is_number_column(column) else _value_column(column, array)
+    import pyarrow as pa
+
+    if not is_number_column(column):
+        return _value_cells(column, array)
+    if pa.types.is_floating(array.type) or pa.types.is_integer(array.type):
+        return _number_column(column, array)
+    return _number_cells(column, array)
 
 
 def _groups(parts: list[np.ndarray], rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

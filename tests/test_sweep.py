@@ -272,6 +272,13 @@ def test_the_columnar_path_flies_every_valid_row_as_its_request():
     typed = typed.set_column(typed.column_names.index("spin_rpm"), "spin_rpm",
                              pa.array([None if r["spin_rpm"] == "" else int(r["spin_rpm"]) for r in rows], pa.int64()))
     assert assert_columnar_flights_equal_fly_columns(typed) == 299
+    odd = typed.set_column(typed.column_names.index("ground_surface"), "ground_surface",
+                           typed["ground_surface"].dictionary_encode())  # a pandas category in Parquet
+    for name in ("launch_direction_deg", "wind_from_deg"):  # decimals, which the model takes as floats
+        odd = odd.set_column(odd.column_names.index(name), name, odd[name].cast(pa.decimal128(12, 6), safe=False))
+    odd = odd.set_column(odd.column_names.index("normalized"), "normalized",
+                         pa.array([r["normalized"] == "true" for r in rows]))
+    assert assert_columnar_flights_equal_fly_columns(odd) == 299
     grid = Grid.parse(["ball_speed_mps=40:70:8", "launch_angle_deg=8:20:4", "spin_rpm=2500,5000", "altitude_m=1600",
                        "wind_speed_mps=5", "ground_elevation_m=-2"])
     assert assert_columnar_flights_equal_fly_columns(pa.table(grid.rows(0, len(grid)))) == 64
