@@ -5,8 +5,10 @@ Writes the section `torch_engine_<cpu|cuda>` of benchmarks/results.json (other s
 table for docs/benchmarks.md. The flight's time runs from the launches to the landings' figures back in NumPy (the
 device's transfers included); the ground phase's is NumPy's bounce and roll of those landings on the CPU.
 
-One command on a lent GPU machine (about 3 minutes on an H100, most of it the ONNX reference and the sweep):
-    python benchmarks/bench_gpu.py --device cuda
+One command on a lent GPU machine (about 3 minutes on an H100, most of it the ONNX reference and the sweep;
+--ray-workers 1 also sweeps the same grid through `--engine ray --device cuda`, an actor on the GPU, Ray's start
+included):
+    python benchmarks/bench_gpu.py --device cuda [--ray-workers 1]
 Here on the CPU, small sizes:
     python benchmarks/bench_gpu.py --device cpu --batches 1024,4096,16384 --sweep-rows 8192 --threads 2
 """
@@ -135,21 +137,23 @@ def parity(bundle: Path, device: str, shots: int) -> list[dict]:
     return rows
 
 
-def sweep_end_to_end(device: str, rows: int, threads: int | None) -> dict:
-    """`golfflight sweep --engine torch` on a grid of `rows` launches to Parquet, as its own process: wall seconds
-    from start to file written (loading included), and the command's own account of where the time went."""
+def sweep_end_to_end(device: str, rows: int, threads: int | None, ray_workers: int | None = None) -> dict:
+    """`golfflight sweep --engine torch` (or, with `ray_workers`, `--engine ray --device` on that many actors) on a
+    grid of `rows` launches to Parquet, as its own process: wall seconds from start to file written (loading
+    included), and the command's own account of where the time went."""
     speeds = max(rows // 400, 1)
     grid = [f"ball_speed_mps=30:80:{speeds}", "launch_angle_deg=6:30:20", "spin_rpm=1500:9000:20"]
     shots = speeds * 400
+    engine = ["--engine", "torch"] if ray_workers is None else ["--engine", "ray", "--workers", str(ray_workers)]
     with tempfile.TemporaryDirectory() as folder:
         command = [sys.executable, "-m", "golfflight", "sweep", "--grid", *grid, "--out", f"{folder}/out.parquet",
-                   "--engine", "torch", "--device", device, "--no-progress",
-                   *(["--threads", str(threads)] if threads else [])]
+                   *engine, "--device", device, "--no-progress", *(["--threads", str(threads)] if threads else [])]
         started = time.perf_counter()
         done = subprocess.run(command, cwd=REPO, capture_output=True, text=True, check=True)
         seconds = time.perf_counter() - started
     print(done.stdout.strip(), flush=True)
-    return {"shots": shots, "seconds": seconds, "shots_per_s": shots / seconds, "summary": done.stdout.strip()}
+    return {"shots": shots, "seconds": seconds, "shots_per_s": shots / seconds, "summary": done.stdout.strip(),
+            "engine": " ".join(engine)}
 
 
 def machine_of(device: torch.device) -> dict:
@@ -176,6 +180,7 @@ def main() -> None:
     parser.add_argument("--sweep-rows", type=int, help="launches of the end-to-end sweep (0: none; default: by device)")
     parser.add_argument("--threads", type=int, help="torch CPU threads (default: torch's)")
     parser.add_argument("--model", help="bundle (default: the shipped models/default)")
+    parser.add_argument("--ray-workers", type=int, help="also sweep through --engine ray --device on this many actors")
     args = parser.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
@@ -195,6 +200,8 @@ def main() -> None:
         if kind in SWEEP_TARGET:
             section["sweep"] |= {"target": f">= {SWEEP_TARGET[kind]:,.0f} shots/s",
                                  "met": section["sweep"]["shots_per_s"] >= SWEEP_TARGET[kind]}
+        if args.ray_workers:
+            section["ray_sweep"] = sweep_end_to_end(args.device, rows, args.threads, args.ray_workers)
     print_table(section)
     write_results(f"torch_engine_{kind}", [section])
 
