@@ -261,7 +261,8 @@ def test_the_cross_field_rules_read_only_presence_and_the_value_rule_columns():
             ["--engine", "ray", "--threads", "2"],
             "--threads goes with --engine ray only beside --device (cuda or cpu): the torch engine",
         ),
-        (["--engine", "local", "--device", "cuda"], "--device goes with --engine torch, or --engine ray with --device"),
+        (["--engine", "local", "--device", "cuda"], "--device goes with --engine torch, or --engine ray"),
+        (["--engine", "local", "--dtype", "float64"], "--dtype goes with --engine torch, or --engine ray with --device"),
     ],
 )
 def test_torch_options_that_do_not_go_with_the_engine_are_refused(tmp_path, capsys, options, message):

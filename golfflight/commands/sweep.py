@@ -31,7 +31,17 @@ shots (the engine splits a batch further where the device's memory needs it)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser("sweep", help="fly a file or grid of launches into a Parquet file (local, Ray or torch)")
+    parser = subparsers.add_parser(
+        "sweep",
+        help="fly a file or grid of launches into a Parquet file (local, Ray or torch)",
+        description="Fly every row of a launches file (CSV or Parquet, simulate's columns) or of a grid into one Parquet "
+        "file, the numbers simulate gives: on local processes (ONNX Runtime), Ray Data actors, or the model rebuilt in "
+        "torch (--engine torch, on --device cpu or cuda). On a Ray cluster with GPUs, --engine ray --device cuda "
+        "flies the torch engine in each actor on a GPU of its own, one actor for each GPU the cluster lists unless "
+        "--workers says fewer (e.g. golfflight sweep --grid ball_speed_mps=30:80:1000 launch_angle_deg=6:30:100 "
+        "spin_rpm=1500:9000:100 --out sweep.parquet --engine ray --device cuda --ray-address auto); it is refused in "
+        "one line where the cluster lists no GPU or a GPU worker cannot build the engine (no torch, no CUDA).",
+    )
     parser.add_argument("launches", nargs="?", help="CSV or Parquet file of launches (simulate's CSV columns)")
     parser.add_argument(
         "--grid", nargs="+", metavar="COLUMN=SPEC",
@@ -94,7 +104,8 @@ def _check_options(args: argparse.Namespace) -> None:
         raise ValueError("--threads takes a whole number of at least 1")
     torch_only = [name for name in ("device", "dtype", "threads") if getattr(args, name) is not None]
     if torch_only and args.engine == "local":
-        raise ValueError(f"--{torch_only[0]} goes with --engine torch, or --engine ray with --device")
+        also = "--engine ray" if torch_only[0] == "device" else "--engine ray with --device"
+        raise ValueError(f"--{torch_only[0]} goes with --engine torch, or {also}")
     if torch_only and args.engine == "ray" and args.device is None:
         raise ValueError(f"--{torch_only[0]} goes with --engine ray only beside --device (cuda or cpu): the torch engine")
     if _torch_on_ray(args) and args.device not in ("cuda", "cpu"):
