@@ -70,13 +70,17 @@ BOUNDS = {
 """The pydantic field constraints a number column is checked against in bulk, and how."""
 
 
+def section_model(section: str) -> type[BaseModel]:
+    """The request model of one of the request's condition objects (air, wind, ground)."""
+    annotation = ShotRequest.model_fields[section].annotation
+    return next(a for a in get_args(annotation) if isinstance(a, type) and issubclass(a, BaseModel))
+
+
 def field_of(column: str) -> tuple[type[BaseModel], str]:
     """The request model and field a column's cells go to (`contract.columns.request_of_cells`)."""
     for section, columns in SECTION_COLUMNS.items():
         if column in columns:
-            annotation = ShotRequest.model_fields[section].annotation
-            model = next(a for a in get_args(annotation) if isinstance(a, type) and issubclass(a, BaseModel))
-            return model, columns[column]
+            return section_model(section), columns[column]
     return ShotRequest, column
 
 
@@ -350,7 +354,7 @@ class _Shared:
 def _section(request: dict, section: str):
     """The validated condition object (air, wind, ground) of a request dict, or None where it gives none."""
     part = request.get(section)
-    return None if part is None else field_of(next(iter(SECTION_COLUMNS[section])))[0].model_validate(part)
+    return None if part is None else section_model(section).model_validate(part)
 
 
 def _made(checked: Checked, rows: np.ndarray, names, make) -> _Shared:
