@@ -319,11 +319,11 @@ def test_ray_actors_fly_the_torch_engine_as_engine_torch_does(tmp_path, capsys):
     torch_out, ray_out = tmp_path / "torch.parquet", tmp_path / "ray.parquet"
     assert sweep(*axes, "--out", torch_out, "--engine", "torch", "--device", "cpu", "--threads", 1,
                  "--chunk-rows", 32) == 0
-    ray.init(num_cpus=3, include_dashboard=False, logging_level="WARNING")
+    ray.init(num_cpus=2, include_dashboard=False, logging_level="WARNING")
     try:
-        assert sweep(*axes, "--out", ray_out, "--engine", "ray", "--device", "cpu", "--workers", 2,
+        assert sweep(*axes, "--out", ray_out, "--engine", "ray", "--device", "cpu", "--workers", 1,
                      "--chunk-rows", 32) == 0
-        assert "on ray with 2 workers (torch on cpu, float32)" in capsys.readouterr().out
+        assert "on ray with 1 workers (torch on cpu, float32)" in capsys.readouterr().out
         assert sweep(*axes, "--out", tmp_path / "gpu.parquet", "--engine", "ray", "--device", "cuda") == 2
         err = capsys.readouterr().err
         assert err.startswith("golfflight sweep: error: --engine ray --device cuda: the Ray cluster lists no GPU")
