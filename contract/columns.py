@@ -126,15 +126,32 @@ def is_flag_set(value) -> bool:
     return str(value).lower() in ("1", "1.0", "true", "yes")
 
 
+_PLACES = {
+    **{column: (None, column) for column in LAUNCH_COLUMNS},
+    **{column: (section, field) for section, columns in SECTION_COLUMNS.items() for column, field in columns.items()},
+    "normalized": (None, "normalized"),
+}
+"""Where each request column's cell goes in a ShotRequest dict (section, field), in the dict's order."""
+
+_ORDER = {column: i for i, column in enumerate(_PLACES)}
+
+
 def request_of_cells(cells: dict) -> dict:
-    """A ShotRequest dict from one row's cells (as `cell_value` reads them; None or missing = not given)."""
-    shot = {k: cells[k] for k in LAUNCH_COLUMNS if cells.get(k) is not None}
-    for name, columns in (("air", AIR_COLUMNS), ("wind", WIND_COLUMNS), ("ground", GROUND_COLUMNS)):
-        part = {field: cells[column] for column, field in columns.items() if cells.get(column) is not None}
-        if part:
-            shot[name] = part
-    if cells.get("normalized") is not None:
-        shot["normalized"] = is_flag_set(cells["normalized"])
+    """A ShotRequest dict from one row's cells (as `cell_value` reads them; None or missing = not given): the launch
+    fields, then the air, wind and ground objects, then `normalized`, each in the order of its columns (only the
+    cells a row has are looked at: a sweep builds one for each of many rows)."""
+    shot: dict = {}
+    for column in sorted(_ORDER.keys() & cells.keys(), key=_ORDER.__getitem__):
+        value = cells[column]
+        if value is None:
+            continue
+        section, field = _PLACES[column]
+        if column == "normalized":
+            shot[field] = is_flag_set(value)
+        elif section is None:
+            shot[field] = value
+        else:
+            shot.setdefault(section, {})[field] = value
     return shot
 
 
