@@ -45,7 +45,8 @@ UNCERTAINTY_EFFECTS = ("wind", "air_density", "drag_scale", "lift_scale")
 """Single effects whose ± --uncertainty compares (the ones most often named on real sets)."""
 
 DRAW_MARGIN = 1.01
-"""Shots drawn per shot kept: the generator's filters drop a few (0.2 % of 100,000), and the set is cut to N."""
+"""Shots drawn per shot kept: the generator's filters drop a few (0.2 % of 100,000; concealing, 0.03 %), and the set
+is cut to N."""
 
 
 def synthetic_set(n: int, seed: int, folder: Path) -> Path:
@@ -66,7 +67,10 @@ def concealed_set(n: int, seed: int, hidden: str, model: str | None, folder: Pat
     if not path.is_file():
         rng = np.random.default_rng(10_000 + seed)
         effects = {name: draw_effect(name, rng) for name in hidden.split("+")}
-        write_shots(path, conceal(effects, n, seed, model=load_model(model)).shots.records)
+        records = conceal(effects, int(n * DRAW_MARGIN) + 10, seed, model=load_model(model)).shots.records
+        if len(records) < n:
+            raise ValueError(f"{len(records)} shots concealed for {n} wanted")
+        write_shots(path, records[:n])
     return path
 
 
