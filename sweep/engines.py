@@ -149,7 +149,7 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int | None, addres
                make_engine: Callable | None = None, gpus_per_actor: int = 0) -> Iterator:
     """Result tables of `source`'s pieces through Ray Data: `map_batches` with `Flyer` as a callable class on a pool
     of `workers` actors of one CPU each, order preserved. Each actor flies with ONNX Runtime, or with the engine
-    `make_engine` builds on its node (the torch engine), asking Ray for `gpus_per_actor` GPUs besides: then
+    `make_engine` builds on its node (the torch engine), asking Ray for `gpus_per_actor` GPUs instead of a CPU: then
     `workers` None is one actor for each GPU the cluster lists (`gpu_actors`), and one actor's engine is built on a
     GPU of the cluster before the sweep starts, so that a node without torch or CUDA is refused in one line.
     Connects to the cluster at `address` if given (and leaves it running), else starts a local Ray instance with a
@@ -235,8 +235,8 @@ def _ray_tables(ray, source, bundle_dir: str, sha256: str, workers: int | None, 
             compute=ray.data.ActorPoolStrategy(size=workers),
             batch_size=1,  # one piece (one row) a call: one engine batch of --chunk-rows shots
             batch_format="pyarrow",
-            num_cpus=1,
-            num_gpus=gpus_per_actor,
+            # A CPU each, or GPUs only: Ray Data warns that both at once is experimental for its map workers.
+            **({"num_gpus": gpus_per_actor} if gpus_per_actor else {"num_cpus": 1}),
         )
         yield from dataset.iter_batches(batch_size=None, batch_format="pyarrow")
     finally:

@@ -305,32 +305,36 @@ def test_a_grid_sweep_equals_simulate_row_for_row(tmp_path):
 def test_ray_actors_fly_the_torch_engine_as_engine_torch_does(tmp_path, capsys):
     """`--engine ray --device cpu`: each actor builds the torch engine itself (`TorchEngineMaker`, sent by Ray) and
     the Parquet file holds the numbers of `--engine torch --device cpu`, every column equal. On the same Ray
-    instance (started here once, left running by the sweep): `--device cuda` is refused in one line because the
-    instance lists no GPU, and an engine an actor could not build (CUDA asked where there is none, as on a GPU node
-    without its driver) is refused before any actor starts."""
+    instance (started here once with one GPU declared, which Ray takes on trust; the sweep leaves it running): an
+    actor asking Ray for that GPU (`RayEngine(gpus=1)`, what `--device cuda` asks; here it flies on the CPU) is placed
+    and gives the same file, one actor for the one GPU listed; and `--device cuda`, whose engine no worker here can
+    build (no CUDA, as on a GPU node without its driver), is refused in one line before any actor starts."""
     ray = pytest.importorskip("ray")
     pytest.importorskip("torch")
-    from golfflight.flight.bundle_location import model_dir
     from golfflight.model_export.torch_engine import TorchEngineMaker
-    from golfflight.sweep.engines import check_actor_engine
+    from golfflight.sweep.run import RayEngine, run_sweep
+    from golfflight.sweep.sources import open_source
 
-    axes = ["--grid", "ball_speed_mps=40:70:5", "launch_angle_deg=8,16", "spin_rpm=2500,6000", "wind_speed_mps=0,6",
+    axes = ["ball_speed_mps=40:70:5", "launch_angle_deg=8,16", "spin_rpm=2500,6000", "wind_speed_mps=0,6",
             "ground_elevation_m=0,-3", "normalized=true,false"]
-    torch_out, ray_out = tmp_path / "torch.parquet", tmp_path / "ray.parquet"
-    assert sweep(*axes, "--out", torch_out, "--engine", "torch", "--device", "cpu", "--threads", 1,
+    outs = {name: tmp_path / f"{name}.parquet" for name in ("torch", "ray", "ray_gpu")}
+    assert sweep("--grid", *axes, "--out", outs["torch"], "--engine", "torch", "--device", "cpu", "--threads", 1,
                  "--chunk-rows", 32) == 0
-    ray.init(num_cpus=2, include_dashboard=False, logging_level="WARNING")
+    ray.init(num_cpus=2, num_gpus=1, include_dashboard=False, logging_level="WARNING")
     try:
-        assert sweep(*axes, "--out", ray_out, "--engine", "ray", "--device", "cpu", "--workers", 1,
+        assert sweep("--grid", *axes, "--out", outs["ray"], "--engine", "ray", "--device", "cpu", "--workers", 1,
                      "--chunk-rows", 32) == 0
         assert "on ray with 1 workers (torch on cpu, float32)" in capsys.readouterr().out
-        assert sweep(*axes, "--out", tmp_path / "gpu.parquet", "--engine", "ray", "--device", "cuda") == 2
+        run_sweep(open_source(None, axes, 32), str(outs["ray_gpu"]), "ray", None, progress=False,
+                  ray_engine=RayEngine(TorchEngineMaker("cpu", threads=1), gpus=1))
+        assert sweep("--grid", *axes, "--out", tmp_path / "cuda.parquet", "--engine", "ray", "--device", "cuda") == 2
         err = capsys.readouterr().err
-        assert err.startswith("golfflight sweep: error: --engine ray --device cuda: the Ray cluster lists no GPU")
-        with pytest.raises(ValueError, match=r"cannot build the torch engine \(DeviceError: --device cuda: this machine "
-                                             r"has no CUDA GPU"):
-            check_actor_engine(ray, TorchEngineMaker("cuda"), str(model_dir(None)), 0)
+        assert err.startswith("golfflight sweep: error: --engine ray: a worker of the Ray cluster cannot build the "
+                              "torch engine (DeviceError: --device cuda: this machine has no CUDA GPU"), err
+        assert len(err.splitlines()) == 1 and not (tmp_path / "cuda.parquet").exists()
     finally:
         ray.shutdown()
-    swept, expected = pq.read_table(ray_out), pq.read_table(torch_out)
-    assert swept.num_rows == 160 and swept.equals(expected)
+    expected = pq.read_table(outs["torch"])
+    assert expected.num_rows == 160
+    for name in ("ray", "ray_gpu"):
+        assert pq.read_table(outs[name]).equals(expected), name
