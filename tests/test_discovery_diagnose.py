@@ -55,6 +55,7 @@ def test_clean_recordings_raise_no_alarm():
     recordings = from_shot_set(conceal({}, 120, seed=8).shots)
     report = diagnose(recordings, reference(), seed=0).report
     assert not report.systematic and report.effects == []
+    assert all("+" not in c.name for c in report.candidates), "no single beat the model, so no pair was fitted"
     assert "No systematic mismatch" in report.statement
     assert report.service_settings.wind is None
 
@@ -159,3 +160,33 @@ def test_a_log_profile_wind_is_named_with_its_uniform_equivalent_and_its_station
     station = report.service_settings.wind_at_station
     assert station.profile == "log" and station.reference_height_m == 10.0
     assert station.speed_mps == pytest.approx(5.0, rel=0.05) and station.from_deg == wind["from_deg"]
+
+
+def test_three_effects_at_once_are_named_by_the_triple_step():
+    """A wind, a ball-speed bias and a spin-axis bias hidden together: the pair beats the best single and the triple
+    beats the pair on held-out sessions, so all three are named, each near its size; the decision says so."""
+    hidden = {
+        "wind": {"speed_mps": 5.0, "from_deg": 60.0},
+        "ball_speed_bias": {"scale": 1.03},
+        "spin_axis_bias": {"offset_deg": 4.5},
+    }
+    recordings = from_shot_set(conceal(hidden, 300, seed=13).shots)
+    report = diagnose(recordings, reference(), seed=0, with_correction=False, progress=False).report
+    fitted = {e.name: e.parameters for e in report.effects}
+    assert set(fitted) == set(hidden)
+    assert fitted["wind"]["speed_mps"] == pytest.approx(5.0, rel=0.1)
+    assert fitted["ball_speed_bias"]["scale"] == pytest.approx(1.03, abs=0.003)
+    assert fitted["spin_axis_bias"]["offset_deg"] == pytest.approx(4.5, rel=0.1)
+    test = report.systematic_test
+    assert test["best_triple"] == "+".join(e.name for e in report.effects)
+    assert test["best_triple_gain_over_pair"] > 0 and test["best_triple_gain_low"] > 0
+
+
+def test_a_pair_gains_no_third_effect():
+    """A wind with a ball-speed bias: the triples tried do not beat the pair beyond doubt, so the pair is named."""
+    hidden = {"wind": {"speed_mps": 4.0, "from_deg": 200.0}, "ball_speed_bias": {"scale": 0.975}}
+    recordings = from_shot_set(conceal(hidden, 300, seed=12).shots)
+    report = diagnose(recordings, reference(), seed=0, with_correction=False, progress=False).report
+    assert {e.name for e in report.effects} == set(hidden)
+    assert "best_triple" in report.systematic_test, "triples were fitted and turned down"
+    assert len([c for c in report.candidates if c.name.count("+") == 2]) >= 1
