@@ -12,8 +12,9 @@ the best singles is combined with the other effects that most reduce its lineari
 pair beats the best single, each of the best pairs with a third (triples). A candidate replaces a simpler one only if
 its held-out error is lower beyond doubt (the lower end of a session-bootstrap interval of the improvement is above
 zero) and by a material share, and, against a controlled model, by more than the model's own error of response to
-the simpler explanation (`Diagnoser.response_error`). Structure the library explanation leaves (the test run again on its residuals) leads
-to the learned correction; a library effect stays beside it only if it beats the correction alone beyond doubt.
+the simpler explanation (`Diagnoser.response_error`). Structure the library explanation leaves (the test run again
+on its residuals) leads to the learned correction; a library effect stays beside it only if it beats the correction
+alone beyond doubt.
 """
 
 from __future__ import annotations
