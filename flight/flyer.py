@@ -25,7 +25,7 @@ from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.constants import BALL_MASS_KG, BALL_RADIUS_M
 from golfflight.flight.field import BallInAir
-from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, ground_phase
+from golfflight.flight.ground import GroundPhase, GroundSpec, batch_surface, ground_phase
 from golfflight.flight.integrator import FORWARD_EULER, GroundPlane, StepRule, integrate, record_for
 from golfflight.flight.limits import FLIGHT_TIME_S
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
@@ -38,6 +38,7 @@ from golfflight.flight.outcomes import (
     ShotFlight,
     landing_figures,
 )
+from golfflight.flight.per_shot import PerShot
 from golfflight.flight.physics import CoefficientModel, State, initial_state
 from golfflight.flight.wind import CALM, Wind
 from golfflight.weights_schema.bundle import CARD_FILE, BundleError
@@ -228,11 +229,9 @@ class Flyer:
     ) -> _Flown:
         """The batch flight behind `fly_batch` and `fly_columns`."""
         n = len(launches)
-        per_shot = [conditions] * n if isinstance(conditions, Conditions) else list(conditions)
-        shot_grounds = [grounds] * n if grounds is None or isinstance(grounds, GroundSpec) else list(grounds)
-        if len(per_shot) != n or len(shot_grounds) != n:
-            raise ValueError(f"{len(per_shot)} conditions and {len(shot_grounds)} grounds for {n} launches")
-        heights = np.array([0.0 if g is None else g.elevation_m for g in shot_grounds])
+        per_shot = PerShot.of(conditions, n, "conditions")
+        shot_grounds = PerShot.of(grounds, n, "grounds")
+        heights = shot_grounds.column(lambda g: 0.0 if g is None else g.elevation_m)
         start = initial_state(*np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH).T)
         field = self._batch_field(per_shot)
         flight = integrate(start, field, self.dt_s, self.max_steps, self.rule, GroundPlane(heights),
@@ -245,9 +244,9 @@ class Flyer:
         for i in np.flatnonzero(~(flight.landed & finite)).tolist():
             unlanded = not flight.landed[i]
             errors[i] = self.unlanded_message(float(flight.apex_m[i]), float(heights[i])) if unlanded else NON_FINITE
-        rolled = flight.landed & finite & np.array([g is not None for g in shot_grounds])
+        rolled = flight.landed & finite & shot_grounds.column(lambda g: g is not None, bool)
         shots = np.flatnonzero(rolled)
-        phase = _ground_phase(flight, shots, [shot_grounds[i] for i in shots], keep_states)
+        phase = _ground_phase(flight, shots, shot_grounds.take(shots), keep_states)
         columns = BatchFlights(
             landing_x_m=x, landing_y_m=y, carry_m=carry, lateral_m=x, apex_m=flight.apex_m,
             apex_time_s=flight.apex_time_s, flight_time_s=flight.flight_time_s, landing_angle_deg=angle,
@@ -256,18 +255,18 @@ class Flyer:
         )
         return _Flown(columns, flight, phase)
 
-    def _batch_field(self, per_shot: list[Conditions]) -> BallInAir:
+    def _batch_field(self, per_shot: PerShot[Conditions]) -> BallInAir:
         """The equations of motion for a batch, each shot in its own air and wind."""
-        inputs = [air_inputs(c) for c in per_shot]
+        inputs = PerShot([air_inputs(c) for c in per_shot.objects], per_shot.index)
         wind = Wind(
-            np.array([c.wind.speed_mps for c in per_shot], dtype=float),
-            np.array([c.wind.from_deg for c in per_shot], dtype=float),
-            np.array([c.wind.profile for c in per_shot]),
-            np.array([a.reference_height_m for a in inputs], dtype=float),
-            np.array([a.roughness_m for a in inputs], dtype=float),
+            per_shot.column(lambda c: c.wind.speed_mps),
+            per_shot.column(lambda c: c.wind.from_deg),
+            per_shot.column(lambda c: c.wind.profile, None),
+            inputs.column(lambda a: a.reference_height_m),
+            inputs.column(lambda a: a.roughness_m),
         )
-        viscosity = np.array([a.kinematic_viscosity_m2_s for a in inputs], dtype=float)
-        density = np.array([a.density_kg_m3 for a in inputs], dtype=float)
+        viscosity = inputs.column(lambda a: a.kinematic_viscosity_m2_s)
+        density = inputs.column(lambda a: a.density_kg_m3)
         return BallInAir(self.in_air(viscosity), density, wind)
 
     def _shot_states(self, history: tuple[np.ndarray, np.ndarray], flight: Flight, shot: int) -> EulerStates:
@@ -281,20 +280,19 @@ class Flyer:
 
 
 def _ground_phase(
-    flight: Flight, shots: np.ndarray, grounds: list[GroundSpec], keep_states: bool
+    flight: Flight, shots: np.ndarray, grounds: PerShot[GroundSpec], keep_states: bool
 ) -> GroundPhase | None:
-    """The ground phase of the landed `shots` of a batch flight, each on its ground, in one batch."""
+    """The ground phase of the landed `shots` of a batch flight, each on its ground (`grounds`, theirs), in one
+    batch."""
     if not shots.size:
         return None
-    distinct = {id(g.surface): g.surface for g in grounds}
-    surface = next(iter(distinct.values())) if len(distinct) == 1 else Surface.stack([g.surface for g in grounds])
     return ground_phase(
         flight.landing_position[shots],
         flight.landing_velocity[shots],
         flight.landing_spin[shots],
-        surface,
-        np.array([g.slope_deg for g in grounds]),
-        np.array([g.slope_dir_deg for g in grounds]),
+        batch_surface(grounds),
+        grounds.column(lambda g: g.slope_deg),
+        grounds.column(lambda g: g.slope_dir_deg),
         keep_states,
     )
 

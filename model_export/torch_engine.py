@@ -14,8 +14,10 @@ shapes), a part stopping once every shot of it has come down; a shot never down 
 figures are not finite, fails with the engine's message (the batch is flown in parts that fit the device).
 
 The ground phase (bounce and roll) is the engine's own NumPy code (`flight.ground.ground_phase`) on the CPU, fed the
-landing states in float64; `seconds` splits the time between the device's flight and that ground phase. A part's
-size is `part_shots`. Torch is imported here only: nothing of the serving install or the sweep package imports this
+landing states in float64. `seconds` holds the time spent in each stage (`STAGES`: preparing a batch's launch states
+and air on the CPU, the device's flight, the figures and ground phase on the CPU), summed over the threads that fly
+batches on one engine at once (a sweep's pieces in flight: `parts_at_once` share the device's memory). A part's size
+is `part_shots`. Torch is imported here only: nothing of the serving install or the sweep package imports this
 module (`golfflight sweep --engine torch` and `--engine ray --device` do, from the command line, and each Ray actor
 of the latter when it unpickles the `TorchEngineMaker` it is sent).
 """
@@ -24,6 +26,7 @@ from __future__ import annotations
 
 import math
 import os
+import threading
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -32,8 +35,9 @@ import numpy as np
 import torch
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import LAUNCH_WIDTH, NON_FINITE, Launch, air_inputs, load_flyer
-from golfflight.flight.ground import GroundSpec, Surface, ground_phase
+from golfflight.flight.ground import GroundSpec, batch_surface, ground_phase
 from golfflight.flight.outcomes import BatchFlights, Rest, landing_figures
+from golfflight.flight.per_shot import PerShot
 from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.model_export.bundle_model import model_from_bundle
 from golfflight.model_export.devices import resolve_device
@@ -56,6 +60,10 @@ STATE_COPIES = 3
 WORKING_BYTES_PER_SHOT = 4096
 """A step's transient memory a shot, beside the kept states, as estimated: the network's two 256-wide and two
 128-wide float32 activations (3 kB) and the equations' temporaries (`bench_gpu.py` measures the peak on a GPU)."""
+
+STAGES = ("prepare", "flight", "ground")
+"""A batch's stages, timed apart (`TorchEngine.seconds`): its launch states, air and grounds as arrays (CPU), its flight
+to the landings back in NumPy (the device, transfers included), its figures and ground phase (CPU, NumPy)."""
 
 LANDING_CHECK_STEPS = 10
 """Steps between the checks whether every shot of a part has come down (each check waits for the device)."""
@@ -102,11 +110,12 @@ class TorchEngine:
     (module docstring)."""
 
     def __init__(self, bundle_dir: str | os.PathLike, device: str = "cpu", dtype: str = "float32",
-                 part_shots: int | None = None) -> None:
+                 part_shots: int | None = None, parts_at_once: int = 1) -> None:
         """Load and verify the bundle (`flight.flyer.load_flyer`, the engine's checks: its step, maximum flight time,
         nominal air and error messages are this engine's) and rebuild its network in torch on `device`; `dtype`
         is the physics' precision; `part_shots` caps the shots flown at once (default: what the device's memory
-        holds). `devices.DeviceError` for a device this machine lacks, ValueError for a dtype it does not know."""
+        holds, shared by `parts_at_once` threads flying batches on this engine at once). `devices.DeviceError` for a device
+        this machine lacks, ValueError for a dtype it does not know."""
         if dtype not in DTYPES:
             raise ValueError(f"dtype {dtype!r}: choose from {', '.join(DTYPES)}")
         self.device, self.dtype = resolve_device(device), DTYPES[dtype]
@@ -114,8 +123,9 @@ class TorchEngine:
         self.card, self.sha256 = self.flyer.card, self.flyer.card.onnx.sha256
         model, _ = model_from_bundle(self.flyer.bundle_dir)
         self.model = model.to(self.device)
-        self.part_limit = part_shots
-        self.seconds = {"flight": 0.0, "ground": 0.0}
+        self.part_limit, self.parts_at_once = part_shots, parts_at_once
+        self.seconds = dict.fromkeys(STAGES, 0.0)
+        self._timing = threading.Lock()
 
     def coefficients(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
         """C_L, C_D, C_M, C_Q [N,4] in the physics' dtype from the network run in float32, as the graph runs."""
@@ -132,7 +142,7 @@ class TorchEngine:
         free += torch.cuda.memory_reserved(self.device) - torch.cuda.memory_allocated(self.device)  # torch's own cache
         itemsize = torch.finfo(self.dtype).bits // 8
         per_shot = (self.flyer.max_steps + 1) * 3 * STATE_COPIES * itemsize + WORKING_BYTES_PER_SHOT
-        return max(1024, int(free * DEVICE_MEMORY_SHARE / per_shot))
+        return max(1024, int(free * DEVICE_MEMORY_SHARE / self.parts_at_once / per_shot))
 
     def fly_columns(
         self,
@@ -146,42 +156,41 @@ class TorchEngine:
         n = len(launches)
         if n == 0:
             raise ValueError("no shots to fly")
-        for given, name in ((conditions, "conditions"), (grounds, "grounds")):
-            if isinstance(given, Sequence) and len(given) != n:
-                raise ValueError(f"{len(given)} {name} for {n} launches")
+        per_shot, shot_grounds = PerShot.of(conditions, n, "conditions"), PerShot.of(grounds, n, "grounds")
         started = time.perf_counter()
-        shot_grounds = Grounds.of(grounds, n)
-        inputs = self._inputs(np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH), conditions, shot_grounds)
+        inputs = self._inputs(np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH), per_shot, shot_grounds)
+        prepared = self._spent("prepare", started)
         size = self.part_shots()
         parts = [self._fly_part(inputs.part(start, min(start + size, n))) for start in range(0, n, size)]
         landings = Landings(*(np.concatenate([getattr(p, name) for p in parts]) for name in Landings.__dataclass_fields__))
-        flown = time.perf_counter()
+        flown = self._spent("flight", prepared)
         columns = self._columns(landings, shot_grounds)
-        self.seconds["flight"] += flown - started
-        self.seconds["ground"] += time.perf_counter() - flown
+        self._spent("ground", flown)
         return columns
 
-    def _inputs(self, launches: np.ndarray, conditions: Sequence[Conditions] | Conditions,
-                grounds: Grounds) -> ShotInputs:
-        """The shots' launch states, air, wind and grounds as the engine's Flyer takes them (`air_inputs`)."""
-        n = len(launches)
+    def _spent(self, stage: str, since: float) -> float:
+        """Count the time since `since` to `stage` (from any thread); now."""
+        now = time.perf_counter()
+        with self._timing:
+            self.seconds[stage] += now - since
+        return now
+
+    def _inputs(self, launches: np.ndarray, conditions: PerShot[Conditions],
+                grounds: PerShot[GroundSpec | None]) -> ShotInputs:
+        """The shots' launch states, air, wind and grounds as the engine's Flyer takes them (`air_inputs`, once for
+        each distinct conditions)."""
         start = initial_state(*launches.T)
-        air = [air_inputs(conditions)] if isinstance(conditions, Conditions) else [air_inputs(c) for c in conditions]
-
-        def column(values: list, dtype: type = float) -> np.ndarray:
-            array = np.array(values, dtype=dtype)
-            return np.repeat(array, n, axis=0) if len(array) == 1 else array
-
+        air = PerShot([air_inputs(c) for c in conditions.objects], conditions.index)
         nominal = self.flyer.kinematic_viscosity_m2_s
         return ShotInputs(
             start.position, start.velocity, start.spin,
-            density=column([a.density_kg_m3 for a in air]),
-            reynolds_scale=reynolds_scale(column([a.kinematic_viscosity_m2_s for a in air]), nominal),
-            wind=column([(a.wind_x_mps, a.wind_y_mps, 0.0) for a in air]),
-            log_profile=column([a.log_profile for a in air], bool),
-            reference_height_m=column([a.reference_height_m for a in air]),
-            roughness_m=column([a.roughness_m for a in air]),
-            ground_m=grounds.elevation_m,
+            density=air.column(lambda a: a.density_kg_m3),
+            reynolds_scale=reynolds_scale(air.column(lambda a: a.kinematic_viscosity_m2_s), nominal),
+            wind=air.column(lambda a: (a.wind_x_mps, a.wind_y_mps, 0.0)),
+            log_profile=air.column(lambda a: a.log_profile, bool),
+            reference_height_m=air.column(lambda a: a.reference_height_m),
+            roughness_m=air.column(lambda a: a.roughness_m),
+            ground_m=_elevations(grounds),
         )
 
     @torch.no_grad()
@@ -227,7 +236,7 @@ class TorchEngine:
             array(peak.height_m + ground), array(peak.time_s), landing.landed.cpu().numpy(),
         )
 
-    def _columns(self, flight: Landings, grounds: Grounds) -> BatchFlights:
+    def _columns(self, flight: Landings, grounds: PerShot[GroundSpec | None]) -> BatchFlights:
         """The batch's figures, errors and rests from its landings (as `flight.flyer.Flyer` makes them from the
         integrator's), the landed shots with a ground bounced and rolled to rest on the CPU."""
         n = len(flight.landed)
@@ -235,17 +244,18 @@ class TorchEngine:
         carry, angle, speed, spin = landing_figures(x, y, *flight.velocity.T, *flight.spin.T)
         numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
         finite = np.isfinite(np.stack(numbers)).all(axis=0)
-        errors = {}
+        errors, heights = {}, _elevations(grounds)
         for i in np.flatnonzero(~(flight.landed & finite)).tolist():
             unlanded = not flight.landed[i]
-            errors[i] = (self.flyer.unlanded_message(float(flight.apex_m[i]), float(grounds.elevation_m[i]))
+            errors[i] = (self.flyer.unlanded_message(float(flight.apex_m[i]), float(heights[i]))
                          if unlanded else NON_FINITE)
-        rolled = flight.landed & finite & grounds.present
+        rolled = flight.landed & finite & grounds.column(lambda g: g is not None, bool)
         shots = np.flatnonzero(rolled)
         phase = None
         if shots.size:
-            phase = ground_phase(flight.position[shots], flight.velocity[shots], flight.spin[shots],
-                                 grounds.surface_of(shots), grounds.slope_deg[shots], grounds.slope_dir_deg[shots])
+            on = grounds.take(shots)
+            phase = ground_phase(flight.position[shots], flight.velocity[shots], flight.spin[shots], batch_surface(on),
+                                 on.column(lambda g: g.slope_deg), on.column(lambda g: g.slope_dir_deg))
         # a shot that never came down has no landing: NaN figures, as the integrator leaves them
         x, y, carry, angle, speed, spin, flight_time = (
             np.where(flight.landed, v, math.nan) for v in (x, y, carry, angle, speed, spin, flight.flight_time_s)
@@ -263,50 +273,22 @@ class TorchEngineMaker:
     """How a sweep's worker builds its own TorchEngine from a bundle path: `golfflight sweep --engine torch` in its
     process, and each Ray actor of `--engine ray --device ...` on its node, on the GPU Ray gave it ("cuda" is that
     actor's one visible GPU). Picklable, so that Ray sends it to the actors; `threads` sets torch's CPU threads first
-    (an actor has one CPU)."""
+    (an actor has one CPU); `parts_at_once` as TorchEngine takes it."""
 
     device: str = "cpu"
     dtype: str = "float32"
     threads: int | None = None
+    parts_at_once: int = 1
 
     def __call__(self, bundle_dir: str | os.PathLike) -> TorchEngine:
         if self.threads is not None:
             torch.set_num_threads(self.threads)
-        return TorchEngine(bundle_dir, self.device, self.dtype)
+        return TorchEngine(bundle_dir, self.device, self.dtype, parts_at_once=self.parts_at_once)
 
 
-@dataclass(frozen=True)
-class Grounds:
-    """A batch's grounds as [N] arrays: whether a shot has one (None: the flight alone, down to z = 0), its
-    elevation, slope and slope direction, and its surface (one for all, or one a shot)."""
-
-    present: np.ndarray
-    elevation_m: np.ndarray
-    slope_deg: np.ndarray
-    slope_dir_deg: np.ndarray
-    surfaces: Surface | list[Surface | None]
-
-    @classmethod
-    def of(cls, grounds: Sequence[GroundSpec | None] | GroundSpec | None, n: int) -> Grounds:
-        """One ground for every shot (or none), or one a shot."""
-        if grounds is None or isinstance(grounds, GroundSpec):
-            one = GroundSpec() if grounds is None else grounds
-            values = (grounds is not None, one.elevation_m, one.slope_deg, one.slope_dir_deg)
-            return cls(*(np.full(n, v) for v in values), surfaces=one.surface)
-        return cls(
-            np.array([g is not None for g in grounds], dtype=bool),
-            *(np.array([0.0 if g is None else getattr(g, name) for g in grounds], dtype=float)
-              for name in ("elevation_m", "slope_deg", "slope_dir_deg")),
-            surfaces=[None if g is None else g.surface for g in grounds],
-        )
-
-    def surface_of(self, shots: np.ndarray) -> Surface:
-        """The surface of these shots (all with a ground): the one surface, or their surfaces stacked."""
-        if isinstance(self.surfaces, Surface):
-            return self.surfaces
-        chosen = [self.surfaces[i] for i in shots.tolist()]
-        distinct = {id(s): s for s in chosen}
-        return next(iter(distinct.values())) if len(distinct) == 1 else Surface.stack(chosen)
+def _elevations(grounds: PerShot[GroundSpec | None]) -> np.ndarray:
+    """Each shot's ground elevation [N] (0: the tee's, for a shot flown alone)."""
+    return grounds.column(lambda g: 0.0 if g is None else g.elevation_m)
 
 
 def _wind(at_reference: torch.Tensor, log_profile: torch.Tensor, reference_height_m: torch.Tensor,

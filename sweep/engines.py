@@ -1,6 +1,7 @@
 """The ways a sweep's pieces are flown, each a generator of result tables in input order: `local_tables` (a pool
 of processes on this machine), `ray_tables` (Ray Data on a local Ray instance or an existing cluster) and
-`in_process_tables` (one engine in this process, whose parallelism is its device's: the torch engine). Each worker
+`in_process_tables` (one engine in this process, whose parallelism is its device's: the torch engine, a few pieces at
+once in threads so that the CPU's work overlaps the device's). Each worker
 holds one `sweep.flyer.Flyer`, and at most a few pieces per worker are in flight, so memory stays bounded however
 long the input is.
 """
@@ -14,13 +15,19 @@ import sys
 import threading
 from collections import deque
 from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from contextlib import contextmanager
 
 from golfflight.sweep.flyer import Flyer
 
 PIECES_PER_WORKER = 2
 """Pieces queued per local worker: one flying and one waiting, so a worker never idles while the driver writes."""
+
+PIECES_IN_FLIGHT = 2
+"""Pieces the in-process engine flies at once, each in a thread of its own: while one piece's flight keeps the device
+busy, another's rows are checked and its landings rolled to rest, and the driver writes the last table (torch lets go
+of Python's lock in its kernels and while it waits for the device, NumPy in its array work, pyarrow while it
+writes)."""
 
 WORKER_IMPORTS = ["golfflight.flight.engine", "golfflight.contract.flying", "golfflight.sweep.flyer"]
 """Modules the local pool's fork server imports before it forks the workers."""
@@ -61,11 +68,21 @@ def local_tables(source, bundle_dir: str, sha256: str, workers: int) -> Iterator
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def in_process_tables(source, flyer: Flyer) -> Iterator:
-    """Result tables of `source`'s pieces flown one after another by `flyer` in this process (an engine that has
-    the device to itself: a pool of processes would only share it)."""
-    for piece in source.pieces():
-        yield flyer(piece)
+def in_process_tables(source, flyer: Flyer, in_flight: int = PIECES_IN_FLIGHT) -> Iterator:
+    """Result tables of `source`'s pieces flown by `flyer` in this process, `in_flight` pieces at once in threads, in
+    input order (an engine that has the device to itself: a pool of processes would only share it; its engine
+    takes pieces from several threads, `model_export.torch_engine.TorchEngine`)."""
+    pool = ThreadPoolExecutor(in_flight, thread_name_prefix="sweep-piece")
+    try:
+        pending = deque()
+        for piece in source.pieces():
+            pending.append(pool.submit(flyer, piece))
+            if len(pending) > in_flight:  # one more waits, so a thread never idles while the driver writes
+                yield pending.popleft().result()
+        while pending:
+            yield pending.popleft().result()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
 
 
 RAY_NOISE = (b"has constructor arguments in the object store and max_restarts > 0",)

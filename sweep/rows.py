@@ -53,6 +53,7 @@ from golfflight.contract.inputs import (
 from golfflight.contract.requests import ShotRequest
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.constants import MPH_TO_MPS
+from golfflight.flight.per_shot import PerShot
 from golfflight.flight.wind import CALM
 from pydantic import BaseModel, ConfigDict, TypeAdapter, ValidationError
 from pydantic.fields import FieldInfo
@@ -327,42 +328,18 @@ def _launches(columns: dict[str, Column], rows: np.ndarray) -> np.ndarray:
     return np.stack([speed, number("launch_angle_deg"), direction, spin, axis], axis=1)
 
 
-@dataclass(frozen=True)
-class _Shared:
-    """Objects the rows share, one per distinct combination of cells, and each row's: `objects[index[i]]`."""
-
-    objects: list
-    index: np.ndarray
-
-    def of(self, rows: np.ndarray) -> _Shared:
-        return _Shared(self.objects, self.index[rows])
-
-    def plus(self, *others: _Shared) -> _Shared:
-        objects, index = list(self.objects), [self.index]
-        for other in others:
-            index.append(other.index + len(objects))
-            objects += other.objects
-        return _Shared(objects, np.concatenate(index))
-
-    def given(self):
-        """One object for every row where they share one (an engine spreads it without a step a row), else a list."""
-        if len(self.index) and (self.index == self.index[0]).all():
-            return self.objects[self.index[0]]
-        return [self.objects[i] for i in self.index.tolist()]
-
-
 def _section(request: dict, section: str):
     """The validated condition object (air, wind, ground) of a request dict, or None where it gives none."""
     part = request.get(section)
     return None if part is None else section_model(section).model_validate(part)
 
 
-def _made(checked: Checked, rows: np.ndarray, names, make) -> _Shared:
+def _made(checked: Checked, rows: np.ndarray, names, make) -> PerShot:
     """One object for each distinct combination of the rows' cells in the columns `names`, made by `make` from the
     request dict of its first row, and each row's."""
     firsts, group = _groups(_key(checked.columns, names), rows)
     cells = cells_of(checked.table, firsts, names)
-    return _Shared([make(request_of_cells(cells[i])) for i in firsts.tolist()], group)
+    return PerShot([make(request_of_cells(cells[i])) for i in firsts.tolist()], group)
 
 
 def fly_checked(engine, checked: Checked) -> ShotColumns:
@@ -379,7 +356,7 @@ def fly_checked(engine, checked: Checked) -> ShotColumns:
     air_of_group = [air_of(air) for air in airs.objects]
     wind_of_group = [wind_of(wind) for wind in winds.objects]
     pairs, pair = _groups([airs.index.astype(np.int64), winds.index.astype(np.int64)], np.arange(n))
-    conditions = _Shared(
+    conditions = PerShot(
         [  # conditions_from(air, wind), each distinct air and wind made once
             STANDARD
             if airs.objects[a] is None and winds.objects[w] is None
@@ -394,15 +371,15 @@ def fly_checked(engine, checked: Checked) -> ShotColumns:
     has_reference = np.array([r is not None for r in references.objects], dtype=bool)
     replays = np.flatnonzero(has_reference[references.index])
     flats = np.flatnonzero(off_flat[grounds.index])
-    own_grounds = _Shared([ground_of(g) for g in grounds.objects], grounds.index)
-    replay_air = _Shared(
+    own_grounds = PerShot([ground_of(g) for g in grounds.objects], grounds.index)
+    replay_air = PerShot(
         [None if r is None else Conditions(air_of(r), CALM) for r in references.objects], references.index[replays]
     )
     launches = _launches(checked.columns, rows)
     flights = engine.fly_columns(
         np.concatenate([launches, launches[replays], launches[flats]]),
-        conditions.plus(replay_air, conditions.of(flats)).given(),
-        own_grounds.plus(own_grounds.of(replays), _Shared([None], np.zeros(len(flats), dtype=np.intp))).given(),
+        conditions.plus(replay_air, conditions.take(flats)),
+        own_grounds.plus(own_grounds.take(replays), PerShot([None], np.zeros(len(flats), dtype=np.intp))),
     )
     return _columns(flights, n, replays, flats)
 

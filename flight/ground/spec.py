@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 from golfflight.flight.ground.surfaces import SURFACES, Surface, holding_slope_deg
 from golfflight.flight.limits import SLOPE_DEG
+from golfflight.flight.per_shot import PerShot
 
 
 @dataclass(frozen=True)
@@ -28,3 +29,12 @@ class GroundSpec:
 
 LEVEL_FAIRWAY = GroundSpec()
 """The ground when none is given: the fitted fairway, level, at the tee's elevation."""
+
+
+def batch_surface(grounds: PerShot[GroundSpec]) -> Surface:
+    """The surface a batch of shots (each with a ground) bounces and rolls on: the one they share, or the parameters
+    of each shot's surface as [N] arrays (`Surface.stack` of the distinct surfaces, spread by shot)."""
+    surfaces = {id(g.surface): g.surface for g in grounds.objects}
+    if len(surfaces) == 1:
+        return next(iter(surfaces.values()))
+    return Surface.stack([g.surface for g in grounds.objects]).take(grounds.index)

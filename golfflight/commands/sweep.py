@@ -113,11 +113,11 @@ def _check_options(args: argparse.Namespace) -> None:
                          "cuda (or cpu)")
 
 
-def _torch_maker(args: argparse.Namespace, threads: int | None):
+def _torch_maker(args: argparse.Namespace, threads: int | None, parts_at_once: int = 1):
     """How the torch engine is built on the asked device (`model_export.torch_engine.TorchEngineMaker`)."""
     from golfflight.model_export.torch_engine import TorchEngineMaker
 
-    return TorchEngineMaker(args.device or "cpu", args.dtype or "float32", threads)
+    return TorchEngineMaker(args.device or "cpu", args.dtype or "float32", threads, parts_at_once)
 
 
 def _engines(args: argparse.Namespace):
@@ -127,7 +127,9 @@ def _engines(args: argparse.Namespace):
     from golfflight.sweep.run import RayEngine
 
     if args.engine == "torch":
-        return _torch_maker(args, args.threads)(model_dir(args.model).resolve()), RayEngine()
+        from golfflight.sweep.engines import PIECES_IN_FLIGHT
+
+        return _torch_maker(args, args.threads, PIECES_IN_FLIGHT)(model_dir(args.model).resolve()), RayEngine()
     if _torch_on_ray(args):
         return None, RayEngine(_torch_maker(args, args.threads or 1), int(args.device == "cuda"))
     return None, RayEngine()
@@ -178,8 +180,9 @@ def run(args: argparse.Namespace) -> int:
         f"on {args.engine} {where}"
     )
     if torch_engine is not None:
-        flight, ground = torch_engine.seconds["flight"], torch_engine.seconds["ground"]
-        print(f"golfflight sweep: torch flight {flight:.2f} s on {torch_engine.device}, ground phase {ground:.2f} s on "
-              f"the CPU (NumPy), the rest ({max(summary.seconds - flight - ground, 0.0):.2f} s) reading, validating "
-              f"and writing rows")
+        spent = torch_engine.seconds
+        print(f"golfflight sweep: torch flight {spent['flight']:.2f} s on {torch_engine.device}; on the CPU, the "
+              f"launches and air {spent['prepare']:.2f} s and the ground phase {spent['ground']:.2f} s (NumPy); "
+              f"seconds summed over the {torch_engine.parts_at_once} pieces flown at once, beside the driver reading, "
+              "validating and writing rows")
     return 0
