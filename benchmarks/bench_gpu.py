@@ -1,9 +1,11 @@
 """The torch engine (`golfflight sweep --engine torch`, `model_export.torch_engine`) on one device: shots per second
-against batch size (the flight alone, and with the ground phase on the CPU), peak memory, carry parity with the ONNX
-Runtime engine on 10,000 mixed shots (float32 and float64 physics), and a sweep end to end through the command line.
-Writes the section `torch_engine_<cpu|cuda>` of benchmarks/results.json (other sections are kept) and prints a
-table for docs/benchmarks.md. The flight's time runs from the launches to the landings' figures back in NumPy (the
-device's transfers included); the ground phase's is NumPy's bounce and roll of those landings on the CPU.
+against batch size (the flight alone, eager and with its Euler step compiled, and with the CPU's share), peak
+memory, carry parity with the ONNX Runtime engine on 10,000 mixed shots (float32 and float64 physics, float32
+compiled), the CPU's share of a sweep in microseconds a row (what caps a sweep however fast the device flies), and
+sweeps end to end through the command line. Writes the section `torch_engine_<cpu|cuda>` of benchmarks/results.json
+(other sections are kept) and prints a table for docs/benchmarks.md. The flight's time runs from the launch states to
+the landings back in NumPy (the device's transfers included); the CPU's share is the batch's launch states and air
+before it, and the figures with NumPy's bounce and roll of the landings after it (`torch_engine.STAGES`).
 
 One command on a lent GPU machine (about 3 minutes on an H100, most of it the ONNX reference and the sweep;
 --ray-workers 1 also sweeps the same grid through `--engine ray --device cuda`, an actor on the GPU, Ray's start
@@ -32,8 +34,12 @@ from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import load_flyer
 from golfflight.flight.ground import SURFACES, GroundSpec
 from golfflight.flight.wind import Wind
-from golfflight.model_export.torch_engine import TorchEngine
+from golfflight.model_export.torch_engine import STAGES, TorchEngine
 from golfflight.shots.clubs import CLUBS
+from golfflight.sweep.engines import PIECES_IN_FLIGHT
+from golfflight.sweep.grid import Grid
+from golfflight.sweep.run import run_sweep
+from golfflight.sweep.sources import GridSource
 
 DEFAULT_BATCHES = {"cuda": (1024, 16_384, 262_144, 1_048_576, 4_194_304), "cpu": (1024, 4096, 16_384)}
 DEFAULT_SWEEP_ROWS = {"cuda": 1_000_000, "cpu": 8192}
@@ -81,34 +87,38 @@ def peak_memory_mb(device: torch.device) -> float:
 
 
 def timed(engine: TorchEngine, launches: np.ndarray, rounds: int) -> dict[str, float]:
-    """Median seconds of `rounds` batches (standard air, calm, a level fairway), split into the flight (on the
-    device, the figures included) and the ground phase (NumPy, on the CPU)."""
-    flights, grounds = [], []
+    """Median seconds of `rounds` batches (standard air, calm, a level fairway) in each of the engine's stages."""
+    spent = {stage: [] for stage in STAGES}
     for _ in range(rounds):
-        engine.seconds = {"flight": 0.0, "ground": 0.0}
+        engine.seconds = dict.fromkeys(STAGES, 0.0)
         engine.fly_columns(launches, STANDARD, GroundSpec(SURFACES["fairway"]))
-        flights.append(engine.seconds["flight"])
-        grounds.append(engine.seconds["ground"])
-    return {"flight_s": statistics.median(flights), "ground_s": statistics.median(grounds)}
+        for stage in STAGES:
+            spent[stage].append(engine.seconds[stage])
+    return {stage: statistics.median(values) for stage, values in spent.items()}
 
 
-def throughput(engine: TorchEngine, batches: list[int], rounds: int) -> list[dict]:
-    """Shots/s of the flight and of the flight with its ground phase, and peak memory, at each batch size."""
-    engine.fly_columns(launches_array(1024), STANDARD, None)  # the device's first kernels and allocations
+def throughput(engines: dict[str, TorchEngine], batches: list[int], rounds: int) -> list[dict]:
+    """Shots/s of the flight (each engine: eager, compiled) and of the whole batch with the CPU's share, and peak
+    memory, at each batch size; the engines interleaved at each size."""
+    for engine in engines.values():
+        engine.fly_columns(launches_array(1024), STANDARD, None)  # first kernels, allocations and compilation
     rows = []
     for n in batches:
         launches = launches_array(n)
-        if engine.device.type == "cuda":
-            torch.cuda.reset_peak_memory_stats(engine.device)
-        seconds = timed(engine, launches, rounds)
-        row = {"batch": n, "shots_per_s": n / seconds["flight_s"], "us_per_shot": seconds["flight_s"] / n * 1e6,
-               "with_ground_shots_per_s": n / (seconds["flight_s"] + seconds["ground_s"]),
-               "ground_us_per_shot": seconds["ground_s"] / n * 1e6, "peak_memory_mb": peak_memory_mb(engine.device),
-               "parts": -(-n // engine.part_shots())}
+        row = {"batch": n}
+        for name, engine in engines.items():
+            if engine.device.type == "cuda":
+                torch.cuda.reset_peak_memory_stats(engine.device)
+            seconds = timed(engine, launches, rounds)
+            cpu = seconds["prepare"] + seconds["ground"]
+            row[name] = {"shots_per_s": n / seconds["flight"], "us_per_shot": seconds["flight"] / n * 1e6,
+                         "with_cpu_shots_per_s": n / (seconds["flight"] + cpu), "cpu_us_per_shot": cpu / n * 1e6,
+                         "peak_memory_mb": peak_memory_mb(engine.device), "parts": -(-n // engine.part_shots())}
+            print(f"batch {n:>9,} {name:>8}: {row[name]['shots_per_s']:>12,.0f} shots/s ({row[name]['us_per_shot']:.2f}"
+                  f" us a shot), with the CPU's share {row[name]['with_cpu_shots_per_s']:>12,.0f} shots/s "
+                  f"({row[name]['cpu_us_per_shot']:.2f} us a shot), peak {row[name]['peak_memory_mb']:,.0f} MB",
+                  flush=True)
         rows.append(row)
-        print(f"batch {n:>9,}: {row['shots_per_s']:>12,.0f} shots/s ({row['us_per_shot']:.2f} us a shot), with the "
-              f"ground phase {row['with_ground_shots_per_s']:>12,.0f} shots/s (ground {row['ground_us_per_shot']:.2f} "
-              f"us a shot on the CPU), peak {row['peak_memory_mb']:,.0f} MB", flush=True)
     return rows
 
 
@@ -120,11 +130,11 @@ def parity(bundle: Path, device: str, shots: int) -> list[dict]:
     reference = load_flyer(bundle).fly_columns(launches, conditions, grounds)
     print(f"ONNX reference: {shots:,} mixed shots in {time.perf_counter() - started:.1f} s", flush=True)
     rows = []
-    for dtype in ("float32", "float64"):
-        got = TorchEngine(bundle, device, dtype).fly_columns(launches, conditions, grounds)
+    for dtype, compiled in (("float32", False), ("float64", False), ("float32", True)):
+        got = TorchEngine(bundle, device, dtype, compile_step=compiled).fly_columns(launches, conditions, grounds)
         landed = np.array([i not in reference.errors for i in range(shots)])
         rolled = got.rolled & reference.rolled
-        row = {"dtype": dtype, "shots": shots, "errors_equal": got.errors == reference.errors,
+        row = {"dtype": dtype, "compiled": compiled, "shots": shots, "errors_equal": got.errors == reference.errors,
                "carry_max_abs_m": float(np.max(np.abs(got.carry_m[landed] - reference.carry_m[landed]))),
                "apex_max_abs_m": float(np.max(np.abs(got.apex_m[landed] - reference.apex_m[landed]))),
                "total_max_abs_m": float(np.max(np.abs(got.rest.total_m[rolled] - reference.rest.total_m[rolled])))}
@@ -132,19 +142,60 @@ def parity(bundle: Path, device: str, shots: int) -> list[dict]:
             row |= {"target": f"carry within {CARRY_TARGET_M * 1e3:g} mm",
                     "met": row["errors_equal"] and row["carry_max_abs_m"] < CARRY_TARGET_M}
         rows.append(row)
-        print(f"parity {dtype}: carry max |d| {row['carry_max_abs_m'] * 1e3:.4f} mm, apex {row['apex_max_abs_m'] * 1e3:.4f}"
+        print(f"parity {dtype}{' compiled' if compiled else ''}: carry max |d| {row['carry_max_abs_m'] * 1e3:.4f} mm, apex {row['apex_max_abs_m'] * 1e3:.4f}"
               f" mm, total {row['total_max_abs_m'] * 1e3:.4f} mm, errors equal {row['errors_equal']}", flush=True)
     return rows
 
 
-def sweep_end_to_end(device: str, rows: int, threads: int | None, ray_workers: int | None = None) -> dict:
-    """`golfflight sweep --engine torch` (or, with `ray_workers`, `--engine ray --device` on that many actors) on a
-    grid of `rows` launches to Parquet, as its own process: wall seconds from start to file written (loading
-    included), and the command's own account of where the time went."""
+SHARE_GRID = ["launch_angle_deg=6:24:19", "spin_rpm=1500:9000:4", "wind_from_deg=0,90,180,270", "wind_speed_mps=5",
+              "altitude_m=0,1600", "ground_surface=fairway,green"]
+"""The grid whose CPU share is measured, beside its ball speeds: 1,216 launches a speed, in two airs, four winds and
+on two surfaces (a sweep's usual mix of a few shared conditions)."""
+
+
+def cpu_share(bundle: Path, device: str, rows: int, rounds: int = 2) -> dict:
+    """A sweep of a grid of about `rows` launches through `run_sweep` in this process, one piece at a time and
+    `PIECES_IN_FLIGHT` at once, interleaved for `rounds`: wall seconds of each, and, from the one-at-a-time runs (no
+    overlap), each stage's microseconds a row and the CPU's (all but the device's flight), whose inverse caps the
+    sweep's rows/s however fast the device flies. An untimed sweep of one ball speed first: the driver's first sweep
+    in a process pays its imports and caches (about 4 us a row more here)."""
+    speeds = max(rows // 1216, 1)
+    grid = Grid.parse([f"ball_speed_mps=30:80:{speeds}", *SHARE_GRID])
+    walls: dict[int, list[float]] = {1: [], PIECES_IN_FLIGHT: []}
+    stages = []
+    with tempfile.TemporaryDirectory() as folder:
+        run_sweep(GridSource(Grid.parse(["ball_speed_mps=50", *SHARE_GRID]), 65_536), f"{folder}/out.parquet",
+                  engine="torch", in_process=TorchEngine(bundle, device), progress=False)
+        for _ in range(rounds):
+            for in_flight, wall in walls.items():
+                engine = TorchEngine(bundle, device, parts_at_once=in_flight)
+                done = run_sweep(GridSource(grid, 65_536), f"{folder}/out.parquet", engine="torch", in_process=engine,
+                                 progress=False, in_flight=in_flight)
+                wall.append(done.seconds)
+                if in_flight == 1:
+                    stages.append({**engine.seconds, "rest": done.seconds - sum(engine.seconds.values())})
+    shots = len(grid)
+    per_row = {f"{stage}_us_per_row": statistics.median(s[stage] for s in stages) / shots * 1e6
+               for stage in (*STAGES, "rest")}
+    cpu = sum(value for key, value in per_row.items() if not key.startswith("flight"))
+    row = {"shots": shots, **per_row, "cpu_us_per_row": cpu, "cpu_ceiling_rows_per_s": 1e6 / cpu,
+           **{f"wall_s_{n}_in_flight": statistics.median(w) for n, w in walls.items()}}
+    print(f"CPU share of a {shots:,}-row sweep: " + ", ".join(f"{k} {v:.2f}" for k, v in per_row.items())
+          + f" (us a row); the CPU's {cpu:.2f} us a row caps a sweep at {1e6 / cpu:,.0f} rows/s; wall "
+          + ", ".join(f"{statistics.median(w):.2f} s with {n} in flight" for n, w in walls.items()), flush=True)
+    return row
+
+
+def sweep_end_to_end(device: str, rows: int, threads: int | None, ray_workers: int | None = None,
+                     compiled: bool = False) -> dict:
+    """`golfflight sweep --engine torch` (`--compile` if `compiled`; or, with `ray_workers`, `--engine ray --device`
+    on that many actors) on a grid of `rows` launches to Parquet, as its own process: wall seconds from start to
+    file written (loading and compiling included), and the command's own account of where the time went."""
     speeds = max(rows // 400, 1)
     grid = [f"ball_speed_mps=30:80:{speeds}", "launch_angle_deg=6:30:20", "spin_rpm=1500:9000:20"]
     shots = speeds * 400
     engine = ["--engine", "torch"] if ray_workers is None else ["--engine", "ray", "--workers", str(ray_workers)]
+    engine += ["--compile"] if compiled else []
     with tempfile.TemporaryDirectory() as folder:
         command = [sys.executable, "-m", "golfflight", "sweep", "--grid", *grid, "--out", f"{folder}/out.parquet",
                    *engine, "--device", device, "--no-progress", *(["--threads", str(threads)] if threads else [])]
@@ -162,13 +213,16 @@ def machine_of(device: torch.device) -> dict:
 
 
 def print_table(section: dict) -> None:
-    print("\n| batch | flight shots/s | us a shot | with ground phase shots/s | ground phase us a shot (CPU) | "
-          "peak memory |")
-    print("|---:|---:|---:|---:|---:|---:|")
+    names = [name for name in section["throughput"][0] if name != "batch"]
+    print("\n| batch | " + " | ".join(f"{name} flight shots/s | {name} us a shot" for name in names)
+          + " | with the CPU's share shots/s (eager) | CPU's share us a shot | peak memory (eager) |")
+    print("|---:|" + "---:|---:|" * len(names) + "---:|---:|---:|")
     for row in section["throughput"]:
-        print(f"| {row['batch']:,} | {row['shots_per_s']:,.0f} | {row['us_per_shot']:.2f} | "
-              f"{row['with_ground_shots_per_s']:,.0f} | {row['ground_us_per_shot']:.2f} | "
-              f"{row['peak_memory_mb']:,.0f} MB |")
+        eager = row["eager"]
+        print(f"| {row['batch']:,} | " + " | ".join(f"{row[n]['shots_per_s']:,.0f} | {row[n]['us_per_shot']:.2f}"
+                                                   for n in names)
+              + f" | {eager['with_cpu_shots_per_s']:,.0f} | {eager['cpu_us_per_shot']:.2f} | "
+              f"{eager['peak_memory_mb']:,.0f} MB |")
 
 
 def main() -> None:
@@ -181,25 +235,33 @@ def main() -> None:
     parser.add_argument("--threads", type=int, help="torch CPU threads (default: torch's)")
     parser.add_argument("--model", help="bundle (default: the shipped models/default)")
     parser.add_argument("--ray-workers", type=int, help="also sweep through --engine ray --device on this many actors")
+    parser.add_argument("--share-rows", type=int, help="launches of the CPU-share sweeps (0: none; default: by device)")
     args = parser.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
-    engine = TorchEngine(load_flyer(args.model).bundle_dir, args.device, "float32")
+    bundle = load_flyer(args.model).bundle_dir
+    engines = {"eager": TorchEngine(bundle, args.device), "compiled": TorchEngine(bundle, args.device, compile_step=True)}
+    engine = engines["eager"]
     kind = engine.device.type
     batches = [int(b) for b in args.batches.split(",")] if args.batches else list(DEFAULT_BATCHES[kind])
     section = {"device": str(engine.device), **machine_of(engine.device), "part_shots": engine.part_shots(),
-               "throughput": throughput(engine, batches, args.rounds),
-               "parity": parity(engine.flyer.bundle_dir, args.device, args.parity_shots)}
-    best = max(row["shots_per_s"] for row in section["throughput"])
+               "throughput": throughput(engines, batches, args.rounds),
+               "parity": parity(bundle, args.device, args.parity_shots)}
+    best = max(row[name]["shots_per_s"] for row in section["throughput"] for name in engines)
     section["flight_best_shots_per_s"] = best
     if kind in FLIGHT_TARGET:
         section["flight_target"] = {"target": f">= {FLIGHT_TARGET[kind]:,.0f} shots/s", "met": best >= FLIGHT_TARGET[kind]}
+    share_rows = DEFAULT_SWEEP_ROWS[kind] if args.share_rows is None else args.share_rows
+    if share_rows:
+        section["cpu_share"] = cpu_share(bundle, args.device, share_rows)
     rows = DEFAULT_SWEEP_ROWS[kind] if args.sweep_rows is None else args.sweep_rows
     if rows:
         section["sweep"] = sweep_end_to_end(args.device, rows, args.threads)
-        if kind in SWEEP_TARGET:
-            section["sweep"] |= {"target": f">= {SWEEP_TARGET[kind]:,.0f} shots/s",
-                                 "met": section["sweep"]["shots_per_s"] >= SWEEP_TARGET[kind]}
+        section["sweep_compiled"] = sweep_end_to_end(args.device, rows, args.threads, compiled=True)
+        for name in ("sweep", "sweep_compiled"):
+            if kind in SWEEP_TARGET:
+                section[name] |= {"target": f">= {SWEEP_TARGET[kind]:,.0f} shots/s",
+                                  "met": section[name]["shots_per_s"] >= SWEEP_TARGET[kind]}
         if args.ray_workers:
             section["ray_sweep"] = sweep_end_to_end(args.device, rows, args.threads, args.ray_workers)
     print_table(section)

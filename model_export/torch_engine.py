@@ -110,12 +110,13 @@ class TorchEngine:
     (module docstring)."""
 
     def __init__(self, bundle_dir: str | os.PathLike, device: str = "cpu", dtype: str = "float32",
-                 part_shots: int | None = None, parts_at_once: int = 1) -> None:
+                 part_shots: int | None = None, parts_at_once: int = 1, compile_step: bool = False) -> None:
         """Load and verify the bundle (`flight.flyer.load_flyer`, the engine's checks: its step, maximum flight time,
         nominal air and error messages are this engine's) and rebuild its network in torch on `device`; `dtype`
         is the physics' precision; `part_shots` caps the shots flown at once (default: what the device's memory
-        holds, shared by `parts_at_once` threads flying batches on this engine at once). `devices.DeviceError` for a device
-        this machine lacks, ValueError for a dtype it does not know."""
+        holds, shared by `parts_at_once` threads flying batches on this engine at once); `compile_step` fuses each
+        Euler step's kernels with torch.compile (`step`: `euler_step`, compiled or eager, once for any part's size). `devices.DeviceError` for a device this machine lacks,
+        ValueError for a dtype it does not know."""
         if dtype not in DTYPES:
             raise ValueError(f"dtype {dtype!r}: choose from {', '.join(DTYPES)}")
         self.device, self.dtype = resolve_device(device), DTYPES[dtype]
@@ -126,6 +127,12 @@ class TorchEngine:
         self.part_limit, self.parts_at_once = part_shots, parts_at_once
         self.seconds = dict.fromkeys(STAGES, 0.0)
         self._timing = threading.Lock()
+        dt = self.flyer.dt_s
+
+        def step(*state_and_air: torch.Tensor | None) -> tuple[torch.Tensor, ...]:
+            return euler_step(self.coefficients, dt, *state_and_air)
+
+        self.step = torch.compile(step, dynamic=True) if compile_step else step
 
     def coefficients(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
         """C_L, C_D, C_M, C_Q [N,4] in the physics' dtype from the network run in float32, as the graph runs."""
@@ -202,29 +209,24 @@ class TorchEngine:
 
         position, velocity, spin = tensor(shots.position), tensor(shots.velocity), tensor(shots.spin)
         density, scale, ground = tensor(shots.density), tensor(shots.reynolds_scale)[:, None], tensor(shots.ground_m)
-        wind_at = _wind(tensor(shots.wind), torch.as_tensor(shots.log_profile, device=self.device),
-                        tensor(shots.reference_height_m), tensor(shots.roughness_m))
-        steps, dt = self.flyer.max_steps, self.flyer.dt_s
+        wind = _wind(tensor(shots.wind), torch.as_tensor(shots.log_profile, device=self.device),
+                     tensor(shots.reference_height_m), tensor(shots.roughness_m))
+        steps = self.flyer.max_steps
         states = [torch.empty((steps + 1, *position.shape), dtype=self.dtype, device=self.device) for _ in range(3)]
         for kept, now in zip(states, (position, velocity, spin), strict=True):
             kept[0] = now
         down = torch.zeros(len(position), dtype=torch.bool, device=self.device)
         last = steps
         for step in range(1, steps + 1):
-            d_position, d_velocity, d_spin = derivatives(
-                position, velocity, spin, self.coefficients, density, scale, wind_at(position[:, 2])
-            )
-            height_before = position[:, 2]
-            position, velocity, spin = position + dt * d_position, velocity + dt * d_velocity, spin + dt * d_spin
+            position, velocity, spin, down = self.step(position, velocity, spin, down, density, scale, ground, *wind)
             for kept, now in zip(states, (position, velocity, spin), strict=True):
                 kept[step] = now
-            down |= (height_before > ground) & (position[:, 2] <= ground)
             if step % LANDING_CHECK_STEPS == 0 and bool(down.all()):
                 last = step
                 break
         positions = states[0][: last + 1]
         positions[:, :, 2] -= ground  # heights above each shot's ground: its plane is the landing's z = 0
-        trajectory = Trajectory(positions, states[1][: last + 1], states[2][: last + 1], dt)
+        trajectory = Trajectory(positions, states[1][: last + 1], states[2][: last + 1], self.flyer.dt_s)
         landing, peak = hard_landing(trajectory), apex(trajectory)
         landing.position[:, 2] += ground
 
@@ -273,17 +275,19 @@ class TorchEngineMaker:
     """How a sweep's worker builds its own TorchEngine from a bundle path: `golfflight sweep --engine torch` in its
     process, and each Ray actor of `--engine ray --device ...` on its node, on the GPU Ray gave it ("cuda" is that
     actor's one visible GPU). Picklable, so that Ray sends it to the actors; `threads` sets torch's CPU threads first
-    (an actor has one CPU); `parts_at_once` as TorchEngine takes it."""
+    (an actor has one CPU); `parts_at_once` and `compile_step` as TorchEngine takes them."""
 
     device: str = "cpu"
     dtype: str = "float32"
     threads: int | None = None
     parts_at_once: int = 1
+    compile_step: bool = False
 
     def __call__(self, bundle_dir: str | os.PathLike) -> TorchEngine:
         if self.threads is not None:
             torch.set_num_threads(self.threads)
-        return TorchEngine(bundle_dir, self.device, self.dtype, parts_at_once=self.parts_at_once)
+        return TorchEngine(bundle_dir, self.device, self.dtype, parts_at_once=self.parts_at_once,
+                           compile_step=self.compile_step)
 
 
 def _elevations(grounds: PerShot[GroundSpec | None]) -> np.ndarray:
@@ -292,18 +296,35 @@ def _elevations(grounds: PerShot[GroundSpec | None]) -> np.ndarray:
 
 
 def _wind(at_reference: torch.Tensor, log_profile: torch.Tensor, reference_height_m: torch.Tensor,
-          roughness_m: torch.Tensor):
+          roughness_m: torch.Tensor) -> tuple[torch.Tensor | None, ...]:
+    """A part's wind as `wind_at` takes it: (at_reference, log_profile, reference_log, roughness), None for what the
+    part does not need (all four in calm air; the last three where no shot follows the log profile)."""
+    if not bool(at_reference.any()):
+        return None, None, None, None
+    if not bool(log_profile.any()):
+        return at_reference, None, None, None
+    return at_reference, log_profile, torch.log(reference_height_m / roughness_m), roughness_m
+
+
+def wind_at(height_m: torch.Tensor, at_reference: torch.Tensor | None, log_profile: torch.Tensor | None,
+            reference_log: torch.Tensor | None, roughness_m: torch.Tensor | None) -> torch.Tensor | None:
     """The air's velocity [N,3] at the balls' heights [N], as `flight.wind.Wind.velocity` gives it: the wind at its
     reference height, times V(h)/V(h_ref) of the log profile for the shots that follow it (zero at and below the
     roughness length); None in calm air."""
-    if not bool(at_reference.any()):
-        return lambda height_m: None
-    if not bool(log_profile.any()):
-        return lambda height_m: at_reference
-    reference_log = torch.log(reference_height_m / roughness_m)
+    if at_reference is None or log_profile is None:
+        return at_reference
+    factor = torch.log(torch.maximum(height_m, roughness_m) / roughness_m) / reference_log
+    return at_reference * torch.where(log_profile, factor, torch.ones_like(factor))[:, None]
 
-    def velocity(height_m: torch.Tensor) -> torch.Tensor:
-        factor = torch.log(torch.maximum(height_m, roughness_m) / roughness_m) / reference_log
-        return at_reference * torch.where(log_profile, factor, torch.ones_like(factor))[:, None]
 
-    return velocity
+def euler_step(coefficients, dt: float, position: torch.Tensor, velocity: torch.Tensor, spin: torch.Tensor,
+               down: torch.Tensor, density: torch.Tensor, scale: torch.Tensor, ground: torch.Tensor,
+               *wind: torch.Tensor | None) -> tuple[torch.Tensor, ...]:
+    """One forward-Euler step of training's equations (`torch_physics.derivatives`) in each shot's air and wind
+    (`wind_at`'s four), and whether each shot has come down through its ground's plane by its end (`down`, kept)."""
+    d_position, d_velocity, d_spin = derivatives(
+        position, velocity, spin, coefficients, density, scale, wind_at(position[:, 2], *wind)
+    )
+    moved = position + dt * d_position
+    down = down | ((position[:, 2] > ground) & (moved[:, 2] <= ground))
+    return moved, velocity + dt * d_velocity, spin + dt * d_spin, down

@@ -72,19 +72,24 @@ def onnx_flights(shots):
 
 @pytest.fixture(scope="module")
 def engines() -> dict[str, TorchEngine]:
-    return {dtype: TorchEngine(load_flyer(None).bundle_dir, "cpu", dtype) for dtype in ("float32", "float64")}
+    """Each precision eager, and float32 with its Euler step compiled (torch.compile: seconds here)."""
+    bundle = load_flyer(None).bundle_dir
+    return {"float32": TorchEngine(bundle, "cpu", "float32"), "float64": TorchEngine(bundle, "cpu", "float64"),
+            "float32-compiled": TorchEngine(bundle, "cpu", "float32", compile_step=True)}
 
 
 def _deviation(got, want, name: str, landed: np.ndarray) -> float:
     return float(np.max(np.abs(getattr(got, name)[landed] - getattr(want, name)[landed])))
 
 
-@pytest.mark.parametrize("dtype, carry_m, figures", [("float32", 1e-3, 2e-2), ("float64", 2e-5, 2e-4)])
+@pytest.mark.parametrize("dtype, carry_m, figures", [
+    ("float32", 1e-3, 2e-2), ("float64", 2e-5, 2e-4), ("float32-compiled", 1e-3, 2e-2),
+])
 def test_the_torch_engine_flies_mixed_shots_as_the_onnx_engine(engines, shots, onnx_flights, dtype, carry_m, figures):
-    """Carries within 1 mm in float32. In float64 the physics agree to rounding and what is left is the network's
-    float32 arithmetic (torch's and ONNX Runtime's sums differ by an ulp: about 1e-7 in a coefficient), some 10 um
-    of carry (the rules themselves are held to 1e-6 m below). The other figures (degrees, rpm, s) and the rests
-    after the ground phase follow."""
+    """Carries within 1 mm in float32, eager or with the step compiled. In float64 the physics agree to rounding and
+    what is left is the network's float32 arithmetic (torch's and ONNX Runtime's sums differ by an ulp: about 1e-7
+    in a coefficient), some 10 um of carry (the rules themselves are held to 1e-6 m below). The other figures
+    (degrees, rpm, s) and the rests after the ground phase follow."""
     got = engines[dtype].fly_columns(*shots)
     assert got.errors == onnx_flights.errors and {1, 2} <= set(got.errors)
     assert "never rose to its landing ground" in got.errors[1]
@@ -181,6 +186,7 @@ def test_the_sweep_on_torch_writes_the_local_engines_columns_and_numbers(tmp_pat
     (["--engine", "torch", "--workers", "2"], "--workers goes with --engine local or ray"),
     (["--device", "cpu"], "--device goes with --engine torch"),
     (["--threads", "1"], "--threads goes with --engine torch"),
+    (["--compile"], "--compile goes with --engine torch"),
     (["--engine", "torch", "--device", "tpu"], "--device 'tpu': not a device name"),
     (["--engine", "torch", "--device", "meta"], "only cpu and cuda are supported"),
 ])

@@ -61,6 +61,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="the torch engine's physics' precision (default float32; the network is float32)")
     parser.add_argument("--threads", type=int, help="the torch engine on a CPU: torch's threads (default: torch's, "
                         "one a core, with --engine torch; 1 in each Ray actor; 1 where other work shares the cores)")
+    parser.add_argument("--compile", action="store_true", default=None,
+                        help="the torch engine: fuse each Euler step's kernels with torch.compile (compiled once a "
+                        "run, in seconds; on a CPU it needs a C compiler)")
     parser.add_argument("--ray-address", help="an existing Ray cluster (e.g. ray://head:10001 or auto); default: a "
                         "local Ray instance, stopped after")
     parser.add_argument(
@@ -102,7 +105,7 @@ def _check_options(args: argparse.Namespace) -> None:
                          "--device)")
     if args.threads is not None and args.threads < 1:
         raise ValueError("--threads takes a whole number of at least 1")
-    torch_only = [name for name in ("device", "dtype", "threads") if getattr(args, name) is not None]
+    torch_only = [name for name in ("device", "dtype", "threads", "compile") if getattr(args, name) is not None]
     if torch_only and args.engine == "local":
         also = "--engine ray" if torch_only[0] == "device" else "--engine ray with --device"
         raise ValueError(f"--{torch_only[0]} goes with --engine torch, or {also}")
@@ -117,7 +120,7 @@ def _torch_maker(args: argparse.Namespace, threads: int | None, parts_at_once: i
     """How the torch engine is built on the asked device (`model_export.torch_engine.TorchEngineMaker`)."""
     from golfflight.model_export.torch_engine import TorchEngineMaker
 
-    return TorchEngineMaker(args.device or "cpu", args.dtype or "float32", threads, parts_at_once)
+    return TorchEngineMaker(args.device or "cpu", args.dtype or "float32", threads, parts_at_once, bool(args.compile))
 
 
 def _engines(args: argparse.Namespace):
