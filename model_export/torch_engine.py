@@ -13,13 +13,14 @@ its neighbours), on heights measured from each shot's ground. Each shot is flown
 shapes), a part stopping once every shot of it has come down; a shot never down by the maximum flight time, or whose
 figures are not finite, fails with the engine's message (the batch is flown in parts that fit the device).
 
-The ground phase (bounce and roll) is the engine's own NumPy code (`flight.ground.ground_phase`) on the CPU, fed the
-landing states in float64. `seconds` holds the time spent in each stage (`STAGES`: preparing a batch's launch states
-and air on the CPU, the device's flight, the figures and ground phase on the CPU), summed over the threads that fly
-batches on one engine at once (a sweep's pieces in flight: `parts_at_once` share the device's memory). A part's size
-is `part_shots`. Torch is imported here only: nothing of the serving install or the sweep package imports this
-module (`golfflight sweep --engine torch` and `--engine ray --device` do, from the command line, and each Ray actor
-of the latter when it unpickles the `TorchEngineMaker` it is sent).
+The ground phase (bounce and roll) of the landing states in float64 is the engine's own: on a GPU its formulas run on
+the device (`torch_ground`, the batch's bookkeeping in torch), on a CPU its NumPy code (`flight.ground.ground_phase`).
+`seconds` holds the time spent in each stage (`STAGES`: preparing a batch's launch states and air on the CPU, the
+device's flight, the figures and ground phase), summed over the threads that fly batches on one engine at once (a
+sweep's pieces in flight: `parts_at_once` share the device's memory). A part's size is `part_shots`. Nothing of the
+serving install or the sweep package imports this module (`golfflight sweep --engine torch` and `--engine ray
+--device` do, from the command line, and each Ray actor of the latter when it unpickles the `TorchEngineMaker` it is
+sent).
 """
 
 from __future__ import annotations
@@ -35,10 +36,12 @@ import numpy as np
 import torch
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import LAUNCH_WIDTH, NON_FINITE, Launch, air_inputs, load_flyer
-from golfflight.flight.ground import GroundSpec, batch_surface, ground_phase
+from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, batch_surface, ground_phase
+from golfflight.flight.ground.phase import plane_normals
 from golfflight.flight.outcomes import BatchFlights, Rest, landing_figures
 from golfflight.flight.per_shot import PerShot
 from golfflight.flight.physics import initial_state, reynolds_scale
+from golfflight.model_export import torch_ground
 from golfflight.model_export.bundle_model import model_from_bundle
 from golfflight.model_export.devices import resolve_device
 from golfflight.model_export.torch_physics import Trajectory, apex, derivatives, hard_landing
@@ -63,7 +66,8 @@ WORKING_BYTES_PER_SHOT = 4096
 
 STAGES = ("prepare", "flight", "ground")
 """A batch's stages, timed apart (`TorchEngine.seconds`): its launch states, air and grounds as arrays (CPU), its flight
-to the landings back in NumPy (the device, transfers included), its figures and ground phase (CPU, NumPy)."""
+to the landings back in NumPy (the device, transfers included), its figures and ground phase (the CPU, and the device
+where the ground phase runs there)."""
 
 LANDING_CHECK_STEPS = 10
 """Steps between the checks whether every shot of a part has come down (each check waits for the device)."""
@@ -110,13 +114,16 @@ class TorchEngine:
     (module docstring)."""
 
     def __init__(self, bundle_dir: str | os.PathLike, device: str = "cpu", dtype: str = "float32",
-                 part_shots: int | None = None, parts_at_once: int = 1, compile_step: bool = False) -> None:
+                 part_shots: int | None = None, parts_at_once: int = 1, compile_step: bool = False,
+                 ground_on_device: bool | None = None) -> None:
         """Load and verify the bundle (`flight.flyer.load_flyer`, the engine's checks: its step, maximum flight time,
         nominal air and error messages are this engine's) and rebuild its network in torch on `device`; `dtype`
         is the physics' precision; `part_shots` caps the shots flown at once (default: what the device's memory
         holds, shared by `parts_at_once` threads flying batches on this engine at once); `compile_step` fuses each
-        Euler step's kernels with torch.compile (`step`: `euler_step`, compiled or eager, once for any part's size). `devices.DeviceError` for a device this machine lacks,
-        ValueError for a dtype it does not know."""
+        Euler step's kernels with torch.compile (`step`: `euler_step`, compiled or eager, once for any part's size);
+        `ground_on_device` bounces and rolls the landings on the device (`torch_ground`; default: on a GPU) instead
+        of NumPy's on the CPU. `devices.DeviceError` for a device this machine lacks, ValueError for a dtype it does
+        not know."""
         if dtype not in DTYPES:
             raise ValueError(f"dtype {dtype!r}: choose from {', '.join(DTYPES)}")
         self.device, self.dtype = resolve_device(device), DTYPES[dtype]
@@ -125,6 +132,7 @@ class TorchEngine:
         model, _ = model_from_bundle(self.flyer.bundle_dir)
         self.model = model.to(self.device)
         self.part_limit, self.parts_at_once = part_shots, parts_at_once
+        self.ground_on_device = self.device.type == "cuda" if ground_on_device is None else ground_on_device
         self.seconds = dict.fromkeys(STAGES, 0.0)
         self._timing = threading.Lock()
         dt = self.flyer.dt_s
@@ -169,11 +177,27 @@ class TorchEngine:
         prepared = self._spent("prepare", started)
         size = self.part_shots()
         parts = [self._fly_part(inputs.part(start, min(start + size, n))) for start in range(0, n, size)]
-        landings = Landings(*(np.concatenate([getattr(p, name) for p in parts]) for name in Landings.__dataclass_fields__))
+        landings = Landings(*(np.concatenate([getattr(p, name) for p in parts])
+                              for name in Landings.__dataclass_fields__))
         flown = self._spent("flight", prepared)
         columns = self._columns(landings, shot_grounds)
         self._spent("ground", flown)
         return columns
+
+    def _ground_on_device(self, position: np.ndarray, velocity: np.ndarray, spin: np.ndarray, surface: Surface,
+                          slope_deg: np.ndarray, slope_dir_deg: np.ndarray) -> GroundPhase:
+        """`flight.ground.ground_phase`'s rests of these landings (NumPy [N,3]) computed on the device in float64
+        (`torch_ground.ground_phase`, the same formulas) and brought back; the planes' normals are NumPy's."""
+        def tensor(values: np.ndarray | float) -> torch.Tensor | float:
+            if np.ndim(values) == 0:
+                return float(values)
+            return torch.as_tensor(values, dtype=torch.float64, device=self.device)
+
+        normal = plane_normals(slope_deg, slope_dir_deg, len(position))
+        on_device = Surface(*(tensor(getattr(surface, name)) for name in Surface.__dataclass_fields__))
+        rest, hops, time_s = torch_ground.ground_phase(tensor(position), tensor(velocity), tensor(spin), tensor(normal),
+                                                       on_device)
+        return GroundPhase(rest.cpu().numpy(), hops.cpu().numpy(), time_s.cpu().numpy())
 
     def _spent(self, stage: str, since: float) -> float:
         """Count the time since `since` to `stage` (from any thread); now."""
@@ -256,8 +280,9 @@ class TorchEngine:
         phase = None
         if shots.size:
             on = grounds.take(shots)
-            phase = ground_phase(flight.position[shots], flight.velocity[shots], flight.spin[shots], batch_surface(on),
-                                 on.column(lambda g: g.slope_deg), on.column(lambda g: g.slope_dir_deg))
+            roll = self._ground_on_device if self.ground_on_device else ground_phase
+            phase = roll(flight.position[shots], flight.velocity[shots], flight.spin[shots], batch_surface(on),
+                         on.column(lambda g: g.slope_deg), on.column(lambda g: g.slope_dir_deg))
         # a shot that never came down has no landing: NaN figures, as the integrator leaves them
         x, y, carry, angle, speed, spin, flight_time = (
             np.where(flight.landed, v, math.nan) for v in (x, y, carry, angle, speed, spin, flight.flight_time_s)

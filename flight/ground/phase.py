@@ -13,7 +13,8 @@ surface holds (`holding_slope_deg`; steeper slopes are refused).
 
 The formulas are written once on (x, y, z) tuples of floats or arrays (`flight.ground.vectors`): `ground_phase` runs
 them on a batch, `ground_phase_one` on one ball's plain floats (the engine's one-shot latency path, where NumPy's
-per-call cost on arrays of one row would cost more than the physics).
+per-call cost on arrays of one row would cost more than the physics), and the torch engine on a device's tensors
+(`model_export.torch_ground`).
 
 Every state of the phase can be kept (`keep_path`): after each impact, each touchdown, each roll step and the rest,
 with velocities, and a level roll's states every ROLL_STEP_S, so a renderer's cubic Hermite resampling follows the
@@ -96,14 +97,14 @@ def _check_slopes(slope: np.ndarray, resistance: np.ndarray) -> None:
         )
 
 
-def _hop(position: tuple, velocity: tuple, duration) -> tuple[tuple, tuple]:
+def hop(position: tuple, velocity: tuple, duration) -> tuple[tuple, tuple]:
     """Position and velocity after a hop of `duration` under gravity alone."""
     fall = 0.5 * GRAVITY_MPS2 * duration * duration
     moved = add(position, velocity, duration)
     return (moved[0], moved[1], moved[2] - fall), (velocity[0], velocity[1], velocity[2] - GRAVITY_MPS2 * duration)
 
 
-def _rolling(velocity: tuple, spin: tuple, normal: tuple) -> tuple:
+def rolling_velocity(velocity: tuple, spin: tuple, normal: tuple) -> tuple:
     """The velocity a ball rolls off with, its slip taken out with the angular momentum about the contact point kept:
     5/7 v_t - 2/7 R n x omega, in the plane."""
     on_plane = add(velocity, normal, -dot(velocity, normal))
@@ -119,14 +120,14 @@ def _ratios(x):
     return where(small, 1.0 - x / 2.0, log / safe), where(small, 0.5 - x / 3.0, (safe - log) / (safe * safe))
 
 
-def _stop(speed, braking, drag):
+def stopping(speed, braking, drag):
     """(distance, time) to stop from `speed` under a constant deceleration `braking` plus drag k v: the ball stops
     after T = ln(1 + k v0 / a) / k, having run v0 / k - a T / k (v0^2 / 2a without drag)."""
     time_ratio, distance_ratio = _ratios(drag * speed / braking)
     return speed * speed / braking * distance_ratio, speed / braking * time_ratio
 
 
-def _decay(drag, t):
+def decay(drag, t):
     """E1 = (1 - exp(-k t)) / k and E2 = (t - E1) / k, without cancellation for small k t (limits t and t^2 / 2):
     under a constant acceleration A and drag k v, v(t) = v0 (1 - k E1) + A E1 and x(t) = x0 + v0 E1 + A E2."""
     kt = drag * t
@@ -137,27 +138,27 @@ def _decay(drag, t):
     return e1, e2
 
 
-def _slope_step(position: tuple, velocity: tuple, downhill: tuple, brake, drag):
+def slope_step(position: tuple, velocity: tuple, downhill: tuple, brake, drag):
     """One ROLL_STEP_S of a roll on a slope: (stops, time taken, rest point, position, velocity after the step).
     Gravity and the rolling resistance act along the direction of motion at the step's middle (a midpoint step:
-    errors fall as the step squared), grass drag exactly (`_decay`); a ball that would stop within the step stops
+    errors fall as the step squared), grass drag exactly (`decay`); a ball that would stop within the step stops
     as on level ground, so the stepped roll meets the closed form as the slope vanishes."""
     speed = norm(velocity)
     direction = times(1.0 / maximum(speed, TINY), velocity)
     acceleration = add(downhill, direction, -brake)
     braking = maximum(-dot(acceleration, direction), TINY)
-    run, stop_time = _stop(speed, braking, drag)
+    run, stop_time = stopping(speed, braking, drag)
     stops = stop_time <= ROLL_STEP_S
-    half_e1, _ = _decay(drag, 0.5 * ROLL_STEP_S)
+    half_e1, _ = decay(drag, 0.5 * ROLL_STEP_S)
     half = add(times(1.0 - drag * half_e1, velocity), acceleration, half_e1)
     midpoint = add(downhill, times(1.0 / maximum(norm(half), TINY), half), -brake)
-    e1, e2 = _decay(drag, ROLL_STEP_S)
+    e1, e2 = decay(drag, ROLL_STEP_S)
     moved = add(add(position, velocity, e1), midpoint, e2)
     after = add(times(1.0 - drag * e1, velocity), midpoint, e1)
     return stops, where(stops, stop_time, ROLL_STEP_S), add(position, direction, run), moved, after
 
 
-def _downhill(normal: tuple) -> tuple:
+def downhill_acceleration(normal: tuple) -> tuple:
     """5/7 of gravity's component along the plane: what accelerates a rolling ball down a slope."""
     along = add((0.0, 0.0, -GRAVITY_MPS2), normal, GRAVITY_MPS2 * normal[2])
     return times(ROLLING_GRAVITY_FRACTION, along)
@@ -199,25 +200,25 @@ def _bounce(position, velocity, spin, normal, surface: Surface, record: _Recorde
         ids = bouncing
         v_out, w_out = impact(velocity[ids], spin[ids], normal[ids], surface.take(ids))
         rebound = np.einsum("ij,ij->i", v_out, normal[ids])
-        hop = (rebound > MIN_HOP_SPEED_MPS) & (hops[ids] < MAX_BOUNCES)
+        hopping = (rebound > MIN_HOP_SPEED_MPS) & (hops[ids] < MAX_BOUNCES)
         velocity[ids], spin[ids] = v_out, w_out
-        flying = ids[hop]
+        flying = ids[hopping]
         if flying.size:
             record.add(flying, time[flying], position[flying], velocity[flying])
-            duration = 2.0 * rebound[hop] / (GRAVITY_MPS2 * normal[flying, 2])
-            landed, incoming = _hop(_columns(position[flying]), _columns(velocity[flying]), duration)
+            duration = 2.0 * rebound[hopping] / (GRAVITY_MPS2 * normal[flying, 2])
+            landed, incoming = hop(_columns(position[flying]), _columns(velocity[flying]), duration)
             position[flying], velocity[flying] = np.stack(landed, -1), np.stack(incoming, -1)
             time[flying] += duration
             hops[flying] += 1
             record.add(flying, time[flying], position[flying], velocity[flying])
         bouncing = flying
-    rolling = np.stack(_rolling(_columns(velocity), _columns(spin), _columns(normal)), -1)
+    rolling = np.stack(rolling_velocity(_columns(velocity), _columns(spin), _columns(normal)), -1)
     return position, rolling, time, hops
 
 
 def _level_states(speed, deceleration, drag, t):
     """Distance run and speed [K] of a level roll at times t [K] from its start (closed form)."""
-    e1, e2 = _decay(drag, t)
+    e1, e2 = decay(drag, t)
     return speed * e1 - deceleration * e2, speed * (1.0 - drag * e1) - deceleration * e1
 
 
@@ -236,16 +237,16 @@ def _record_level(record: _Recorder, ids, start_time, position, velocity, resist
 
 
 def _roll_level(position, velocity, resistance, drag):
-    """Rest point and roll time on level ground (closed form, `_stop`)."""
+    """Rest point and roll time on level ground (closed form, `stopping`)."""
     speed = np.linalg.norm(velocity, axis=-1)
-    distance, time = _stop(speed, resistance * GRAVITY_MPS2, drag)
+    distance, time = stopping(speed, resistance * GRAVITY_MPS2, drag)
     direction = velocity / np.maximum(speed, TINY)[:, None]
     return position + direction * distance[:, None], time
 
 
 def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder, ids, start):
-    """Rest point and roll time on slopes, in `_slope_step`s until every ball has stopped."""
-    downhill = np.stack(_downhill(_columns(normal)), -1)
+    """Rest point and roll time on slopes, in `slope_step`s until every ball has stopped."""
+    downhill = np.stack(downhill_acceleration(_columns(normal)), -1)
     brake = resistance * GRAVITY_MPS2 * normal[:, 2]
     position, velocity = position.copy(), velocity.copy()
     rest, time = position.copy(), np.zeros(len(position))
@@ -253,7 +254,7 @@ def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder,
     for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
         if not moving.size:
             break
-        stops, taken, stop_at, moved, after = _slope_step(
+        stops, taken, stop_at, moved, after = slope_step(
             _columns(position[moving]), _columns(velocity[moving]), _columns(downhill[moving]), brake[moving],
             drag[moving],
         )
@@ -335,11 +336,11 @@ def ground_phase_one(
         duration = 2.0 * rebound / (GRAVITY_MPS2 * normal[2])
         if path is not None:
             path.append((time, position, velocity))
-        position, velocity = _hop(position, velocity, duration)
+        position, velocity = hop(position, velocity, duration)
         time, hops = time + duration, hops + 1
         if path is not None:
             path.append((time, position, velocity))
-    rolling = _rolling(velocity, spin, normal)
+    rolling = rolling_velocity(velocity, spin, normal)
     if path is not None and norm(rolling) > 0.0:
         path.append((time, position, rolling))
     rest, roll_time = _roll_one(position, rolling, normal, surface, slope_deg, path, time)
@@ -355,7 +356,7 @@ def _roll_one(position: tuple, rolling: tuple, normal: tuple, surface: Surface, 
     drag = float(surface.grass_drag_per_s)
     if slope_deg == 0.0:
         speed = norm(rolling)
-        distance, roll_time = _stop(speed, surface.rolling_resistance * GRAVITY_MPS2, drag)
+        distance, roll_time = stopping(speed, surface.rolling_resistance * GRAVITY_MPS2, drag)
         direction = times(1.0 / max(speed, TINY), rolling)
         if path is not None:
             times_s = np.arange(ROLL_STEP_S, float(roll_time) - 1e-9, ROLL_STEP_S)
@@ -363,10 +364,10 @@ def _roll_one(position: tuple, rolling: tuple, normal: tuple, surface: Surface, 
             path += [(start + t, add(position, direction, r), times(v, direction))
                      for t, r, v in zip(times_s.tolist(), run.tolist(), now.tolist(), strict=True)]
         return add(position, direction, float(distance)), float(roll_time)
-    downhill, brake = _downhill(normal), surface.rolling_resistance * GRAVITY_MPS2 * normal[2]
+    downhill, brake = downhill_acceleration(normal), surface.rolling_resistance * GRAVITY_MPS2 * normal[2]
     elapsed = 0.0
     for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
-        stops, taken, stop_at, position, rolling = _slope_step(position, rolling, downhill, brake, drag)
+        stops, taken, stop_at, position, rolling = slope_step(position, rolling, downhill, brake, drag)
         elapsed += float(taken)
         if stops:
             return stop_at, elapsed

@@ -8,11 +8,11 @@ and roll off slower.
 
 Skid: the contact point slips at s = v + R n x omega. Kinetic friction mu g cos(phi) against the slip slows the
 centre by mu g cos(phi) and spins the ball up by (5/2) mu g cos(phi) / R, so the slip falls at (7/2) mu g cos(phi)
-along its own direction: the skid lasts |s0| / ((7/2) mu g cos(phi)) and ends rolling at `phase._rolling`'s velocity
-(friction at the contact point keeps the angular momentum about it), the centre moving at the mean of its start and
-end velocities. On a slope gravity changes that angular momentum at a steady rate, adding 5/7 of its along-plane
-part times the skid's duration (`phase._downhill`); the duration is taken as on the level: within 1 cm and 1 mm/s of
-a fine integration of the skid on 2-4 degree slopes.
+along its own direction: the skid lasts |s0| / ((7/2) mu g cos(phi)) and ends rolling at the velocity of
+`phase.rolling_velocity` (friction at the contact point keeps the angular momentum about it), the centre moving at
+the mean of its start and end velocities. On a slope gravity changes that angular momentum at a steady rate, adding
+5/7 of its along-plane part times the skid's duration (`phase.downhill_acceleration`); the duration is taken as on
+the level: within 1 cm and 1 mm/s of a fine integration of the skid on 2-4 degree slopes.
 
 Roll: as after a landing (`flight.ground.phase`): rolling resistance, grass drag and 5/7 of gravity along a slope,
 level ground in closed form, slopes in ROLL_STEP_S steps, so a putt on a slope breaks downhill.
@@ -24,7 +24,14 @@ import math
 from typing import NamedTuple
 
 from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
-from golfflight.flight.ground.phase import GroundPath, _downhill, _ground_path, _roll_one, _rolling, plane_normal_one
+from golfflight.flight.ground.phase import (
+    GroundPath,
+    _ground_path,
+    _roll_one,
+    downhill_acceleration,
+    plane_normal_one,
+    rolling_velocity,
+)
 from golfflight.flight.ground.surfaces import Surface
 from golfflight.flight.ground.vectors import add, cross, dot, norm, times
 
@@ -72,8 +79,8 @@ def putt_phase(
     spin = (omega * math.cos(psi), 0.0, -omega * math.sin(psi))
     slip = add(velocity, cross(normal, spin), BALL_RADIUS_M)
     skid_time = norm(slip) / (3.5 * SKID_FRICTION * GRAVITY_MPS2 * normal[2])
-    downhill = _downhill(normal)
-    rolling = add(_rolling(velocity, spin, normal), downhill, skid_time)
+    downhill = downhill_acceleration(normal)
+    rolling = add(rolling_velocity(velocity, spin, normal), downhill, skid_time)
     start = add(times(0.5 * skid_time, velocity), rolling, 0.5 * skid_time)
     rows = [(0.0, _ORIGIN, velocity)] + ([(skid_time, start, rolling)] if skid_time > 0.0 else [])
     path = rows if keep_path else None
