@@ -43,8 +43,11 @@ from golfflight.sweep.grid import Grid
 from golfflight.sweep.run import run_sweep
 from golfflight.sweep.sources import GridSource
 
+from golfflight.commands.sweep import TORCH_CHUNK_ROWS
+
 DEFAULT_BATCHES = {"cuda": (1024, 16_384, 262_144, 1_048_576, 4_194_304), "cpu": (1024, 4096, 16_384)}
-DEFAULT_SWEEP_ROWS = {"cuda": 1_000_000, "cpu": 8192}
+DEFAULT_SWEEP_ROWS = {"cuda": 4_194_304, "cpu": 8192}
+"""Rows of the sweeps (the CPU's share, and end to end): on a GPU four of its million-row chunks."""
 PARITY_SHOTS = 10_000
 CARRY_TARGET_M = 1e-3
 """Issue 33: carries within 1 mm of the ONNX engine on 10,000 mixed shots in float32."""
@@ -160,11 +163,12 @@ on two surfaces (a sweep's usual mix of a few shared conditions)."""
 
 
 def cpu_share(bundle: Path, device: str, rows: int, rounds: int = 2) -> dict:
-    """A sweep of a grid of about `rows` launches through `run_sweep` in this process, one piece at a time and
-    `PIECES_IN_FLIGHT` at once, interleaved for `rounds`: wall seconds of each, and, from the one-at-a-time runs (no
-    overlap), each stage's microseconds a row and the CPU's (all but the device's flight), whose inverse caps the
-    sweep's rows/s however fast the device flies. An untimed sweep of one ball speed first: the driver's first sweep
-    in a process pays its imports and caches (about 4 us a row more here)."""
+    """A sweep of a grid of about `rows` launches through `run_sweep` in this process, in the command line's chunks
+    for the device, one piece at a time and `PIECES_IN_FLIGHT` at once, interleaved for `rounds`: wall seconds of
+    each, and, from the one-at-a-time runs (no overlap), each stage's microseconds a row and the CPU's (all but the
+    device's flight), whose inverse caps the sweep's rows/s however fast the device flies. An untimed sweep of one
+    ball speed first: the driver's first sweep in a process pays its imports and caches (about 4 us a row more
+    here)."""
     speeds = max(rows // 1216, 1)
     grid = Grid.parse([f"ball_speed_mps=30:80:{speeds}", *SHARE_GRID])
     walls: dict[int, list[float]] = {1: [], PIECES_IN_FLIGHT: []}
@@ -175,7 +179,8 @@ def cpu_share(bundle: Path, device: str, rows: int, rounds: int = 2) -> dict:
         for _ in range(rounds):
             for in_flight, wall in walls.items():
                 engine = TorchEngine(bundle, device, parts_at_once=in_flight)
-                done = run_sweep(GridSource(grid, 65_536), f"{folder}/out.parquet", engine="torch", in_process=engine,
+                done = run_sweep(GridSource(grid, TORCH_CHUNK_ROWS[engine.device.type]), f"{folder}/out.parquet",
+                                 engine="torch", in_process=engine,
                                  progress=False, in_flight=in_flight)
                 wall.append(done.seconds)
                 if in_flight == 1:
