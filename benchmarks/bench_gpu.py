@@ -9,12 +9,15 @@ the landings back in NumPy (the device's transfers included); around it are the 
 it, and the figures and the bounce and roll of the landings after it (`torch_engine.STAGES`); the CPU's share of a
 sweep is all but the flight, the driver's work included.
 
-One command on a lent GPU machine (about 3 minutes on an H100, most of it the ONNX reference and the sweep;
+One command on a lent GPU machine (estimated at 5-6 minutes on an H100, not yet run there: three engines at five batch
+sizes, three compilations, and five sweeps of 4,194,304 rows; each measurement is written to benchmarks/results.json
+as soon as it is made, so a run cut short keeps what it measured; copy that file into $OUT;
 --ray-workers 1 also sweeps the same grid through `--engine ray --device cuda`, an actor on the GPU, Ray's start
 included):
     python benchmarks/bench_gpu.py --device cuda [--ray-workers 1]
 Here on the CPU, small sizes:
-    python benchmarks/bench_gpu.py --device cpu --batches 1024,4096,16384 --sweep-rows 8192 --threads 2
+    python benchmarks/bench_gpu.py --device cpu --batches 1024,4096,16384 --parity-shots 3000 --share-rows 124032 \
+        --sweep-rows 30000 --threads 2
 """
 
 from __future__ import annotations
@@ -106,8 +109,6 @@ def throughput(engines: dict[str, TorchEngine], batches: list[int], rounds: int)
     """Shots/s of the flight (each engine: eager, compiled, the ground phase on the other side) and of the whole batch
     with its launch states and ground phase, and peak memory, at each batch size; the engines interleaved at each
     size."""
-    for engine in engines.values():
-        engine.fly_columns(launches_array(1024), STANDARD, None)  # first kernels, allocations and compilation
     rows = []
     for n in batches:
         launches = launches_array(n)
@@ -122,28 +123,30 @@ def throughput(engines: dict[str, TorchEngine], batches: list[int], rounds: int)
                          "prepare_us_per_shot": seconds["prepare"] / n * 1e6,
                          "ground_us_per_shot": seconds["ground"] / n * 1e6,
                          "peak_memory_mb": peak_memory_mb(engine.device), "parts": -(-n // engine.part_shots())}
-            print(f"batch {n:>9,} {name:>8}: {row[name]['shots_per_s']:>12,.0f} shots/s ({row[name]['us_per_shot']:.2f}"
-                  f" us a shot), whole {row[name]['whole_shots_per_s']:>12,.0f} shots/s (launch states "
-                  f"{row[name]['prepare_us_per_shot']:.2f}, figures and ground phase {row[name]['ground_us_per_shot']:.2f}"
-                  f" us a shot), peak {row[name]['peak_memory_mb']:,.0f} MB",
+            r = row[name]
+            print(f"batch {n:>9,} {name:>8}: {r['shots_per_s']:>12,.0f} shots/s ({r['us_per_shot']:.2f} us a shot), "
+                  f"whole {r['whole_shots_per_s']:>12,.0f} shots/s (launch states {r['prepare_us_per_shot']:.2f}, "
+                  f"figures and ground phase {r['ground_us_per_shot']:.2f} us a shot), "
+                  f"peak {r['peak_memory_mb']:,.0f} MB",
                   flush=True)
         rows.append(row)
     return rows
 
 
-def parity(bundle: Path, device: str, shots: int) -> list[dict]:
-    """Carry (and rest) max |difference| from the ONNX engine's batch path on `shots` mixed shots, per precision."""
+def parity(bundle: Path, device: str, shots: int, compiled: bool = True) -> list[dict]:
+    """Carry (and rest) max |difference| from the ONNX engine's batch path on `shots` mixed shots, per precision (and
+    float32 with its step compiled, if `compiled`)."""
     launches = launches_array(shots, seed=7)
     conditions, grounds = mixed_conditions(shots)
     started = time.perf_counter()
     reference = load_flyer(bundle).fly_columns(launches, conditions, grounds)
     print(f"ONNX reference: {shots:,} mixed shots in {time.perf_counter() - started:.1f} s", flush=True)
     rows = []
-    for dtype, compiled in (("float32", False), ("float64", False), ("float32", True)):
-        got = TorchEngine(bundle, device, dtype, compile_step=compiled).fly_columns(launches, conditions, grounds)
+    for dtype, compile_step in (("float32", False), ("float64", False), ("float32", True))[: 3 if compiled else 2]:
+        got = TorchEngine(bundle, device, dtype, compile_step=compile_step).fly_columns(launches, conditions, grounds)
         landed = np.array([i not in reference.errors for i in range(shots)])
         rolled = got.rolled & reference.rolled
-        row = {"dtype": dtype, "compiled": compiled, "shots": shots, "errors_equal": got.errors == reference.errors,
+        row = {"dtype": dtype, "compiled": compile_step, "shots": shots, "errors_equal": got.errors == reference.errors,
                "carry_max_abs_m": float(np.max(np.abs(got.carry_m[landed] - reference.carry_m[landed]))),
                "apex_max_abs_m": float(np.max(np.abs(got.apex_m[landed] - reference.apex_m[landed]))),
                "total_max_abs_m": float(np.max(np.abs(got.rest.total_m[rolled] - reference.rest.total_m[rolled])))}
@@ -151,8 +154,10 @@ def parity(bundle: Path, device: str, shots: int) -> list[dict]:
             row |= {"target": f"carry within {CARRY_TARGET_M * 1e3:g} mm",
                     "met": row["errors_equal"] and row["carry_max_abs_m"] < CARRY_TARGET_M}
         rows.append(row)
-        print(f"parity {dtype}{' compiled' if compiled else ''}: carry max |d| {row['carry_max_abs_m'] * 1e3:.4f} mm, apex {row['apex_max_abs_m'] * 1e3:.4f}"
-              f" mm, total {row['total_max_abs_m'] * 1e3:.4f} mm, errors equal {row['errors_equal']}", flush=True)
+        label = f"{dtype}{' compiled' if compile_step else ''}"
+        print(f"parity {label}: carry max |d| {row['carry_max_abs_m'] * 1e3:.4f} mm, apex "
+              f"{row['apex_max_abs_m'] * 1e3:.4f} mm, total {row['total_max_abs_m'] * 1e3:.4f} mm, errors equal "
+              f"{row['errors_equal']}", flush=True)
     return rows
 
 
@@ -211,8 +216,11 @@ def sweep_end_to_end(device: str, rows: int, threads: int | None, ray_workers: i
         command = [sys.executable, "-m", "golfflight", "sweep", "--grid", *grid, "--out", f"{folder}/out.parquet",
                    *engine, "--device", device, "--no-progress", *(["--threads", str(threads)] if threads else [])]
         started = time.perf_counter()
-        done = subprocess.run(command, cwd=REPO, capture_output=True, text=True, check=True)
+        done = subprocess.run(command, cwd=REPO, capture_output=True, text=True, check=False)
         seconds = time.perf_counter() - started
+    if done.returncode:
+        print(f"{' '.join(engine)}: failed ({done.stderr.strip()[-500:]})", flush=True)
+        return {"shots": shots, "engine": " ".join(engine), "error": done.stderr.strip()[-2000:]}
     print(done.stdout.strip(), flush=True)
     return {"shots": shots, "seconds": seconds, "shots_per_s": shots / seconds, "summary": done.stdout.strip(),
             "engine": " ".join(engine)}
@@ -236,6 +244,27 @@ def print_table(section: dict) -> None:
                   f"{r['peak_memory_mb']:,.0f} MB |")
 
 
+def warmed_engines(bundle: Path, device: str) -> tuple[dict[str, TorchEngine], dict[str, str]]:
+    """The engines to time (eager, compiled, the ground phase on the other side), each flown once (the first
+    kernels, allocations and compilation), and why any could not be (a device's compiler missing, say): on a lent
+    machine's few minutes, one engine that fails must not lose the others' numbers."""
+    eager = TorchEngine(bundle, device)
+    elsewhere = "cpu" if eager.ground_on_device else "device"
+    makers = {"eager": lambda: eager, "compiled": lambda: TorchEngine(bundle, device, compile_step=True),
+              f"ground on {elsewhere}": lambda: TorchEngine(bundle, device,
+                                                            ground_on_device=not eager.ground_on_device)}
+    engines, failed = {}, {}
+    for name, make in makers.items():
+        try:
+            engine = make()
+            engine.fly_columns(launches_array(1024), STANDARD, GroundSpec(SURFACES["fairway"]))
+            engines[name] = engine
+        except Exception as error:  # noqa: BLE001 - recorded in the results, the other engines still timed
+            failed[name] = f"{type(error).__name__}: {error}"
+            print(f"{name}: could not fly ({failed[name]})", flush=True)
+    return engines, failed
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--device", default="cuda" if torch.cuda.is_available() else "cpu")
@@ -251,34 +280,39 @@ def main() -> None:
     if args.threads:
         torch.set_num_threads(args.threads)
     bundle = load_flyer(args.model).bundle_dir
-    engine = TorchEngine(bundle, args.device)
-    elsewhere = "cpu" if engine.ground_on_device else "device"
-    engines = {"eager": engine, "compiled": TorchEngine(bundle, args.device, compile_step=True),
-               f"ground on {elsewhere}": TorchEngine(bundle, args.device, ground_on_device=not engine.ground_on_device)}
+    engines, failed = warmed_engines(bundle, args.device)
+    engine = engines["eager"]
     kind = engine.device.type
     batches = [int(b) for b in args.batches.split(",")] if args.batches else list(DEFAULT_BATCHES[kind])
     section = {"device": str(engine.device), **machine_of(engine.device), "part_shots": engine.part_shots(),
-               "throughput": throughput(engines, batches, args.rounds),
-               "parity": parity(bundle, args.device, args.parity_shots)}
+               "could_not_fly": failed}
+
+    def measured(name: str, value) -> None:
+        """Keep a measurement in the section and write the section now (a run cut short keeps what it measured)."""
+        section[name] = value
+        write_results(f"torch_engine_{kind}", [section])
+
+    measured("throughput", throughput(engines, batches, args.rounds))
+    measured("parity", parity(bundle, args.device, args.parity_shots, compiled="compiled" in engines))
     best = max(row[name]["shots_per_s"] for row in section["throughput"] for name in engines)
-    section["flight_best_shots_per_s"] = best
+    measured("flight_best_shots_per_s", best)
     if kind in FLIGHT_TARGET:
-        section["flight_target"] = {"target": f">= {FLIGHT_TARGET[kind]:,.0f} shots/s", "met": best >= FLIGHT_TARGET[kind]}
+        measured("flight_target", {"target": f">= {FLIGHT_TARGET[kind]:,.0f} shots/s",
+                                   "met": best >= FLIGHT_TARGET[kind]})
     share_rows = DEFAULT_SWEEP_ROWS[kind] if args.share_rows is None else args.share_rows
     if share_rows:
-        section["cpu_share"] = cpu_share(bundle, args.device, share_rows)
+        measured("cpu_share", cpu_share(bundle, args.device, share_rows))
     rows = DEFAULT_SWEEP_ROWS[kind] if args.sweep_rows is None else args.sweep_rows
-    if rows:
-        section["sweep"] = sweep_end_to_end(args.device, rows, args.threads)
-        section["sweep_compiled"] = sweep_end_to_end(args.device, rows, args.threads, compiled=True)
-        for name in ("sweep", "sweep_compiled"):
-            if kind in SWEEP_TARGET:
-                section[name] |= {"target": f">= {SWEEP_TARGET[kind]:,.0f} shots/s",
-                                  "met": section[name]["shots_per_s"] >= SWEEP_TARGET[kind]}
-        if args.ray_workers:
-            section["ray_sweep"] = sweep_end_to_end(args.device, rows, args.threads, args.ray_workers)
+    for name, compiled, ray_workers in (("sweep", False, None), ("sweep_compiled", True, None),
+                                        ("ray_sweep", False, args.ray_workers)):
+        if not rows or (compiled and "compiled" not in engines) or (name == "ray_sweep" and not ray_workers):
+            continue
+        result = sweep_end_to_end(args.device, rows, args.threads, ray_workers, compiled)
+        if kind in SWEEP_TARGET and name != "ray_sweep" and "error" not in result:
+            result |= {"target": f">= {SWEEP_TARGET[kind]:,.0f} shots/s",
+                       "met": result["shots_per_s"] >= SWEEP_TARGET[kind]}
+        measured(name, result)
     print_table(section)
-    write_results(f"torch_engine_{kind}", [section])
 
 
 if __name__ == "__main__":
