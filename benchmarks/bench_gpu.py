@@ -169,14 +169,16 @@ on two surfaces (a sweep's usual mix of a few shared conditions)."""
 
 def cpu_share(bundle: Path, device: str, rows: int, rounds: int = 2) -> dict:
     """A sweep of a grid of about `rows` launches through `run_sweep` in this process, in the command line's chunks
-    for the device, one piece at a time and `PIECES_IN_FLIGHT` at once, interleaved for `rounds`: wall seconds of
+    for the device, one piece at a time, `PIECES_IN_FLIGHT` (the command line's) and twice that at once (does the
+    overlap grow with more threads on a machine of many cores?), interleaved for `rounds`: wall seconds of
     each, and, from the one-at-a-time runs (no overlap), each stage's microseconds a row and the CPU's (all but the
-    device's flight), whose inverse caps the sweep's rows/s however fast the device flies. An untimed sweep of one
+    device's flight; on a GPU the ground phase's time on the device with it), whose inverse caps the sweep's rows/s
+    however fast the device flies. An untimed sweep of one
     ball speed first: the driver's first sweep in a process pays its imports and caches (about 4 us a row more
     here)."""
     speeds = max(rows // 1216, 1)
     grid = Grid.parse([f"ball_speed_mps=30:80:{speeds}", *SHARE_GRID])
-    walls: dict[int, list[float]] = {1: [], PIECES_IN_FLIGHT: []}
+    walls: dict[int, list[float]] = {1: [], PIECES_IN_FLIGHT: [], 2 * PIECES_IN_FLIGHT: []}
     stages = []
     with tempfile.TemporaryDirectory() as folder:
         run_sweep(GridSource(Grid.parse(["ball_speed_mps=50", *SHARE_GRID]), 65_536), f"{folder}/out.parquet",
@@ -185,8 +187,7 @@ def cpu_share(bundle: Path, device: str, rows: int, rounds: int = 2) -> dict:
             for in_flight, wall in walls.items():
                 engine = TorchEngine(bundle, device, parts_at_once=in_flight)
                 done = run_sweep(GridSource(grid, TORCH_CHUNK_ROWS[engine.device.type]), f"{folder}/out.parquet",
-                                 engine="torch", in_process=engine,
-                                 progress=False, in_flight=in_flight)
+                                 engine="torch", in_process=engine, progress=False, in_flight=in_flight)
                 wall.append(done.seconds)
                 if in_flight == 1:
                     stages.append({**engine.seconds, "rest": done.seconds - sum(engine.seconds.values())})

@@ -12,8 +12,6 @@ keeps none). The planes' normals and the surfaces' parameters come in as tensors
 
 from __future__ import annotations
 
-from dataclasses import fields
-
 import torch
 from golfflight.flight.constants import GRAVITY_MPS2
 from golfflight.flight.ground import Surface
@@ -36,12 +34,6 @@ def _columns(a: torch.Tensor) -> tuple[torch.Tensor, ...]:
     return a[:, 0], a[:, 1], a[:, 2]
 
 
-def _take(surface: Surface, index: torch.Tensor) -> Surface:
-    """The parameters of some balls (fields that are tensors a ball; floats shared)."""
-    return Surface(*(v[index] if isinstance(v, torch.Tensor) else v for v in (getattr(surface, f.name)
-                                                                            for f in fields(Surface))))
-
-
 def _bounce(position: torch.Tensor, velocity: torch.Tensor, spin: torch.Tensor, normal: torch.Tensor,
             surface: Surface) -> tuple[torch.Tensor, ...]:
     """Impacts and hops until every ball rolls: (roll-start position, rolling velocity, time, hops)."""
@@ -53,7 +45,7 @@ def _bounce(position: torch.Tensor, velocity: torch.Tensor, spin: torch.Tensor, 
     while bouncing.numel():
         ids = bouncing
         v_out, w_out = impact_components(_columns(velocity[ids]), _columns(spin[ids]), _columns(normal[ids]),
-                                         _take(surface, ids))
+                                         surface.take(ids))
         v_out, w_out = torch.stack(v_out, -1), torch.stack(w_out, -1)
         rebound = torch.einsum("ij,ij->i", v_out, normal[ids])
         hopping = (rebound > MIN_HOP_SPEED_MPS) & (hops[ids] < MAX_BOUNCES)
