@@ -9,7 +9,7 @@ from golfflight.flight.ground import SURFACES, Surface, ground_phase
 from golfflight.flight.ground.phase import plane_normals
 
 torch = pytest.importorskip("torch")
-from golfflight.model_export.torch_ground import ground_phase as device_ground_phase  # noqa: E402
+from golfflight.model_export.torch_ground import ground_phase as device_ground_phase
 
 SURFACE_NAMES = ("fairway", "green", "rough", "firm_fairway", "bunker")
 
@@ -50,3 +50,22 @@ def test_the_device_ground_phase_gives_numpys_rests_hops_and_times(mixed):
     np.testing.assert_allclose(time_s.numpy(), want.time_s, rtol=0, atol=1e-9)
     assert (want.rest_position[:, 0] < position[:, 0]).any(), "no ball spun back: the case is not covered"
     assert (want.bounces > 1).any() and (slope > 0).any() == mixed
+
+
+def test_the_vectors_functions_answer_in_the_library_of_their_arguments():
+    """Plain numbers (NumPy's scalars among them) stay plain, arrays NumPy's, tensors torch's (the device's)."""
+    from golfflight.flight.ground import vectors
+
+    for name, args in (("minimum", (0.3, 0.5)), ("maximum", (0.3, 0.5)), ("atan2", (0.3, 0.5)), ("cos", (0.3,)),
+                       ("sin", (0.3,)), ("log1p", (0.3,)), ("expm1", (0.3,))):
+        function = getattr(vectors, name)
+        plain = function(*args)
+        assert isinstance(plain, float), name
+        assert function(*(np.float32(a) for a in args)) == pytest.approx(plain, rel=1e-6), name
+        array = function(*(np.full(2, a) for a in args))
+        assert isinstance(array, np.ndarray) and array.tolist() == [plain, plain], name
+        tensor = function(torch.full((2,), args[0], dtype=torch.float64), *args[1:])
+        assert isinstance(tensor, torch.Tensor) and tensor.tolist() == pytest.approx([plain, plain], rel=1e-15), name
+    assert vectors.where(np.bool_(True), 1.0, 2.0) == 1.0
+    assert vectors.where(torch.tensor([True, False]), 1.0, torch.tensor([5.0, 6.0], dtype=torch.float64)).tolist() == [
+        1.0, 6.0]

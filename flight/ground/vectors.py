@@ -34,8 +34,9 @@ def norm(a: tuple):
     return dot(a, a) ** 0.5
 
 
-NUMBERS = (float, int)
-"""Plain numbers: one ball's components, on the one-shot latency path (checked before anything slower)."""
+NUMBERS = (float, int, np.generic)
+"""Plain numbers (NumPy's scalars among them): one ball's components, on the one-shot latency path (checked before
+anything slower)."""
 
 
 def _torch(name: str, *values):
