@@ -232,17 +232,29 @@ def read_column(column: str, array) -> Column:
     return _number_cells(column, array)
 
 
+MIX = np.uint64(0x9E3779B97F4A7C15)
+"""Odd 64-bit multiplier (2^64 / golden ratio) that mixes the group-key parts into one hash."""
+
+
 def _groups(parts: list[np.ndarray], rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Rows (indices) grouped by equal values across `parts` (int64 arrays over every row): each group's first row,
-    and each row's group."""
+    and each row's group. The parts are hashed into one 64-bit number a row and grouped by one sort of those; every
+    group is then checked to hold one value of each part, and where two keys shared a hash the rows are grouped by
+    the keys themselves (exact either way; the hash about 3x faster than sorting the keys as bytes)."""
     if not parts or not len(rows):
         return rows[:1], np.zeros(len(rows), dtype=np.intp)
-    keys = np.ascontiguousarray(np.stack([part[rows] for part in parts], axis=1))
-    _, first, inverse = np.unique(
-        keys.view(np.dtype((np.void, keys.dtype.itemsize * keys.shape[1]))).ravel(),
-        return_index=True,
-        return_inverse=True,
-    )
+    columns = [np.ascontiguousarray(part[rows], dtype=np.int64) for part in parts]
+    mixed = np.zeros(len(rows), dtype=np.uint64)
+    for column in columns:
+        mixed = (mixed ^ column.view(np.uint64)) * MIX
+        mixed ^= mixed >> np.uint64(29)
+    _, first, inverse = np.unique(mixed, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    if all(np.array_equal(column, column[first][inverse]) for column in columns):
+        return rows[first], inverse
+    keys = np.stack(columns, axis=1)
+    _, first, inverse = np.unique(keys.view(np.dtype((np.void, 8 * len(columns)))).ravel(), return_index=True,
+                                  return_inverse=True)
     return rows[first], inverse.reshape(-1)
 
 

@@ -296,3 +296,25 @@ def test_gpu_actors_are_one_a_gpu_and_never_more_than_the_cluster_lists():
         gpu_actors({"GPU": 4.0}, 5, 1)
     with pytest.raises(ValueError, match=r"the Ray cluster lists no GPU \(ray.cluster_resources\(\) has none\)"):
         gpu_actors({"CPU": 16.0}, None, 1)
+
+
+@pytest.mark.parametrize("collide", [False, True], ids=["hashed", "every hash equal: grouped by the keys"])
+def test_rows_are_grouped_by_equal_keys_whatever_their_hashes(monkeypatch, collide):
+    """`sweep.rows._groups`: rows with equal values in every part share a group and no others do, each group's row
+    the first of its rows; where hashes collide (forced here: every row's hash equal) the keys themselves decide."""
+    from golfflight.sweep import rows
+
+    if collide:
+        monkeypatch.setattr(rows, "MIX", np.uint64(0))
+    rng = np.random.default_rng(5)
+    parts = [rng.integers(0, 3, 500).astype(np.int64), rng.integers(-2, 2, 500).astype(np.int64) * 2**40,
+             np.where(rng.random(500) < 0.5, np.float64(1.5).view(np.int64), 0)]
+    chosen = np.flatnonzero(rng.random(500) < 0.8)
+    firsts, group = rows._groups(parts, chosen)
+    keys = [tuple(int(part[i]) for part in parts) for i in chosen.tolist()]
+    expected_first = {}
+    for row, key in zip(chosen.tolist(), keys, strict=True):
+        expected_first.setdefault(key, row)
+    assert sorted(firsts.tolist()) == sorted(expected_first.values())
+    for row, key, g in zip(chosen.tolist(), keys, group.tolist(), strict=True):
+        assert firsts[g] == expected_first[key], row
