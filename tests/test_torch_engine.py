@@ -72,7 +72,8 @@ def onnx_flights(shots):
 
 @pytest.fixture(scope="module")
 def engines() -> dict[str, TorchEngine]:
-    """Each precision eager, and float32 with its Euler step compiled (torch.compile: seconds here)."""
+    """Each precision eager, float32 with its Euler step compiled (torch.compile: seconds here), and float64 with its
+    ground phase in torch (`model_export.torch_ground`, a GPU's; here on the CPU)."""
     bundle = load_flyer(None).bundle_dir
     return {"float32": TorchEngine(bundle, "cpu", "float32"), "float64": TorchEngine(bundle, "cpu", "float64"),
             "float32-compiled": TorchEngine(bundle, "cpu", "float32", compile_step=True),
@@ -88,11 +89,10 @@ def _deviation(got, want, name: str, landed: np.ndarray) -> float:
     ("float64-ground-on-device", 2e-5, 2e-4),
 ])
 def test_the_torch_engine_flies_mixed_shots_as_the_onnx_engine(engines, shots, onnx_flights, dtype, carry_m, figures):
-    """Carries within 1 mm in float32, eager or with the step compiled, and the ground phase on the device (torch,
-    here the CPU) as NumPy's. In float64 the physics agree to rounding and
+    """Carries within 1 mm in float32, eager or with the step compiled. In float64 the physics agree to rounding and
     what is left is the network's float32 arithmetic (torch's and ONNX Runtime's sums differ by an ulp: about 1e-7
-    in a coefficient), some 10 um of carry (the rules themselves are held to 1e-6 m below). The other figures
-    (degrees, rpm, s) and the rests after the ground phase follow."""
+    in a coefficient), some 10 um of carry (the rules themselves are held to 1e-6 m below), with the ground phase in
+    NumPy or in torch. The other figures (degrees, rpm, s) and the rests after the ground phase follow."""
     got = engines[dtype].fly_columns(*shots)
     assert got.errors == onnx_flights.errors and {1, 2} <= set(got.errors)
     assert "never rose to its landing ground" in got.errors[1]
