@@ -25,7 +25,7 @@ from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.constants import BALL_MASS_KG, BALL_RADIUS_M
 from golfflight.flight.field import BallInAir
-from golfflight.flight.ground import GroundPhase, GroundSpec, batch_surface, ground_phase
+from golfflight.flight.ground import GroundPhase, GroundSpec, batch_surface, elevations, ground_phase
 from golfflight.flight.integrator import FORWARD_EULER, GroundPlane, StepRule, integrate, record_for
 from golfflight.flight.limits import FLIGHT_TIME_S
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
@@ -231,7 +231,7 @@ class Flyer:
         n = len(launches)
         per_shot = PerShot.of(conditions, n, "conditions")
         shot_grounds = PerShot.of(grounds, n, "grounds")
-        heights = shot_grounds.column(lambda g: 0.0 if g is None else g.elevation_m)
+        heights = elevations(shot_grounds)
         start = initial_state(*np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH).T)
         field = self._batch_field(per_shot)
         flight = integrate(start, field, self.dt_s, self.max_steps, self.rule, GroundPlane(heights),

@@ -36,7 +36,7 @@ import numpy as np
 import torch
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import LAUNCH_WIDTH, NON_FINITE, Launch, air_inputs, load_flyer
-from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, batch_surface, ground_phase
+from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, batch_surface, elevations, ground_phase
 from golfflight.flight.ground.phase import plane_normals
 from golfflight.flight.outcomes import BatchFlights, Rest, landing_figures
 from golfflight.flight.per_shot import PerShot
@@ -221,7 +221,7 @@ class TorchEngine:
             log_profile=air.column(lambda a: a.log_profile, bool),
             reference_height_m=air.column(lambda a: a.reference_height_m),
             roughness_m=air.column(lambda a: a.roughness_m),
-            ground_m=_elevations(grounds),
+            ground_m=elevations(grounds),
         )
 
     @torch.no_grad()
@@ -270,7 +270,7 @@ class TorchEngine:
         carry, angle, speed, spin = landing_figures(x, y, *flight.velocity.T, *flight.spin.T)
         numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
         finite = np.isfinite(np.stack(numbers)).all(axis=0)
-        errors, heights = {}, _elevations(grounds)
+        errors, heights = {}, elevations(grounds)
         for i in np.flatnonzero(~(flight.landed & finite)).tolist():
             unlanded = not flight.landed[i]
             errors[i] = (self.flyer.unlanded_message(float(flight.apex_m[i]), float(heights[i]))
@@ -313,11 +313,6 @@ class TorchEngineMaker:
             torch.set_num_threads(self.threads)
         return TorchEngine(bundle_dir, self.device, self.dtype, parts_at_once=self.parts_at_once,
                            compile_step=self.compile_step)
-
-
-def _elevations(grounds: PerShot[GroundSpec | None]) -> np.ndarray:
-    """Each shot's ground elevation [N] (0: the tee's, for a shot flown alone)."""
-    return grounds.column(lambda g: 0.0 if g is None else g.elevation_m)
 
 
 def _wind(at_reference: torch.Tensor, log_profile: torch.Tensor, reference_height_m: torch.Tensor,

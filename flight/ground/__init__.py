@@ -4,7 +4,7 @@ surface parameters; `putt_phase` skids and rolls a putt that starts on the groun
 
 from golfflight.flight.ground.phase import GroundPath, GroundPhase, OneRest, ground_phase, ground_phase_one
 from golfflight.flight.ground.putt import SKID_FRICTION, PuttPhase, putt_phase
-from golfflight.flight.ground.spec import LEVEL_FAIRWAY, GroundSpec, batch_surface
+from golfflight.flight.ground.spec import LEVEL_FAIRWAY, GroundSpec, batch_surface, elevations
 from golfflight.flight.ground.surfaces import SURFACES, Surface, green_rolling_resistance, holding_slope_deg, surface
 
 __all__ = [
@@ -18,6 +18,7 @@ __all__ = [
     "PuttPhase",
     "Surface",
     "batch_surface",
+    "elevations",
     "green_rolling_resistance",
     "ground_phase",
     "ground_phase_one",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
 from golfflight.flight.ground.surfaces import SURFACES, Surface, holding_slope_deg
 from golfflight.flight.limits import SLOPE_DEG
 from golfflight.flight.per_shot import PerShot
@@ -38,3 +39,8 @@ def batch_surface(grounds: PerShot[GroundSpec]) -> Surface:
     if len(surfaces) == 1:
         return next(iter(surfaces.values()))
     return Surface.stack([g.surface for g in grounds.objects]).take(grounds.index)
+
+
+def elevations(grounds: PerShot[GroundSpec | None]) -> np.ndarray:
+    """Each shot's ground elevation [N]: its plane's, or the tee's (0) for a shot flown alone (no ground)."""
+    return grounds.column(lambda g: 0.0 if g is None else g.elevation_m)

@@ -186,8 +186,9 @@ def run(args: argparse.Namespace) -> int:
     )
     if torch_engine is not None:
         spent = torch_engine.seconds
-        print(f"golfflight sweep: torch flight {spent['flight']:.2f} s on {torch_engine.device}; on the CPU, the "
-              f"launches and air {spent['prepare']:.2f} s and the ground phase {spent['ground']:.2f} s (NumPy); "
+        ground = f"torch on {torch_engine.device}" if torch_engine.ground_on_device else "NumPy on the CPU"
+        print(f"golfflight sweep: torch flight {spent['flight']:.2f} s on {torch_engine.device}; the launches and air "
+              f"{spent['prepare']:.2f} s on the CPU and the ground phase {spent['ground']:.2f} s ({ground}); "
               f"seconds summed over the {torch_engine.parts_at_once} pieces flown at once, beside the driver reading, "
               "validating and writing rows")
     return 0
