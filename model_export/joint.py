@@ -36,7 +36,15 @@ from golfflight.model_export.observations import (
     ObservedShots,
     load_observed,
 )
-from golfflight.model_export.torch_physics import DT_S, T_SIM_S, euler_rollout, hard_landing, positions_at
+from golfflight.model_export.stacked_runs import StackedNetworks, clip_per_run, run_of_rows, runs_held
+from golfflight.model_export.torch_physics import (
+    DT_S,
+    T_SIM_S,
+    Coefficients,
+    euler_rollout,
+    hard_landing,
+    positions_at,
+)
 from golfflight.model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, load_checkpoint, save_checkpoint
 from golfflight.shots.files import write_text_atomic
 from golfflight.shots.progress import print_line, progress_bar
@@ -104,75 +112,95 @@ class JointConfig:
         return asdict(self)
 
 
-class LatentConditions(nn.Module):
-    """Per-group winds (x, y in m/s), per-air-group log density factors, per-ball log (lift, drag) scales."""
+class PerRun(nn.Module):
+    """Parameters with a leading run axis (`model_export.stacked_runs`), saved one run at a time without it."""
 
-    def __init__(self, data: ObservedData) -> None:
+    def run_state(self, run: int) -> dict[str, torch.Tensor]:
+        """One run's values, as its checkpoint holds them (no run axis)."""
+        return {name: value[run].detach().clone() for name, value in self.state_dict().items()}
+
+    @torch.no_grad()
+    def load_run_state(self, run: int, state: dict[str, torch.Tensor]) -> None:
+        """Set one run's values from a checkpoint's (`run_state`)."""
+        for name, value in self.state_dict().items():
+            value[run] = state[name]
+
+
+class LatentConditions(PerRun):
+    """Per-group winds (x, y in m/s), per-air-group log density factors, per-ball log (lift, drag) scales, each
+    once a run: a leading axis of `runs`, the runs trained side by side (`model_export.stacked_runs`)."""
+
+    def __init__(self, data: ObservedData, runs: int = 1) -> None:
         super().__init__()
-        self.wind = nn.Parameter(torch.zeros(len(data.wind_groups), 2))
-        self.log_density = nn.Parameter(torch.zeros(len(data.air_groups)))
-        self.log_ball_scale = nn.Parameter(torch.zeros(len(data.balls), 2))
+        self.wind = nn.Parameter(torch.zeros(runs, len(data.wind_groups), 2))
+        self.log_density = nn.Parameter(torch.zeros(runs, len(data.air_groups)))
+        self.log_ball_scale = nn.Parameter(torch.zeros(runs, len(data.balls), 2))
 
     @staticmethod
-    def _pick(values: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
-        """values[index] with zeros where index is -1 (no latent for this shot)."""
-        if values.shape[0] == 0:
-            return values.new_zeros((index.shape[0], *values.shape[1:]))
-        picked = values[index.clamp_min(0)]
+    def _pick(values: torch.Tensor, run: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
+        """values[run, index] with zeros where index is -1 (no latent for this shot)."""
+        if values.shape[1] == 0:
+            return values.new_zeros((index.shape[0], *values.shape[2:]))
+        picked = values[run, index.clamp_min(0)]
         keep = (index >= 0).reshape(-1, *([1] * (picked.dim() - 1)))
         return torch.where(keep, picked, torch.zeros_like(picked))
 
-    def for_shots(self, shots: ObservedShots) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """Wind [n,3], density [n] and coefficient scale [n,4] (C_L, C_D, C_M, C_Q) of these shots."""
-        wind_xy = self._pick(self.wind, shots.wind_group)
+    def for_shots(self, shots: ObservedShots, run: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Wind [n,3], density [n] and coefficient scale [n,4] (C_L, C_D, C_M, C_Q) of these shots, each shot in
+        the latent conditions of its run (`run` [n])."""
+        wind_xy = self._pick(self.wind, run, shots.wind_group)
         wind = torch.cat([wind_xy, wind_xy.new_zeros(len(shots), 1)], dim=1)
-        density = shots.density * self._pick(self.log_density, shots.air_group).exp()
-        lift_drag = self._pick(self.log_ball_scale, shots.ball).exp()
+        density = shots.density * self._pick(self.log_density, run, shots.air_group).exp()
+        lift_drag = self._pick(self.log_ball_scale, run, shots.ball).exp()
         scale = torch.cat([lift_drag, lift_drag.new_ones(len(shots), 2)], dim=1)
         return wind, density, scale
 
     def prior(self, config: JointConfig, wind_source: torch.Tensor, air_source: torch.Tensor,
               sources: list[str]) -> torch.Tensor:
-        """Negative log prior (Gaussian, up to a constant): winds and ball scales about zero, each source's mean
-        wind about calm; a known-air source's group densities about its stated air and their mean tightly so
-        (`mean_density_prior`); an unknown-air source's group densities about the source's own mean, which is
-        loose (`unknown_mean_density_prior`), so that only the sources with known air set the level.
+        """Negative log prior of each run [runs] (Gaussian, up to a constant): winds and ball scales about zero,
+        each source's mean wind about calm; a known-air source's group densities about its stated air and their
+        mean tightly so (`mean_density_prior`); an unknown-air source's group densities about the source's own
+        mean, which is loose (`unknown_mean_density_prior`), so that only the sources with known air set the level.
         `*_source` [groups] name the source of each wind and air group."""
-        total = (self.wind / config.wind_prior_mps).pow(2).sum() + (self.log_ball_scale / config.ball_prior).pow(2).sum()
+        total = (self.wind / config.wind_prior_mps).pow(2).sum(dim=(1, 2)) + (
+            self.log_ball_scale / config.ball_prior).pow(2).sum(dim=(1, 2))
         for s in wind_source.unique():
-            total = total + (self.wind[wind_source == s].mean(dim=0) / config.mean_wind_prior_mps).pow(2).sum()
+            total = total + (self.wind[:, wind_source == s].mean(dim=1) / config.mean_wind_prior_mps).pow(2).sum(dim=1)
         for s in air_source.unique():
-            values = self.log_density[air_source == s]
-            mean = values.mean()
+            values = self.log_density[:, air_source == s]
+            mean = values.mean(dim=1)
             if sources[int(s)] in config.unknown_air_sources:
-                total = total + ((values - mean) / config.density_prior).pow(2).sum()
+                total = total + ((values - mean[:, None]) / config.density_prior).pow(2).sum(dim=1)
                 total = total + (mean / config.unknown_mean_density_prior).pow(2)
             else:
-                total = total + (values / config.density_prior).pow(2).sum() + (mean / config.mean_density_prior).pow(2)
+                total = total + (values / config.density_prior).pow(2).sum(dim=1) + (
+                    mean / config.mean_density_prior).pow(2)
         return 0.5 * total
 
     @torch.no_grad()
     def source_density_factors(self, config: JointConfig, air_source: torch.Tensor, sources: list[str]
                                ) -> torch.Tensor:
-        """Per source [n_sources]: the fitted mean density factor of an unknown-air source, 1 for every other: the
-        air a validation shot of a range session is flown in (its source's, not one block's)."""
-        factors = torch.ones(len(sources), device=self.log_density.device)
+        """Per run and source [runs, sources]: the fitted mean density factor of an unknown-air source, 1 for every
+        other: the air a validation shot of a range session is flown in (its source's, not one block's)."""
+        factors = torch.ones(self.log_density.shape[0], len(sources), device=self.log_density.device)
         for s in air_source.unique():
             if sources[int(s)] in config.unknown_air_sources:
-                factors[int(s)] = self.log_density[air_source == s].mean().exp()
+                factors[:, int(s)] = self.log_density[:, air_source == s].mean(dim=1).exp()
         return factors
 
 
-class NoiseScales(nn.Module):
+class NoiseScales(PerRun):
     """How much more each source scatters than the radar, per observable (and for its path): sigma = radar sigma
     x exp(softplus(s)) (never below the radar's), fitted by maximum likelihood (the loss adds log sigma), so gusts,
-    mishits and TrackMan's extrapolations widen an observable's sigma instead of dominating the fit."""
+    mishits and TrackMan's extrapolations widen an observable's sigma instead of dominating the fit. Once a run
+    (a leading axis of `runs`), like `LatentConditions`."""
 
-    def __init__(self, n_sources: int) -> None:
+    def __init__(self, n_sources: int, runs: int = 1) -> None:
         super().__init__()
-        self.raw = nn.Parameter(torch.zeros(n_sources, len(OBSERVABLES) + 1))
+        self.raw = nn.Parameter(torch.zeros(runs, n_sources, len(OBSERVABLES) + 1))
 
     def factors(self) -> torch.Tensor:
+        """[runs, sources, observables + path]."""
         return nn.functional.softplus(self.raw).exp()
 
 
@@ -184,16 +212,23 @@ class Predicted:
     path: torch.Tensor
     landed: torch.Tensor
 
+    def rows(self, start: int, stop: int) -> Predicted:
+        """The shots start to stop (one run's of a stacked flight)."""
+        return Predicted(self.observables[start:stop], self.path[start:stop], self.landed[start:stop])
 
-def fly(model: nn.Module, shots: ObservedShots, config: JointConfig, latent: LatentConditions | None,
-        source_density: torch.Tensor | None = None) -> Predicted:
+
+def fly(model: Coefficients, shots: ObservedShots, config: JointConfig, latent: LatentConditions | None,
+        source_density: torch.Tensor | None = None, run: torch.Tensor | None = None) -> Predicted:
     """Euler rollout of the shots: with their latent conditions, or, when `latent` is None, calm in their recorded
-    air times their source's fitted density factor (`source_density` [n_sources], where given)."""
+    air times their source's fitted density factor (`source_density` [runs, sources], where given). `run` [n] is
+    each shot's run where `model` is several stacked (`stacked_runs.StackedNetworks`); None: all of run 0."""
+    if run is None:
+        run = torch.zeros(len(shots), dtype=torch.long, device=shots.source.device)
     if latent is None:
-        factor = 1.0 if source_density is None else source_density[shots.source]
+        factor = 1.0 if source_density is None else source_density[run, shots.source]
         wind, density, scale = None, shots.density * factor, None
     else:
-        wind, density, scale = latent.for_shots(shots)
+        wind, density, scale = latent.for_shots(shots, run)
     trajectory = euler_rollout(shots.position, shots.velocity, shots.spin, model, density, config.dt_s,
                                config.t_sim_s, shots.reynolds_scale[:, None], wind, scale)
     landing = hard_landing(trajectory)
@@ -209,14 +244,13 @@ def _huber(x: torch.Tensor, delta: float) -> torch.Tensor:
     return nn.functional.huber_loss(x, torch.zeros_like(x), reduction="none", delta=delta)
 
 
-def shot_losses(predicted: Predicted, shots: ObservedShots, delta: float, scales: torch.Tensor | None = None
+def shot_losses(predicted: Predicted, shots: ObservedShots, delta: float, factors: torch.Tensor | None = None
                 ) -> torch.Tensor:
     """Per-shot loss [n]: Huber of the noise-scaled residual of each recorded observable, plus the path's samples
-    (3-D distance over the path noise) scaled to count as PATH_OBSERVATIONS observations in all. With `scales`
-    (`NoiseScales.factors()`, [sources, 6]) each sigma is widened by its source's factor and log sigma is added
+    (3-D distance over the path noise) scaled to count as PATH_OBSERVATIONS observations in all. With `factors`
+    (each shot's row of `NoiseScales.factors()`, [n, 6]) each sigma is widened by its factor and log sigma is added
     (the negative log likelihood, so the factors are fitted too)."""
-    factor = torch.ones(len(shots), len(OBSERVABLES) + 1, device=shots.sigma.device) if scales is None else (
-        scales[shots.source])
+    factor = torch.ones(len(shots), len(OBSERVABLES) + 1, device=shots.sigma.device) if factors is None else factors
     mask = shots.target_mask & predicted.landed[:, None]
     sigma = shots.sigma * factor[:, :-1]
     residual = torch.where(mask, (predicted.observables - shots.targets) / sigma, 0.0)
@@ -250,13 +284,20 @@ def weighted_mean(values: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
 
 
 @torch.no_grad()
-def evaluate(model: nn.Module, shots: ObservedShots, config: JointConfig, sources: list[str],
-             latent: LatentConditions | None = None, scales: torch.Tensor | None = None,
-             source_density: torch.Tensor | None = None) -> dict[str, Any]:
-    """Loss and per-source errors in physical units: landing error (m), mean absolute error and mean signed error
-    (bias) of every observable, path error (m), over the shots that have each."""
-    predicted = fly(model, shots, config, latent, source_density)
-    losses = shot_losses(predicted, shots, config.huber_delta, scales)
+def evaluate(model: Coefficients, shots: ObservedShots, config: JointConfig, sources: list[str],
+             source_density: torch.Tensor | None = None, runs: int = 1) -> list[dict[str, Any]]:
+    """Each run's (of `runs` stacked in `model`) loss and per-source errors in physical units on `shots`, flown calm
+    in their air times `source_density` [runs, sources] (`fly`): landing error (m), mean absolute error and mean
+    signed error (bias) of every observable, path error (m), over the shots that have each."""
+    n = len(shots)
+    every = shots if runs == 1 else shots.take(torch.arange(n, device=shots.source.device).repeat(runs))
+    predicted = fly(model, every, config, None, source_density, run_of_rows(runs, n, shots.source.device))
+    return [score(predicted.rows(r * n, (r + 1) * n), shots, config, sources) for r in range(runs)]
+
+
+def score(predicted: Predicted, shots: ObservedShots, config: JointConfig, sources: list[str]) -> dict[str, Any]:
+    """Loss and per-source errors of one run's flights of `shots` (`evaluate`)."""
+    losses = shot_losses(predicted, shots, config.huber_delta)
     metrics: dict[str, Any] = {"loss": float(weighted_mean(losses, shots.weight)), "sources": {}}
     signed = predicted.observables - shots.targets
     error = signed.abs()
@@ -284,23 +325,25 @@ def evaluate(model: nn.Module, shots: ObservedShots, config: JointConfig, source
     return metrics
 
 
-def conditions_report(latent: LatentConditions, data: ObservedData, train: ObservedShots) -> dict[str, Any]:
-    """The fitted latent conditions, readable: winds as speed and from-direction, density ratios, ball scales."""
+def conditions_report(latent: LatentConditions, data: ObservedData, train: ObservedShots, run: int = 0
+                      ) -> dict[str, Any]:
+    """Run `run`'s fitted latent conditions, readable: winds as speed and from-direction, density ratios, ball
+    scales."""
     def count(index: torch.Tensor, i: int) -> int:
         return int((index == i).sum())
 
     wind = []
     for i, group in enumerate(data.wind_groups.names):
-        x, y = (float(v) for v in latent.wind[i].detach())
+        x, y = (float(v) for v in latent.wind[run, i].detach())
         fitted = Wind.from_components(x, y)
         speed, from_deg = float(fitted.speed_mps), float(fitted.from_deg)
         source = data.sources[int(train.source[train.wind_group == i][0])]
         wind.append({"group": group, "source": source, "n_shots": count(train.wind_group, i), "x_mps": x,
                      "y_mps": y, "speed_mps": speed, "from_deg": from_deg})
-    air = [{"group": g, "n_shots": count(train.air_group, i), "density_ratio": float(latent.log_density[i].detach().exp())}
+    air = [{"group": g, "n_shots": count(train.air_group, i), "density_ratio": float(latent.log_density[run, i].detach().exp())}
            for i, g in enumerate(data.air_groups.names)]
-    ball = [{"ball": b, "n_shots": count(train.ball, i), "lift_scale": float(latent.log_ball_scale[i, 0].detach().exp()),
-             "drag_scale": float(latent.log_ball_scale[i, 1].detach().exp())} for i, b in enumerate(data.balls.names)]
+    ball = [{"ball": b, "n_shots": count(train.ball, i), "lift_scale": float(latent.log_ball_scale[run, i, 0].detach().exp()),
+             "drag_scale": float(latent.log_ball_scale[run, i, 1].detach().exp())} for i, b in enumerate(data.balls.names)]
     return {"wind": wind, "air": air, "ball": ball}
 
 
@@ -312,8 +355,8 @@ def _group_sources(group: torch.Tensor, source: torch.Tensor, n_groups: int) -> 
     return out
 
 
-def _noise_report(noise: NoiseScales, data: ObservedData) -> dict[str, dict[str, float]]:
-    factors = noise.factors().detach()
+def _noise_report(noise: NoiseScales, data: ObservedData, run: int) -> dict[str, dict[str, float]]:
+    factors = noise.factors()[run].detach()
     names = [*OBSERVABLES, "path"]
     return {source: {n: float(factors[i, j]) for j, n in enumerate(names)} for i, source in enumerate(data.sources)}
 
@@ -329,28 +372,45 @@ class JointResult:
 
 def train_joint(data_path: str | os.PathLike, out_dir: str | os.PathLike, config: JointConfig,
                 init: nn.Module, progress: bool = True, device: str = DEFAULT_DEVICE) -> JointResult:
-    """Train `init` (a coefficient module, changed in place and moved to `device`) jointly with the latent
-    conditions on a merged file; writes OUT/last.pt (the `model_export.training` checkpoint format), history.json
-    and conditions.json (the latent conditions and noise factors), all of the last epoch finished. The latent
+    """Train the coefficient module `init` (a copy: `init` is left as it is) jointly with the latent conditions on
+    a merged file; writes OUT/last.pt (the `model_export.training` checkpoint format), history.json and
+    conditions.json (the latent conditions and noise factors), all of the last epoch finished. The latent
     conditions are initialised and the batches drawn on the CPU whatever the device."""
+    return train_joint_runs(data_path, [out_dir], [config], init, progress, device)[0]
+
+
+def train_joint_runs(data_path: str | os.PathLike, out_dirs: list[str | os.PathLike], configs: list[JointConfig],
+                     init: nn.Module, progress: bool = True, device: str = DEFAULT_DEVICE) -> list[JointResult]:
+    """Several joint runs from `init` that differ only in their seed, trained side by side in one rollout
+    (`model_export.stacked_runs`): each run as `train_joint` trains it alone, written to its own folder."""
+    if len(out_dirs) != len(configs) or not configs:
+        raise ValueError(f"one folder a run: {len(out_dirs)} folders for {len(configs)} configurations")
+    differ = [c.seed for c in configs if replace(c, seed=0) != replace(configs[0], seed=0)]
+    if differ:
+        raise ValueError(f"runs trained side by side may differ only in their seed; seeds {differ} differ from "
+                         f"seed {configs[0].seed}'s configuration in more")
     where = resolve_device(device)
     torch.set_flush_denormal(True)
     try:
-        return _train_joint(Path(data_path), Path(out_dir), config, init.to(where), progress, where)
+        return _train_joint(Path(data_path), [Path(d) for d in out_dirs], configs,
+                            StackedNetworks(init, len(configs)).to(where), progress, where)
     finally:
         torch.set_flush_denormal(False)
 
 
-def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.Module,
-                 progress: bool, device: torch.device) -> JointResult:
-    out_dir.mkdir(parents=True, exist_ok=True)
+def _train_joint(data_path: Path, out_dirs: list[Path], configs: list[JointConfig], networks: StackedNetworks,
+                 progress: bool, device: torch.device) -> list[JointResult]:
+    config, runs = configs[0], len(configs)
+    for out_dir in out_dirs:
+        out_dir.mkdir(parents=True, exist_ok=True)
     data = load_observed(data_path, config.weights)
     data = replace(data, train=data.train.to(device), val=data.val.to(device))
     torch.manual_seed(config.seed)
-    latent, noise = LatentConditions(data).to(device), NoiseScales(len(data.sources)).to(device)
+    latent = LatentConditions(data, runs).to(device)
+    noise = NoiseScales(len(data.sources), runs).to(device)
     wind_source = _group_sources(data.train.wind_group, data.train.source, len(data.wind_groups))
     air_source = _group_sources(data.train.air_group, data.train.source, len(data.air_groups))
-    optimizer = torch.optim.Adam([{"params": model.parameters(), "lr": config.lr},
+    optimizer = torch.optim.Adam([{"params": networks.parameters(), "lr": config.lr},
                                   {"params": latent.parameters(), "lr": config.latent_lr},
                                   {"params": noise.parameters(), "lr": config.noise_lr}])
     train = spread_heavy_rows(data.train)
@@ -358,40 +418,51 @@ def _train_joint(data_path: Path, out_dir: Path, config: JointConfig, model: nn.
     total_steps = config.epochs * math.ceil(len(train) / config.batch_size)
     schedule = torch.optim.lr_scheduler.LambdaLR(
         optimizer, lambda step: cosine_factor(step, total_steps, config.final_lr_fraction))
-    history: list[dict[str, Any]] = []
-    final: dict[str, Any] | None = None
+    histories: list[list[dict[str, Any]]] = [[] for _ in configs]
+    finals: list[dict[str, Any] | None] = [None] * runs
     for epoch in range(1, config.epochs + 1):
         started = time.perf_counter()
-        order = torch.randperm(len(train), generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch))
-        order = order.to(device)
-        sums, steps = 0.0, 0
+        orders = [torch.randperm(len(train), generator=torch.Generator().manual_seed(c.seed * 100_003 + epoch)
+                                 ).to(device) for c in configs]
+        sums, steps = [0.0] * runs, [0] * runs
         batches = range(0, len(train), config.batch_size)
         for start in progress_bar(batches, f"epoch {epoch}/{config.epochs}", unit="batch", shown=progress):
-            batch = train.take(order[start:start + config.batch_size])
+            picked = [order[start:start + config.batch_size] for order in orders]
+            batch = train.take(picked[0] if runs == 1 else torch.cat(picked))
+            size = len(picked[0])
+            run = run_of_rows(runs, size, device)
             optimizer.zero_grad(set_to_none=True)
-            losses = shot_losses(fly(model, batch, config, latent), batch, config.huber_delta, noise.factors())
-            loss = (losses * batch.weight).sum() / total_weight * (len(train) / len(batch))
+            losses = shot_losses(fly(networks, batch, config, latent, run=run), batch, config.huber_delta,
+                                 noise.factors()[run, batch.source])
+            loss = (losses * batch.weight).reshape(runs, size).sum(dim=1) / total_weight * (len(train) / size)
             loss = loss + latent.prior(config, wind_source, air_source, data.sources) / len(train)
-            if not torch.isfinite(loss):
+            finite = torch.isfinite(loss)
+            if not finite.any():
                 continue
-            loss.backward()
-            torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip_norm)
-            optimizer.step()
+            (loss.sum() if finite.all() else loss[finite].sum()).backward()
+            clip_per_run(networks.parameters(), config.grad_clip_norm, runs)
+            with runs_held(optimizer, ~finite):
+                optimizer.step()
             schedule.step()
-            sums += float(loss.detach())
-            steps += 1
+            for r, (value, stepped) in enumerate(zip(loss.detach().tolist(), finite.tolist())):
+                if stepped:
+                    sums[r] += value
+                    steps[r] += 1
         source_density = latent.source_density_factors(config, air_source, data.sources)
-        metrics = evaluate(model, data.val, config, data.sources, source_density=source_density)
-        row = {"epoch": epoch, "train_loss": sums / max(steps, 1), "val_loss": metrics["loss"],
-               "val": metrics["sources"], "seconds": time.perf_counter() - started,
-               "selection_loss": selection_loss(metrics, config),
-               "source_density": dict(zip(data.sources, source_density.tolist()))}
-        history.append(row)
-        if progress:
-            print_line(f"epoch {epoch}: train {row['train_loss']:.3f}, felt {row['selection_loss']:.2f} m " + ", ".join(
-                f"{k} {felt_error_m(v):.2f}" for k, v in metrics["sources"].items()))
-        final = _save_run(out_dir, epoch, config, model, latent, noise, data, history, metrics)
-    return JointResult(out_dir, history, final)
+        metrics = evaluate(networks, data.val, config, data.sources, source_density, runs)
+        seconds = time.perf_counter() - started
+        for r, c in enumerate(configs):
+            row = {"epoch": epoch, "train_loss": sums[r] / max(steps[r], 1), "val_loss": metrics[r]["loss"],
+                   "val": metrics[r]["sources"], "seconds": seconds, "selection_loss": selection_loss(metrics[r], c),
+                   "source_density": dict(zip(data.sources, source_density[r].tolist()))}
+            histories[r].append(row)
+            if progress:
+                print_line(f"epoch {epoch}: " + (f"seed {c.seed}: " if runs > 1 else "")
+                           + f"train {row['train_loss']:.3f}, felt {row['selection_loss']:.2f} m " + ", ".join(
+                               f"{k} {felt_error_m(v):.2f}" for k, v in metrics[r]["sources"].items()))
+            finals[r] = _save_run(out_dirs[r], epoch, c, networks.run_state(r), latent, noise, r, data,
+                                  histories[r], metrics[r])
+    return [JointResult(d, h, f) for d, h, f in zip(out_dirs, histories, finals)]
 
 
 def felt_error_m(row: dict[str, float]) -> float:
@@ -410,16 +481,16 @@ def selection_loss(metrics: dict[str, Any], config: JointConfig) -> float:
     return sum(felt_error_m(v) for v in selected) / len(selected)
 
 
-def _save_run(out_dir: Path, epoch: int, config: JointConfig, model: nn.Module, latent: LatentConditions,
-              noise: NoiseScales, data: ObservedData, history: list[dict[str, Any]],
-              metrics: dict[str, Any]) -> dict[str, Any]:
-    """Write OUT/last.pt, conditions.json and history.json of a run's latest epoch; its `final` record."""
+def _save_run(out_dir: Path, epoch: int, config: JointConfig, model_state: dict[str, torch.Tensor],
+              latent: LatentConditions, noise: NoiseScales, run: int, data: ObservedData,
+              history: list[dict[str, Any]], metrics: dict[str, Any]) -> dict[str, Any]:
+    """Write OUT/last.pt, conditions.json and history.json of run `run`'s latest epoch; its `final` record."""
     payload = {"format": CHECKPOINT_FORMAT, "kind": "joint", "epoch": epoch, "config": config.as_dict(),
-               "model": model.state_dict(), "latent": latent.state_dict(), "noise": noise.state_dict(),
+               "model": model_state, "latent": latent.run_state(run), "noise": noise.run_state(run),
                "history": history}
     save_checkpoint(out_dir / "last.pt", payload)
     final = {"epoch": epoch, "val_loss": selection_loss(metrics, config), "val": metrics["sources"]}
-    report = conditions_report(latent, data, data.train) | {"noise_factors": _noise_report(noise, data)}
+    report = conditions_report(latent, data, data.train, run) | {"noise_factors": _noise_report(noise, data, run)}
     write_text_atomic(out_dir / "conditions.json", json.dumps(report, indent=2) + "\n")
     write_text_atomic(out_dir / "history.json",
                       json.dumps({"config": config.as_dict(), "final": final, "epochs": history}, indent=2) + "\n")
@@ -443,17 +514,17 @@ def soup_runs(data_path: str | os.PathLike, run_dirs: list[Path], out_dir: str |
     data = load_observed(Path(data_path), config.weights)
     latent, noise = LatentConditions(data), NoiseScales(len(data.sources))
     model.load_state_dict(_mean_state([p["model"] for p in payloads]))
-    latent.load_state_dict(_mean_state([p["latent"] for p in payloads]))
-    noise.load_state_dict(_mean_state([p["noise"] for p in payloads]))
+    latent.load_run_state(0, _mean_state([p["latent"] for p in payloads]))
+    noise.load_run_state(0, _mean_state([p["noise"] for p in payloads]))
     model.eval()
     air_source = _group_sources(data.train.air_group, data.train.source, len(data.air_groups))
-    metrics = evaluate(model, data.val, config, data.sources,
-                       source_density=latent.source_density_factors(config, air_source, data.sources))
+    metrics, = evaluate(model, data.val, config, data.sources,
+                        latent.source_density_factors(config, air_source, data.sources))
     epoch = payloads[0]["epoch"]
     row = {"epoch": epoch, "val_loss": metrics["loss"], "val": metrics["sources"],
            "selection_loss": selection_loss(metrics, config), "soup_of": [str(d) for d in run_dirs]}
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    final = _save_run(out_dir, epoch, config, model, latent, noise, data, [row], metrics)
+    final = _save_run(out_dir, epoch, config, model.state_dict(), latent, noise, 0, data, [row], metrics)
     return JointResult(out_dir, [row], final)
 

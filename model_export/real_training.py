@@ -17,7 +17,7 @@ import numpy as np
 from golfflight.flight.constants import YARD_M
 from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.export import export_bundle
-from golfflight.model_export.joint import JointConfig, JointResult, soup_runs, train_joint
+from golfflight.model_export.joint import JointConfig, JointResult, soup_runs, train_joint, train_joint_runs
 from golfflight.model_export.observations import NOISE, OBSERVABLES, PATH_OBSERVATIONS, PATH_SIGMA_M
 from golfflight.model_export.real_data import SourceData, build
 from golfflight.model_export.training import TrainConfig, load_checkpoint
@@ -189,11 +189,21 @@ def train_seed(data_file: Path, run_dir: Path, init: str | os.PathLike, config: 
 
 
 def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig], jobs: int,
-                 threads: int, progress: bool, device: str) -> dict[str, JointResult]:
-    """Each seed's joint run (WORK/NAME), by name: one after the other with their epoch bars, or `jobs` at once in
-    processes of their own (silent there) with a bar over the seeds finished."""
+                 threads: int, progress: bool, device: str, stacked: bool) -> dict[str, JointResult]:
+    """Each seed's joint run (WORK/NAME), by name: side by side in one rollout (`stacked`), one after the other with
+    their epoch bars, or `jobs` at once in processes of their own (silent there) with a bar over the seeds finished."""
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
+    if stacked:
+        import torch
+
+        torch.set_num_threads(threads)
+        progress_step(f"{', '.join(configs)} side by side", progress)
+        model = _network(init)
+        model.train()
+        results = train_joint_runs(data_file, [work / name for name in configs], list(configs.values()), model,
+                                   progress, device)
+        return dict(zip(configs, results))
     if jobs <= 1:
         runs = {}
         for index, (name, c) in enumerate(configs.items(), start=1):
@@ -211,16 +221,20 @@ def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: 
 def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str | os.PathLike,
                config: JointConfig, seeds: tuple[int, ...], out: str | os.PathLike | None,
                source_names: tuple[str, ...] | None = None, progress: bool = True, jobs: int = 1,
-               threads: int = 2, device: str = DEFAULT_DEVICE) -> RealRun:
+               threads: int = 2, device: str = DEFAULT_DEVICE, stacked: bool = False) -> RealRun:
     """Build WORK/real_flights.csv from DATA_ROOT, train one joint run per seed from the bundle INIT (WORK/seed-S;
-    `jobs` seeds at a time, each with `threads` torch threads, on `device`), average several seeds' weights into a
-    soup (WORK/soup, scored on the CPU), and export the run with the lowest validation felt error to OUT (if given).
-    With `progress`, each step, and the epochs (one seed at a time) or the seeds (several at once), go to standard
-    error. On a GPU the seeds run one after another (`jobs` 1): processes of their own would share the one device."""
+    on `device`: `jobs` seeds at a time, each with `threads` torch threads, or all side by side in one rollout,
+    `stacked`), average several seeds' weights into a soup (WORK/soup, scored on the CPU), and export the run with
+    the lowest validation felt error to OUT (if given). With `progress`, each step, and the epochs (one seed at a
+    time or all stacked) or the seeds (several processes), go to standard error. On a GPU the seeds run one after
+    another or stacked: processes of their own would share the one device."""
     from golfflight.weights_schema.bundle import load_bundle
 
+    if stacked and jobs > 1:
+        raise ValueError(f"--jobs {jobs} or --stack-seeds: stacked seeds train in one process")
     if resolve_device(device).type != "cpu" and jobs > 1:
-        raise ValueError(f"--jobs {jobs} goes with --device cpu: on {device} the seeds run one after another")
+        raise ValueError(f"--jobs {jobs} goes with --device cpu: on {device} the seeds run one after another, or "
+                         "side by side with --stack-seeds")
 
     started = time.perf_counter()
     work = Path(work)
@@ -229,7 +243,7 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     progress_step(f"building {data_file} from the real sources...", progress)
     sources = build(data_root, data_file, *(() if source_names is None else (source_names,)))
     configs = {f"seed-{seed}": replace(config, seed=seed) for seed in seeds}
-    runs = _train_seeds(data_file, work, init, configs, jobs, threads, progress, device)
+    runs = _train_seeds(data_file, work, init, configs, jobs, threads, progress, device, stacked)
     finished = [run.out_dir for run in runs.values() if run.final]
     if len(finished) > 1:
         progress_step(f"averaging {len(finished)} seeds' weights (the soup)...", progress)

@@ -80,7 +80,7 @@ def test_an_unknown_air_sources_mean_density_is_free_a_known_ones_is_held():
     expected = 0.5 * (tour_groups + (x / config.unknown_mean_density_prior) ** 2 + (x / config.mean_density_prior) ** 2)
     assert total == pytest.approx(expected, rel=1e-5)
     factors = latent.source_density_factors(config, air_source, sources)
-    assert factors.tolist() == pytest.approx([0.95, 1.0])
+    assert factors.tolist() == [pytest.approx([0.95, 1.0])]
 
 
 def test_heavy_shots_are_spread_over_batches_at_the_same_total_weight():

@@ -39,6 +39,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--threads", type=int, default=2, help="torch CPU threads per seed")
     parser.add_argument("--jobs", type=int, default=1, help="seeds trained at once, each in its own process")
     parser.add_argument("--device", default="cpu", help="where to train: cpu (default) or cuda[:N] (with --jobs 1)")
+    parser.add_argument("--stack-seeds", action="store_true",
+                        help="train the seeds side by side in one rollout (each with its own minibatches, moments and "
+                        "clipping: the same runs up to float rounding), for about one seed's kernel launches on a GPU")
     parser.add_argument(
         "--quiet", action="store_true", help="no progress on standard error and no line per epoch on standard output"
     )
@@ -58,7 +61,8 @@ def run(args: argparse.Namespace) -> int:
         raise SystemExit(f"golfflight train-real: --epochs must be at least 1, got {args.epochs}")
     result = train_real(args.data_root or shared_data_dir(), args.work, args.init,
                         JointConfig(epochs=args.epochs, lr=args.lr), args.seeds, args.out, names,
-                        progress=not args.quiet, jobs=args.jobs, threads=args.threads, device=args.device)
+                        progress=not args.quiet, jobs=args.jobs, threads=args.threads, device=args.device,
+                        stacked=args.stack_seeds)
     for data in result.sources:
         print(f"{data.name}: {len(data.records)} shots ({data.kind})")
     for name, run_result in result.runs.items():
