@@ -1,15 +1,17 @@
-"""One epoch of `golfflight train-real`'s joint run (`model_export.joint.train_joint`) on a device: its wall time, and
-the ATen operations it dispatches (forward rollouts, backward, optimizer steps, the epoch's validation). Each is at
-least one kernel launch on a GPU, so their count times an operation's fixed cost on the device (timed here on tiny
-tensors) bounds an eager epoch there from below, however fast the device computes: what issue 33's target (an epoch
-10x faster than on 16 CPU cores) is up against. Writes a row of the section `train_epoch_<cpu|cuda>`
-of benchmarks/results.json (one a device and thread count) and prints it as a table row for docs/benchmarks.md.
+"""One epoch of `golfflight train-real`'s joint run (`model_export.joint.train_joint_runs`) on a device, for 1 or
+more seeds side by side (`--runs`, as `train-real --stack-seeds` trains them): its wall time, and the ATen operations
+it dispatches (forward rollouts, backward, optimizer steps, the epoch's validation). Each is at least one kernel
+launch on a GPU, so their count times an operation's fixed cost on the device (timed here on tiny tensors) bounds an
+eager epoch there from below, however fast the device computes: what issue 33's target (an epoch 10x faster than on
+16 CPU cores) is up against, and what stacking seeds shares out. Writes a row of the section `train_epoch_<cpu|cuda>`
+of benchmarks/results.json (one a device, thread count and number of runs) and prints it as a table row for
+docs/benchmarks.md.
 
 The training file is built from the shared data (`model_export.real_data.build`, the held-out sets never read), or
 given (`--data`: a lent machine has no shared data; carry the file there):
-    python benchmarks/bench_train.py --device cpu --threads 1
-    python benchmarks/bench_train.py --device cuda --data real_flights.csv    # then --device cpu --threads 16 there,
-                                                                               # the issue's baseline, same machine
+    python benchmarks/bench_train.py --device cpu --threads 1 --runs 1,4
+    python benchmarks/bench_train.py --device cuda --data real_flights.csv --runs 1,16  # then --device cpu
+                                                                  # --threads 16 there: the baseline, same machine
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from common import REPO, RESULTS, write_results
 from golfflight.flight.bundle_location import model_dir
 from golfflight.model_export.bundle_model import model_from_bundle
 from golfflight.model_export.devices import resolve_device
-from golfflight.model_export.joint import JointConfig, JointResult, train_joint
+from golfflight.model_export.joint import JointConfig, JointResult, train_joint_runs
 from golfflight.model_export.real_data import build
 from golfflight.model_export.real_training import DATA_FILE
 from torch.utils._python_dispatch import TorchDispatchMode
@@ -51,17 +53,21 @@ class OpCounter(TorchDispatchMode):
         return func(*args, **(kwargs or {}))
 
 
-def epoch(data: Path, device: str, folder: Path, counter: OpCounter | None = None) -> tuple[float, JointResult]:
-    """Wall seconds of one epoch from the shipped bundle's network (under `counter` if given), and its result."""
+def epoch(data: Path, device: str, folder: Path, runs: int, counter: OpCounter | None = None
+          ) -> tuple[float, list[JointResult]]:
+    """Wall seconds of one epoch of `runs` seeds side by side from the shipped bundle's network (under `counter` if
+    given), and their results."""
     model, _ = model_from_bundle(model_dir(None))
     model.train()
+    configs = [replace(JointConfig(), epochs=1, seed=seed) for seed in range(runs)]
+    folders = [folder / f"seed-{seed}" for seed in range(runs)]
     started = time.perf_counter()
     if counter is None:
-        result = train_joint(data, folder, replace(JointConfig(), epochs=1), model, False, device)
+        results = train_joint_runs(data, folders, configs, model, False, device)
     else:
         with counter:
-            result = train_joint(data, folder, replace(JointConfig(), epochs=1), model, False, device)
-    return time.perf_counter() - started, result
+            results = train_joint_runs(data, folders, configs, model, False, device)
+    return time.perf_counter() - started, results
 
 
 def op_cost_us(device: torch.device) -> float:
@@ -84,10 +90,16 @@ def main() -> None:
     parser.add_argument("--device", default="cuda" if torch.cuda.is_available() else "cpu")
     parser.add_argument("--data", type=Path, help=f"the training file (default: built from {DATA_ROOT})")
     parser.add_argument("--threads", type=int, help="torch CPU threads (default: torch's)")
+    parser.add_argument("--runs", default="1", help="seeds side by side, comma-separated counts (default 1)")
     args = parser.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
     device = resolve_device(args.device)
+    cost = op_cost_us(device)
+    rows = []
+    print("\n| device | torch threads | seeds side by side | epoch | a seed's share | operations dispatched | "
+          "an operation's fixed cost | their floor | felt error after it (seed 0) |\n"
+          "|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     with tempfile.TemporaryDirectory() as folder:
         data = args.data
         if data is None:
@@ -95,22 +107,26 @@ def main() -> None:
                 raise SystemExit(f"no shared data at {DATA_ROOT}: give --data FILE")
             data = Path(folder) / DATA_FILE
             build(DATA_ROOT, data)
-        seconds, result = epoch(data, args.device, Path(folder) / "timed")
-        counter = OpCounter()
-        epoch(data, args.device, Path(folder) / "counted", counter)
-    cost = op_cost_us(device)
-    row = {"device": str(device), "torch": torch.__version__, "torch_threads": torch.get_num_threads(),
-           "epoch_s": seconds, "epoch_history_s": result.history[0]["seconds"], "ops": counter.count,
-           "op_cost_us": cost, "ops_floor_s": counter.count * cost * 1e-6,
-           "val_loss": result.history[0]["val_loss"], "selection_loss": result.history[0]["selection_loss"]}
-    print("\n| device | torch threads | epoch | operations dispatched | an operation's fixed cost | their floor | "
-          "felt error after it |\n|---|---:|---:|---:|---:|---:|---:|")
-    print(f"| {row['device']} | {row['torch_threads']} | {seconds:.1f} s | {counter.count:,} | {cost:.2f} µs | "
-          f"{row['ops_floor_s']:.1f} s | {row['selection_loss']:.2f} m |")
+        for runs in (int(part) for part in args.runs.split(",")):
+            seconds, results = epoch(data, args.device, Path(folder) / f"timed-{runs}", runs)
+            counter = OpCounter()
+            epoch(data, args.device, Path(folder) / f"counted-{runs}", runs, counter)
+            first = results[0].history[0]
+            row = {"device": str(device), "torch": torch.__version__, "torch_threads": torch.get_num_threads(),
+                   "runs": runs, "epoch_s": seconds, "seed_share_s": seconds / runs,
+                   "epoch_history_s": first["seconds"], "ops": counter.count, "op_cost_us": cost,
+                   "ops_floor_s": counter.count * cost * 1e-6, "val_loss": first["val_loss"],
+                   "selection_loss": first["selection_loss"],
+                   "selection_losses": [r.history[0]["selection_loss"] for r in results]}
+            rows.append(row)
+            print(f"| {row['device']} | {row['torch_threads']} | {runs} | {seconds:.1f} s | {seconds / runs:.1f} s | "
+                  f"{counter.count:,} | {cost:.2f} µs | {row['ops_floor_s']:.1f} s | {row['selection_loss']:.2f} m |",
+                  flush=True)
     section = f"train_epoch_{device.type}"
     kept = json.loads(RESULTS.read_text()).get(section, {}).get("rows", []) if RESULTS.is_file() else []
-    others = [r for r in kept if (r["device"], r["torch_threads"]) != (row["device"], row["torch_threads"])]
-    write_results(section, [*others, row])
+    key = lambda r: (r["device"], r["torch_threads"], r.get("runs", 1))
+    fresh = {key(r) for r in rows}
+    write_results(section, [*(r for r in kept if key(r) not in fresh), *rows])
 
 
 if __name__ == "__main__":

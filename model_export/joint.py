@@ -41,7 +41,9 @@ from golfflight.model_export.torch_physics import (
     DT_S,
     T_SIM_S,
     Coefficients,
+    EulerStep,
     euler_rollout,
+    euler_step,
     hard_landing,
     positions_at,
 )
@@ -218,10 +220,12 @@ class Predicted:
 
 
 def fly(model: Coefficients, shots: ObservedShots, config: JointConfig, latent: LatentConditions | None,
-        source_density: torch.Tensor | None = None, run: torch.Tensor | None = None) -> Predicted:
+        source_density: torch.Tensor | None = None, run: torch.Tensor | None = None,
+        step: EulerStep = euler_step) -> Predicted:
     """Euler rollout of the shots: with their latent conditions, or, when `latent` is None, calm in their recorded
     air times their source's fitted density factor (`source_density` [runs, sources], where given). `run` [n] is
-    each shot's run where `model` is several stacked (`stacked_runs.StackedNetworks`); None: all of run 0."""
+    each shot's run where `model` is several stacked (`stacked_runs.StackedNetworks`); None: all of run 0. `step`:
+    `euler_step`, eager or compiled."""
     if run is None:
         run = torch.zeros(len(shots), dtype=torch.long, device=shots.source.device)
     if latent is None:
@@ -230,7 +234,7 @@ def fly(model: Coefficients, shots: ObservedShots, config: JointConfig, latent: 
     else:
         wind, density, scale = latent.for_shots(shots, run)
     trajectory = euler_rollout(shots.position, shots.velocity, shots.spin, model, density, config.dt_s,
-                               config.t_sim_s, shots.reynolds_scale[:, None], wind, scale)
+                               config.t_sim_s, shots.reynolds_scale[:, None], wind, scale, step)
     landing = hard_landing(trajectory)
     v = landing.velocity
     angle = torch.rad2deg(torch.atan2(-v[:, 2], torch.linalg.vector_norm(v[:, :2], dim=-1)))
@@ -285,13 +289,14 @@ def weighted_mean(values: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
 
 @torch.no_grad()
 def evaluate(model: Coefficients, shots: ObservedShots, config: JointConfig, sources: list[str],
-             source_density: torch.Tensor | None = None, runs: int = 1) -> list[dict[str, Any]]:
+             source_density: torch.Tensor | None = None, runs: int = 1, step: EulerStep = euler_step
+             ) -> list[dict[str, Any]]:
     """Each run's (of `runs` stacked in `model`) loss and per-source errors in physical units on `shots`, flown calm
-    in their air times `source_density` [runs, sources] (`fly`): landing error (m), mean absolute error and mean
-    signed error (bias) of every observable, path error (m), over the shots that have each."""
+    in their air times `source_density` [runs, sources] (`fly`, with `step`): landing error (m), mean absolute error
+    and mean signed error (bias) of every observable, path error (m), over the shots that have each."""
     n = len(shots)
     every = shots if runs == 1 else shots.take(torch.arange(n, device=shots.source.device).repeat(runs))
-    predicted = fly(model, every, config, None, source_density, run_of_rows(runs, n, shots.source.device))
+    predicted = fly(model, every, config, None, source_density, run_of_rows(runs, n, shots.source.device), step)
     return [score(predicted.rows(r * n, (r + 1) * n), shots, config, sources) for r in range(runs)]
 
 
@@ -340,10 +345,11 @@ def conditions_report(latent: LatentConditions, data: ObservedData, train: Obser
         source = data.sources[int(train.source[train.wind_group == i][0])]
         wind.append({"group": group, "source": source, "n_shots": count(train.wind_group, i), "x_mps": x,
                      "y_mps": y, "speed_mps": speed, "from_deg": from_deg})
-    air = [{"group": g, "n_shots": count(train.air_group, i), "density_ratio": float(latent.log_density[run, i].detach().exp())}
+    density, ball_scale = latent.log_density[run].detach().exp(), latent.log_ball_scale[run].detach().exp()
+    air = [{"group": g, "n_shots": count(train.air_group, i), "density_ratio": float(density[i])}
            for i, g in enumerate(data.air_groups.names)]
-    ball = [{"ball": b, "n_shots": count(train.ball, i), "lift_scale": float(latent.log_ball_scale[run, i, 0].detach().exp()),
-             "drag_scale": float(latent.log_ball_scale[run, i, 1].detach().exp())} for i, b in enumerate(data.balls.names)]
+    ball = [{"ball": b, "n_shots": count(train.ball, i), "lift_scale": float(ball_scale[i, 0]),
+             "drag_scale": float(ball_scale[i, 1])} for i, b in enumerate(data.balls.names)]
     return {"wind": wind, "air": air, "ball": ball}
 
 
@@ -371,16 +377,19 @@ class JointResult:
 
 
 def train_joint(data_path: str | os.PathLike, out_dir: str | os.PathLike, config: JointConfig,
-                init: nn.Module, progress: bool = True, device: str = DEFAULT_DEVICE) -> JointResult:
+                init: nn.Module, progress: bool = True, device: str = DEFAULT_DEVICE, compile_step: bool = False
+                ) -> JointResult:
     """Train the coefficient module `init` (a copy: `init` is left as it is) jointly with the latent conditions on
     a merged file; writes OUT/last.pt (the `model_export.training` checkpoint format), history.json and
     conditions.json (the latent conditions and noise factors), all of the last epoch finished. The latent
-    conditions are initialised and the batches drawn on the CPU whatever the device."""
-    return train_joint_runs(data_path, [out_dir], [config], init, progress, device)[0]
+    conditions are initialised and the batches drawn on the CPU whatever the device. `compile_step` fuses each
+    Euler step's kernels, forward and backward, with torch.compile (once for every batch size)."""
+    return train_joint_runs(data_path, [out_dir], [config], init, progress, device, compile_step)[0]
 
 
 def train_joint_runs(data_path: str | os.PathLike, out_dirs: list[str | os.PathLike], configs: list[JointConfig],
-                     init: nn.Module, progress: bool = True, device: str = DEFAULT_DEVICE) -> list[JointResult]:
+                     init: nn.Module, progress: bool = True, device: str = DEFAULT_DEVICE, compile_step: bool = False
+                     ) -> list[JointResult]:
     """Several joint runs from `init` that differ only in their seed, trained side by side in one rollout
     (`model_export.stacked_runs`): each run as `train_joint` trains it alone, written to its own folder."""
     if len(out_dirs) != len(configs) or not configs:
@@ -392,14 +401,15 @@ def train_joint_runs(data_path: str | os.PathLike, out_dirs: list[str | os.PathL
     where = resolve_device(device)
     torch.set_flush_denormal(True)
     try:
+        step = torch.compile(euler_step, dynamic=True) if compile_step else euler_step
         return _train_joint(Path(data_path), [Path(d) for d in out_dirs], configs,
-                            StackedNetworks(init, len(configs)).to(where), progress, where)
+                            StackedNetworks(init, len(configs)).to(where), progress, where, step)
     finally:
         torch.set_flush_denormal(False)
 
 
 def _train_joint(data_path: Path, out_dirs: list[Path], configs: list[JointConfig], networks: StackedNetworks,
-                 progress: bool, device: torch.device) -> list[JointResult]:
+                 progress: bool, device: torch.device, step: EulerStep) -> list[JointResult]:
     config, runs = configs[0], len(configs)
     for out_dir in out_dirs:
         out_dir.mkdir(parents=True, exist_ok=True)
@@ -432,7 +442,7 @@ def _train_joint(data_path: Path, out_dirs: list[Path], configs: list[JointConfi
             size = len(picked[0])
             run = run_of_rows(runs, size, device)
             optimizer.zero_grad(set_to_none=True)
-            losses = shot_losses(fly(networks, batch, config, latent, run=run), batch, config.huber_delta,
+            losses = shot_losses(fly(networks, batch, config, latent, run=run, step=step), batch, config.huber_delta,
                                  noise.factors()[run, batch.source])
             loss = (losses * batch.weight).reshape(runs, size).sum(dim=1) / total_weight * (len(train) / size)
             loss = loss + latent.prior(config, wind_source, air_source, data.sources) / len(train)
@@ -449,7 +459,7 @@ def _train_joint(data_path: Path, out_dirs: list[Path], configs: list[JointConfi
                     sums[r] += value
                     steps[r] += 1
         source_density = latent.source_density_factors(config, air_source, data.sources)
-        metrics = evaluate(networks, data.val, config, data.sources, source_density, runs)
+        metrics = evaluate(networks, data.val, config, data.sources, source_density, runs, step)
         seconds = time.perf_counter() - started
         for r, c in enumerate(configs):
             row = {"epoch": epoch, "train_loss": sums[r] / max(steps[r], 1), "val_loss": metrics[r]["loss"],

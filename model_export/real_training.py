@@ -177,42 +177,66 @@ def _network(init: str | os.PathLike) -> nn.Module:
     return model
 
 
+@dataclass(frozen=True)
+class SeedPlan:
+    """How `train_real` trains its seeds: on `device`, `jobs` at a time in processes of their own or all side by
+    side in one rollout (`stacked`), each process with `threads` torch threads; `compile_step` fuses each Euler
+    step's kernels with torch.compile. On a GPU the seeds run one after another or stacked: processes of their own
+    would share the one device."""
+
+    device: str = DEFAULT_DEVICE
+    jobs: int = 1
+    threads: int = 2
+    stacked: bool = False
+    compile_step: bool = False
+
+    def check(self) -> None:
+        """ValueError, in the command line's words, for a plan that cannot run here."""
+        if self.stacked and self.jobs > 1:
+            raise ValueError(f"--jobs {self.jobs} or --stack-seeds: stacked seeds train in one process")
+        if resolve_device(self.device).type != "cpu" and self.jobs > 1:
+            raise ValueError(f"--jobs {self.jobs} goes with --device cpu: on {self.device} the seeds run one after "
+                             "another, or side by side with --stack-seeds")
+
+
 def train_seed(data_file: Path, run_dir: Path, init: str | os.PathLike, config: JointConfig, threads: int,
-               progress: bool, device: str = DEFAULT_DEVICE) -> JointResult:
+               progress: bool, device: str = DEFAULT_DEVICE, compile_step: bool = False) -> JointResult:
     """One seed's joint run from the bundle `init` on `device` (a process of its own when seeds run in parallel)."""
     import torch
 
     torch.set_num_threads(threads)
     model = _network(init)
     model.train()
-    return train_joint(data_file, run_dir, config, model, progress, device)
+    return train_joint(data_file, run_dir, config, model, progress, device, compile_step)
 
 
-def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig], jobs: int,
-                 threads: int, progress: bool, device: str, stacked: bool) -> dict[str, JointResult]:
-    """Each seed's joint run (WORK/NAME), by name: side by side in one rollout (`stacked`), one after the other with
-    their epoch bars, or `jobs` at once in processes of their own (silent there) with a bar over the seeds finished."""
+def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig],
+                 plan: SeedPlan, progress: bool) -> dict[str, JointResult]:
+    """Each seed's joint run (WORK/NAME), by name, as `plan` says: side by side in one rollout, one after the other
+    with their epoch bars, or several at once in processes of their own (silent there) with a bar over the seeds
+    finished."""
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    if stacked:
+    if plan.stacked:
         import torch
 
-        torch.set_num_threads(threads)
+        torch.set_num_threads(plan.threads)
         progress_step(f"{', '.join(configs)} side by side", progress)
         model = _network(init)
         model.train()
         results = train_joint_runs(data_file, [work / name for name in configs], list(configs.values()), model,
-                                   progress, device)
+                                   progress, plan.device, plan.compile_step)
         return dict(zip(configs, results))
-    if jobs <= 1:
+    if plan.jobs <= 1:
         runs = {}
         for index, (name, c) in enumerate(configs.items(), start=1):
             progress_step(f"{name} ({index} of {len(configs)})", progress)
-            runs[name] = train_seed(data_file, work / name, init, c, threads, progress, device)
+            runs[name] = train_seed(data_file, work / name, init, c, plan.threads, progress, plan.device,
+                                    plan.compile_step)
         return runs
-    with ProcessPoolExecutor(jobs) as pool:
-        futures = {pool.submit(train_seed, data_file, work / name, init, c, threads, False, device): name
-                   for name, c in configs.items()}
+    with ProcessPoolExecutor(plan.jobs) as pool:
+        futures = {pool.submit(train_seed, data_file, work / name, init, c, plan.threads, False, plan.device,
+                               plan.compile_step): name for name, c in configs.items()}
         done = {futures[f]: f.result() for f in progress_bar(as_completed(futures), "seeds", total=len(futures),
                                                              unit="seed", shown=progress)}
     return {name: done[name] for name in configs}
@@ -220,22 +244,15 @@ def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: 
 
 def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str | os.PathLike,
                config: JointConfig, seeds: tuple[int, ...], out: str | os.PathLike | None,
-               source_names: tuple[str, ...] | None = None, progress: bool = True, jobs: int = 1,
-               threads: int = 2, device: str = DEFAULT_DEVICE, stacked: bool = False) -> RealRun:
-    """Build WORK/real_flights.csv from DATA_ROOT, train one joint run per seed from the bundle INIT (WORK/seed-S;
-    on `device`: `jobs` seeds at a time, each with `threads` torch threads, or all side by side in one rollout,
-    `stacked`), average several seeds' weights into a soup (WORK/soup, scored on the CPU), and export the run with
-    the lowest validation felt error to OUT (if given). With `progress`, each step, and the epochs (one seed at a
-    time or all stacked) or the seeds (several processes), go to standard error. On a GPU the seeds run one after
-    another or stacked: processes of their own would share the one device."""
+               source_names: tuple[str, ...] | None = None, progress: bool = True,
+               plan: SeedPlan = SeedPlan()) -> RealRun:
+    """Build WORK/real_flights.csv from DATA_ROOT, train one joint run per seed from the bundle INIT (WORK/seed-S,
+    as `plan` says), average several seeds' weights into a soup (WORK/soup, scored on the CPU), and export the run
+    with the lowest validation felt error to OUT (if given). With `progress`, each step, and the epochs (one seed at
+    a time or all stacked) or the seeds (several processes), go to standard error."""
     from golfflight.weights_schema.bundle import load_bundle
 
-    if stacked and jobs > 1:
-        raise ValueError(f"--jobs {jobs} or --stack-seeds: stacked seeds train in one process")
-    if resolve_device(device).type != "cpu" and jobs > 1:
-        raise ValueError(f"--jobs {jobs} goes with --device cpu: on {device} the seeds run one after another, or "
-                         "side by side with --stack-seeds")
-
+    plan.check()
     started = time.perf_counter()
     work = Path(work)
     work.mkdir(parents=True, exist_ok=True)
@@ -243,7 +260,7 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     progress_step(f"building {data_file} from the real sources...", progress)
     sources = build(data_root, data_file, *(() if source_names is None else (source_names,)))
     configs = {f"seed-{seed}": replace(config, seed=seed) for seed in seeds}
-    runs = _train_seeds(data_file, work, init, configs, jobs, threads, progress, device, stacked)
+    runs = _train_seeds(data_file, work, init, configs, plan, progress)
     finished = [run.out_dir for run in runs.values() if run.final]
     if len(finished) > 1:
         progress_step(f"averaging {len(finished)} seeds' weights (the soup)...", progress)

@@ -21,24 +21,22 @@ from torch.func import functional_call, stack_module_state, vmap
 class StackedNetworks:
     """`runs` copies of a coefficient module (`(v_rel, omega) -> [N, 4]`) trained side by side. Called on N = runs x n
     shots, run-major (run r's shots are rows r*n to (r+1)*n), each run's shots go through its own weights. One run
-    is the module itself on its only slice (no vmap), so a single run computes exactly what the module computes."""
+    is a copy of the module itself, with its own parameters (no run axis, no vmap): exactly the module's steps."""
 
     def __init__(self, module: nn.Module, runs: int) -> None:
         if runs < 1:
             raise ValueError(f"runs must be at least 1, got {runs}")
         self.runs = runs
         self.base = copy.deepcopy(module)
-        params, buffers = stack_module_state([module] * runs)
-        self.params = {name: nn.Parameter(value) for name, value in params.items()}
-        self.buffers = buffers
+        self.params, self.buffers = stack_module_state([module] * runs) if runs > 1 else ({}, {})
 
-    def parameters(self) -> list[nn.Parameter]:
-        """The stacked parameters [runs, ...], in the module's order: what the optimizer steps."""
-        return list(self.params.values())
+    def parameters(self) -> list[torch.Tensor]:
+        """What the optimizer steps: the stacked parameters [runs, ...] in the module's order (one run: the copy's)."""
+        return list(self.base.parameters()) if self.runs == 1 else list(self.params.values())
 
     def __call__(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
         if self.runs == 1:
-            return functional_call(self.base, self._slice(0), (v_rel, omega))
+            return self.base(v_rel, omega)
         n = v_rel.shape[0] // self.runs
 
         def one_run(params: dict, buffers: dict, v: torch.Tensor, w: torch.Tensor) -> torch.Tensor:
@@ -48,13 +46,12 @@ class StackedNetworks:
                             omega.reshape(self.runs, n, -1))
         return out.reshape(self.runs * n, -1)
 
-    def _slice(self, run: int) -> dict[str, torch.Tensor]:
-        return {name: value[run] for name, value in (*self.params.items(), *self.buffers.items())}
-
     def run_state(self, run: int) -> dict[str, torch.Tensor]:
         """Run `run`'s weights as the module's own state dict (what its checkpoint holds)."""
-        sliced = self._slice(run)
-        return {name: sliced[name].detach().clone() for name in self.base.state_dict()}
+        if self.runs == 1:
+            return {name: value.detach().clone() for name, value in self.base.state_dict().items()}
+        stacked = self.params | self.buffers
+        return {name: stacked[name][run].detach().clone() for name in self.base.state_dict()}
 
     def run_module(self, run: int) -> nn.Module:
         """A copy of the module holding run `run`'s weights (in evaluation mode)."""
@@ -64,7 +61,7 @@ class StackedNetworks:
 
     def to(self, device: torch.device) -> StackedNetworks:
         self.base.to(device)
-        self.params = {name: nn.Parameter(value.detach().to(device)) for name, value in self.params.items()}
+        self.params = {name: value.detach().to(device).requires_grad_() for name, value in self.params.items()}
         self.buffers = {name: value.to(device) for name, value in self.buffers.items()}
         return self
 

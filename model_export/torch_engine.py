@@ -3,11 +3,11 @@ rebuilt on training's physics, for `golfflight sweep --engine torch`.
 
 The coefficient network is the bundle's ONNX graph's weights in the training code's model class
 (`bundle_model.model_from_bundle`, checked against ONNX Runtime on probe inputs), run in float32 as the graph runs;
-the equations of motion are training's (`torch_physics.derivatives`, one forward-Euler step as `euler_rollout` takes
-it), in float32 or float64. What the engine takes, this takes: every shot's air (density, and its kinematic viscosity
-as the Reynolds scale of the network's inputs), its wind (uniform, or the log profile evaluated at the ball's height
-each step) and its ground's elevation, down to the engine's maximum flight time. The landing and apex are
-training's `hard_landing` and `apex`, which hold the integrator's rules (the state interpolated linearly to the
+the equations of motion are training's (`torch_physics.euler_step`, the forward-Euler step `euler_rollout`
+repeats), in float32 or float64. What the engine takes, this takes: every shot's air (density, and its kinematic
+viscosity as the Reynolds scale of the network's inputs), its wind (uniform, or the log profile evaluated at the
+ball's height each step) and its ground's elevation, down to the engine's maximum flight time. The landing and apex
+are training's `hard_landing` and `apex`, which hold the integrator's rules (the state interpolated linearly to the
 ground's plane between the two steps around the first downward crossing; the parabola through the highest state and
 its neighbours), on heights measured from each shot's ground. Each shot is flown for the whole batch's steps (fixed
 shapes), a part stopping once every shot of it has come down; a shot never down by the maximum flight time, or whose
@@ -44,7 +44,7 @@ from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.model_export import torch_ground
 from golfflight.model_export.bundle_model import model_from_bundle
 from golfflight.model_export.devices import resolve_device
-from golfflight.model_export.torch_physics import Trajectory, apex, derivatives, hard_landing
+from golfflight.model_export.torch_physics import Trajectory, apex, euler_step, hard_landing
 
 DTYPES = {"float32": torch.float32, "float64": torch.float64}
 """The physics' precisions by name (the network always runs in float32, as the bundle's graph does)."""
@@ -120,7 +120,7 @@ class TorchEngine:
         nominal air and error messages are this engine's) and rebuild its network in torch on `device`; `dtype`
         is the physics' precision; `part_shots` caps the shots flown at once (default: what the device's memory
         holds, shared by `parts_at_once` threads flying batches on this engine at once); `compile_step` fuses each
-        Euler step's kernels with torch.compile (`step`: `euler_step`, compiled or eager, once for any part's size);
+        Euler step's kernels with torch.compile (`step`: `flight_step`, compiled or eager, once for any part's size);
         `ground_on_device` bounces and rolls the landings on the device (`torch_ground`; default: on a GPU) instead
         of NumPy's on the CPU. `devices.DeviceError` for a device this machine lacks, ValueError for a dtype it does
         not know."""
@@ -138,7 +138,7 @@ class TorchEngine:
         dt = self.flyer.dt_s
 
         def step(*state_and_air: torch.Tensor | None) -> tuple[torch.Tensor, ...]:
-            return euler_step(self.coefficients, dt, *state_and_air)
+            return flight_step(self.coefficients, dt, *state_and_air)
 
         self.step = torch.compile(step, dynamic=True) if compile_step else step
 
@@ -337,14 +337,12 @@ def wind_at(height_m: torch.Tensor, at_reference: torch.Tensor | None, log_profi
     return at_reference * torch.where(log_profile, factor, torch.ones_like(factor))[:, None]
 
 
-def euler_step(coefficients, dt: float, position: torch.Tensor, velocity: torch.Tensor, spin: torch.Tensor,
-               down: torch.Tensor, density: torch.Tensor, scale: torch.Tensor, ground: torch.Tensor,
-               *wind: torch.Tensor | None) -> tuple[torch.Tensor, ...]:
-    """One forward-Euler step of training's equations (`torch_physics.derivatives`) in each shot's air and wind
+def flight_step(coefficients, dt: float, position: torch.Tensor, velocity: torch.Tensor, spin: torch.Tensor,
+                down: torch.Tensor, density: torch.Tensor, scale: torch.Tensor, ground: torch.Tensor,
+                *wind: torch.Tensor | None) -> tuple[torch.Tensor, ...]:
+    """One forward-Euler step of training's equations (`torch_physics.euler_step`) in each shot's air and wind
     (`wind_at`'s four), and whether each shot has come down through its ground's plane by its end (`down`, kept)."""
-    d_position, d_velocity, d_spin = derivatives(
-        position, velocity, spin, coefficients, density, scale, wind_at(position[:, 2], *wind)
-    )
-    moved = position + dt * d_position
+    moved, velocity, spin = euler_step(position, velocity, spin, coefficients, density, dt, scale,
+                                       wind_at(position[:, 2], *wind))
     down = down | ((position[:, 2] > ground) & (moved[:, 2] <= ground))
-    return moved, velocity + dt * d_velocity, spin + dt * d_spin, down
+    return moved, velocity, spin, down

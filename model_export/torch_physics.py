@@ -122,6 +122,28 @@ def derivatives(
     return velocity, acceleration - acceleration.new_tensor([0.0, 0.0, GRAVITY_MPS2]), spin_acceleration
 
 
+def euler_step(
+    position: torch.Tensor,
+    velocity: torch.Tensor,
+    spin: torch.Tensor,
+    coefficients: Coefficients,
+    density: torch.Tensor | float,
+    dt: float,
+    reynolds_scale: torch.Tensor | float = 1.0,
+    wind: torch.Tensor | None = None,
+    coefficient_scale: torch.Tensor | None = None,
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """One forward-Euler step of `derivatives` (arguments as there): the position, velocity and spin dt later."""
+    d_position, d_velocity, d_spin = derivatives(
+        position, velocity, spin, coefficients, density, reynolds_scale, wind, coefficient_scale
+    )
+    return position + dt * d_position, velocity + dt * d_velocity, spin + dt * d_spin
+
+
+EulerStep = Callable[..., tuple[torch.Tensor, torch.Tensor, torch.Tensor]]
+"""`euler_step` or the same compiled (`torch.compile`), as `euler_rollout` takes it."""
+
+
 def euler_rollout(
     position: torch.Tensor,
     velocity: torch.Tensor,
@@ -133,15 +155,15 @@ def euler_rollout(
     reynolds_scale: torch.Tensor | float = 1.0,
     wind: torch.Tensor | None = None,
     coefficient_scale: torch.Tensor | None = None,
+    step: EulerStep = euler_step,
 ) -> Trajectory:
     """Forward Euler over the whole t_sim for every shot (no early stop: fixed shapes stay batched, differentiable);
-    `wind` and `coefficient_scale` as in `derivatives`."""
+    `wind` and `coefficient_scale` as in `derivatives`; `step` is `euler_step`, eager or compiled."""
     positions, velocities, spins = [position], [velocity], [spin]
     for _ in range(int(round(t_sim / dt))):
-        d_position, d_velocity, d_spin = derivatives(
-            position, velocity, spin, coefficients, density, reynolds_scale, wind, coefficient_scale
+        position, velocity, spin = step(
+            position, velocity, spin, coefficients, density, dt, reynolds_scale, wind, coefficient_scale
         )
-        position, velocity, spin = position + dt * d_position, velocity + dt * d_velocity, spin + dt * d_spin
         positions.append(position)
         velocities.append(velocity)
         spins.append(spin)

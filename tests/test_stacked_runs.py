@@ -5,14 +5,15 @@ import copy
 import json
 
 import pytest
+import torch
+from golfflight.model_export.joint import JointConfig, train_joint, train_joint_runs
+from golfflight.model_export.real_training import SeedPlan, _train_seeds
+from golfflight.model_export.stacked_runs import StackedNetworks, clip_per_run, runs_held
+from golfflight.model_export.training import load_checkpoint
+from golfflight.model_export.variants import PhysNN, PhysQ
+from test_real_training import REPO_ROOT, _windy_set
 
-torch = pytest.importorskip("torch")
-
-from golfflight.model_export.joint import JointConfig, train_joint, train_joint_runs  # noqa: E402
-from golfflight.model_export.stacked_runs import StackedNetworks, clip_per_run, runs_held  # noqa: E402
-from golfflight.model_export.training import load_checkpoint  # noqa: E402
-from golfflight.model_export.variants import PhysNN, PhysQ  # noqa: E402
-from test_real_training import _windy_set  # noqa: E402
+from golfflight.cli import main
 
 
 def _shots(n: int, seed: int) -> tuple[torch.Tensor, torch.Tensor]:
@@ -113,13 +114,10 @@ def test_runs_side_by_side_must_differ_only_in_their_seed(tmp_path):
 
 
 def test_train_real_trains_its_seeds_stacked_each_in_its_folder(tmp_path):
-    from golfflight.model_export.real_training import _train_seeds
-    from test_real_training import REPO_ROOT
-
     _windy_set(tmp_path / "windy.csv", {"a": (0.0, 1.0)}, n_per_group=6)
     configs = {f"seed-{s}": JointConfig(epochs=1, batch_size=4, seed=s, weights={"sentry-2022": 1.0}) for s in (3, 4)}
-    runs = _train_seeds(tmp_path / "windy.csv", tmp_path / "work", REPO_ROOT / "models" / "default", configs, 1, 1,
-                        False, "cpu", True)
+    runs = _train_seeds(tmp_path / "windy.csv", tmp_path / "work", REPO_ROOT / "models" / "default", configs,
+                        SeedPlan(threads=1, stacked=True), False)
     assert list(runs) == ["seed-3", "seed-4"]
     for name, run in runs.items():
         assert run.out_dir == tmp_path / "work" / name and run.final["epoch"] == 1
@@ -127,9 +125,21 @@ def test_train_real_trains_its_seeds_stacked_each_in_its_folder(tmp_path):
 
 
 def test_stacked_seeds_are_one_process_so_jobs_are_refused(tmp_path, capsys):
-    from golfflight.cli import main
-
     assert main(["train-real", "--work", str(tmp_path / "work"), "--data-root", str(tmp_path), "--stack-seeds",
                  "--jobs", "2", "--quiet"]) == 2
     assert "--jobs 2 or --stack-seeds: stacked seeds train in one process" in capsys.readouterr().err
     assert not (tmp_path / "work").exists()
+
+
+def test_a_compiled_step_trains_the_run_the_eager_step_trains(tmp_path):
+    """`train-real --compile`: the Euler step fused by torch.compile, forward and backward, changes rounding only."""
+    _windy_set(tmp_path / "windy.csv", {"a": (0.0, 1.0)}, n_per_group=6)
+    torch.manual_seed(0)
+    start = PhysNN("phys-nn+", (8,))
+    config = JointConfig(epochs=1, batch_size=4, lr=3e-3)
+    runs = [train_joint(tmp_path / "windy.csv", tmp_path / name, config, start, progress=False, compile_step=fused)
+            for name, fused in (("eager", False), ("compiled", True))]
+    weights = [load_checkpoint(run.out_dir / "last.pt")["model"] for run in runs]
+    for name in weights[0]:
+        torch.testing.assert_close(weights[1][name], weights[0][name], rtol=1e-4, atol=1e-6)
+    assert runs[1].final["val_loss"] == pytest.approx(runs[0].final["val_loss"], rel=1e-4)

@@ -42,6 +42,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--stack-seeds", action="store_true",
                         help="train the seeds side by side in one rollout (each with its own minibatches, moments and "
                         "clipping: the same runs up to float rounding), for about one seed's kernel launches on a GPU")
+    parser.add_argument("--compile", action="store_true",
+                        help="fuse each Euler step's kernels, forward and backward, with torch.compile (compiled "
+                        "once a run, in seconds to a minute; on a CPU it needs a C compiler)")
     parser.add_argument(
         "--quiet", action="store_true", help="no progress on standard error and no line per epoch on standard output"
     )
@@ -51,7 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from golfflight.model_export.joint import JointConfig
     from golfflight.model_export.real_data import BUILDERS
-    from golfflight.model_export.real_training import train_real
+    from golfflight.model_export.real_training import SeedPlan, train_real
 
     names = tuple(n.strip() for n in args.sources.split(","))
     unknown = [n for n in names if n not in BUILDERS]
@@ -61,8 +64,8 @@ def run(args: argparse.Namespace) -> int:
         raise SystemExit(f"golfflight train-real: --epochs must be at least 1, got {args.epochs}")
     result = train_real(args.data_root or shared_data_dir(), args.work, args.init,
                         JointConfig(epochs=args.epochs, lr=args.lr), args.seeds, args.out, names,
-                        progress=not args.quiet, jobs=args.jobs, threads=args.threads, device=args.device,
-                        stacked=args.stack_seeds)
+                        progress=not args.quiet, plan=SeedPlan(args.device, args.jobs, args.threads,
+                                                               args.stack_seeds, args.compile))
     for data in result.sources:
         print(f"{data.name}: {len(data.records)} shots ({data.kind})")
     for name, run_result in result.runs.items():
