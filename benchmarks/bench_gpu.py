@@ -12,9 +12,9 @@ sweep is all but the flight, the driver's work included.
 One command on a lent GPU machine (estimated at 5-6 minutes on an H100, not yet run there: three engines at five batch
 sizes, three compilations, and five sweeps of 4,194,304 rows; each measurement is written to benchmarks/results.json
 as soon as it is made, so a run cut short keeps what it measured; copy that file into $OUT;
---ray-workers 1 also sweeps the same grid through `--engine ray --device cuda`, an actor on the GPU, Ray's start
-included):
-    python benchmarks/bench_gpu.py --device cuda [--ray-workers 1]
+--ray-workers 1,2,4 also sweeps the same grid through `--engine ray --device cuda` with that many actors sharing the
+GPU, `--actors-per-gpu`, Ray's start included):
+    python benchmarks/bench_gpu.py --device cuda [--ray-workers 1,2,4]
 Here on the CPU, small sizes:
     python benchmarks/bench_gpu.py --device cpu --batches 1024,4096,16384 --parity-shots 3000 --share-rows 124032 \
         --sweep-rows 30000 --threads 2
@@ -206,12 +206,13 @@ def cpu_share(bundle: Path, device: str, rows: int, rounds: int = 2) -> dict:
 def sweep_end_to_end(device: str, rows: int, threads: int | None, ray_workers: int | None = None,
                      compiled: bool = False) -> dict:
     """`golfflight sweep --engine torch` (`--compile` if `compiled`; or, with `ray_workers`, `--engine ray --device`
-    on that many actors) on a grid of `rows` launches to Parquet, as its own process: wall seconds from start to
+    on that many actors, all on the one GPU with `--actors-per-gpu` where the device is cuda) on a grid of `rows` launches to Parquet, as its own process: wall seconds from start to
     file written (loading and compiling included), and the command's own account of where the time went."""
     speeds = max(rows // 400, 1)
     grid = [f"ball_speed_mps=30:80:{speeds}", "launch_angle_deg=6:30:20", "spin_rpm=1500:9000:20"]
     shots = speeds * 400
-    engine = ["--engine", "torch"] if ray_workers is None else ["--engine", "ray", "--workers", str(ray_workers)]
+    actors = ["--actors-per-gpu" if device == "cuda" else "--workers", str(ray_workers)]
+    engine = ["--engine", "torch"] if ray_workers is None else ["--engine", "ray", *actors]
     engine += ["--compile"] if compiled else []
     with tempfile.TemporaryDirectory() as folder:
         command = [sys.executable, "-m", "golfflight", "sweep", "--grid", *grid, "--out", f"{folder}/out.parquet",
@@ -275,7 +276,9 @@ def main() -> None:
     parser.add_argument("--sweep-rows", type=int, help="launches of the end-to-end sweep (0: none; default: by device)")
     parser.add_argument("--threads", type=int, help="torch CPU threads (default: torch's)")
     parser.add_argument("--model", help="bundle (default: the shipped models/default)")
-    parser.add_argument("--ray-workers", type=int, help="also sweep through --engine ray --device on this many actors")
+    parser.add_argument("--ray-workers", type=lambda text: [int(k) for k in text.split(",")], default=[],
+                        help="also sweep through --engine ray --device on this many actors (comma-separated counts; "
+                        "on cuda, all sharing its one GPU)")
     parser.add_argument("--share-rows", type=int, help="launches of the CPU-share sweeps (0: none; default: by device)")
     args = parser.parse_args()
     if args.threads:
@@ -305,11 +308,11 @@ def main() -> None:
         measured("cpu_share", cpu_share(bundle, args.device, share_rows))
     rows = DEFAULT_SWEEP_ROWS[kind] if args.sweep_rows is None else args.sweep_rows
     for name, compiled, ray_workers in (("sweep", False, None), ("sweep_compiled", True, None),
-                                        ("ray_sweep", False, args.ray_workers)):
-        if not rows or (compiled and "compiled" not in engines) or (name == "ray_sweep" and not ray_workers):
+                                        *((f"ray_sweep_{k}", False, k) for k in args.ray_workers)):
+        if not rows or (compiled and "compiled" not in engines):
             continue
         result = sweep_end_to_end(args.device, rows, args.threads, ray_workers, compiled)
-        if kind in SWEEP_TARGET and name != "ray_sweep" and "error" not in result:
+        if kind in SWEEP_TARGET and ray_workers is None and "error" not in result:
             result |= {"target": f">= {SWEEP_TARGET[kind]:,.0f} shots/s",
                        "met": result["shots_per_s"] >= SWEEP_TARGET[kind]}
         measured(name, result)

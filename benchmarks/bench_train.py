@@ -1,30 +1,31 @@
-"""One epoch of `golfflight train-real`'s joint run (`model_export.joint.train_joint_runs`) on a device, for 1 or
-more seeds side by side (`--runs`, as `train-real --stack-seeds` trains them): its wall time, and the ATen operations
-it dispatches (forward rollouts, backward, optimizer steps, the epoch's validation). Each is at least one kernel
-launch on a GPU, so their count times an operation's fixed cost on the device (timed here on tiny tensors) bounds an
-eager epoch there from below, however fast the device computes: what issue 33's target (an epoch 10x faster than on
-16 CPU cores) is up against, and what stacking seeds shares out. Writes a row of the section `train_epoch_<cpu|cuda>`
-of benchmarks/results.json (one a device, thread count and number of runs) and prints it as a table row for
+"""An epoch of `golfflight train-real`'s joint run (`model_export.joint.train_joint_runs`) on a device, for 1 or
+more seeds side by side (`--runs`, as `train-real --stack-seeds` trains them), eager and with the Euler step compiled
+(`--compile`, as `train-real --compile`): its wall time (the second of two epochs; the first compiles), and the ATen
+operations one eager epoch dispatches (forward rollouts, backward, optimizer steps, the epoch's validation). Each is
+at least one kernel launch on a GPU, so their count times an operation's fixed cost on the device (timed here on tiny
+tensors) bounds an eager epoch there from below, however fast the device computes: what issue 33's target (an epoch
+10x faster than on 16 CPU cores) is up against, and what stacking seeds shares out. Writes the section
+`train_epoch_<cpu|cuda>` of benchmarks/results.json (this run's rows) and prints them as a table for
 docs/benchmarks.md.
 
 The training file is built from the shared data (`model_export.real_data.build`, the held-out sets never read), or
 given (`--data`: a lent machine has no shared data; carry the file there):
-    python benchmarks/bench_train.py --device cpu --threads 1 --runs 1,4
-    python benchmarks/bench_train.py --device cuda --data real_flights.csv --runs 1,16  # then --device cpu
-                                                                  # --threads 16 there: the baseline, same machine
+    python benchmarks/bench_train.py --device cpu --threads 1 --runs 1,4 --compile
+    python benchmarks/bench_train.py --device cuda --data real_flights.csv --runs 1,16 --compile  # then --device
+                                                         # cpu --threads 16 there: the baseline, on the same machine
 """
 
 from __future__ import annotations
 
 import argparse
-import json
+import contextlib
 import tempfile
 import time
 from dataclasses import replace
 from pathlib import Path
 
 import torch
-from common import REPO, RESULTS, write_results
+from common import REPO, write_results
 from golfflight.flight.bundle_location import model_dir
 from golfflight.model_export.bundle_model import model_from_bundle
 from golfflight.model_export.devices import resolve_device
@@ -53,21 +54,32 @@ class OpCounter(TorchDispatchMode):
         return func(*args, **(kwargs or {}))
 
 
-def epoch(data: Path, device: str, folder: Path, runs: int, counter: OpCounter | None = None
-          ) -> tuple[float, list[JointResult]]:
-    """Wall seconds of one epoch of `runs` seeds side by side from the shipped bundle's network (under `counter` if
-    given), and their results."""
+def train(data: Path, device: str, folder: Path, runs: int, epochs: int, compile_step: bool = False,
+          counter: OpCounter | None = None) -> list[JointResult]:
+    """`epochs` epochs of `runs` seeds side by side from the shipped bundle's network (under `counter` if given)."""
     model, _ = model_from_bundle(model_dir(None))
     model.train()
-    configs = [replace(JointConfig(), epochs=1, seed=seed) for seed in range(runs)]
+    configs = [replace(JointConfig(), epochs=epochs, seed=seed) for seed in range(runs)]
     folders = [folder / f"seed-{seed}" for seed in range(runs)]
-    started = time.perf_counter()
-    if counter is None:
-        results = train_joint_runs(data, folders, configs, model, False, device)
-    else:
-        with counter:
-            results = train_joint_runs(data, folders, configs, model, False, device)
-    return time.perf_counter() - started, results
+    with counter or contextlib.nullcontext():
+        return train_joint_runs(data, folders, configs, model, False, device, compile_step)
+
+
+def measure(data: Path, device: str, folder: Path, runs: int, compile_step: bool) -> dict:
+    """An epoch's seconds: the second of two (the first compiles where `compile_step`), and, eager, the operations
+    one epoch dispatches. Compiled runs start from an empty compile cache: torch.compile keeps its versions of
+    `euler_step` by the function, so the runs' counts before would add up to its limit of eight (then it runs eager)."""
+    if compile_step:
+        torch._dynamo.reset()
+    history = train(data, device, folder / "timed", runs, 2, compile_step)[0].history
+    row = {"runs": runs, "compiled": compile_step, "epoch_s": history[1]["seconds"],
+           "first_epoch_s": history[0]["seconds"], "seed_share_s": history[1]["seconds"] / runs,
+           "selection_loss": history[1]["selection_loss"], "ops": None}
+    if not compile_step:
+        counter = OpCounter()
+        train(data, device, folder / "counted", runs, 1, counter=counter)
+        row["ops"] = counter.count
+    return row
 
 
 def op_cost_us(device: torch.device) -> float:
@@ -91,15 +103,16 @@ def main() -> None:
     parser.add_argument("--data", type=Path, help=f"the training file (default: built from {DATA_ROOT})")
     parser.add_argument("--threads", type=int, help="torch CPU threads (default: torch's)")
     parser.add_argument("--runs", default="1", help="seeds side by side, comma-separated counts (default 1)")
+    parser.add_argument("--compile", action="store_true", help="each count eager and then compiled")
     args = parser.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
     device = resolve_device(args.device)
     cost = op_cost_us(device)
     rows = []
-    print("\n| device | torch threads | seeds side by side | epoch | a seed's share | operations dispatched | "
-          "an operation's fixed cost | their floor | felt error after it (seed 0) |\n"
-          "|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("\n| device | torch threads | seeds side by side | step | epoch | a seed's share | first epoch | "
+          "operations dispatched (an epoch) | their floor | felt error after epoch 2 (seed 0) |\n"
+          "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|")
     with tempfile.TemporaryDirectory() as folder:
         data = args.data
         if data is None:
@@ -108,25 +121,19 @@ def main() -> None:
             data = Path(folder) / DATA_FILE
             build(DATA_ROOT, data)
         for runs in (int(part) for part in args.runs.split(",")):
-            seconds, results = epoch(data, args.device, Path(folder) / f"timed-{runs}", runs)
-            counter = OpCounter()
-            epoch(data, args.device, Path(folder) / f"counted-{runs}", runs, counter)
-            first = results[0].history[0]
-            row = {"device": str(device), "torch": torch.__version__, "torch_threads": torch.get_num_threads(),
-                   "runs": runs, "epoch_s": seconds, "seed_share_s": seconds / runs,
-                   "epoch_history_s": first["seconds"], "ops": counter.count, "op_cost_us": cost,
-                   "ops_floor_s": counter.count * cost * 1e-6, "val_loss": first["val_loss"],
-                   "selection_loss": first["selection_loss"],
-                   "selection_losses": [r.history[0]["selection_loss"] for r in results]}
-            rows.append(row)
-            print(f"| {row['device']} | {row['torch_threads']} | {runs} | {seconds:.1f} s | {seconds / runs:.1f} s | "
-                  f"{counter.count:,} | {cost:.2f} µs | {row['ops_floor_s']:.1f} s | {row['selection_loss']:.2f} m |",
-                  flush=True)
-    section = f"train_epoch_{device.type}"
-    kept = json.loads(RESULTS.read_text()).get(section, {}).get("rows", []) if RESULTS.is_file() else []
-    key = lambda r: (r["device"], r["torch_threads"], r.get("runs", 1))
-    fresh = {key(r) for r in rows}
-    write_results(section, [*(r for r in kept if key(r) not in fresh), *rows])
+            for compiled in (False, True) if args.compile else (False,):
+                row = {"device": str(device), "torch": torch.__version__, "torch_threads": torch.get_num_threads(),
+                       "op_cost_us": cost, **measure(data, args.device, Path(folder) / f"{runs}-{compiled}", runs,
+                                                    compiled)}
+                row["ops_floor_s"] = None if row["ops"] is None else row["ops"] * cost * 1e-6
+                rows.append(row)
+                ops = "—" if row["ops"] is None else f"{row['ops']:,}"
+                floor = "—" if row["ops_floor_s"] is None else f"{row['ops_floor_s']:.1f} s"
+                print(f"| {row['device']} | {row['torch_threads']} | {runs} | {'compiled' if compiled else 'eager'} | "
+                      f"{row['epoch_s']:.1f} s | {row['seed_share_s']:.1f} s | {row['first_epoch_s']:.1f} s | {ops} | "
+                      f"{floor} | {row['selection_loss']:.3f} m |", flush=True)
+    print(f"\nan operation's fixed cost on {device}: {cost:.2f} µs")
+    write_results(f"train_epoch_{device.type}", rows)
 
 
 if __name__ == "__main__":

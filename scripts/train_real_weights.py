@@ -7,7 +7,8 @@ is never read: the merged file comes from `model_export.real_data.build`, which 
         --grid 'pga-2023-table=5,20,80' --grid 'trackman-model=0.1,0.5' --seeds 0
 
 Writes WORK/weights.json (every run's final validation metrics) and prints the table; the best weights (lowest
-felt error, mean over seeds) come first.
+felt error, mean over seeds) come first. With `--stack-seeds` each weight set's seeds train side by side in one
+process (`model_export.stacked_runs`: the same runs up to float rounding), a process a weight set.
 """
 
 from __future__ import annotations
@@ -23,7 +24,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from golfflight.model_export.joint import JointConfig, felt_error_m
+import torch
+from golfflight.model_export.bundle_model import model_from_bundle
+from golfflight.model_export.joint import JointConfig, felt_error_m, train_joint_runs
 from golfflight.model_export.real_data import DEFAULT_SOURCES, build
 from golfflight.model_export.real_training import DATA_FILE, train_seed
 from golfflight.shots.markdown import table
@@ -54,6 +57,16 @@ def run_one(data_file: Path, run_dir: Path, init: str, config: JointConfig) -> d
     return {"dir": str(run_dir), "weights": config.weights, "seed": config.seed, **(result.final or {})}
 
 
+def run_stacked(data_file: Path, run_dirs: list[Path], init: str, configs: list[JointConfig]) -> list[dict]:
+    """One weight set's seeds side by side in this process (one torch thread)."""
+    torch.set_num_threads(1)
+    model, _ = model_from_bundle(init)
+    model.train()
+    results = train_joint_runs(data_file, run_dirs, configs, model, progress=False)
+    return [{"dir": str(d), "weights": c.weights, "seed": c.seed, **(r.final or {})}
+            for d, c, r in zip(run_dirs, configs, results)]
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--work", type=Path, required=True)
@@ -66,6 +79,7 @@ def main() -> int:
     parser.add_argument("--seeds", default="0")
     parser.add_argument("--epochs", type=int, default=20)
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--stack-seeds", action="store_true", help="each weight set's seeds side by side, a process each")
     args = parser.parse_args()
     started = time.perf_counter()
     args.work.mkdir(parents=True, exist_ok=True)
@@ -76,9 +90,18 @@ def main() -> int:
     base = JointConfig(epochs=args.epochs, lr=1e-3)
     configs = [replace(base, weights=w, seed=int(s)) for w in weight_sets(base.weights, grid)
                for s in args.seeds.split(",")]
+    dirs = [args.work / f"run-{i}" for i in range(len(configs))]
     with ProcessPoolExecutor(args.jobs) as pool:
-        futures = [pool.submit(run_one, data_file, args.work / f"run-{i}", args.init, c) for i, c in enumerate(configs)]
-        runs = [f.result() for f in futures]
+        if args.stack_seeds:
+            sets: dict[str, list[int]] = {}
+            for i, c in enumerate(configs):
+                sets.setdefault(label(c.weights, grid), []).append(i)
+            futures = [pool.submit(run_stacked, data_file, [dirs[i] for i in runs], args.init,
+                                   [configs[i] for i in runs]) for runs in sets.values()]
+            runs = [run for f in futures for run in f.result()]
+        else:
+            futures = [pool.submit(run_one, data_file, d, args.init, c) for d, c in zip(dirs, configs)]
+            runs = [f.result() for f in futures]
     (args.work / "weights.json").write_text(json.dumps({"grid": grid, "runs": runs}, indent=2) + "\n")
     sources = [s for s in base.select_on if any(s in r.get("val", {}) for r in runs)]
     by_weights: dict[str, list[dict]] = {}

@@ -7,6 +7,7 @@ few pieces per worker are in flight, so memory stays bounded however long the in
 
 from __future__ import annotations
 
+import math
 import multiprocessing
 import os
 import re
@@ -162,11 +163,12 @@ def ray_noise_filtered(noise: tuple[bytes, ...] = RAY_NOISE):
 
 
 def ray_tables(source, bundle_dir: str, sha256: str, workers: int | None, address: str | None,
-               make_engine: Callable | None = None, gpus_per_actor: int = 0) -> Iterator:
+               make_engine: Callable | None = None, gpus_per_actor: float = 0) -> Iterator:
     """Result tables of `source`'s pieces through Ray Data: `map_batches` with `Flyer` as a callable class on a pool
     of `workers` actors of one CPU each, order preserved. Each actor flies with ONNX Runtime, or with the engine
-    `make_engine` builds on its node (the torch engine), asking Ray for `gpus_per_actor` GPUs instead of a CPU: then
-    `workers` None is one actor for each GPU the cluster lists (`gpu_actors`), and one actor's engine is built on a
+    `make_engine` builds on its node (the torch engine), asking Ray for `gpus_per_actor` GPUs instead of a CPU (a
+    fraction: several actors share a GPU): then `workers` None is as many actors as the cluster's GPUs hold
+    (`gpu_actors`), and one actor's engine is built on a
     GPU of the cluster before the sweep starts, so that a node without torch or CUDA is refused in one line.
     Connects to the cluster at `address` if given (and leaves it running), else starts a local Ray instance with a
     CPU for each worker and one for reading (every CPU and GPU of this machine for GPU actors), and stops it after."""
@@ -182,21 +184,29 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int | None, addres
         yield from _ray_tables(ray, source, bundle_dir, sha256, workers, address, make_engine, gpus_per_actor)
 
 
-def gpu_actors(resources: dict, workers: int | None, gpus_per_actor: int) -> int:
-    """The actors of a sweep on GPUs: `workers`, or one for each GPU of `resources` (`ray.cluster_resources()`);
-    ValueError where the cluster lists no GPU or fewer than the actors need (an actor Ray cannot place would wait for
-    ever)."""
-    gpus = int(resources.get("GPU", 0))
+def gpu_actors(resources: dict, workers: int | None, gpus_per_actor: float) -> int:
+    """The actors of a sweep on GPUs: `workers`, or as many as the cluster's GPUs (`resources`,
+    `ray.cluster_resources()`) hold at `gpus_per_actor` each (1: one a GPU; 0.5: two) and its CPUs at one each beside
+    the one that reads (Ray Data gives a GPU actor a CPU too); ValueError where the cluster lists no GPU or fewer GPUs
+    or CPUs than the actors need (an actor Ray cannot place, or a read with no CPU left, would wait for ever)."""
+    gpus, cpus = int(resources.get("GPU", 0)), int(resources.get("CPU", 0))
     if gpus < gpus_per_actor:
         raise ValueError(
             "--engine ray --device cuda: the Ray cluster lists no GPU (ray.cluster_resources() has none); start its "
             "nodes with their GPUs (ray start --num-gpus N, or a KubeRay worker group with nvidia.com/gpu), or sweep "
             "on CPUs without --device"
         )
-    most = gpus // gpus_per_actor
-    if workers is not None and workers > most:
+    by_gpus = math.floor(gpus / gpus_per_actor + 1e-9)
+    most = min(by_gpus, cpus - 1)
+    if most < 1:
+        raise ValueError(f"--engine ray --device cuda: the Ray cluster lists {cpus} CPUs; each GPU actor takes one "
+                         "and reading the launches one more")
+    if workers is not None and workers > by_gpus:
         raise ValueError(f"--workers {workers}: the Ray cluster lists {gpus} GPUs, and each actor takes "
-                         f"{gpus_per_actor} (leave --workers out for one actor a GPU)")
+                         f"{gpus_per_actor:g} (leave --workers out for {most} actors)")
+    if workers is not None and workers > most:
+        raise ValueError(f"--workers {workers}: the Ray cluster lists {cpus} CPUs, and each actor takes one beside "
+                         f"the one that reads (leave --workers out for {most} actors)")
     return most if workers is None else workers
 
 
@@ -209,7 +219,7 @@ def _engine_problem(make_engine: Callable, bundle_dir: str) -> str | None:
     return None
 
 
-def check_actor_engine(ray, make_engine: Callable, bundle_dir: str, gpus: int) -> None:
+def check_actor_engine(ray, make_engine: Callable, bundle_dir: str, gpus: float) -> None:
     """Build one engine as an actor would, in a Ray task asking for `gpus` GPUs, before any actor starts; ValueError
     saying why where it fails (a node without torch fails before the task runs: the error's last line says so)."""
     task = ray.remote(num_cpus=1, num_gpus=gpus, max_retries=0)(_engine_problem)
@@ -223,7 +233,7 @@ def check_actor_engine(ray, make_engine: Callable, bundle_dir: str, gpus: int) -
 
 
 def _ray_tables(ray, source, bundle_dir: str, sha256: str, workers: int | None, address: str | None,
-                make_engine: Callable | None, gpus_per_actor: int) -> Iterator:
+                make_engine: Callable | None, gpus_per_actor: float) -> Iterator:
     from golfflight.sweep.ray_input import PiecesDatasource
 
     started = not ray.is_initialized()

@@ -32,10 +32,11 @@ Engine = Literal["local", "ray", "torch"]
 @dataclass(frozen=True)
 class RayEngine:
     """What each Ray actor flies with: ONNX Runtime on its CPU (`make` None), or the engine `make` builds from the
-    bundle's path on the actor's node (`model_export.torch_engine.TorchEngineMaker`), with `gpus` GPUs of its own."""
+    bundle's path on the actor's node (`model_export.torch_engine.TorchEngineMaker`), with `gpus` GPUs of its own
+    (a fraction where actors share one)."""
 
     make: Callable[[str], ColumnsEngine] | None = None
-    gpus: int = 0
+    gpus: float = 0
 
 
 @dataclass(frozen=True)

@@ -307,7 +307,8 @@ def test_ray_actors_fly_the_torch_engine_as_engine_torch_does(tmp_path, capsys):
     the Parquet file holds the numbers of `--engine torch --device cpu`, every column equal. On the same Ray
     instance (started here once with one GPU declared, which Ray takes on trust; the sweep leaves it running): an
     actor asking Ray for that GPU (`RayEngine(gpus=1)`, what `--device cuda` asks; here it flies on the CPU) is placed
-    and gives the same file, one actor for the one GPU listed; and `--device cuda`, whose engine no worker here can
+    and gives the same file, one actor for the one GPU listed, as do two actors asking for half of it each
+    (`--actors-per-gpu 2`); and `--device cuda`, whose engine no worker here can
     build (no CUDA, as on a GPU node without its driver), is refused in one line before any actor starts."""
     ray = pytest.importorskip("ray")
     pytest.importorskip("torch")
@@ -317,16 +318,18 @@ def test_ray_actors_fly_the_torch_engine_as_engine_torch_does(tmp_path, capsys):
 
     axes = ["ball_speed_mps=40:70:5", "launch_angle_deg=8,16", "spin_rpm=2500,6000", "wind_speed_mps=0,6",
             "ground_elevation_m=0,-3", "normalized=true,false"]
-    outs = {name: tmp_path / f"{name}.parquet" for name in ("torch", "ray", "ray_gpu")}
+    outs = {name: tmp_path / f"{name}.parquet" for name in ("torch", "ray", "ray_gpu", "ray_half_gpu")}
     assert sweep("--grid", *axes, "--out", outs["torch"], "--engine", "torch", "--device", "cpu", "--threads", 1,
                  "--chunk-rows", 32) == 0
-    ray.init(num_cpus=2, num_gpus=1, include_dashboard=False, logging_level="WARNING")
+    ray.init(num_cpus=3, num_gpus=1, include_dashboard=False, logging_level="WARNING")
     try:
         assert sweep("--grid", *axes, "--out", outs["ray"], "--engine", "ray", "--device", "cpu", "--workers", 1,
                      "--chunk-rows", 32) == 0
         assert "on ray with 1 workers (torch on cpu, float32)" in capsys.readouterr().out
         run_sweep(open_source(None, axes, 32), str(outs["ray_gpu"]), "ray", None, progress=False,
                   ray_engine=RayEngine(TorchEngineMaker("cpu", threads=1), gpus=1))
+        run_sweep(open_source(None, axes, 32), str(outs["ray_half_gpu"]), "ray", None, progress=False,
+                  ray_engine=RayEngine(TorchEngineMaker("cpu", threads=1, parts_at_once=2), gpus=0.5))
         assert sweep("--grid", *axes, "--out", tmp_path / "cuda.parquet", "--engine", "ray", "--device", "cuda") == 2
         err = capsys.readouterr().err
         assert err.startswith("golfflight sweep: error: --engine ray: a worker of the Ray cluster cannot build the "
@@ -336,5 +339,5 @@ def test_ray_actors_fly_the_torch_engine_as_engine_torch_does(tmp_path, capsys):
         ray.shutdown()
     expected = pq.read_table(outs["torch"])
     assert expected.num_rows == 160
-    for name in ("ray", "ray_gpu"):
+    for name in ("ray", "ray_gpu", "ray_half_gpu"):
         assert pq.read_table(outs[name]).equals(expected), name

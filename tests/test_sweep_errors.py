@@ -263,6 +263,11 @@ def test_the_cross_field_rules_read_only_presence_and_the_value_rule_columns():
         ),
         (["--engine", "local", "--device", "cuda"], "--device goes with --engine torch, or --engine ray"),
         (["--engine", "local", "--dtype", "float64"], "--dtype goes with --engine torch, or --engine ray with --device"),
+        (["--engine", "ray", "--device", "cpu", "--actors-per-gpu", "2"],
+         "--actors-per-gpu goes with --engine ray --device cuda"),
+        (["--engine", "torch", "--actors-per-gpu", "2"], "--actors-per-gpu goes with --engine ray --device cuda"),
+        (["--engine", "ray", "--device", "cuda", "--actors-per-gpu", "0"],
+         "--actors-per-gpu takes a whole number of at least 1"),
     ],
 )
 def test_torch_options_that_do_not_go_with_the_engine_are_refused(tmp_path, capsys, options, message):
@@ -287,13 +292,25 @@ def test_ray_on_gpus_without_torch_is_refused_in_one_line(tmp_path, capfd, monke
     ]
 
 
-def test_gpu_actors_are_one_a_gpu_and_never_more_than_the_cluster_lists():
+def test_gpu_actors_are_what_the_gpus_hold_and_never_more_than_the_cluster_lists():
     from golfflight.sweep.engines import gpu_actors
 
     assert gpu_actors({"CPU": 16.0, "GPU": 4.0}, None, 1) == 4
     assert gpu_actors({"CPU": 16.0, "GPU": 4.0}, 2, 1) == 2
-    with pytest.raises(ValueError, match=r"--workers 5: the Ray cluster lists 4 GPUs, and each actor takes 1"):
-        gpu_actors({"GPU": 4.0}, 5, 1)
+    assert gpu_actors({"CPU": 16.0, "GPU": 4.0}, None, 1 / 3) == 12
+    assert gpu_actors({"CPU": 3.0, "GPU": 1.0}, None, 0.5) == 2
+    with pytest.raises(ValueError, match=r"--workers 5: the Ray cluster lists 4 GPUs, and each actor takes 1 "
+                                         r"\(leave --workers out for 4 actors\)"):
+        gpu_actors({"CPU": 16.0, "GPU": 4.0}, 5, 1)
+    with pytest.raises(ValueError, match=r"--workers 3: the Ray cluster lists 1 GPUs, and each actor takes 0.5"):
+        gpu_actors({"CPU": 16.0, "GPU": 1.0}, 3, 0.5)
+    # A GPU actor takes a CPU too, and reading one more: two actors on 2 CPUs would wait for ever.
+    assert gpu_actors({"CPU": 2.0, "GPU": 1.0}, None, 0.5) == 1
+    with pytest.raises(ValueError, match=r"--workers 2: the Ray cluster lists 2 CPUs, and each actor takes one "
+                                         r"beside the one that reads \(leave --workers out for 1 actors\)"):
+        gpu_actors({"CPU": 2.0, "GPU": 1.0}, 2, 0.5)
+    with pytest.raises(ValueError, match=r"lists 1 CPUs; each GPU actor takes one and reading the launches one more"):
+        gpu_actors({"CPU": 1.0, "GPU": 1.0}, None, 1)
     with pytest.raises(ValueError, match=r"the Ray cluster lists no GPU \(ray.cluster_resources\(\) has none\)"):
         gpu_actors({"CPU": 16.0}, None, 1)
 

@@ -5,10 +5,11 @@ product: START:STOP:COUNT, V1,V2,... or V per column, `sweep.grid`). Output: one
 (`row`), its columns and its flight, the same numbers as `golfflight simulate`. `--engine local` flies on a pool of
 processes here, `--engine ray` through Ray Data (a local Ray instance, or a cluster's with `--ray-address`),
 `--engine torch` in this process on `--device cpu` or `cuda` (the bundle rebuilt in torch,
-`model_export.torch_engine`). `--engine ray --device cuda` flies the torch engine in each Ray actor on a GPU of its
-own (one actor a GPU: the engine sizes its batches to the GPU's free memory, so two on one GPU would only contend;
-`--workers` left out is one actor for each GPU the cluster lists); `--device cpu` there flies it on each actor's CPU,
-the numbers of `--engine torch`. Needs the `sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray` and the
+`model_export.torch_engine`). `--engine ray --device cuda` flies the torch engine in each Ray actor on a GPU (one
+actor a GPU, or `--actors-per-gpu K` sharing each, so that one actor's host work, checking rows, rolling to rest and
+writing, overlaps another's flight; each engine sizes its batches to its share of the GPU's free memory;
+`--workers` left out is as many actors as the cluster's GPUs hold); `--device cpu` there flies it on each actor's
+CPU, the numbers of `--engine torch`. Needs the `sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray` and the
 `train` extra (torch) for `--engine torch` and `--device`.
 """
 
@@ -38,8 +39,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Fly every row of a launches file (CSV or Parquet, simulate's columns) or of a grid into one Parquet "
         "file, the numbers simulate gives: on local processes (ONNX Runtime), Ray Data actors, or the model rebuilt in "
         "torch (--engine torch, on --device cpu or cuda). On a Ray cluster with GPUs, --engine ray --device cuda "
-        "flies the torch engine in each actor on a GPU of its own, one actor for each GPU the cluster lists unless "
-        "--workers says fewer (e.g. golfflight sweep --grid ball_speed_mps=30:80:1000 launch_angle_deg=6:30:100 "
+        "flies the torch engine in each actor on a GPU (--actors-per-gpu K sharing each), as many actors as the "
+        "cluster's GPUs hold unless --workers says fewer (e.g. golfflight sweep --grid ball_speed_mps=30:80:1000 launch_angle_deg=6:30:100 "
         "spin_rpm=1500:9000:100 --out sweep.parquet --engine ray --device cuda --ray-address auto); it is refused in "
         "one line where the cluster lists no GPU or a GPU worker cannot build the engine (no torch, no CUDA).",
     )
@@ -57,11 +58,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--chunk-rows", type=int, help=f"shots a batch (default {CHUNK_ROWS}; with the torch engine "
                         f"{TORCH_CHUNK_ROWS['cpu']} on a CPU, {TORCH_CHUNK_ROWS['cuda']} on a GPU)")
     parser.add_argument("--device", help="the torch engine's device: --engine torch: cpu (default), cuda or cuda:N; "
-                        "--engine ray: cuda (each actor on a GPU of its own that Ray gives it) or cpu")
+                        "--engine ray: cuda (each actor on a GPU, or a share of one, that Ray gives it) or cpu")
     parser.add_argument("--dtype", choices=("float32", "float64"),
                         help="the torch engine's physics' precision (default float32; the network is float32)")
     parser.add_argument("--threads", type=int, help="the torch engine on a CPU: torch's threads (default: torch's, "
                         "one a core, with --engine torch; 1 in each Ray actor; 1 where other work shares the cores)")
+    parser.add_argument("--actors-per-gpu", type=int, help="--engine ray --device cuda: Ray actors sharing each GPU "
+                        "(default 1), each asking Ray for 1/K of one and flying in 1/K of its memory")
     parser.add_argument("--compile", action="store_true", default=None,
                         help="the torch engine: fuse each Euler step's kernels with torch.compile (compiled once a "
                         "run, in seconds; on a CPU it needs a C compiler)")
@@ -106,6 +109,10 @@ def _check_options(args: argparse.Namespace) -> None:
                          "--device)")
     if args.threads is not None and args.threads < 1:
         raise ValueError("--threads takes a whole number of at least 1")
+    if args.actors_per_gpu is not None and (args.engine != "ray" or args.device != "cuda"):
+        raise ValueError("--actors-per-gpu goes with --engine ray --device cuda")
+    if args.actors_per_gpu is not None and args.actors_per_gpu < 1:
+        raise ValueError("--actors-per-gpu takes a whole number of at least 1")
     torch_only = [name for name in ("device", "dtype", "threads", "compile") if getattr(args, name) is not None]
     if torch_only and args.engine == "local":
         also = "--engine ray" if torch_only[0] == "device" else "--engine ray with --device"
@@ -126,7 +133,7 @@ def _torch_maker(args: argparse.Namespace, threads: int | None, parts_at_once: i
 
 def _engines(args: argparse.Namespace):
     """The torch engine `--engine torch` flies in this process (the bundle rebuilt in torch), or None; and what each
-    Ray actor flies with (`sweep.run.RayEngine`: the torch engine on a GPU of its own with `--device cuda`)."""
+    Ray actor flies with (`sweep.run.RayEngine`: the torch engine on a GPU, or 1/K of one, with `--device cuda`)."""
     from golfflight.flight.bundle_location import model_dir
     from golfflight.sweep.run import RayEngine
 
@@ -135,7 +142,8 @@ def _engines(args: argparse.Namespace):
 
         return _torch_maker(args, args.threads, PIECES_IN_FLIGHT)(model_dir(args.model).resolve()), RayEngine()
     if _torch_on_ray(args):
-        return None, RayEngine(_torch_maker(args, args.threads or 1), int(args.device == "cuda"))
+        sharing = args.actors_per_gpu or 1
+        return None, RayEngine(_torch_maker(args, args.threads or 1, sharing), (args.device == "cuda") / sharing)
     return None, RayEngine()
 
 
@@ -177,7 +185,7 @@ def run(args: argparse.Namespace) -> int:
     if torch_engine is not None:
         where = f"({torch_engine.device}, {dtype})"
     else:
-        where = f"with {workers} workers" if workers else "with one actor a GPU"
+        where = f"with {workers} workers" if workers else f"with {args.actors_per_gpu or 1} actors a GPU"
         where += f" (torch on {args.device}, {dtype})" if ray_engine.make else ""
     print(
         f"golfflight sweep: {summary.written:,} shots written to {args.out} ({summary.skipped:,} rows skipped{whole}, "
