@@ -5,8 +5,8 @@ operations one eager epoch dispatches (forward rollouts, backward, optimizer ste
 at least one kernel launch on a GPU, so their count times an operation's fixed cost on the device (timed here on tiny
 tensors) bounds an eager epoch there from below, however fast the device computes: what issue 33's target (an epoch
 10x faster than on 16 CPU cores) is up against, and what stacking seeds shares out. Writes the section
-`train_epoch_<cpu|cuda>` of benchmarks/results.json (this run's rows) and prints them as a table for
-docs/benchmarks.md.
+`train_epoch_<cpu|cuda>` of benchmarks/results.json (a row a device, thread count, number of seeds and step; a rerun
+replaces its own) and prints them as a table for docs/benchmarks.md.
 
 The training file is built from the shared data (`model_export.real_data.build`, the held-out sets never read), or
 given (`--data`: a lent machine has no shared data; carry the file there):
@@ -19,13 +19,14 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import json
 import tempfile
 import time
 from dataclasses import replace
 from pathlib import Path
 
 import torch
-from common import REPO, write_results
+from common import REPO, RESULTS, write_results
 from golfflight.flight.bundle_location import model_dir
 from golfflight.model_export.bundle_model import model_from_bundle
 from golfflight.model_export.devices import resolve_device
@@ -133,7 +134,15 @@ def main() -> None:
                       f"{row['epoch_s']:.1f} s | {row['seed_share_s']:.1f} s | {row['first_epoch_s']:.1f} s | {ops} | "
                       f"{floor} | {row['selection_loss']:.3f} m |", flush=True)
     print(f"\nan operation's fixed cost on {device}: {cost:.2f} µs")
-    write_results(f"train_epoch_{device.type}", rows)
+    section = f"train_epoch_{device.type}"
+    kept = json.loads(RESULTS.read_text()).get(section, {}).get("rows", []) if RESULTS.is_file() else []
+    fresh = {_key(r) for r in rows}
+    write_results(section, [*(r for r in kept if "compiled" in r and _key(r) not in fresh), *rows])
+
+
+def _key(row: dict) -> tuple:
+    """What a row measured: a rerun of the same replaces it in results.json."""
+    return row["device"], row["torch_threads"], row["runs"], row["compiled"]
 
 
 if __name__ == "__main__":
