@@ -53,12 +53,6 @@ class StackedNetworks:
         stacked = self.params | self.buffers
         return {name: stacked[name][run].detach().clone() for name in self.base.state_dict()}
 
-    def run_module(self, run: int) -> nn.Module:
-        """A copy of the module holding run `run`'s weights (in evaluation mode)."""
-        module = copy.deepcopy(self.base)
-        module.load_state_dict(self.run_state(run))
-        return module.eval()
-
     def to(self, device: torch.device) -> StackedNetworks:
         self.base.to(device)
         self.params = {name: value.detach().to(device).requires_grad_() for name, value in self.params.items()}
