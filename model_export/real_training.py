@@ -179,10 +179,10 @@ def _network(init: str | os.PathLike) -> nn.Module:
 
 @dataclass(frozen=True)
 class SeedPlan:
-    """How `train_real` trains its seeds: on `device`, `jobs` at a time in processes of their own or all side by
-    side in one rollout (`stacked`), each process with `threads` torch threads; `compile_step` fuses each Euler
-    step's kernels with torch.compile. On a GPU the seeds run one after another or stacked: processes of their own
-    would share the one device."""
+    """How `train_real` trains its seeds: on `device`, in `jobs` processes of their own at a time, each with
+    `threads` torch threads; one seed a process, or (`stacked`) the seeds shared out over the processes and each
+    process's side by side in one rollout; `compile_step` fuses each Euler step's kernels with torch.compile. On a
+    GPU one process: the seeds one after another, or all stacked."""
 
     device: str = DEFAULT_DEVICE
     jobs: int = 1
@@ -192,8 +192,6 @@ class SeedPlan:
 
     def check(self) -> None:
         """ValueError, in the command line's words, for a plan that cannot run here."""
-        if self.stacked and self.jobs > 1:
-            raise ValueError(f"--jobs {self.jobs} or --stack-seeds: stacked seeds train in one process")
         if resolve_device(self.device).type != "cpu" and self.jobs > 1:
             raise ValueError(f"--jobs {self.jobs} goes with --device cpu: on {self.device} the seeds run one after "
                              "another, or side by side with --stack-seeds")
@@ -210,36 +208,53 @@ def train_seed(data_file: Path, run_dir: Path, init: str | os.PathLike, config: 
     return train_joint(data_file, run_dir, config, model, progress, device, compile_step)
 
 
+def train_stacked(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig],
+                  threads: int, progress: bool, device: str = DEFAULT_DEVICE, compile_step: bool = False
+                  ) -> dict[str, JointResult]:
+    """Seeds side by side in one rollout from the bundle `init` (`joint.train_joint_runs`), each in WORK/NAME."""
+    import torch
+
+    torch.set_num_threads(threads)
+    model = _network(init)
+    model.train()
+    results = train_joint_runs(data_file, [work / name for name in configs], list(configs.values()), model, progress,
+                               device, compile_step)
+    return dict(zip(configs, results))
+
+
 def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig],
                  plan: SeedPlan, progress: bool) -> dict[str, JointResult]:
-    """Each seed's joint run (WORK/NAME), by name, as `plan` says: side by side in one rollout, one after the other
-    with their epoch bars, or several at once in processes of their own (silent there) with a bar over the seeds
-    finished."""
+    """Each seed's joint run (WORK/NAME), by name, as `plan` says. In this process: stacked, or one after the other,
+    with their epoch bars. In several (`plan.jobs`, silent there): a seed or a stack of seeds each, with a bar over
+    those finished."""
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    if plan.stacked:
-        import torch
-
-        torch.set_num_threads(plan.threads)
-        progress_step(f"{', '.join(configs)} side by side", progress)
-        model = _network(init)
-        model.train()
-        results = train_joint_runs(data_file, [work / name for name in configs], list(configs.values()), model,
-                                   progress, plan.device, plan.compile_step)
-        return dict(zip(configs, results))
+    names = list(configs)
     if plan.jobs <= 1:
+        if plan.stacked:
+            progress_step(f"{', '.join(names)} side by side", progress)
+            return train_stacked(data_file, work, init, configs, plan.threads, progress, plan.device,
+                                 plan.compile_step)
         runs = {}
         for index, (name, c) in enumerate(configs.items(), start=1):
             progress_step(f"{name} ({index} of {len(configs)})", progress)
             runs[name] = train_seed(data_file, work / name, init, c, plan.threads, progress, plan.device,
                                     plan.compile_step)
         return runs
+    done: dict[str, JointResult] = {}
     with ProcessPoolExecutor(plan.jobs) as pool:
-        futures = {pool.submit(train_seed, data_file, work / name, init, c, plan.threads, False, plan.device,
-                               plan.compile_step): name for name, c in configs.items()}
-        done = {futures[f]: f.result() for f in progress_bar(as_completed(futures), "seeds", total=len(futures),
-                                                             unit="seed", shown=progress)}
-    return {name: done[name] for name in configs}
+        if plan.stacked:
+            stacks = [{name: configs[name] for name in names[i::plan.jobs]} for i in range(min(plan.jobs, len(names)))]
+            futures = [pool.submit(train_stacked, data_file, work, init, stack, plan.threads, False, plan.device,
+                                   plan.compile_step) for stack in stacks]
+            unit = "stack"
+        else:
+            futures = {pool.submit(train_seed, data_file, work / name, init, c, plan.threads, False, plan.device,
+                                   plan.compile_step): name for name, c in configs.items()}
+            unit = "seed"
+        for future in progress_bar(as_completed(futures), f"{unit}s", total=len(futures), unit=unit, shown=progress):
+            done |= future.result() if plan.stacked else {futures[future]: future.result()}
+    return {name: done[name] for name in names}
 
 
 def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str | os.PathLike,

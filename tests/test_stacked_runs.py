@@ -124,10 +124,31 @@ def test_train_real_trains_its_seeds_stacked_each_in_its_folder(tmp_path):
         assert load_checkpoint(run.out_dir / "last.pt")["config"]["seed"] == configs[name].seed
 
 
-def test_stacked_seeds_are_one_process_so_jobs_are_refused(tmp_path, capsys):
+def test_stacked_seeds_shared_out_over_processes_are_the_seeds_stacked_in_one(tmp_path):
+    """`--stack-seeds --jobs 2`: seeds 0 and 2 stacked in one process, 1 in another, each in its folder."""
+    _windy_set(tmp_path / "windy.csv", {"a": (0.0, 1.0)}, n_per_group=6)
+    configs = {f"seed-{s}": JointConfig(epochs=1, batch_size=4, seed=s, weights={"sentry-2022": 1.0}) for s in (0, 1, 2)}
+    init = REPO_ROOT / "models" / "default"
+    shared = _train_seeds(tmp_path / "windy.csv", tmp_path / "shared", init, configs,
+                          SeedPlan(jobs=2, threads=1, stacked=True), False)
+    one = _train_seeds(tmp_path / "windy.csv", tmp_path / "one", init, configs, SeedPlan(threads=1, stacked=True),
+                       False)
+    assert list(shared) == list(configs)
+    for name, run in shared.items():
+        assert run.out_dir == tmp_path / "shared" / name
+        weights = [load_checkpoint(r.out_dir / "last.pt")["model"] for r in (run, one[name])]
+        for key in weights[0]:
+            torch.testing.assert_close(weights[0][key], weights[1][key], rtol=1e-5, atol=1e-6)
+
+
+def test_stacked_seeds_on_a_gpu_are_one_process(tmp_path, capsys, monkeypatch):
+    from golfflight.model_export import real_training
+
+    monkeypatch.setattr(real_training, "resolve_device", lambda name: torch.device("cuda"))
     assert main(["train-real", "--work", str(tmp_path / "work"), "--data-root", str(tmp_path), "--stack-seeds",
-                 "--jobs", "2", "--quiet"]) == 2
-    assert "--jobs 2 or --stack-seeds: stacked seeds train in one process" in capsys.readouterr().err
+                 "--jobs", "2", "--device", "cuda", "--quiet"]) == 2
+    assert "--jobs 2 goes with --device cpu: on cuda the seeds run one after another, or side by side with " \
+           "--stack-seeds" in capsys.readouterr().err
     assert not (tmp_path / "work").exists()
 
 

@@ -41,7 +41,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--device", default="cpu", help="where to train: cpu (default) or cuda[:N] (with --jobs 1)")
     parser.add_argument("--stack-seeds", action="store_true",
                         help="train the seeds side by side in one rollout (each with its own minibatches, moments and "
-                        "clipping: the same runs up to float rounding), for about one seed's kernel launches on a GPU")
+                        "clipping: the same runs up to float rounding), for about one seed's kernel launches on a GPU; "
+                        "with --jobs N, the seeds shared out over N processes, each stacking its share")
     parser.add_argument("--compile", action="store_true",
                         help="fuse each Euler step's kernels, forward and backward, with torch.compile (compiled "
                         "once a run, in seconds to a minute; on a CPU it needs a C compiler)")
