@@ -200,26 +200,26 @@ class SeedPlan:
 def train_seed(data_file: Path, run_dir: Path, init: str | os.PathLike, config: JointConfig, threads: int,
                progress: bool, device: str = DEFAULT_DEVICE, compile_step: bool = False) -> JointResult:
     """One seed's joint run from the bundle `init` on `device` (a process of its own when seeds run in parallel)."""
-    import torch
-
-    torch.set_num_threads(threads)
-    model = _network(init)
-    model.train()
-    return train_joint(data_file, run_dir, config, model, progress, device, compile_step)
+    return train_joint(data_file, run_dir, config, _start(init, threads), progress, device, compile_step)
 
 
 def train_stacked(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig],
                   threads: int, progress: bool, device: str = DEFAULT_DEVICE, compile_step: bool = False
                   ) -> dict[str, JointResult]:
     """Seeds side by side in one rollout from the bundle `init` (`joint.train_joint_runs`), each in WORK/NAME."""
+    results = train_joint_runs(data_file, [work / name for name in configs], list(configs.values()),
+                               _start(init, threads), progress, device, compile_step)
+    return dict(zip(configs, results))
+
+
+def _start(init: str | os.PathLike, threads: int) -> nn.Module:
+    """The network of the bundle `init` in training mode, with torch on `threads` CPU threads in this process."""
     import torch
 
     torch.set_num_threads(threads)
     model = _network(init)
     model.train()
-    results = train_joint_runs(data_file, [work / name for name in configs], list(configs.values()), model, progress,
-                               device, compile_step)
-    return dict(zip(configs, results))
+    return model
 
 
 def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig],

@@ -37,7 +37,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--seeds", type=_seeds, default=(0, 1, 2))
     parser.add_argument("--lr", type=float, default=1e-3, help="Adam learning rate of the network")
     parser.add_argument("--threads", type=int, default=2, help="torch CPU threads per seed")
-    parser.add_argument("--jobs", type=int, default=1, help="seeds trained at once, each in its own process")
+    parser.add_argument("--jobs", type=int, default=1, help="processes training seeds at once: a seed each, or with "
+                        "--stack-seeds a share of the seeds each")
     parser.add_argument("--device", default="cpu", help="where to train: cpu (default) or cuda[:N] (with --jobs 1)")
     parser.add_argument("--stack-seeds", action="store_true",
                         help="train the seeds side by side in one rollout (each with its own minibatches, moments and "
