@@ -206,8 +206,9 @@ def cpu_share(bundle: Path, device: str, rows: int, rounds: int = 2) -> dict:
 def sweep_end_to_end(device: str, rows: int, threads: int | None, ray_workers: int | None = None,
                      compiled: bool = False) -> dict:
     """`golfflight sweep --engine torch` (`--compile` if `compiled`; or, with `ray_workers`, `--engine ray --device`
-    on that many actors, all on the one GPU with `--actors-per-gpu` where the device is cuda) on a grid of `rows` launches to Parquet, as its own process: wall seconds from start to
-    file written (loading and compiling included), and the command's own account of where the time went."""
+    on that many actors, all on the one GPU with `--actors-per-gpu` where the device is cuda) on a grid of `rows`
+    launches to Parquet, as its own process: wall seconds from start to file written (loading and compiling
+    included), and the command's own account of where the time went."""
     speeds = max(rows // 400, 1)
     grid = [f"ball_speed_mps=30:80:{speeds}", "launch_angle_deg=6:30:20", "spin_rpm=1500:9000:20"]
     shots = speeds * 400

@@ -79,7 +79,8 @@ def main() -> int:
     parser.add_argument("--seeds", default="0")
     parser.add_argument("--epochs", type=int, default=20)
     parser.add_argument("--jobs", type=int, default=2)
-    parser.add_argument("--stack-seeds", action="store_true", help="each weight set's seeds side by side, a process each")
+    parser.add_argument("--stack-seeds", action="store_true",
+                        help="each weight set's seeds side by side, a process each")
     args = parser.parse_args()
     started = time.perf_counter()
     args.work.mkdir(parents=True, exist_ok=True)

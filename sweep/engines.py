@@ -168,8 +168,8 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int | None, addres
     of `workers` actors of one CPU each, order preserved. Each actor flies with ONNX Runtime, or with the engine
     `make_engine` builds on its node (the torch engine), asking Ray for `gpus_per_actor` GPUs instead of a CPU (a
     fraction: several actors share a GPU): then `workers` None is as many actors as the cluster's GPUs hold
-    (`gpu_actors`), and one actor's engine is built on a
-    GPU of the cluster before the sweep starts, so that a node without torch or CUDA is refused in one line.
+    (`gpu_actors`), and one actor's engine is built on a GPU of the cluster before the sweep starts, so that a node
+    without torch or CUDA is refused in one line.
     Connects to the cluster at `address` if given (and leaves it running), else starts a local Ray instance with a
     CPU for each worker and one for reading (every CPU and GPU of this machine for GPU actors), and stops it after."""
     import logging

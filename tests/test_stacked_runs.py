@@ -127,7 +127,8 @@ def test_train_real_trains_its_seeds_stacked_each_in_its_folder(tmp_path):
 def test_stacked_seeds_shared_out_over_processes_are_the_seeds_stacked_in_one(tmp_path):
     """`--stack-seeds --jobs 2`: seeds 0 and 2 stacked in one process, 1 in another, each in its folder."""
     _windy_set(tmp_path / "windy.csv", {"a": (0.0, 1.0)}, n_per_group=6)
-    configs = {f"seed-{s}": JointConfig(epochs=1, batch_size=4, seed=s, weights={"sentry-2022": 1.0}) for s in (0, 1, 2)}
+    configs = {f"seed-{s}": JointConfig(epochs=1, batch_size=4, seed=s, weights={"sentry-2022": 1.0})
+               for s in (0, 1, 2)}
     init = REPO_ROOT / "models" / "default"
     shared = _train_seeds(tmp_path / "windy.csv", tmp_path / "shared", init, configs,
                           SeedPlan(jobs=2, threads=1, stacked=True), False)

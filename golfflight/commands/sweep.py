@@ -9,8 +9,8 @@ processes here, `--engine ray` through Ray Data (a local Ray instance, or a clus
 actor a GPU, or `--actors-per-gpu K` sharing each, so that one actor's host work, checking rows, rolling to rest and
 writing, overlaps another's flight; each engine sizes its batches to its share of the GPU's free memory;
 `--workers` left out is as many actors as the cluster's GPUs hold); `--device cpu` there flies it on each actor's
-CPU, the numbers of `--engine torch`. Needs the `sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray` and the
-`train` extra (torch) for `--engine torch` and `--device`.
+CPU, the numbers of `--engine torch`. Needs the `sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray`
+and the `train` extra (torch) for `--engine torch` and `--device`.
 """
 
 from __future__ import annotations
@@ -40,8 +40,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "file, the numbers simulate gives: on local processes (ONNX Runtime), Ray Data actors, or the model rebuilt in "
         "torch (--engine torch, on --device cpu or cuda). On a Ray cluster with GPUs, --engine ray --device cuda "
         "flies the torch engine in each actor on a GPU (--actors-per-gpu K sharing each), as many actors as the "
-        "cluster's GPUs hold unless --workers says fewer (e.g. golfflight sweep --grid ball_speed_mps=30:80:1000 launch_angle_deg=6:30:100 "
-        "spin_rpm=1500:9000:100 --out sweep.parquet --engine ray --device cuda --ray-address auto); it is refused in "
+        "cluster's GPUs hold unless --workers says fewer (e.g. golfflight sweep --grid ball_speed_mps=30:80:1000 "
+        "launch_angle_deg=6:30:100 spin_rpm=1500:9000:100 --out sweep.parquet --engine ray --device cuda "
+        "--ray-address auto); it is refused in "
         "one line where the cluster lists no GPU or a GPU worker cannot build the engine (no torch, no CUDA).",
     )
     parser.add_argument("launches", nargs="?", help="CSV or Parquet file of launches (simulate's CSV columns)")
