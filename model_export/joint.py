@@ -11,7 +11,8 @@ carry. Validation shots are flown calm in their recorded air (a range session's 
 the service would fly them. A run ends on its last epoch, where the cosine-decayed learning rates have settled it
 (picking the lowest of noisy per-epoch validation losses picked early, barely moved epochs); runs are compared by
 `selection_loss`: per validation source the carry's mean absolute error plus its absolute bias (what a simulator
-player feels), averaged over the sources with each counting equally.
+player feels), averaged over the sources with each counting equally. Seeds can train side by side in one rollout
+(`train_joint_runs`, `model_export.stacked_runs`): the latent conditions and noise factors then carry a run axis.
 """
 
 from __future__ import annotations
