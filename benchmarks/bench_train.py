@@ -28,11 +28,10 @@ from pathlib import Path
 import torch
 from common import REPO, RESULTS, write_results
 from golfflight.flight.bundle_location import model_dir
-from golfflight.model_export.bundle_model import model_from_bundle
 from golfflight.model_export.devices import resolve_device
-from golfflight.model_export.joint import JointConfig, JointResult, train_joint_runs
+from golfflight.model_export.joint import JointConfig, JointResult
 from golfflight.model_export.real_data import build
-from golfflight.model_export.real_training import DATA_FILE
+from golfflight.model_export.real_training import DATA_FILE, train_stacked
 from torch.utils._python_dispatch import TorchDispatchMode
 
 DATA_ROOT = REPO.parent / "shared" / "data"
@@ -57,13 +56,12 @@ class OpCounter(TorchDispatchMode):
 
 def train(data: Path, device: str, folder: Path, runs: int, epochs: int, compile_step: bool = False,
           counter: OpCounter | None = None) -> list[JointResult]:
-    """`epochs` epochs of `runs` seeds side by side from the shipped bundle's network (under `counter` if given)."""
-    model, _ = model_from_bundle(model_dir(None))
-    model.train()
-    configs = [replace(JointConfig(), epochs=epochs, seed=seed) for seed in range(runs)]
-    folders = [folder / f"seed-{seed}" for seed in range(runs)]
+    """`epochs` epochs of `runs` seeds side by side from the shipped bundle's network (under `counter` if given), as
+    `train-real --stack-seeds` trains them (`real_training.train_stacked`)."""
+    configs = {f"seed-{seed}": replace(JointConfig(), epochs=epochs, seed=seed) for seed in range(runs)}
     with counter or contextlib.nullcontext():
-        return train_joint_runs(data, folders, configs, model, False, device, compile_step)
+        return list(train_stacked(data, folder, model_dir(None), configs, torch.get_num_threads(), False, device,
+                                  compile_step).values())
 
 
 def measure(data: Path, device: str, folder: Path, runs: int, compile_step: bool) -> dict:

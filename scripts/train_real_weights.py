@@ -24,11 +24,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import torch
-from golfflight.model_export.bundle_model import model_from_bundle
-from golfflight.model_export.joint import JointConfig, felt_error_m, train_joint_runs
+from golfflight.model_export.joint import JointConfig, felt_error_m
 from golfflight.model_export.real_data import DEFAULT_SOURCES, build
-from golfflight.model_export.real_training import DATA_FILE, train_seed
+from golfflight.model_export.real_training import DATA_FILE, train_seed, train_stacked
 from golfflight.shots.markdown import table
 from golfflight.shots.paths import shared_data_dir
 
@@ -57,14 +55,11 @@ def run_one(data_file: Path, run_dir: Path, init: str, config: JointConfig) -> d
     return {"dir": str(run_dir), "weights": config.weights, "seed": config.seed, **(result.final or {})}
 
 
-def run_stacked(data_file: Path, run_dirs: list[Path], init: str, configs: list[JointConfig]) -> list[dict]:
-    """One weight set's seeds side by side in this process (one torch thread)."""
-    torch.set_num_threads(1)
-    model, _ = model_from_bundle(init)
-    model.train()
-    results = train_joint_runs(data_file, run_dirs, configs, model, progress=False)
-    return [{"dir": str(d), "weights": c.weights, "seed": c.seed, **(r.final or {})}
-            for d, c, r in zip(run_dirs, configs, results)]
+def run_stacked(data_file: Path, work: Path, init: str, configs: dict[str, JointConfig]) -> list[dict]:
+    """One weight set's seeds (WORK/NAME) side by side in this process (one torch thread)."""
+    results = train_stacked(data_file, work, init, configs, threads=1, progress=False)
+    return [{"dir": str(r.out_dir), "weights": configs[name].weights, "seed": configs[name].seed, **(r.final or {})}
+            for name, r in results.items()]
 
 
 def main() -> int:
@@ -97,8 +92,8 @@ def main() -> int:
             sets: dict[str, list[int]] = {}
             for i, c in enumerate(configs):
                 sets.setdefault(label(c.weights, grid), []).append(i)
-            futures = [pool.submit(run_stacked, data_file, [dirs[i] for i in runs], args.init,
-                                   [configs[i] for i in runs]) for runs in sets.values()]
+            futures = [pool.submit(run_stacked, data_file, args.work, args.init,
+                                   {dirs[i].name: configs[i] for i in runs}) for runs in sets.values()]
             runs = [run for f in futures for run in f.result()]
         else:
             futures = [pool.submit(run_one, data_file, d, args.init, c) for d, c in zip(dirs, configs)]

@@ -144,7 +144,8 @@ def _engines(args: argparse.Namespace):
         return _torch_maker(args, args.threads, PIECES_IN_FLIGHT)(model_dir(args.model).resolve()), RayEngine()
     if _torch_on_ray(args):
         sharing = args.actors_per_gpu or 1
-        return None, RayEngine(_torch_maker(args, args.threads or 1, sharing), (args.device == "cuda") / sharing)
+        gpus = 1 / sharing if args.device == "cuda" else 0
+        return None, RayEngine(_torch_maker(args, args.threads or 1, sharing), gpus)
     return None, RayEngine()
 
 
