@@ -226,7 +226,8 @@ def fly(model: Coefficients, shots: ObservedShots, config: JointConfig, latent: 
     """Euler rollout of the shots: with their latent conditions, or, when `latent` is None, calm in their recorded
     air times their source's fitted density factor (`source_density` [runs, sources], where given). `run` [n] is
     each shot's run where `model` is several stacked (`stacked_runs.StackedNetworks`); None: all of run 0. `step`:
-    `euler_step`, eager or compiled."""
+    `euler_step`, eager or compiled. The rollout stops once every shot has come down and its last path sample is
+    flown (`euler_rollout`'s `stop_after_s`): what is read of it, the landing, apex and path, is the same."""
     if run is None:
         run = torch.zeros(len(shots), dtype=torch.long, device=shots.source.device)
     if latent is None:
@@ -234,8 +235,10 @@ def fly(model: Coefficients, shots: ObservedShots, config: JointConfig, latent: 
         wind, density, scale = None, shots.density * factor, None
     else:
         wind, density, scale = latent.for_shots(shots, run)
+    last_sample_s = float(shots.path_times.max()) if shots.path_times.numel() else 0.0
     trajectory = euler_rollout(shots.position, shots.velocity, shots.spin, model, density, config.dt_s,
-                               config.t_sim_s, shots.reynolds_scale[:, None], wind, scale, step)
+                               config.t_sim_s, shots.reynolds_scale[:, None], wind, scale, step,
+                               stop_after_s=last_sample_s)
     landing = hard_landing(trajectory)
     v = landing.velocity
     angle = torch.rad2deg(torch.atan2(-v[:, 2], torch.linalg.vector_norm(v[:, :2], dim=-1)))

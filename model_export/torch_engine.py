@@ -9,9 +9,11 @@ viscosity as the Reynolds scale of the network's inputs), its wind (uniform, or 
 ball's height each step) and its ground's elevation, down to the engine's maximum flight time. The landing and apex
 are training's `hard_landing` and `apex`, which hold the integrator's rules (the state interpolated linearly to the
 ground's plane between the two steps around the first downward crossing; the parabola through the highest state and
-its neighbours), on heights measured from each shot's ground. Each shot is flown for the whole batch's steps (fixed
-shapes), a part stopping once every shot of it has come down; a shot never down by the maximum flight time, or whose
-figures are not finite, fails with the engine's message (the batch is flown in parts that fit the device).
+its neighbours), on heights measured from each shot's ground. A part's shots fly together; every LANDING_CHECK_STEPS
+steps those that have come down are set aside once they are SET_ASIDE_SHARE of those flying (`Aloft`: a sweep's
+shots land from one to ten seconds after the launch, and a part otherwise flies every shot for its longest flight),
+the part stopping once every shot has come down; a shot never down by the maximum flight time, or whose figures are
+not finite, fails with the engine's message (the batch is flown in parts that fit the device).
 
 The ground phase (bounce and roll) of the landing states in float64 is the engine's own: on a GPU its formulas run on
 the device (`torch_ground`, the batch's bookkeeping in torch), on a CPU its NumPy code (`flight.ground.ground_phase`).
@@ -30,7 +32,7 @@ import os
 import threading
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import torch
@@ -44,7 +46,7 @@ from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.model_export import torch_ground
 from golfflight.model_export.bundle_model import model_from_bundle
 from golfflight.model_export.devices import resolve_device
-from golfflight.model_export.torch_physics import Trajectory, apex, euler_step, hard_landing
+from golfflight.model_export.torch_physics import LANDING_CHECK_STEPS, Trajectory, apex, euler_step, hard_landing
 
 DTYPES = {"float32": torch.float32, "float64": torch.float64}
 """The physics' precisions by name (the network always runs in float32, as the bundle's graph does)."""
@@ -69,8 +71,9 @@ STAGES = ("prepare", "flight", "ground")
 to the landings back in NumPy (the device, transfers included), its figures and ground phase (the CPU, and the device
 where the ground phase runs there)."""
 
-LANDING_CHECK_STEPS = 10
-"""Steps between the checks whether every shot of a part has come down (each check waits for the device)."""
+SET_ASIDE_SHARE = 0.125
+"""The shots of a part that must have come down since they were last set aside before the rest fly on without them
+(each setting aside gathers the rest's states and air: not worth it for a few)."""
 
 
 @dataclass(frozen=True)
@@ -107,6 +110,52 @@ class Landings:
     apex_m: np.ndarray
     apex_time_s: np.ndarray
     landed: np.ndarray
+
+
+@dataclass(frozen=True)
+class Aloft:
+    """The shots of a part the step still flies, as torch tensors on the device: their rows of the part (None: every
+    row), their state, whether each has come down through its ground's plane, their air and ground, and their wind
+    (`_wind`'s four)."""
+
+    rows: torch.Tensor | None
+    position: torch.Tensor
+    velocity: torch.Tensor
+    spin: torch.Tensor
+    down: torch.Tensor
+    density: torch.Tensor
+    scale: torch.Tensor
+    ground: torch.Tensor
+    wind: tuple[torch.Tensor | None, ...]
+
+    def step_inputs(self) -> tuple[torch.Tensor | None, ...]:
+        """`flight_step`'s arguments after its coefficients and dt."""
+        return (self.position, self.velocity, self.spin, self.down, self.density, self.scale, self.ground,
+                *self.wind)
+
+    def stepped(self, state: tuple[torch.Tensor, ...]) -> Aloft:
+        """These shots with `flight_step`'s new position, velocity, spin and down."""
+        position, velocity, spin, down = state
+        return replace(self, position=position, velocity=velocity, spin=spin, down=down)
+
+    def keep(self, states: list[torch.Tensor], step: int) -> None:
+        """Write these shots' position, velocity and spin as the part's `step` ([steps + 1, N, 3] each); a shot set
+        aside keeps the state it was set aside in, below its ground, so that the landing and apex read the same
+        first crossing and highest state as if it had flown on."""
+        for kept, now in zip(states, (self.position, self.velocity, self.spin), strict=True):
+            if self.rows is None:
+                kept[step] = now
+            else:
+                kept[step] = kept[step - 1]
+                kept[step, self.rows] = now
+
+    def still_up(self) -> Aloft:
+        """The shots of these not yet down (waits for the device: which they are)."""
+        up = torch.nonzero(self.down.logical_not()).squeeze(1)
+        rows = up if self.rows is None else self.rows[up]
+        wind = tuple(None if part is None else part[up] for part in self.wind)
+        return Aloft(rows, self.position[up], self.velocity[up], self.spin[up], self.down[up], self.density[up],
+                     self.scale[up], self.ground[up], wind)
 
 
 class TorchEngine:
@@ -227,7 +276,8 @@ class TorchEngine:
     @torch.no_grad()
     def _fly_part(self, shots: ShotInputs) -> Landings:
         """One part's flights on the device: forward Euler from the launch until every shot has come down through its
-        ground's plane or the maximum flight time has passed, then training's landing and apex."""
+        ground's plane or the maximum flight time has passed (the shots down set aside as they land, `Aloft`), then
+        training's landing and apex."""
         def tensor(array: np.ndarray) -> torch.Tensor:
             return torch.as_tensor(array, dtype=self.dtype, device=self.device)
 
@@ -240,14 +290,18 @@ class TorchEngine:
         for kept, now in zip(states, (position, velocity, spin), strict=True):
             kept[0] = now
         down = torch.zeros(len(position), dtype=torch.bool, device=self.device)
+        aloft = Aloft(None, position, velocity, spin, down, density, scale, ground, wind)
         last = steps
         for step in range(1, steps + 1):
-            position, velocity, spin, down = self.step(position, velocity, spin, down, density, scale, ground, *wind)
-            for kept, now in zip(states, (position, velocity, spin), strict=True):
-                kept[step] = now
-            if step % LANDING_CHECK_STEPS == 0 and bool(down.all()):
-                last = step
-                break
+            aloft = aloft.stepped(self.step(*aloft.step_inputs()))
+            aloft.keep(states, step)
+            if step % LANDING_CHECK_STEPS == 0:
+                up = int(aloft.down.logical_not().sum())
+                if up == 0:
+                    last = step
+                    break
+                if up <= len(aloft.down) * (1 - SET_ASIDE_SHARE) and up > 1:
+                    aloft = aloft.still_up()
         positions = states[0][: last + 1]
         positions[:, :, 2] -= ground  # heights above each shot's ground: its plane is the landing's z = 0
         trajectory = Trajectory(positions, states[1][: last + 1], states[2][: last + 1], self.flyer.dt_s)

@@ -23,6 +23,9 @@ DT_S = 0.1
 T_SIM_S = 10.0
 """Simulated time (section 2.3.2): longer than any flight in the data, so 100 network calls."""
 
+LANDING_CHECK_STEPS = 10
+"""Steps between the checks whether every shot has come down (each waits for the device: not every step)."""
+
 LANDING_SEARCH_START_S = 1.0
 """The soft-argmax landing (`soft_landing`, training's L_p) searches from i_s = floor(1 s / dt) on, so the tee
 (r_z = 1 cm) is never taken for the landing."""
@@ -156,17 +159,26 @@ def euler_rollout(
     wind: torch.Tensor | None = None,
     coefficient_scale: torch.Tensor | None = None,
     step: EulerStep = euler_step,
+    stop_after_s: float | None = None,
 ) -> Trajectory:
-    """Forward Euler over the whole t_sim for every shot (no early stop: fixed shapes stay batched, differentiable);
-    `wind` and `coefficient_scale` as in `derivatives`; `step` is `euler_step`, eager or compiled."""
+    """Forward Euler for every shot together (fixed shapes stay batched, differentiable) over the whole t_sim, or,
+    with `stop_after_s`, to the first check (every LANDING_CHECK_STEPS steps) at or after that time where every shot
+    has come down: started above z = 0 and below it now. What reads the states only up to each shot's landing and up
+    to `stop_after_s` (`hard_landing`, `apex`, `positions_at` up to that time) then reads the same numbers, and the
+    steps after the last landing are not flown. `wind` and `coefficient_scale` as in `derivatives`; `step` is
+    `euler_step`, eager or compiled."""
     positions, velocities, spins = [position], [velocity], [spin]
-    for _ in range(int(round(t_sim / dt))):
+    started_up = position[:, 2].detach() > 0
+    for done in range(1, round(t_sim / dt) + 1):
         position, velocity, spin = step(
             position, velocity, spin, coefficients, density, dt, reynolds_scale, wind, coefficient_scale
         )
         positions.append(position)
         velocities.append(velocity)
         spins.append(spin)
+        if (stop_after_s is not None and done % LANDING_CHECK_STEPS == 0 and done * dt >= stop_after_s
+                and bool((started_up & (position[:, 2].detach() <= 0)).all())):
+            break
     return Trajectory(torch.stack(positions), torch.stack(velocities), torch.stack(spins), dt)
 
 

@@ -88,7 +88,8 @@ def predict(
     model: nn.Module, shots: ShotTensors, config: TrainConfig, soft: bool
 ) -> tuple[torch.Tensor, torch.Tensor | None]:
     """Landing point [N,2] and apex [N] (None for the NN baseline): soft-argmax landing for training, the runtime's
-    landing (first crossing interpolated to r_z = 0) for validation; the apex as the runtime measures it."""
+    landing (first crossing interpolated to r_z = 0) for validation; the apex as the runtime measures it. The soft
+    landing weighs every step; validation's rollout stops once every shot has come down (`euler_rollout`)."""
     if config.variant == "nn":
         return model(shots.velocity, shots.spin), None
     trajectory = euler_rollout(
@@ -100,6 +101,7 @@ def predict(
         config.dt_s,
         config.t_sim_s,
         shots.reynolds_scale[:, None],
+        stop_after_s=None if soft else 0.0,
     )
     if soft:
         landing = soft_landing(trajectory, config.soft_argmax_temperature_m)

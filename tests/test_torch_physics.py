@@ -17,6 +17,7 @@ from golfflight.model_export.torch_physics import (
     derivatives,
     euler_rollout,
     hard_landing,
+    positions_at,
     soft_landing,
 )
 from golfflight.model_export.variants import PhysQ
@@ -175,3 +176,34 @@ def test_soft_landing_has_gradients_and_no_landing_is_flagged():
         assert drag.grad is not None and torch.isfinite(drag.grad) and drag.grad < 0
     short = Trajectory(trajectory.positions[:15], trajectory.velocities[:15], trajectory.spins[:15], 0.1)
     assert not hard_landing(short).landed.any()
+
+
+def test_a_rollout_stopped_once_every_shot_is_down_reads_the_same_landing_apex_path_and_gradient(launch_state):
+    """`stop_after_s`: the rollout stops at the first check after that time where every shot has come down, flying
+    fewer steps; the landing, apex and positions up to that time are the full rollout's, and so is the gradient of a
+    loss of them. A shot started at or below the ground has not come down by being below it: the rollout runs on."""
+    model = PhysQ(dtype=torch.float64)
+    start = [_torch(getattr(launch_state, name)) for name in ("position", "velocity", "spin")]
+    with torch.no_grad():
+        down_by_7_s = hard_landing(euler_rollout(*start, model, DENSITY)).time_s < 7.0
+    start = [state[down_by_7_s] for state in start]
+    times = torch.linspace(0.0, 3.0, 7, dtype=torch.float64).expand(len(start[0]), 7)
+
+    def measured(stop_after_s: float | None) -> tuple[list[torch.Tensor], list[torch.Tensor], int]:
+        model.zero_grad()
+        trajectory = euler_rollout(*start, model, DENSITY, stop_after_s=stop_after_s)
+        landing = hard_landing(trajectory)
+        figures = [landing.position, landing.velocity, landing.time_s, apex(trajectory).height_m,
+                   positions_at(trajectory, times)]
+        sum(figure.sum() for figure in figures).backward()
+        return figures, [p.grad.clone() for p in model.parameters()], trajectory.positions.shape[0]
+
+    full, full_gradient, full_steps = measured(None)
+    stopped, stopped_gradient, stopped_steps = measured(3.0)
+    assert len(times) > 32 and full_steps == 101 and stopped_steps == 71
+    for want, got in zip(full + full_gradient, stopped + stopped_gradient, strict=True):
+        torch.testing.assert_close(got, want, rtol=0, atol=0)
+    assert euler_rollout(*start, model, DENSITY, stop_after_s=9.0).positions.shape[0] == 91  # not before 9 s
+    below = start[0].clone()
+    below[0, 2] = -0.01
+    assert euler_rollout(below, *start[1:], model, DENSITY, stop_after_s=0.0).positions.shape[0] == 101
