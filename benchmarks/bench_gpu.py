@@ -1,6 +1,7 @@
 """The torch engine (`golfflight sweep --engine torch`, `model_export.torch_engine`) on one device: shots per second
 against batch size (the flight alone, eager and with its Euler step compiled, and with its launch states and ground
-phase, the ground phase where the engine puts it and on the other side: the device or NumPy on the CPU), peak memory,
+phase, the ground phase where the engine puts it and on the other side: the device or NumPy on the CPU; and eager
+with every shot flown to its part's last step, the landed shots never set aside), peak memory,
 carry parity with the ONNX Runtime engine on 10,000 mixed shots (float32 and float64 physics, float32
 compiled), the CPU's share of a sweep in microseconds a row (what caps a sweep however fast the device flies), and
 sweeps end to end through the command line. Writes the section `torch_engine_<cpu|cuda>` of benchmarks/results.json
@@ -9,7 +10,7 @@ the landings back in NumPy (the device's transfers included); around it are the 
 it, and the figures and the bounce and roll of the landings after it (`torch_engine.STAGES`); the CPU's share of a
 sweep is all but the flight, the driver's work included.
 
-One command on a lent GPU machine (estimated at 5-6 minutes on an H100, not yet run there: three engines at five batch
+One command on a lent GPU machine (estimated at 6-7 minutes on an H100, not yet run there: four engines at five batch
 sizes, three compilations, and five sweeps of 4,194,304 rows; each measurement is written to benchmarks/results.json
 as soon as it is made, so a run cut short keeps what it measured; copy that file into $OUT;
 --ray-workers 1,2,4 also sweeps the same grid through `--engine ray --device cuda` with that many actors sharing the
@@ -106,9 +107,8 @@ def timed(engine: TorchEngine, launches: np.ndarray, rounds: int) -> dict[str, f
 
 
 def throughput(engines: dict[str, TorchEngine], batches: list[int], rounds: int) -> list[dict]:
-    """Shots/s of the flight (each engine: eager, compiled, the ground phase on the other side) and of the whole batch
-    with its launch states and ground phase, and peak memory, at each batch size; the engines interleaved at each
-    size."""
+    """Shots/s of the flight (each engine of `warmed_engines`) and of the whole batch with its launch states and ground
+    phase, and peak memory, at each batch size; the engines interleaved at each size."""
     rows = []
     for n in batches:
         launches = launches_array(n)
@@ -248,14 +248,16 @@ def print_table(section: dict) -> None:
 
 
 def warmed_engines(bundle: Path, device: str) -> tuple[dict[str, TorchEngine], dict[str, str]]:
-    """The engines to time (eager, compiled, the ground phase on the other side), each flown once (the first
-    kernels, allocations and compilation), and why any could not be (a device's compiler missing, say): on a lent
-    machine's few minutes, one engine that fails must not lose the others' numbers."""
+    """The engines to time (eager, compiled, the ground phase on the other side, and eager with every shot flown to
+    its part's last step: landed shots never set aside), each flown once (the first kernels, allocations and
+    compilation), and why any could not be (a device's compiler missing, say): on a lent machine's few minutes, one
+    engine that fails must not lose the others' numbers."""
     eager = TorchEngine(bundle, device)
     elsewhere = "cpu" if eager.ground_on_device else "device"
     makers = {"eager": lambda: eager, "compiled": lambda: TorchEngine(bundle, device, compile_step=True),
               f"ground on {elsewhere}": lambda: TorchEngine(bundle, device,
-                                                            ground_on_device=not eager.ground_on_device)}
+                                                            ground_on_device=not eager.ground_on_device),
+              "none set aside": lambda: TorchEngine(bundle, device, set_aside_share=1.0)}
     engines, failed = {}, {}
     for name, make in makers.items():
         try:

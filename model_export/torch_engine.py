@@ -72,8 +72,8 @@ to the landings back in NumPy (the device, transfers included), its figures and 
 where the ground phase runs there)."""
 
 SET_ASIDE_SHARE = 0.125
-"""The shots of a part that must have come down since they were last set aside before the rest fly on without them
-(each setting aside gathers the rest's states and air: not worth it for a few)."""
+"""The share of a part's flying shots that must have come down before the rest fly on without them (each setting
+aside gathers the rest's states and air: not worth it for a few)."""
 
 
 @dataclass(frozen=True)
@@ -164,23 +164,26 @@ class TorchEngine:
 
     def __init__(self, bundle_dir: str | os.PathLike, device: str = "cpu", dtype: str = "float32",
                  part_shots: int | None = None, parts_at_once: int = 1, compile_step: bool = False,
-                 ground_on_device: bool | None = None) -> None:
+                 ground_on_device: bool | None = None, set_aside_share: float = SET_ASIDE_SHARE) -> None:
         """Load and verify the bundle (`flight.flyer.load_flyer`, the engine's checks: its step, maximum flight time,
         nominal air and error messages are this engine's) and rebuild its network in torch on `device`; `dtype`
         is the physics' precision; `part_shots` caps the shots flown at once (default: what the device's memory
         holds, shared by `parts_at_once` threads flying batches on this engine at once); `compile_step` fuses each
         Euler step's kernels with torch.compile (`step`: `flight_step`, compiled or eager, once for any part's size);
         `ground_on_device` bounces and rolls the landings on the device (`torch_ground`; default: on a GPU) instead
-        of NumPy's on the CPU. `devices.DeviceError` for a device this machine lacks, ValueError for a dtype it does
-        not know."""
+        of NumPy's on the CPU; `set_aside_share` is the share of a part's flying shots that must be down before they
+        are set aside (1: never, every shot flies to the part's last step). `devices.DeviceError` for a device this
+        machine lacks, ValueError for a dtype it does not know or a share outside (0, 1]."""
         if dtype not in DTYPES:
             raise ValueError(f"dtype {dtype!r}: choose from {', '.join(DTYPES)}")
+        if not 0 < set_aside_share <= 1:
+            raise ValueError(f"set_aside_share {set_aside_share}: must be more than 0 and at most 1")
         self.device, self.dtype = resolve_device(device), DTYPES[dtype]
         self.flyer = load_flyer(bundle_dir)
         self.card, self.sha256 = self.flyer.card, self.flyer.card.onnx.sha256
         model, _ = model_from_bundle(self.flyer.bundle_dir)
         self.model = model.to(self.device)
-        self.part_limit, self.parts_at_once = part_shots, parts_at_once
+        self.part_limit, self.parts_at_once, self.set_aside_share = part_shots, parts_at_once, set_aside_share
         self.ground_on_device = self.device.type == "cuda" if ground_on_device is None else ground_on_device
         self.seconds = dict.fromkeys(STAGES, 0.0)
         self._timing = threading.Lock()
@@ -300,7 +303,7 @@ class TorchEngine:
                 if up == 0:
                     last = step
                     break
-                if up <= len(aloft.down) * (1 - SET_ASIDE_SHARE) and up > 1:
+                if up <= len(aloft.down) * (1 - self.set_aside_share) and up > 1:
                     aloft = aloft.still_up()
         positions = states[0][: last + 1]
         positions[:, :, 2] -= ground  # heights above each shot's ground: its plane is the landing's z = 0

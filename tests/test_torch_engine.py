@@ -161,7 +161,7 @@ def test_a_batch_split_into_parts_flies_the_same_numbers(shots):
 
 def test_shots_set_aside_as_they_land_fly_the_same_numbers(shots, monkeypatch):
     """Shots that have come down are set aside while the rest fly on (`torch_engine.Aloft`): the same figures, errors
-    and rests as when every shot flies to the part's last step (SET_ASIDE_SHARE 1: never set aside), to the float32
+    and rests as when every shot flies to the part's last step (a share of 1: never set aside), to the float32
     network's ulp (a row of a matrix product can round differently beside other rows), and fewer shot-steps flown."""
     bundle = load_flyer(None).bundle_dir
     flown = []
@@ -174,8 +174,7 @@ def test_shots_set_aside_as_they_land_fly_the_same_numbers(shots, monkeypatch):
     monkeypatch.setattr(torch_engine, "flight_step", counted)
     aside = TorchEngine(bundle, "cpu", "float64").fly_columns(*shots)
     aside_steps, flown[:] = sum(flown), []
-    monkeypatch.setattr(torch_engine, "SET_ASIDE_SHARE", 1.0)
-    together = TorchEngine(bundle, "cpu", "float64").fly_columns(*shots)
+    together = TorchEngine(bundle, "cpu", "float64", set_aside_share=1.0).fly_columns(*shots)
     assert aside.errors == together.errors and {1, 2} <= set(aside.errors)
     for name in FIGURES:
         np.testing.assert_allclose(getattr(aside, name), getattr(together, name), rtol=1e-8, atol=1e-6, err_msg=name)
@@ -183,6 +182,8 @@ def test_shots_set_aside_as_they_land_fly_the_same_numbers(shots, monkeypatch):
     np.testing.assert_array_equal(aside.rest.bounces, together.rest.bounces)
     assert sum(flown) == SHOTS * torch_engine.load_flyer(None).max_steps  # two shots never land: every step flown
     assert aside_steps < 0.6 * sum(flown)
+    with pytest.raises(ValueError, match="set_aside_share 0: must be more than 0 and at most 1"):
+        TorchEngine(bundle, "cpu", set_aside_share=0)
 
 def sweep(*argv) -> int:
     return main(["sweep", *map(str, argv), "--no-progress"])
