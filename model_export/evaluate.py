@@ -191,8 +191,9 @@ class CoefficientSamples:
 
 @torch.no_grad()
 def coefficient_samples(model: nn.Module, config: TrainConfig, val: ValidationSet, air: Air) -> CoefficientSamples:
-    """The model's C_L, C_D, C_Q against the spin ratio at every in-flight step of its own validation rollouts, and
-    the reference world's C_L, C_D at the same states in `air` (its Reynolds numbers)."""
+    """The model's C_L, C_D, C_Q against the spin ratio at every in-flight step of its own validation rollouts (each
+    stopped once its shots are down), and the reference world's C_L, C_D at the same states in `air` (its Reynolds
+    numbers)."""
     model = model.double().eval()
     parts: list[list[np.ndarray]] = [[] for _ in range(4)]
     states: list[tuple[np.ndarray, np.ndarray]] = []
@@ -208,6 +209,7 @@ def coefficient_samples(model: nn.Module, config: TrainConfig, val: ValidationSe
             config.dt_s,
             config.t_sim_s,
             scale[:, None],
+            stop_after_s=0.0,
         )
         landing_time = hard_landing(trajectory).time_s
         times = torch.arange(trajectory.positions.shape[0], dtype=torch.float64)[:, None] * config.dt_s
