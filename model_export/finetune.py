@@ -127,10 +127,12 @@ def finetune(
     seed: int = 0,
     progress: bool = True,
     device: str = DEFAULT_DEVICE,
+    compile_step: bool = False,
 ) -> FinetuneResult:
     """Fine-tune `model` on `data` for `epochs` and export OUT (model.onnx + model_card.json) from the best epoch,
     if it beats the base model's validation landing error; the run goes to OUT/finetune-run/. With `progress`, its
-    steps and epochs go to standard error and a line per epoch to standard output; `device` as `training.train`'s."""
+    steps and epochs go to standard error and a line per epoch to standard output; `device` and `compile_step` as
+    `training.train` takes them."""
     if epochs < 1:
         raise ValueError(f"epochs must be at least 1, got {epochs}")
     where = resolve_device(device)
@@ -141,7 +143,8 @@ def finetune(
     train_file = prepare_data(data, val_fraction, run_dir)
     progress_step("measuring the starting model on the validation shots...", progress)
     before = _base_metrics(base, config, train_file, where)
-    result = train(train_file, run_dir, config, progress=progress, init_state=base.state, device=device)
+    result = train(train_file, run_dir, config, progress=progress, init_state=base.state, device=device,
+                   compile_step=compile_step)
     improved = result.best is not None and result.best["landing_error_m"] < before["landing_error_m"]
     progress_step(f"exporting {out}...", progress and improved)
     card = export_checkpoint(run_dir, out) if improved else None

@@ -47,6 +47,7 @@ from golfflight.model_export.torch_physics import (
     euler_step,
     hard_landing,
     positions_at,
+    training_step,
 )
 from golfflight.model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, load_checkpoint, save_checkpoint
 from golfflight.shots.files import write_text_atomic
@@ -405,9 +406,9 @@ def train_joint_runs(data_path: str | os.PathLike, out_dirs: list[str | os.PathL
     where = resolve_device(device)
     torch.set_flush_denormal(True)
     try:
-        step = torch.compile(euler_step, dynamic=True) if compile_step else euler_step
         return _train_joint(Path(data_path), [Path(d) for d in out_dirs], configs,
-                            StackedNetworks(init, len(configs)).to(where), progress, where, step)
+                            StackedNetworks(init, len(configs)).to(where), progress, where,
+                            training_step(compile_step))
     finally:
         torch.set_flush_denormal(False)
 

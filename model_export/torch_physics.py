@@ -147,6 +147,12 @@ EulerStep = Callable[..., tuple[torch.Tensor, torch.Tensor, torch.Tensor]]
 """`euler_step` or the same compiled (`torch.compile`), as `euler_rollout` takes it."""
 
 
+def training_step(compiled: bool) -> EulerStep:
+    """`euler_step`, or, `compiled`, the same with its kernels fused by torch.compile, forward and backward
+    (`dynamic=True`: one compilation for every batch size)."""
+    return torch.compile(euler_step, dynamic=True) if compiled else euler_step
+
+
 def euler_rollout(
     position: torch.Tensor,
     velocity: torch.Tensor,

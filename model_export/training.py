@@ -24,9 +24,12 @@ from golfflight.model_export.torch_physics import (
     DT_S,
     SOFT_ARGMAX_TEMPERATURE_M,
     T_SIM_S,
+    EulerStep,
     euler_rollout,
+    euler_step,
     hard_landing,
     soft_landing,
+    training_step,
 )
 from golfflight.model_export.variants import build_model
 from golfflight.shots.files import write_atomic, write_text_atomic
@@ -85,11 +88,12 @@ class RunResult:
 
 
 def predict(
-    model: nn.Module, shots: ShotTensors, config: TrainConfig, soft: bool
+    model: nn.Module, shots: ShotTensors, config: TrainConfig, soft: bool, step: EulerStep = euler_step
 ) -> tuple[torch.Tensor, torch.Tensor | None]:
     """Landing point [N,2] and apex [N] (None for the NN baseline): soft-argmax landing for training, the runtime's
     landing (first crossing interpolated to r_z = 0) for validation; the apex as the runtime measures it. The soft
-    landing weighs every step; validation's rollout stops once every shot has come down (`euler_rollout`)."""
+    landing weighs every step; validation's rollout stops once every shot has come down (`euler_rollout`). `step`:
+    `euler_step`, eager or compiled."""
     if config.variant == "nn":
         return model(shots.velocity, shots.spin), None
     trajectory = euler_rollout(
@@ -101,6 +105,7 @@ def predict(
         config.dt_s,
         config.t_sim_s,
         shots.reynolds_scale[:, None],
+        step=step,
         stop_after_s=None if soft else 0.0,
     )
     if soft:
@@ -124,14 +129,16 @@ def errors(landing: torch.Tensor, apex: torch.Tensor | None, shots: ShotTensors)
 
 
 @torch.no_grad()
-def validate(model: nn.Module, shots: ShotTensors, config: TrainConfig) -> dict[str, float]:
-    """Validation metrics with the runtime's landing and apex (`torch_physics.hard_landing`, `apex`), in m and yd."""
+def validate(model: nn.Module, shots: ShotTensors, config: TrainConfig, step: EulerStep = euler_step
+             ) -> dict[str, float]:
+    """Validation metrics with the runtime's landing and apex (`torch_physics.hard_landing`, `apex`), in m and yd
+    (`step` as `predict` takes it)."""
     model.eval()
     sums = {"landing": 0.0, "apex": 0.0}
     for start in range(0, len(shots), VALIDATION_BATCH):
         stop = min(start + VALIDATION_BATCH, len(shots))
         batch = shots.take(torch.arange(start, stop, device=shots.position.device))
-        landing, apex = predict(model, batch, config, soft=False)
+        landing, apex = predict(model, batch, config, soft=False, step=step)
         l_p, l_h = errors(landing, apex, batch)
         sums["landing"] += float(l_p) * int(batch.landing_mask.sum())
         sums["apex"] += float(l_h) * int(batch.apex_mask.sum())
@@ -193,6 +200,7 @@ def _train_epoch(
     config: TrainConfig,
     epoch: int,
     progress: bool,
+    step: EulerStep,
 ) -> dict[str, Any]:
     """One pass over the training shots in a seeded order (drawn on the CPU, so every device takes the same); a
     batch whose loss or gradient is not finite is skipped (no optimiser step) and counted. Returns the mean L_p, L_h
@@ -205,7 +213,7 @@ def _train_epoch(
     for b in bar:
         batch = shots.take(order[b * config.batch_size : (b + 1) * config.batch_size])
         optimizer.zero_grad(set_to_none=True)
-        l_p, l_h = errors(*predict(model, batch, config, soft=True), batch)
+        l_p, l_h = errors(*predict(model, batch, config, soft=True, step=step), batch)
         loss = l_p + l_h if config.loss == "lp+lh" else l_p
         if not torch.isfinite(loss):
             skipped += 1
@@ -247,13 +255,15 @@ def train(
     init_state: dict[str, torch.Tensor] | None = None,
     skip_bad_rows: bool = False,
     device: str = DEFAULT_DEVICE,
+    compile_step: bool = False,
 ) -> RunResult:
     """Train `config.variant` on the file's train split, validating on its val split after every epoch.
 
     `init_state` starts from these weights instead of a fresh initialisation (fine-tuning; with `resume`, the run's
     own last.pt wins); `skip_bad_rows` leaves malformed rows of the data file out (listed in the result's data
     summary) instead of refusing it; `device` is where the model and the shots live ("cpu", "cuda"; the model is
-    initialised and the batches drawn on the CPU either way, `devices.DeviceError` where it is missing).
+    initialised and the batches drawn on the CPU either way, `devices.DeviceError` where it is missing);
+    `compile_step` fuses each Euler step's kernels, forward and backward, with torch.compile (`training_step`).
     Denormal floats are flushed to zero while training (without it the first backward passes through the rollout
     hit denormals and a CPU batch runs 20-100x slower), and the CPU's normal mode is restored afterwards."""
     if config.loss == "observables":
@@ -261,7 +271,8 @@ def train(
     where = resolve_device(device)
     torch.set_flush_denormal(True)
     try:
-        return _train(data_path, out_dir, config, resume, progress, init_state, skip_bad_rows, where)
+        return _train(data_path, out_dir, config, resume, progress, init_state, skip_bad_rows, where,
+                      training_step(compile_step))
     finally:
         torch.set_flush_denormal(False)
 
@@ -275,6 +286,7 @@ def _train(
     init_state: dict[str, torch.Tensor] | None,
     skip_bad_rows: bool,
     device: torch.device,
+    step: EulerStep,
 ) -> RunResult:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -300,9 +312,9 @@ def _train(
 
     for epoch in range(first_epoch, config.epochs + 1):
         started = time.perf_counter()
-        row = {"epoch": epoch, **_train_epoch(model, optimizer, train_set, config, epoch, progress)}
+        row = {"epoch": epoch, **_train_epoch(model, optimizer, train_set, config, epoch, progress, step)}
         row["train_seconds"] = time.perf_counter() - started
-        metrics = validate(model, val_set, config)
+        metrics = validate(model, val_set, config, step)
         row |= {"epoch_seconds": time.perf_counter() - started, **{f"val_{k}": v for k, v in metrics.items()}}
         history.append(row)
         if progress:

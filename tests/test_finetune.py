@@ -129,6 +129,7 @@ def test_command_line(base, unsplit, tmp_path, capsys):
         "32",
         "--out",
         str(tmp_path / "mine"),
+        "--compile",
     ]
     assert main(args) == 0
     out = capsys.readouterr().out

@@ -12,6 +12,8 @@ from golfflight.model_export.data import load_training_data
 from golfflight.model_export.training import TrainConfig, load_checkpoint, train
 from golfflight.shots.records import read_shots
 
+from golfflight.cli import main
+
 torch.set_num_threads(1)  # tiny models: one thread is as fast, and immune to other jobs on the 2 cores
 
 TINY = dict(variant="phys-nn-pm", hidden=(32, 16), batch_size=32, lr=3e-3)
@@ -104,3 +106,18 @@ def test_nn_baseline_trains_on_landing_only(tiny_shots, tmp_path):
         progress=False,
     )
     assert math.isfinite(result.best["landing_error_m"]) and "max_height_error_m" not in result.best
+
+
+def test_a_compiled_step_trains_what_the_eager_step_trains(run, tiny_shots, tmp_path):
+    """`golfflight train --compile`: the Euler step fused by torch.compile, forward and backward (the soft landing's
+    rollout and validation's), changes rounding only: the eager run's weights and validation errors after three
+    epochs. Compiled from an empty cache: torch.compile keeps its versions of `euler_step` by the function."""
+    torch._dynamo.reset()
+    assert main(["train", "--data", str(tiny_shots), "--out", str(tmp_path), "--variant", TINY["variant"],
+                 "--hidden", ",".join(map(str, TINY["hidden"])), "--batch-size", str(TINY["batch_size"]),
+                 "--lr", str(TINY["lr"]), "--epochs", "3", "--threads", "1", "--quiet", "--compile"]) == 0
+    eager, compiled = (load_checkpoint(folder / "last.pt") for folder in (run.out_dir, tmp_path))
+    for name, tensor in eager["model"].items():
+        torch.testing.assert_close(compiled["model"][name], tensor, rtol=1e-4, atol=1e-6)
+    for key in ("landing_error_m", "max_height_error_m"):
+        assert compiled["metrics"][key] == pytest.approx(eager["metrics"][key], rel=1e-4)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from golfflight.commands.train import COMPILE_HELP
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
@@ -30,6 +32,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--device", default="cpu", help="where to train: cpu (default) or cuda[:N]")
+    parser.add_argument("--compile", action="store_true", help=COMPILE_HELP)
     parser.add_argument(
         "--quiet", action="store_true", help="no progress on standard error and no line per epoch on standard output"
     )
@@ -53,6 +56,7 @@ def run(args: argparse.Namespace) -> int:
         args.seed,
         progress=not args.quiet,
         device=args.device,
+        compile_step=args.compile,
     )
     data, base = result.run.data, result.base_metrics
     print(f"data: {data.n_train} train, {data.n_val} val shots; left out {data.filters}")

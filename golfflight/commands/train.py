@@ -6,6 +6,10 @@ import argparse
 
 from golfflight.model_export import DEFAULT_HIDDEN, VARIANTS
 
+COMPILE_HELP = ("fuse each Euler step's kernels, forward and backward, with torch.compile (compiled once a run, in "
+                "seconds to a minute; on a CPU it needs a C compiler)")
+"""`--compile` of the commands that train (`train`, `train-real`, `finetune`)."""
+
 
 def _hidden(text: str) -> tuple[int, ...]:
     try:
@@ -45,6 +49,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--threads", type=int, default=2, help="torch CPU threads (1 is faster on a busy machine)")
     parser.add_argument("--device", default="cpu", help="where to train: cpu (default) or cuda[:N]")
+    parser.add_argument("--compile", action="store_true", help=COMPILE_HELP)
     parser.add_argument(
         "--quiet", action="store_true", help="no progress on standard error and no line per epoch on standard output"
     )
@@ -69,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
     )
     result = train(
         args.data, args.out, config, resume=args.resume, progress=not args.quiet, skip_bad_rows=args.skip_bad_rows,
-        device=args.device,
+        device=args.device, compile_step=args.compile,
     )
     data = result.data
     for problem in data.bad_rows:

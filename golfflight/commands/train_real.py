@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 
+from golfflight.commands.train import COMPILE_HELP
 from golfflight.shots.paths import shared_data_dir
 
 
@@ -44,9 +45,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="train the seeds side by side in one rollout (each with its own minibatches, moments and "
                         "clipping: the same runs up to float rounding), for about one seed's kernel launches on a GPU; "
                         "with --jobs N, the seeds shared out over N processes, each stacking its share")
-    parser.add_argument("--compile", action="store_true",
-                        help="fuse each Euler step's kernels, forward and backward, with torch.compile (compiled "
-                        "once a run, in seconds to a minute; on a CPU it needs a C compiler)")
+    parser.add_argument("--compile", action="store_true", help=COMPILE_HELP)
     parser.add_argument(
         "--quiet", action="store_true", help="no progress on standard error and no line per epoch on standard output"
     )
