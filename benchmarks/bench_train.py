@@ -4,15 +4,17 @@ more seeds side by side (`--runs`, as `train-real --stack-seeds` trains them), e
 operations one eager epoch dispatches (forward rollouts, backward, optimizer steps, the epoch's validation). Each is
 at least one kernel launch on a GPU, so their count times an operation's fixed cost on the device (timed here on tiny
 tensors) bounds an eager epoch there from below, however fast the device computes: what issue 33's target (an epoch
-10x faster than on 16 CPU cores) is up against, and what stacking seeds shares out. Writes the section
-`train_epoch_<cpu|cuda>` of benchmarks/results.json (a row a device, thread count, number of seeds and step; a rerun
-replaces its own) and prints them as a table for docs/benchmarks.md.
+10x faster than on 16 CPU cores) is up against, and what stacking seeds shares out. On a CPU `--jobs N` trains the
+seeds in N processes at once, each stacking its share (`train-real --stack-seeds --jobs N`): a many-core machine's
+way, and the baseline a GPU is to beat. Writes the section `train_epoch_<cpu|cuda>` of benchmarks/results.json (a row
+a device, process count, thread count, number of seeds and step; a rerun replaces its own) and prints them as a table
+for docs/benchmarks.md.
 
 The training file is built from the shared data (`model_export.real_data.build`, the held-out sets never read), or
 given (`--data`: a lent machine has no shared data; carry the file there):
     python benchmarks/bench_train.py --device cpu --threads 1 --runs 1,4 --compile
-    python benchmarks/bench_train.py --device cuda --data real_flights.csv --runs 1,16 --compile  # then --device
-                                                         # cpu --threads 16 there: the baseline, on the same machine
+    python benchmarks/bench_train.py --device cuda --data real_flights.csv --runs 1,16 --compile  # then, there,
+    python benchmarks/bench_train.py --device cpu --data real_flights.csv --runs 16 --jobs 16 --threads 1  # baseline
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from golfflight.flight.bundle_location import model_dir
 from golfflight.model_export.devices import resolve_device
 from golfflight.model_export.joint import JointConfig, JointResult
 from golfflight.model_export.real_data import build
-from golfflight.model_export.real_training import DATA_FILE, train_stacked
+from golfflight.model_export.real_training import DATA_FILE, SeedPlan, train_seeds
 from torch.utils._python_dispatch import TorchDispatchMode
 
 DATA_ROOT = REPO.parent / "shared" / "data"
@@ -55,26 +57,30 @@ class OpCounter(TorchDispatchMode):
 
 
 def train(data: Path, device: str, folder: Path, runs: int, epochs: int, compile_step: bool = False,
-          counter: OpCounter | None = None) -> list[JointResult]:
-    """`epochs` epochs of `runs` seeds side by side from the shipped bundle's network (under `counter` if given), as
-    `train-real --stack-seeds` trains them (`real_training.train_stacked`)."""
+          jobs: int = 1, counter: OpCounter | None = None) -> list[JointResult]:
+    """`epochs` epochs of `runs` seeds from the shipped bundle's network (under `counter` if given), as `train-real
+    --stack-seeds --jobs JOBS` trains them (`real_training.train_seeds`): side by side in this process, or shared
+    out over `jobs` processes, each stacking its share on this process's torch threads."""
     configs = {f"seed-{seed}": replace(JointConfig(), epochs=epochs, seed=seed) for seed in range(runs)}
+    plan = SeedPlan(device, jobs, torch.get_num_threads(), stacked=True, compile_step=compile_step)
+    plan.check()
     with counter or contextlib.nullcontext():
-        return list(train_stacked(data, folder, model_dir(None), configs, torch.get_num_threads(), False, device,
-                                  compile_step).values())
+        return list(train_seeds(data, folder, model_dir(None), configs, plan, progress=False).values())
 
 
-def measure(data: Path, device: str, folder: Path, runs: int, compile_step: bool) -> dict:
-    """An epoch's seconds: the second of two (the first compiles where `compile_step`), and, eager, the operations
-    one epoch dispatches. Compiled runs start from an empty compile cache: torch.compile keeps its versions of
+def measure(data: Path, device: str, folder: Path, runs: int, compile_step: bool, jobs: int = 1) -> dict:
+    """An epoch's seconds: the second of two (the first compiles where `compile_step`; with `jobs` processes, the
+    slowest process's second epoch, all of them training at once), and, eager in one process, the operations one
+    epoch dispatches. Compiled runs start from an empty compile cache: torch.compile keeps its versions of
     `euler_step` by the function, so the runs' counts before would add up to its limit of eight (then it runs eager)."""
     if compile_step:
         torch._dynamo.reset()
-    history = train(data, device, folder / "timed", runs, 2, compile_step)[0].history
-    row = {"runs": runs, "compiled": compile_step, "epoch_s": history[1]["seconds"],
-           "first_epoch_s": history[0]["seconds"], "seed_share_s": history[1]["seconds"] / runs,
-           "selection_loss": history[1]["selection_loss"], "ops": None}
-    if not compile_step:
+    results = train(data, device, folder / "timed", runs, 2, compile_step, jobs)
+    epoch_s = max(result.history[1]["seconds"] for result in results)
+    row = {"runs": runs, "jobs": jobs, "compiled": compile_step, "epoch_s": epoch_s,
+           "first_epoch_s": max(result.history[0]["seconds"] for result in results), "seed_share_s": epoch_s / runs,
+           "selection_loss": results[0].history[1]["selection_loss"], "ops": None}
+    if not compile_step and jobs == 1:
         counter = OpCounter()
         train(data, device, folder / "counted", runs, 1, counter=counter)
         row["ops"] = counter.count
@@ -103,15 +109,18 @@ def main() -> None:
     parser.add_argument("--threads", type=int, help="torch CPU threads (default: torch's)")
     parser.add_argument("--runs", default="1", help="seeds side by side, comma-separated counts (default 1)")
     parser.add_argument("--compile", action="store_true", help="each count eager and then compiled")
+    parser.add_argument("--jobs", type=int, default=1,
+                        help="processes training at once on a CPU, the seeds shared out over them (as train-real "
+                        "--stack-seeds --jobs N; each with --threads torch threads; default 1)")
     args = parser.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
     device = resolve_device(args.device)
     cost = op_cost_us(device)
     rows = []
-    print("\n| device | torch threads | seeds side by side | step | epoch | a seed's share | first epoch | "
+    print("\n| device | processes | torch threads | seeds | step | epoch | a seed's share | first epoch | "
           "operations dispatched (an epoch) | their floor | felt error after epoch 2 (seed 0) |\n"
-          "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|")
+          "|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|")
     with tempfile.TemporaryDirectory() as folder:
         data = args.data
         if data is None:
@@ -123,12 +132,13 @@ def main() -> None:
             for compiled in (False, True) if args.compile else (False,):
                 row = {"device": str(device), "torch": torch.__version__, "torch_threads": torch.get_num_threads(),
                        "op_cost_us": cost, **measure(data, args.device, Path(folder) / f"{runs}-{compiled}", runs,
-                                                    compiled)}
+                                                    compiled, args.jobs)}
                 row["ops_floor_s"] = None if row["ops"] is None else row["ops"] * cost * 1e-6
                 rows.append(row)
                 ops = "—" if row["ops"] is None else f"{row['ops']:,}"
                 floor = "—" if row["ops_floor_s"] is None else f"{row['ops_floor_s']:.1f} s"
-                print(f"| {row['device']} | {row['torch_threads']} | {runs} | {'compiled' if compiled else 'eager'} | "
+                print(f"| {row['device']} | {args.jobs} | {row['torch_threads']} | {runs} | "
+                      f"{'compiled' if compiled else 'eager'} | "
                       f"{row['epoch_s']:.1f} s | {row['seed_share_s']:.1f} s | {row['first_epoch_s']:.1f} s | {ops} | "
                       f"{floor} | {row['selection_loss']:.3f} m |", flush=True)
     print(f"\nan operation's fixed cost on {device}: {cost:.2f} µs")
@@ -140,7 +150,7 @@ def main() -> None:
 
 def _key(row: dict) -> tuple:
     """What a row measured: a rerun of the same replaces it in results.json."""
-    return row["device"], row["torch_threads"], row["runs"], row["compiled"]
+    return row["device"], row.get("jobs", 1), row["torch_threads"], row["runs"], row["compiled"]
 
 
 if __name__ == "__main__":

@@ -222,7 +222,7 @@ def _start(init: str | os.PathLike, threads: int) -> nn.Module:
     return model
 
 
-def _train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig],
+def train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig],
                  plan: SeedPlan, progress: bool) -> dict[str, JointResult]:
     """Each seed's joint run (WORK/NAME), by name, as `plan` says. In this process: stacked, or one after the other,
     with their epoch bars. In several (`plan.jobs`, silent there): a seed or a stack of seeds each, with a bar over
@@ -275,7 +275,7 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     progress_step(f"building {data_file} from the real sources...", progress)
     sources = build(data_root, data_file, *(() if source_names is None else (source_names,)))
     configs = {f"seed-{seed}": replace(config, seed=seed) for seed in seeds}
-    runs = _train_seeds(data_file, work, init, configs, plan, progress)
+    runs = train_seeds(data_file, work, init, configs, plan, progress)
     finished = [run.out_dir for run in runs.values() if run.final]
     if len(finished) > 1:
         progress_step(f"averaging {len(finished)} seeds' weights (the soup)...", progress)

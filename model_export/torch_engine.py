@@ -303,7 +303,7 @@ class TorchEngine:
                 if up == 0:
                     last = step
                     break
-                if up <= len(aloft.down) * (1 - self.set_aside_share) and up > 1:
+                if up <= len(aloft.down) * (1 - self.set_aside_share) and up > 1:  # (one row: compiled again)
                     aloft = aloft.still_up()
         positions = states[0][: last + 1]
         positions[:, :, 2] -= ground  # heights above each shot's ground: its plane is the landing's z = 0

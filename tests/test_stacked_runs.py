@@ -7,7 +7,7 @@ import json
 import pytest
 import torch
 from golfflight.model_export.joint import JointConfig, train_joint, train_joint_runs
-from golfflight.model_export.real_training import SeedPlan, _train_seeds
+from golfflight.model_export.real_training import SeedPlan, train_seeds
 from golfflight.model_export.stacked_runs import StackedNetworks, clip_per_run, runs_held
 from golfflight.model_export.training import load_checkpoint
 from golfflight.model_export.variants import PhysNN, PhysQ
@@ -116,7 +116,7 @@ def test_runs_side_by_side_must_differ_only_in_their_seed(tmp_path):
 def test_train_real_trains_its_seeds_stacked_each_in_its_folder(tmp_path):
     _windy_set(tmp_path / "windy.csv", {"a": (0.0, 1.0)}, n_per_group=6)
     configs = {f"seed-{s}": JointConfig(epochs=1, batch_size=4, seed=s, weights={"sentry-2022": 1.0}) for s in (3, 4)}
-    runs = _train_seeds(tmp_path / "windy.csv", tmp_path / "work", REPO_ROOT / "models" / "default", configs,
+    runs = train_seeds(tmp_path / "windy.csv", tmp_path / "work", REPO_ROOT / "models" / "default", configs,
                         SeedPlan(threads=1, stacked=True), False)
     assert list(runs) == ["seed-3", "seed-4"]
     for name, run in runs.items():
@@ -130,9 +130,9 @@ def test_stacked_seeds_shared_out_over_processes_are_the_seeds_stacked_in_one(tm
     configs = {f"seed-{s}": JointConfig(epochs=1, batch_size=4, seed=s, weights={"sentry-2022": 1.0})
                for s in (0, 1, 2)}
     init = REPO_ROOT / "models" / "default"
-    shared = _train_seeds(tmp_path / "windy.csv", tmp_path / "shared", init, configs,
+    shared = train_seeds(tmp_path / "windy.csv", tmp_path / "shared", init, configs,
                           SeedPlan(jobs=2, threads=1, stacked=True), False)
-    one = _train_seeds(tmp_path / "windy.csv", tmp_path / "one", init, configs, SeedPlan(threads=1, stacked=True),
+    one = train_seeds(tmp_path / "windy.csv", tmp_path / "one", init, configs, SeedPlan(threads=1, stacked=True),
                        False)
     assert list(shared) == list(configs)
     for name, run in shared.items():
