@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.metadata
 import json
 import os
 import platform
@@ -64,6 +65,15 @@ def median_of_rounds(rounds: list[dict[str, float]]) -> dict[str, float]:
     return summary
 
 
+def _version(distribution: str) -> str | None:
+    """An installed distribution's version, None where it is missing (a lent GPU machine has no fastapi or uvicorn,
+    and the benchmarks that run there do not need them)."""
+    try:
+        return importlib.metadata.version(distribution)
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
 def machine() -> dict:
     cpu = platform.processor()
     try:
@@ -71,10 +81,6 @@ def machine() -> dict:
             cpu = next(line.split(":", 1)[1].strip() for line in info if line.startswith("model name"))
     except (OSError, StopIteration):
         pass
-    import fastapi
-    import onnxruntime
-    import uvicorn
-
     return {
         "cpu": cpu,
         "cores": os.cpu_count(),
@@ -82,9 +88,7 @@ def machine() -> dict:
         "platform": platform.platform(),
         "python": platform.python_version(),
         "numpy": np.__version__,
-        "onnxruntime": onnxruntime.__version__,
-        "fastapi": fastapi.__version__,
-        "uvicorn": uvicorn.__version__,
+        **{name: _version(name) for name in ("onnxruntime", "fastapi", "uvicorn")},
         "openblas_env": {k: v for k, v in os.environ.items() if k.startswith("OPENBLAS_")},
         "measured_utc": datetime.now(UTC).isoformat(timespec="seconds"),
     }

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Issue 33's GPU measurements on a machine lent by the `device` tool, prepared here and run there in two commands.
+#
+# The lent machine's image has PyTorch (2.11, CUDA), onnxruntime, pyarrow, numpy and scipy but neither pydantic nor
+# Ray, reaches no package index and has no shared data. So, here, first:
+#     bash scripts/gpu_session.sh prepare
+# downloads the wheels it lacks (pydantic and its four needs, for its Python 3.12; .whl/, 2.8 MB) and builds the
+# train-real file (build/real_flights.csv and its trajectories, by model_export.real_data.build: the held-out sets
+# are never read). Then, each as one `run` carrying [".whl", "build"], results back in $OUT:
+#     bash scripts/gpu_session.sh flight   # bench_gpu.py --device cuda: shots/s by batch, parity, the CPU's share,
+#                                          # 4,194,304-row sweeps (about 6 minutes; --ray-workers left out: Ray's
+#                                          # wheel alone is over the 64 MiB a call may carry)
+#     bash scripts/gpu_session.sh train    # bench_train.py: cuda, 1 and 16 seeds, eager and compiled; then the
+#                                          # same machine's 16 cores as 16 processes (about 6 minutes)
+# Each step has its own time limit, and benchmarks/results.json (each script writes its rows as it measures them)
+# is copied into $OUT after each, so a step cut short keeps what the others measured.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+
+WHEELS=(pydantic==2.14.4 pydantic_core==2.50.5 annotated-types==0.8.0 typing-inspection==0.4.5 typing_extensions==4.16.0)
+TRAIN_FILE=build/real_flights.csv
+
+prepare() {
+    grep -qx "/.whl/" .git/info/exclude 2>/dev/null || echo "/.whl/" >> .git/info/exclude
+    python3 -m pip download -q --no-deps --only-binary=:all: --python-version 3.12 --implementation cp \
+        --platform manylinux_2_28_x86_64 --platform manylinux_2_17_x86_64 --platform manylinux2014_x86_64 \
+        -d .whl "${WHEELS[@]}" || exit 1
+    python3 -c "from golfflight.model_export.real_data import build; from golfflight.shots.paths import shared_data_dir; \
+build(shared_data_dir(), '$TRAIN_FILE')" || exit 1
+    du -sh .whl build
+}
+
+on_device() {
+    python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl \
+        || exit 1
+    export PYTHONPATH=/tmp/site PYTHONUNBUFFERED=1
+    nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader
+    python3 -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name())"
+}
+
+step() {  # step NAME SECONDS COMMAND...: run it under a time limit, its output in $OUT/NAME.log, the results copied
+    local name=$1 limit=$2
+    shift 2
+    echo "== $* (at most ${limit} s)"
+    timeout "$limit" "$@" 2>&1 | tee "$OUT/$name.log"
+    cp benchmarks/results.json "$OUT/results.json"
+}
+
+case "${1:-}" in
+    prepare) prepare ;;
+    flight)
+        on_device
+        step flight 540 python3 benchmarks/bench_gpu.py --device cuda
+        ;;
+    train)
+        on_device
+        step train-cuda 420 python3 benchmarks/bench_train.py --device cuda --data "$TRAIN_FILE" --runs 1,16 --compile
+        step train-cpu 120 python3 benchmarks/bench_train.py --device cpu --data "$TRAIN_FILE" --runs 16 --jobs 16 --threads 1
+        ;;
+    *) echo "usage: bash scripts/gpu_session.sh prepare|flight|train" >&2; exit 2 ;;
+esac
