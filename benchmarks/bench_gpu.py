@@ -14,7 +14,8 @@ One command on a lent GPU machine (estimated at 6-7 minutes on an H100, not yet 
 sizes, three compilations, and five sweeps of 4,194,304 rows; each measurement is written to benchmarks/results.json
 as soon as it is made, so a run cut short keeps what it measured; copy that file into $OUT;
 --ray-workers 1,2,4 also sweeps the same grid through `--engine ray --device cuda` with that many actors sharing the
-GPU, `--actors-per-gpu`, Ray's start included: about 2 minutes more, not yet run there either):
+GPU, `--actors-per-gpu`, Ray's start included: about 2 minutes more, not yet run there either, and only where Ray is
+installed; scripts/gpu_session.sh runs this script on the project's lent machines, whose image lacks Ray):
     python benchmarks/bench_gpu.py --device cuda [--ray-workers 1,2,4]
 Here on the CPU, small sizes:
     python benchmarks/bench_gpu.py --device cpu --batches 1024,4096,16384 --parity-shots 3000 --share-rows 124032 \
