@@ -10,8 +10,8 @@ the landings back in NumPy (the device's transfers included); around it are the 
 it, and the figures and the bounce and roll of the landings after it (`torch_engine.STAGES`); the CPU's share of a
 sweep is all but the flight, the driver's work included.
 
-One command on a lent GPU machine (estimated at 6-7 minutes on an H100, not yet run there: four engines at five batch
-sizes, three compilations, and five sweeps of 4,194,304 rows; each measurement is written to benchmarks/results.json
+One command on a lent GPU machine (estimated at 7-8 minutes on an H100, not yet run there: four engines at five batch
+sizes, three compilations, and seven sweeps of 4,194,304 rows, two of them by 2 and 4 processes sharing the GPU; each measurement is written to benchmarks/results.json
 as soon as it is made, so a run cut short keeps what it measured; copy that file into $OUT;
 --ray-workers 1,2,4 also sweeps the same grid through `--engine ray --device cuda` with that many actors sharing the
 GPU, `--actors-per-gpu`, Ray's start included: about 2 minutes more, not yet run there either, and only where Ray is
@@ -60,6 +60,9 @@ FLIGHT_TARGET = {"cuda": 5_000_000.0}
 """Issue 33 on one H100: the flight alone at 5 M shots/s or more (with compilation, CUDA graphs or a fused step)."""
 SWEEP_TARGET = {"cuda": 2_000_000.0}
 """Issue 33 on one H100: a sweep to Parquet at 2 M shots/s or more end to end."""
+DEFAULT_TORCH_WORKERS = {"cuda": (2, 4), "cpu": ()}
+"""Processes sharing the device in the `--engine torch --workers K` sweeps: on a GPU, so that one process's host work
+overlaps another's flight (a CPU's cores are its flight: the sweep in one process is the faster there)."""
 
 
 def launches_array(n: int, seed: int = 0) -> np.ndarray:
@@ -204,18 +207,24 @@ def cpu_share(bundle: Path, device: str, rows: int, rounds: int = 2) -> dict:
     return row
 
 
-def sweep_end_to_end(device: str, rows: int, threads: int | None, ray_workers: int | None = None,
-                     compiled: bool = False) -> dict:
-    """`golfflight sweep --engine torch` (`--compile` if `compiled`; or, with `ray_workers`, `--engine ray --device`
-    on that many actors, all on the one GPU with `--actors-per-gpu` where the device is cuda) on a grid of `rows`
-    launches to Parquet, as its own process: wall seconds from start to file written (loading and compiling
-    included), and the command's own account of where the time went."""
+def engine_options(device: str, compiled: bool = False, ray_workers: int | None = None,
+                   torch_workers: int | None = None) -> list[str]:
+    """The sweep's engine options: `--engine torch` in its process (`--compile` if `compiled`), or in a pool of
+    `torch_workers` processes sharing the device (`--workers`), or, with `ray_workers`, `--engine ray --device` on
+    that many actors, all on the one GPU with `--actors-per-gpu` where the device is cuda."""
+    if ray_workers is not None:
+        return ["--engine", "ray", "--actors-per-gpu" if device == "cuda" else "--workers", str(ray_workers)]
+    pool = [] if torch_workers is None else ["--workers", str(torch_workers)]
+    return ["--engine", "torch", *pool, *(["--compile"] if compiled else [])]
+
+
+def sweep_end_to_end(device: str, rows: int, threads: int | None, engine: list[str]) -> dict:
+    """`golfflight sweep` with `engine` (`engine_options`) on a grid of `rows` launches to Parquet, as its own
+    process: wall seconds from start to file written (loading and compiling included), and the command's own account
+    of where the time went."""
     speeds = max(rows // 400, 1)
     grid = [f"ball_speed_mps=30:80:{speeds}", "launch_angle_deg=6:30:20", "spin_rpm=1500:9000:20"]
     shots = speeds * 400
-    actors = ["--actors-per-gpu" if device == "cuda" else "--workers", str(ray_workers)]
-    engine = ["--engine", "torch"] if ray_workers is None else ["--engine", "ray", *actors]
-    engine += ["--compile"] if compiled else []
     with tempfile.TemporaryDirectory() as folder:
         command = [sys.executable, "-m", "golfflight", "sweep", "--grid", *grid, "--out", f"{folder}/out.parquet",
                    *engine, "--device", device, "--no-progress", *(["--threads", str(threads)] if threads else [])]
@@ -228,6 +237,11 @@ def sweep_end_to_end(device: str, rows: int, threads: int | None, ray_workers: i
     print(done.stdout.strip(), flush=True)
     return {"shots": shots, "seconds": seconds, "shots_per_s": shots / seconds, "summary": done.stdout.strip(),
             "engine": " ".join(engine)}
+
+
+def counts(text: str) -> list[int]:
+    """Comma-separated whole numbers (an empty text: none)."""
+    return [int(k) for k in text.split(",") if k]
 
 
 def machine_of(device: torch.device) -> dict:
@@ -280,9 +294,12 @@ def main() -> None:
     parser.add_argument("--sweep-rows", type=int, help="launches of the end-to-end sweep (0: none; default: by device)")
     parser.add_argument("--threads", type=int, help="torch CPU threads (default: torch's)")
     parser.add_argument("--model", help="bundle (default: the shipped models/default)")
-    parser.add_argument("--ray-workers", type=lambda text: [int(k) for k in text.split(",")], default=[],
+    parser.add_argument("--ray-workers", type=counts, default=[],
                         help="also sweep through --engine ray --device on this many actors (comma-separated counts; "
                         "on cuda, all sharing its one GPU)")
+    parser.add_argument("--torch-workers", type=counts,
+                        help="also sweep through --engine torch --workers K, K processes sharing the device "
+                        "(comma-separated counts; default 2,4 on cuda, none on a CPU)")
     parser.add_argument("--share-rows", type=int, help="launches of the CPU-share sweeps (0: none; default: by device)")
     args = parser.parse_args()
     if args.threads:
@@ -311,12 +328,17 @@ def main() -> None:
     if share_rows:
         measured("cpu_share", cpu_share(bundle, args.device, share_rows))
     rows = DEFAULT_SWEEP_ROWS[kind] if args.sweep_rows is None else args.sweep_rows
-    for name, compiled, ray_workers in (("sweep", False, None), ("sweep_compiled", True, None),
-                                        *((f"ray_sweep_{k}", False, k) for k in args.ray_workers)):
+    torch_workers = DEFAULT_TORCH_WORKERS[kind] if args.torch_workers is None else args.torch_workers
+    for name, compiled, options in (
+        ("sweep", False, engine_options(args.device)),
+        ("sweep_compiled", True, engine_options(args.device, compiled=True)),
+        *((f"torch_workers_sweep_{k}", False, engine_options(args.device, torch_workers=k)) for k in torch_workers),
+        *((f"ray_sweep_{k}", False, engine_options(args.device, ray_workers=k)) for k in args.ray_workers),
+    ):
         if not rows or (compiled and "compiled" not in engines):
             continue
-        result = sweep_end_to_end(args.device, rows, args.threads, ray_workers, compiled)
-        if kind in SWEEP_TARGET and ray_workers is None and "error" not in result:
+        result = sweep_end_to_end(args.device, rows, args.threads, options)
+        if kind in SWEEP_TARGET and "error" not in result:
             result |= {"target": f">= {SWEEP_TARGET[kind]:,.0f} shots/s",
                        "met": result["shots_per_s"] >= SWEEP_TARGET[kind]}
         measured(name, result)

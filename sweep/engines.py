@@ -1,5 +1,5 @@
 """The ways a sweep's pieces are flown, each a generator of result tables in input order: `local_tables` (a pool of
-processes on this machine), `ray_tables` (Ray Data on a local Ray instance or an existing cluster) and
+processes on this machine, each with ONNX Runtime or its own torch engine), `ray_tables` (Ray Data on a local Ray instance or an existing cluster) and
 `in_process_tables` (one engine in this process, whose parallelism is its device's: the torch engine, a few pieces at
 once in threads so that the CPU's work overlaps the device's). Each worker holds one `sweep.flyer.Flyer`, and at most a
 few pieces per worker are in flight, so memory stays bounded however long the input is.
@@ -36,25 +36,27 @@ _flyer: Flyer | None = None
 """The flyer of a local pool's worker process (made once by `_start_worker`)."""
 
 
-def _start_worker(bundle_dir: str, sha256: str, source) -> None:
+def _start_worker(bundle_dir: str, sha256: str, source, make: Callable | None) -> None:
     global _flyer
-    _flyer = Flyer(bundle_dir, sha256, source)
+    _flyer = Flyer(bundle_dir, sha256, source, make_engine=make)
 
 
 def _fly(piece):
     return _flyer(piece)
 
 
-def local_tables(source, bundle_dir: str, sha256: str, workers: int) -> Iterator:
+def local_tables(source, bundle_dir: str, sha256: str, workers: int, make: Callable | None = None) -> Iterator:
     """Result tables of `source`'s pieces, flown by `workers` processes forked from a fresh server process that has
-    imported the engine once (not from this one: the driver's Arrow and progress threads stay behind)."""
+    imported the engine once (not from this one: the driver's Arrow and progress threads stay behind), each with
+    ONNX Runtime or the engine `make` builds (`model_export.torch_engine.TorchEngineMaker`: torch is imported, and a
+    GPU taken, in each worker, never in the server)."""
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(WORKER_IMPORTS)
     pool = ProcessPoolExecutor(
         workers,
         mp_context=context,
         initializer=_start_worker,
-        initargs=(bundle_dir, sha256, source),
+        initargs=(bundle_dir, sha256, source, make),
     )
     try:
         pending = deque()

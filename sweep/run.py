@@ -26,14 +26,16 @@ SHOWN_PROBLEMS = 20
 """Problems listed when a sweep is refused (the rest are counted)."""
 
 Engine = Literal["local", "ray", "torch"]
-"""Where the pieces fly: a pool of processes here, Ray, or the torch engine the command line hands `run_sweep`."""
+"""Where the pieces fly: a pool of processes here, Ray, or the torch engine (the one the command line hands
+`run_sweep`, or one in each process of a pool here)."""
 
 
 @dataclass(frozen=True)
-class RayEngine:
-    """What each Ray actor flies with: ONNX Runtime on its CPU (`make` None), or the engine `make` builds from the
-    bundle's path on the actor's node (`model_export.torch_engine.TorchEngineMaker`), with `gpus` GPUs of its own
-    (a fraction where actors share one)."""
+class WorkerEngine:
+    """What each worker process (a Ray actor, or a process of the pool here under `engine="torch"`) flies with:
+    ONNX Runtime on its CPU (`make` None), or the engine `make` builds from the bundle's path on the worker's node
+    (`model_export.torch_engine.TorchEngineMaker`), with, on Ray, `gpus` GPUs of its own (a fraction where actors
+    share one)."""
 
     make: Callable[[str], ColumnsEngine] | None = None
     gpus: float = 0
@@ -58,22 +60,25 @@ class Summary:
 
 
 def _tables(source: Source, engine: Engine, workers: int | None, model: str | None, ray_address: str | None,
-            in_process: ColumnsEngine | None, ray_engine: RayEngine, in_flight: int) -> Iterator:
+            in_process: ColumnsEngine | None, worker_engine: WorkerEngine, in_flight: int) -> Iterator:
     """Result tables from the chosen engine, its workers loading the bundle the driver verified here (or flying
-    with `in_process`, an engine already loaded from it, `in_flight` pieces at once, or each Ray actor with the
-    engine `ray_engine` makes)."""
+    with `in_process`, an engine already loaded from it, `in_flight` pieces at once, or each worker with the engine
+    `worker_engine` makes: Ray's actors, and under `engine="torch"` without `in_process` a pool here)."""
     from golfflight.flight.bundle_check import verify_bundle
     from golfflight.sweep.engines import in_process_tables, local_tables, ray_tables
 
     bundle = model_dir(model).resolve()
     sha256 = verify_bundle(bundle).onnx.sha256
     if engine == "torch":
-        if in_process is None:
-            raise ValueError("the torch engine is flown in this process: pass it as in_process")
-        return in_process_tables(source, Flyer(str(bundle), sha256, source, engine=in_process), in_flight)
+        if in_process is not None:
+            return in_process_tables(source, Flyer(str(bundle), sha256, source, engine=in_process), in_flight)
+        if worker_engine.make is None or workers is None:
+            raise ValueError("the torch engine flies in this process (in_process) or in a pool of `workers` "
+                             "processes, each with the engine worker_engine.make builds")
+        return local_tables(source, str(bundle), sha256, workers, worker_engine.make)
     if engine == "ray":
-        return ray_tables(source, str(bundle), sha256, workers, ray_address, ray_engine.make, ray_engine.gpus)
-    return local_tables(source, str(bundle), sha256, workers)
+        return ray_tables(source, str(bundle), sha256, workers, ray_address, worker_engine.make, worker_engine.gpus)
+    return local_tables(source, str(bundle), sha256, workers, worker_engine.make)
 
 
 def _text_columns(schema) -> list[str]:
@@ -106,13 +111,14 @@ def run_sweep(
     progress: bool = True,
     skipped: Callable[[str], None] = print,
     in_process: ColumnsEngine | None = None,
-    ray_engine: RayEngine = RayEngine(),
+    worker_engine: WorkerEngine = WorkerEngine(),
     in_flight: int = PIECES_IN_FLIGHT,
 ) -> Summary:
     """Fly every row of `source` on `engine` and write `out` (Parquet): the input row's number, its columns, its
     flight (module docstring). `skipped` gets each problem of a row left out under `skip_bad_rows`; `in_process` is
     the engine `engine="torch"` flies with (`model_export.torch_engine.TorchEngine`, loaded from `model`), `in_flight`
-    pieces at once; `ray_engine` what each actor of `engine="ray"` flies with (`workers` None: one actor a GPU)."""
+    pieces at once; `worker_engine` what each actor of `engine="ray"` flies with (`workers` None: one actor a GPU),
+    and, without `in_process`, each of the `workers` processes of `engine="torch"`."""
     import pyarrow as pa
     import pyarrow.compute as pc
     import pyarrow.parquet as pq
@@ -123,7 +129,7 @@ def run_sweep(
     counts = {"rows": 0, "written": 0, "skipped": 0, "chunks": 0, "chunks_skipped": 0, "failed": 0}
 
     def write(path: str) -> None:
-        tables = _tables(source, engine, workers, model, ray_address, in_process, ray_engine, in_flight)
+        tables = _tables(source, engine, workers, model, ray_address, in_process, worker_engine, in_flight)
         bar = tqdm(total=source.total_rows, unit="shot", unit_scale=True, disable=not progress, desc="sweep")
         with closing(tables), bar, pq.ParquetWriter(path, schema, use_dictionary=_text_columns(schema)) as writer:
             for table in tables:

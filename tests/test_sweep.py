@@ -306,14 +306,14 @@ def test_ray_actors_fly_the_torch_engine_as_engine_torch_does(tmp_path, capsys):
     """`--engine ray --device cpu`: each actor builds the torch engine itself (`TorchEngineMaker`, sent by Ray) and
     the Parquet file holds the numbers of `--engine torch --device cpu`, every column equal. On the same Ray
     instance (started here once with one GPU declared, which Ray takes on trust; the sweep leaves it running): an
-    actor asking Ray for that GPU (`RayEngine(gpus=1)`, what `--device cuda` asks; here it flies on the CPU) is placed
+    actor asking Ray for that GPU (`WorkerEngine(gpus=1)`, what `--device cuda` asks; here it flies on the CPU) is placed
     and gives the same file, one actor for the one GPU listed, as do two actors asking for half of it each
     (`--actors-per-gpu 2`); and `--device cuda`, whose engine no worker here can
     build (no CUDA, as on a GPU node without its driver), is refused in one line before any actor starts."""
     ray = pytest.importorskip("ray")
     pytest.importorskip("torch")
     from golfflight.model_export.torch_engine import TorchEngineMaker
-    from golfflight.sweep.run import RayEngine, run_sweep
+    from golfflight.sweep.run import WorkerEngine, run_sweep
     from golfflight.sweep.sources import open_source
 
     axes = ["ball_speed_mps=40:70:5", "launch_angle_deg=8,16", "spin_rpm=2500,6000", "wind_speed_mps=0,6",
@@ -327,9 +327,9 @@ def test_ray_actors_fly_the_torch_engine_as_engine_torch_does(tmp_path, capsys):
                      "--chunk-rows", 32) == 0
         assert "on ray with 1 workers (torch on cpu, float32)" in capsys.readouterr().out
         run_sweep(open_source(None, axes, 32), str(outs["ray_gpu"]), "ray", None, progress=False,
-                  ray_engine=RayEngine(TorchEngineMaker("cpu", threads=1), gpus=1))
+                  worker_engine=WorkerEngine(TorchEngineMaker("cpu", threads=1), gpus=1))
         run_sweep(open_source(None, axes, 32), str(outs["ray_half_gpu"]), "ray", None, progress=False,
-                  ray_engine=RayEngine(TorchEngineMaker("cpu", threads=1, parts_at_once=2), gpus=0.5))
+                  worker_engine=WorkerEngine(TorchEngineMaker("cpu", threads=1, parts_at_once=2), gpus=0.5))
         assert sweep("--grid", *axes, "--out", tmp_path / "cuda.parquet", "--engine", "ray", "--device", "cuda") == 2
         err = capsys.readouterr().err
         assert err.startswith("golfflight sweep: error: --engine ray: a worker of the Ray cluster cannot build the "

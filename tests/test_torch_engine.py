@@ -214,8 +214,26 @@ def test_the_sweep_on_torch_writes_the_local_engines_columns_and_numbers(tmp_pat
             assert got[name].to_pylist() == want[name].to_pylist(), name
 
 
+def test_the_torch_engine_in_a_pool_of_processes_writes_the_in_process_engines_file(tmp_path, capsys):
+    """`--engine torch --workers 2`: two processes here, each with its own torch engine (one thread), fly the
+    pieces and the driver writes them in order: the file of the torch engine in this process, to the float32
+    network's rounding."""
+    alone, pooled = tmp_path / "alone.parquet", tmp_path / "pooled.parquet"
+    assert sweep(*GRID, "--out", alone, "--engine", "torch", "--device", "cpu", "--threads", 1, "--chunk-rows", 32) == 0
+    assert sweep(*GRID, "--out", pooled, "--engine", "torch", "--device", "cpu", "--workers", 2,
+                 "--chunk-rows", 32) == 0
+    assert "on torch with 2 workers (torch on cpu, float32)" in capsys.readouterr().out
+    want, got = pq.read_table(alone), pq.read_table(pooled)
+    assert got.schema == want.schema and got.num_rows == 160
+    for name, field in zip(want.column_names, want.schema, strict=True):
+        if field.type == "double":
+            np.testing.assert_allclose(got[name].to_numpy(), want[name].to_numpy(), rtol=1e-9, atol=1e-9,
+                                       err_msg=name)
+        else:
+            assert got[name].to_pylist() == want[name].to_pylist(), name
+
+
 @pytest.mark.parametrize("argv, message", [
-    (["--engine", "torch", "--workers", "2"], "--workers goes with --engine local or ray"),
     (["--device", "cpu"], "--device goes with --engine torch"),
     (["--threads", "1"], "--threads goes with --engine torch"),
     (["--compile"], "--compile goes with --engine torch"),

@@ -5,7 +5,8 @@ product: START:STOP:COUNT, V1,V2,... or V per column, `sweep.grid`). Output: one
 (`row`), its columns and its flight, the same numbers as `golfflight simulate`. `--engine local` flies on a pool of
 processes here, `--engine ray` through Ray Data (a local Ray instance, or a cluster's with `--ray-address`),
 `--engine torch` in this process on `--device cpu` or `cuda` (the bundle rebuilt in torch,
-`model_export.torch_engine`). `--engine ray --device cuda` flies the torch engine in each Ray actor on a GPU (one
+`model_export.torch_engine`), or with `--workers K` in K processes here, each with its own torch engine on the
+device (sharing one GPU, so that one process's host work overlaps another's flight, as Ray's actors do). `--engine ray --device cuda` flies the torch engine in each Ray actor on a GPU (one
 actor a GPU, or `--actors-per-gpu K` sharing each, so that one actor's host work, checking rows, rolling to rest and
 writing, overlaps another's flight; each engine sizes its batches to its share of the GPU's free memory;
 `--workers` left out is as many actors as the cluster's GPUs hold); `--device cpu` there flies it on each actor's
@@ -53,9 +54,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", required=True, help="the results' Parquet file (written whole or not at all)")
     parser.add_argument("--model", help="model bundle directory (default: the shipped models/default)")
     parser.add_argument("--engine", choices=("local", "ray", "torch"), default="local",
-                        help="local processes, Ray Data, or the model in torch in this process (--device)")
+                        help="local processes, Ray Data, or the model in torch (--device) in this process")
     parser.add_argument("--workers", type=int, help="processes or Ray actors (default: this machine's cores; with "
-                        "--engine ray --device cuda, one actor for each GPU of the Ray cluster)")
+                        "--engine ray --device cuda, one actor for each GPU of the Ray cluster; with --engine torch, "
+                        "this process alone: K processes here, each with its own torch engine, sharing the device)")
     parser.add_argument("--chunk-rows", type=int, help=f"shots a batch (default {CHUNK_ROWS}; with the torch engine "
                         f"{TORCH_CHUNK_ROWS['cpu']} on a CPU, {TORCH_CHUNK_ROWS['cuda']} on a GPU)")
     parser.add_argument("--device", help="the torch engine's device: --engine torch: cpu (default), cuda or cuda:N; "
@@ -105,9 +107,6 @@ def _check_options(args: argparse.Namespace) -> None:
         raise ValueError("--workers and --chunk-rows take a whole number of at least 1")
     if args.ray_address and args.engine != "ray":
         raise ValueError("--ray-address goes with --engine ray")
-    if args.engine == "torch" and args.workers is not None:
-        raise ValueError("--workers goes with --engine local or ray (--engine torch flies in this process, on its "
-                         "--device)")
     if args.threads is not None and args.threads < 1:
         raise ValueError("--threads takes a whole number of at least 1")
     if args.actors_per_gpu is not None and (args.engine != "ray" or args.device != "cuda"):
@@ -134,19 +133,23 @@ def _torch_maker(args: argparse.Namespace, threads: int | None, parts_at_once: i
 
 def _engines(args: argparse.Namespace):
     """The torch engine `--engine torch` flies in this process (the bundle rebuilt in torch), or None; and what each
-    Ray actor flies with (`sweep.run.RayEngine`: the torch engine on a GPU, or 1/K of one, with `--device cuda`)."""
+    worker flies with (`sweep.run.WorkerEngine`): each Ray actor, the torch engine on a GPU, or 1/K of one, with
+    `--device cuda`; each of `--engine torch --workers K`'s processes, the torch engine in 1/K of the device's
+    memory (one torch thread each on a CPU unless `--threads`)."""
     from golfflight.flight.bundle_location import model_dir
-    from golfflight.sweep.run import RayEngine
+    from golfflight.sweep.run import WorkerEngine
 
+    if args.engine == "torch" and args.workers is not None:
+        return None, WorkerEngine(_torch_maker(args, args.threads or 1, args.workers))
     if args.engine == "torch":
         from golfflight.sweep.engines import PIECES_IN_FLIGHT
 
-        return _torch_maker(args, args.threads, PIECES_IN_FLIGHT)(model_dir(args.model).resolve()), RayEngine()
+        return _torch_maker(args, args.threads, PIECES_IN_FLIGHT)(model_dir(args.model).resolve()), WorkerEngine()
     if _torch_on_ray(args):
         sharing = args.actors_per_gpu or 1
         gpus = 1 / sharing if args.device == "cuda" else 0
-        return None, RayEngine(_torch_maker(args, args.threads or 1, sharing), gpus)
-    return None, RayEngine()
+        return None, WorkerEngine(_torch_maker(args, args.threads or 1, sharing), gpus)
+    return None, WorkerEngine()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -163,8 +166,8 @@ def run(args: argparse.Namespace) -> int:
     on_gpu = (args.device or "cpu").startswith("cuda")
     chunk_rows = args.chunk_rows or (TORCH_CHUNK_ROWS["cuda" if on_gpu else "cpu"] if torch_anywhere else CHUNK_ROWS)
     source = open_source(args.launches, args.grid, chunk_rows)
-    torch_engine, ray_engine = _engines(args)
-    workers = 1 if torch_engine is not None else args.workers or (None if ray_engine.gpus else os.cpu_count() or 1)
+    torch_engine, worker_engine = _engines(args)
+    workers = 1 if torch_engine is not None else args.workers or (None if worker_engine.gpus else os.cpu_count() or 1)
     summary = run_sweep(
         source,
         args.out,
@@ -176,7 +179,7 @@ def run(args: argparse.Namespace) -> int:
         progress=not args.no_progress,
         skipped=lambda problem: print(f"golfflight sweep: skipped: {problem}", file=sys.stderr),
         in_process=torch_engine,
-        ray_engine=ray_engine,
+        worker_engine=worker_engine,
     )
     whole = (
         f", {summary.chunks_skipped:,} of {summary.chunks:,} chunks skipped whole for want of a valid row"
@@ -188,7 +191,7 @@ def run(args: argparse.Namespace) -> int:
         where = f"({torch_engine.device}, {dtype})"
     else:
         where = f"with {workers} workers" if workers else f"with {args.actors_per_gpu or 1} actors a GPU"
-        where += f" (torch on {args.device}, {dtype})" if ray_engine.make else ""
+        where += f" (torch on {args.device}, {dtype})" if worker_engine.make else ""
     print(
         f"golfflight sweep: {summary.written:,} shots written to {args.out} ({summary.skipped:,} rows skipped{whole}, "
         f"{summary.failed:,} could not be flown) in {summary.seconds:.1f} s: {summary.shots_per_second:,.0f} shots/s "
