@@ -11,8 +11,9 @@ it, and the figures and the bounce and roll of the landings after it (`torch_eng
 sweep is all but the flight, the driver's work included.
 
 One command on a lent GPU machine (estimated at 7-8 minutes on an H100, not yet run there: four engines at five batch
-sizes, three compilations, and seven sweeps of 4,194,304 rows, two of them by 2 and 4 processes sharing the GPU; each measurement is written to benchmarks/results.json
-as soon as it is made, so a run cut short keeps what it measured; copy that file into $OUT;
+sizes, three compilations, and seven sweeps of 4,194,304 rows, two of them by 2 and 4 processes sharing the GPU;
+each measurement is written to benchmarks/results.json as soon as it is made, so a run cut short keeps what it
+measured; copy that file into $OUT;
 --ray-workers 1,2,4 also sweeps the same grid through `--engine ray --device cuda` with that many actors sharing the
 GPU, `--actors-per-gpu`, Ray's start included: about 2 minutes more, not yet run there either, and only where Ray is
 installed; scripts/gpu_session.sh runs this script on the project's lent machines, whose image lacks Ray):

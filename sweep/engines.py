@@ -1,8 +1,9 @@
 """The ways a sweep's pieces are flown, each a generator of result tables in input order: `local_tables` (a pool of
-processes on this machine, each with ONNX Runtime or its own torch engine), `ray_tables` (Ray Data on a local Ray instance or an existing cluster) and
-`in_process_tables` (one engine in this process, whose parallelism is its device's: the torch engine, a few pieces at
-once in threads so that the CPU's work overlaps the device's). Each worker holds one `sweep.flyer.Flyer`, and at most a
-few pieces per worker are in flight, so memory stays bounded however long the input is.
+processes on this machine, each with ONNX Runtime or its own torch engine), `ray_tables` (Ray Data on a local Ray
+instance or an existing cluster) and `in_process_tables` (one engine in this process, whose parallelism is its
+device's: the torch engine, a few pieces at once in threads so that the CPU's work overlaps the device's). Each worker
+holds one `sweep.flyer.Flyer`, and at most a few pieces per worker are in flight, so memory stays bounded however long
+the input is.
 """
 
 from __future__ import annotations

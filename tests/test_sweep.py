@@ -306,8 +306,8 @@ def test_ray_actors_fly_the_torch_engine_as_engine_torch_does(tmp_path, capsys):
     """`--engine ray --device cpu`: each actor builds the torch engine itself (`TorchEngineMaker`, sent by Ray) and
     the Parquet file holds the numbers of `--engine torch --device cpu`, every column equal. On the same Ray
     instance (started here once with one GPU declared, which Ray takes on trust; the sweep leaves it running): an
-    actor asking Ray for that GPU (`WorkerEngine(gpus=1)`, what `--device cuda` asks; here it flies on the CPU) is placed
-    and gives the same file, one actor for the one GPU listed, as do two actors asking for half of it each
+    actor asking Ray for that GPU (`WorkerEngine(gpus=1)`, what `--device cuda` asks; here it flies on the CPU) is
+    placed and gives the same file, one actor for the one GPU listed, as do two actors asking for half of it each
     (`--actors-per-gpu 2`); and `--device cuda`, whose engine no worker here can
     build (no CUDA, as on a GPU node without its driver), is refused in one line before any actor starts."""
     ray = pytest.importorskip("ray")

@@ -217,12 +217,15 @@ def test_the_sweep_on_torch_writes_the_local_engines_columns_and_numbers(tmp_pat
 def test_the_torch_engine_in_a_pool_of_processes_writes_the_in_process_engines_file(tmp_path, capsys):
     """`--engine torch --workers 2`: two processes here, each with its own torch engine (one thread), fly the
     pieces and the driver writes them in order: the file of the torch engine in this process, to the float32
-    network's rounding."""
+    network's rounding. A device this machine lacks is refused in the driver."""
     alone, pooled = tmp_path / "alone.parquet", tmp_path / "pooled.parquet"
     assert sweep(*GRID, "--out", alone, "--engine", "torch", "--device", "cpu", "--threads", 1, "--chunk-rows", 32) == 0
     assert sweep(*GRID, "--out", pooled, "--engine", "torch", "--device", "cpu", "--workers", 2,
                  "--chunk-rows", 32) == 0
     assert "on torch with 2 workers (torch on cpu, float32)" in capsys.readouterr().out
+    assert sweep(*GRID, "--out", tmp_path / "none.parquet", "--engine", "torch", "--device", "tpu", "--workers", 2) == 2
+    assert "--device 'tpu': not a device name" in capsys.readouterr().err  # in one line, before any worker starts
+    assert not (tmp_path / "none.parquet").exists()
     want, got = pq.read_table(alone), pq.read_table(pooled)
     assert got.schema == want.schema and got.num_rows == 160
     for name, field in zip(want.column_names, want.schema, strict=True):

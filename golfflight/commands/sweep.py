@@ -6,7 +6,8 @@ product: START:STOP:COUNT, V1,V2,... or V per column, `sweep.grid`). Output: one
 processes here, `--engine ray` through Ray Data (a local Ray instance, or a cluster's with `--ray-address`),
 `--engine torch` in this process on `--device cpu` or `cuda` (the bundle rebuilt in torch,
 `model_export.torch_engine`), or with `--workers K` in K processes here, each with its own torch engine on the
-device (sharing one GPU, so that one process's host work overlaps another's flight, as Ray's actors do). `--engine ray --device cuda` flies the torch engine in each Ray actor on a GPU (one
+device (sharing one GPU, so that one process's host work overlaps another's flight, as Ray's actors do). `--engine
+ray --device cuda` flies the torch engine in each Ray actor on a GPU (one
 actor a GPU, or `--actors-per-gpu K` sharing each, so that one actor's host work, checking rows, rolling to rest and
 writing, overlaps another's flight; each engine sizes its batches to its share of the GPU's free memory;
 `--workers` left out is as many actors as the cluster's GPUs hold); `--device cpu` there flies it on each actor's
@@ -140,6 +141,9 @@ def _engines(args: argparse.Namespace):
     from golfflight.sweep.run import WorkerEngine
 
     if args.engine == "torch" and args.workers is not None:
+        from golfflight.model_export.devices import resolve_device
+
+        resolve_device(args.device or "cpu")  # refused here in one line, not in each worker's start
         return None, WorkerEngine(_torch_maker(args, args.threads or 1, args.workers))
     if args.engine == "torch":
         from golfflight.sweep.engines import PIECES_IN_FLIGHT
