@@ -180,7 +180,7 @@ def test_shots_set_aside_as_they_land_fly_the_same_numbers(shots, monkeypatch):
         np.testing.assert_allclose(getattr(aside, name), getattr(together, name), rtol=1e-8, atol=1e-6, err_msg=name)
     np.testing.assert_allclose(aside.rest.total_m, together.rest.total_m, rtol=1e-8, atol=1e-6)
     np.testing.assert_array_equal(aside.rest.bounces, together.rest.bounces)
-    assert sum(flown) == SHOTS * torch_engine.load_flyer(None).max_steps  # two shots never land: every step flown
+    assert sum(flown) == SHOTS * load_flyer(None).max_steps  # two shots never land: every step flown
     assert aside_steps < 0.6 * sum(flown)
     with pytest.raises(ValueError, match="set_aside_share 0: must be more than 0 and at most 1"):
         TorchEngine(bundle, "cpu", set_aside_share=0)
