@@ -220,8 +220,7 @@ def test_the_torch_engine_in_a_pool_of_processes_writes_the_in_process_engines_f
     network's rounding. A device this machine lacks is refused in the driver."""
     alone, pooled = tmp_path / "alone.parquet", tmp_path / "pooled.parquet"
     assert sweep(*GRID, "--out", alone, "--engine", "torch", "--device", "cpu", "--threads", 1, "--chunk-rows", 32) == 0
-    assert sweep(*GRID, "--out", pooled, "--engine", "torch", "--device", "cpu", "--workers", 2,
-                 "--chunk-rows", 32) == 0
+    assert sweep(*GRID, "--out", pooled, "--engine", "torch", "--workers", 2, "--chunk-rows", 32) == 0  # cpu
     assert "on torch with 2 workers (torch on cpu, float32)" in capsys.readouterr().out
     assert sweep(*GRID, "--out", tmp_path / "none.parquet", "--engine", "torch", "--device", "tpu", "--workers", 2) == 2
     assert "--device 'tpu': not a device name" in capsys.readouterr().err  # in one line, before any worker starts

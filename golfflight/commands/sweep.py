@@ -7,11 +7,10 @@ processes here, `--engine ray` through Ray Data (a local Ray instance, or a clus
 `--engine torch` in this process on `--device cpu` or `cuda` (the bundle rebuilt in torch,
 `model_export.torch_engine`), or with `--workers K` in K processes here, each with its own torch engine on the
 device (sharing one GPU, so that one process's host work overlaps another's flight, as Ray's actors do). `--engine
-ray --device cuda` flies the torch engine in each Ray actor on a GPU (one
-actor a GPU, or `--actors-per-gpu K` sharing each, so that one actor's host work, checking rows, rolling to rest and
-writing, overlaps another's flight; each engine sizes its batches to its share of the GPU's free memory;
-`--workers` left out is as many actors as the cluster's GPUs hold); `--device cpu` there flies it on each actor's
-CPU, the numbers of `--engine torch`. Needs the `sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray`
+ray --device cuda` flies the torch engine in each Ray actor on a GPU (one actor a GPU, or `--actors-per-gpu K`
+sharing each, so that one actor's host work, checking rows, rolling to rest and writing, overlaps another's flight;
+each engine sizes its batches to its share of the GPU's free memory; `--workers` left out is as many actors as the
+cluster's GPUs hold); `--device cpu` there flies it on each actor's CPU, the numbers of `--engine torch`. Needs the `sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray`
 and the `train` extra (torch) for `--engine torch` and `--device`.
 """
 
@@ -195,7 +194,7 @@ def run(args: argparse.Namespace) -> int:
         where = f"({torch_engine.device}, {dtype})"
     else:
         where = f"with {workers} workers" if workers else f"with {args.actors_per_gpu or 1} actors a GPU"
-        where += f" (torch on {args.device}, {dtype})" if worker_engine.make else ""
+        where += f" (torch on {args.device or 'cpu'}, {dtype})" if worker_engine.make else ""
     print(
         f"golfflight sweep: {summary.written:,} shots written to {args.out} ({summary.skipped:,} rows skipped{whole}, "
         f"{summary.failed:,} could not be flown) in {summary.seconds:.1f} s: {summary.shots_per_second:,.0f} shots/s "
