@@ -10,13 +10,14 @@ the landings back in NumPy (the device's transfers included); around it are the 
 it, and the figures and the bounce and roll of the landings after it (`torch_engine.STAGES`); the CPU's share of a
 sweep is all but the flight, the driver's work included.
 
-One command on a lent GPU machine (estimated at 7-8 minutes on an H100, not yet run there: four engines at five batch
-sizes, three compilations, and seven sweeps of 4,194,304 rows, two of them by 2 and 4 processes sharing the GPU;
-each measurement is written to benchmarks/results.json as soon as it is made, so a run cut short keeps what it
-measured; copy that file into $OUT;
---ray-workers 1,2,4 also sweeps the same grid through `--engine ray --device cuda` with that many actors sharing the
-GPU, `--actors-per-gpu`, Ray's start included: about 2 minutes more, not yet run there either, and only where Ray is
-installed; scripts/gpu_session.sh runs this script on the project's lent machines, whose image lacks Ray):
+One command on a GPU machine (with the defaults estimated at 7-8 minutes on an H100, not yet run there: four engines
+at five batch sizes, two compilations, and seven sweeps of 4,194,304 rows, two of them by 2 and 4 processes sharing
+the GPU; each measurement is written to benchmarks/results.json as soon as it is made, so a run cut short keeps what
+it measured). `--engines` chooses the engines timed beside the eager one and `--sweep-timeout` stops a sweep that
+runs too long: scripts/gpu_session.sh runs the script in parts that fit the project's lent machines (15 minutes of
+device time a session, training's measurements included; their image lacks Ray). --ray-workers 1,2,4 also sweeps the
+same grid through `--engine ray --device cuda` with that many actors sharing the GPU, `--actors-per-gpu`, Ray's
+start included: about 2 minutes more, not yet run there either, and only where Ray is installed:
     python benchmarks/bench_gpu.py --device cuda [--ray-workers 1,2,4]
 Here on the CPU, small sizes:
     python benchmarks/bench_gpu.py --device cpu --batches 1024,4096,16384 --parity-shots 3000 --share-rows 124032 \
@@ -26,7 +27,9 @@ Here on the CPU, small sizes:
 from __future__ import annotations
 
 import argparse
+import os
 import resource
+import signal
 import statistics
 import subprocess
 import sys
@@ -138,17 +141,21 @@ def throughput(engines: dict[str, TorchEngine], batches: list[int], rounds: int)
     return rows
 
 
-def parity(bundle: Path, device: str, shots: int, compiled: bool = True) -> list[dict]:
-    """Carry (and rest) max |difference| from the ONNX engine's batch path on `shots` mixed shots, per precision (and
-    float32 with its step compiled, if `compiled`)."""
+def parity(bundle: Path, device: str, shots: int, engines: dict[str, TorchEngine]) -> list[dict]:
+    """Carry (and rest) max |difference| from the ONNX engine's batch path on `shots` mixed shots, per precision: float32
+    by the warmed eager engine (and the compiled one, if `engines` has it: no second compilation), float64 by one
+    built here."""
     launches = launches_array(shots, seed=7)
     conditions, grounds = mixed_conditions(shots)
     started = time.perf_counter()
     reference = load_flyer(bundle).fly_columns(launches, conditions, grounds)
     print(f"ONNX reference: {shots:,} mixed shots in {time.perf_counter() - started:.1f} s", flush=True)
+    cases = [("float32", False, engines["eager"]), ("float64", False, TorchEngine(bundle, device, "float64"))]
+    if "compiled" in engines:
+        cases.append(("float32", True, engines["compiled"]))
     rows = []
-    for dtype, compile_step in (("float32", False), ("float64", False), ("float32", True))[: 3 if compiled else 2]:
-        got = TorchEngine(bundle, device, dtype, compile_step=compile_step).fly_columns(launches, conditions, grounds)
+    for dtype, compile_step, engine in cases:
+        got = engine.fly_columns(launches, conditions, grounds)
         landed = np.array([i not in reference.errors for i in range(shots)])
         rolled = got.rolled & reference.rolled
         row = {"dtype": dtype, "compiled": compile_step, "shots": shots, "errors_equal": got.errors == reference.errors,
@@ -219,10 +226,11 @@ def engine_options(device: str, compiled: bool = False, ray_workers: int | None 
     return ["--engine", "torch", *pool, *(["--compile"] if compiled else [])]
 
 
-def sweep_end_to_end(device: str, rows: int, threads: int | None, engine: list[str]) -> dict:
+def sweep_end_to_end(device: str, rows: int, threads: int | None, engine: list[str], timeout_s: float) -> dict:
     """`golfflight sweep` with `engine` (`engine_options`) on a grid of `rows` launches to Parquet, as its own
     process: wall seconds from start to file written (loading and compiling included), and the command's own account
-    of where the time went."""
+    of where the time went; a sweep still running after `timeout_s` is stopped and said to be (a lent machine's
+    minutes are few)."""
     speeds = max(rows // 400, 1)
     grid = [f"ball_speed_mps=30:80:{speeds}", "launch_angle_deg=6:30:20", "spin_rpm=1500:9000:20"]
     shots = speeds * 400
@@ -230,13 +238,21 @@ def sweep_end_to_end(device: str, rows: int, threads: int | None, engine: list[s
         command = [sys.executable, "-m", "golfflight", "sweep", "--grid", *grid, "--out", f"{folder}/out.parquet",
                    *engine, "--device", device, "--no-progress", *(["--threads", str(threads)] if threads else [])]
         started = time.perf_counter()
-        done = subprocess.run(command, cwd=REPO, capture_output=True, text=True, check=False)
+        with subprocess.Popen(command, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                              start_new_session=True) as process:  # its own group: a pool's workers stop with it
+            try:
+                stdout, stderr = process.communicate(timeout=timeout_s)
+            except subprocess.TimeoutExpired:
+                os.killpg(process.pid, signal.SIGKILL)
+                process.communicate()
+                print(f"{' '.join(engine)}: stopped after {timeout_s:g} s", flush=True)
+                return {"shots": shots, "engine": " ".join(engine), "error": f"stopped after {timeout_s:g} s"}
         seconds = time.perf_counter() - started
-    if done.returncode:
-        print(f"{' '.join(engine)}: failed ({done.stderr.strip()[-500:]})", flush=True)
-        return {"shots": shots, "engine": " ".join(engine), "error": done.stderr.strip()[-2000:]}
-    print(done.stdout.strip(), flush=True)
-    return {"shots": shots, "seconds": seconds, "shots_per_s": shots / seconds, "summary": done.stdout.strip(),
+    if process.returncode:
+        print(f"{' '.join(engine)}: failed ({stderr.strip()[-500:]})", flush=True)
+        return {"shots": shots, "engine": " ".join(engine), "error": stderr.strip()[-2000:]}
+    print(stdout.strip(), flush=True)
+    return {"shots": shots, "seconds": seconds, "shots_per_s": shots / seconds, "summary": stdout.strip(),
             "engine": " ".join(engine)}
 
 
@@ -263,19 +279,25 @@ def print_table(section: dict) -> None:
                   f"{r['peak_memory_mb']:,.0f} MB |")
 
 
-def warmed_engines(bundle: Path, device: str) -> tuple[dict[str, TorchEngine], dict[str, str]]:
-    """The engines to time (eager, compiled, the ground phase on the other side, and eager with every shot flown to
-    its part's last step: landed shots never set aside), each flown once (the first kernels, allocations and
+OTHER_ENGINES = ("compiled", "ground-elsewhere", "none-set-aside")
+"""The engines timed beside the eager one (`--engines`): its step compiled, its ground phase on the other side (the
+CPU's NumPy on a GPU, the device's torch on a CPU), and every shot flown to its part's last step (landed shots never
+set aside)."""
+
+
+def warmed_engines(bundle: Path, device: str, others: list[str]) -> tuple[dict[str, TorchEngine], dict[str, str]]:
+    """The eager engine and the `others` (OTHER_ENGINES) to time, each flown once (the first kernels, allocations and
     compilation), and why any could not be (a device's compiler missing, say): on a lent machine's few minutes, one
     engine that fails must not lose the others' numbers."""
     eager = TorchEngine(bundle, device)
     elsewhere = "cpu" if eager.ground_on_device else "device"
-    makers = {"eager": lambda: eager, "compiled": lambda: TorchEngine(bundle, device, compile_step=True),
-              f"ground on {elsewhere}": lambda: TorchEngine(bundle, device,
-                                                            ground_on_device=not eager.ground_on_device),
-              "none set aside": lambda: TorchEngine(bundle, device, set_aside_share=1.0)}
-    engines, failed = {}, {}
-    for name, make in makers.items():
+    makers = {"compiled": ("compiled", lambda: TorchEngine(bundle, device, compile_step=True)),
+              "ground-elsewhere": (f"ground on {elsewhere}",
+                                   lambda: TorchEngine(bundle, device, ground_on_device=not eager.ground_on_device)),
+              "none-set-aside": ("none set aside", lambda: TorchEngine(bundle, device, set_aside_share=1.0))}
+    engines, failed = {"eager": eager}, {}
+    eager.fly_columns(launches_array(1024), STANDARD, GroundSpec(SURFACES["fairway"]))
+    for name, make in (makers[other] for other in others):
         try:
             engine = make()
             engine.fly_columns(launches_array(1024), STANDARD, GroundSpec(SURFACES["fairway"]))
@@ -284,6 +306,15 @@ def warmed_engines(bundle: Path, device: str) -> tuple[dict[str, TorchEngine], d
             failed[name] = f"{type(error).__name__}: {error}"
             print(f"{name}: could not fly ({failed[name]})", flush=True)
     return engines, failed
+
+
+def engine_names(text: str) -> list[str]:
+    """Comma-separated names of OTHER_ENGINES (an empty text: none)."""
+    names = [name for name in text.split(",") if name]
+    unknown = sorted(set(names) - set(OTHER_ENGINES))
+    if unknown:
+        raise argparse.ArgumentTypeError(f"{', '.join(unknown)}: choose from {', '.join(OTHER_ENGINES)}")
+    return names
 
 
 def main() -> None:
@@ -301,12 +332,17 @@ def main() -> None:
     parser.add_argument("--torch-workers", type=counts,
                         help="also sweep through --engine torch --workers K, K processes sharing the device "
                         "(comma-separated counts; default 2,4 on cuda, none on a CPU)")
+    parser.add_argument("--engines", type=engine_names, default=list(OTHER_ENGINES),
+                        help=f"engines timed beside the eager one, comma-separated (default all: "
+                        f"{','.join(OTHER_ENGINES)}; the compiled one also flies the parity and the compiled sweep)")
+    parser.add_argument("--sweep-timeout", type=float, default=300.0,
+                        help="seconds an end-to-end sweep may run before it is stopped (default 300)")
     parser.add_argument("--share-rows", type=int, help="launches of the CPU-share sweeps (0: none; default: by device)")
     args = parser.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
     bundle = load_flyer(args.model).bundle_dir
-    engines, failed = warmed_engines(bundle, args.device)
+    engines, failed = warmed_engines(bundle, args.device, args.engines)
     engine = engines["eager"]
     kind = engine.device.type
     batches = [int(b) for b in args.batches.split(",")] if args.batches else list(DEFAULT_BATCHES[kind])
@@ -319,7 +355,7 @@ def main() -> None:
         write_results(f"torch_engine_{kind}", [section])
 
     measured("throughput", throughput(engines, batches, args.rounds))
-    measured("parity", parity(bundle, args.device, args.parity_shots, compiled="compiled" in engines))
+    measured("parity", parity(bundle, args.device, args.parity_shots, engines))
     best = max(row[name]["shots_per_s"] for row in section["throughput"] for name in engines)
     measured("flight_best_shots_per_s", best)
     if kind in FLIGHT_TARGET:
@@ -338,7 +374,7 @@ def main() -> None:
     ):
         if not rows or (compiled and "compiled" not in engines):
             continue
-        result = sweep_end_to_end(args.device, rows, args.threads, options)
+        result = sweep_end_to_end(args.device, rows, args.threads, options, args.sweep_timeout)
         if kind in SWEEP_TARGET and "error" not in result:
             result |= {"target": f">= {SWEEP_TARGET[kind]:,.0f} shots/s",
                        "met": result["shots_per_s"] >= SWEEP_TARGET[kind]}

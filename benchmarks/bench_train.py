@@ -68,10 +68,11 @@ def train(data: Path, device: str, folder: Path, runs: int, epochs: int, compile
         return list(train_seeds(data, folder, model_dir(None), configs, plan, progress=False).values())
 
 
-def measure(data: Path, device: str, folder: Path, runs: int, compile_step: bool, jobs: int = 1) -> dict:
+def measure(data: Path, device: str, folder: Path, runs: int, compile_step: bool, jobs: int = 1,
+            count_ops: bool = True) -> dict:
     """An epoch's seconds: the second of two (the first compiles where `compile_step`; with `jobs` processes, the
-    slowest process's second epoch, all of them training at once), and, eager in one process, the operations one
-    epoch dispatches. Compiled runs start from an empty compile cache: torch.compile keeps its versions of
+    slowest process's second epoch, all of them training at once), and, eager in one process where `count_ops`, the
+    operations one epoch dispatches (a third epoch, slower for the counting). Compiled runs start from an empty compile cache: torch.compile keeps its versions of
     `euler_step` by the function, so the runs' counts before would add up to its limit of eight (then it runs eager)."""
     if compile_step:
         torch._dynamo.reset()
@@ -80,7 +81,7 @@ def measure(data: Path, device: str, folder: Path, runs: int, compile_step: bool
     row = {"runs": runs, "jobs": jobs, "compiled": compile_step, "epoch_s": epoch_s,
            "first_epoch_s": max(result.history[0]["seconds"] for result in results), "seed_share_s": epoch_s / runs,
            "selection_loss": results[0].history[1]["selection_loss"], "ops": None}
-    if not compile_step and jobs == 1:
+    if count_ops and not compile_step and jobs == 1:
         counter = OpCounter()
         train(data, device, folder / "counted", runs, 1, counter=counter)
         row["ops"] = counter.count
@@ -112,6 +113,9 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=1,
                         help="processes training at once on a CPU, the seeds shared out over them (as train-real "
                         "--stack-seeds --jobs N; each with --threads torch threads; default 1)")
+    parser.add_argument("--count-ops", action=argparse.BooleanOptionalAction, default=True,
+                        help="count an eager epoch's operations in a third epoch (default; --no-count-ops saves its "
+                        "time: the counts do not depend on the device)")
     args = parser.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
@@ -132,7 +136,7 @@ def main() -> None:
             for compiled in (False, True) if args.compile else (False,):
                 row = {"device": str(device), "torch": torch.__version__, "torch_threads": torch.get_num_threads(),
                        "op_cost_us": cost, **measure(data, args.device, Path(folder) / f"{runs}-{compiled}", runs,
-                                                    compiled, args.jobs)}
+                                                    compiled, args.jobs, args.count_ops)}
                 row["ops_floor_s"] = None if row["ops"] is None else row["ops"] * cost * 1e-6
                 rows.append(row)
                 ops = "—" if row["ops"] is None else f"{row['ops']:,}"
@@ -141,8 +145,13 @@ def main() -> None:
                       f"{'compiled' if compiled else 'eager'} | "
                       f"{row['epoch_s']:.1f} s | {row['seed_share_s']:.1f} s | {row['first_epoch_s']:.1f} s | {ops} | "
                       f"{floor} | {row['selection_loss']:.3f} m |", flush=True)
+                write_rows(f"train_epoch_{device.type}", rows)
     print(f"\nan operation's fixed cost on {device}: {cost:.2f} µs")
-    section = f"train_epoch_{device.type}"
+
+
+def write_rows(section: str, rows: list[dict]) -> None:
+    """The section of benchmarks/results.json with `rows` in it, in place of the rows that measured the same (written
+    after each measurement: a run cut short keeps what it measured)."""
     kept = json.loads(RESULTS.read_text()).get(section, {}).get("rows", []) if RESULTS.is_file() else []
     fresh = {_key(r) for r in rows}
     write_results(section, [*(r for r in kept if "compiled" in r and _key(r) not in fresh), *rows])
