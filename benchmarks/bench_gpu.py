@@ -142,9 +142,9 @@ def throughput(engines: dict[str, TorchEngine], batches: list[int], rounds: int)
 
 
 def parity(bundle: Path, device: str, shots: int, engines: dict[str, TorchEngine]) -> list[dict]:
-    """Carry (and rest) max |difference| from the ONNX engine's batch path on `shots` mixed shots, per precision: float32
-    by the warmed eager engine (and the compiled one, if `engines` has it: no second compilation), float64 by one
-    built here."""
+    """Carry (and rest) max |difference| from the ONNX engine's batch path on `shots` mixed shots, per precision:
+    float32 by the warmed eager engine (and the compiled one, if `engines` has it: no second compilation), float64 by
+    one built here."""
     launches = launches_array(shots, seed=7)
     conditions, grounds = mixed_conditions(shots)
     started = time.perf_counter()

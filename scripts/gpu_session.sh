@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Issue 33's GPU measurements on a machine lent by the `device` tool, prepared here and run there in two commands.
+# Issue 33's GPU measurements on a machine lent by the `device` tool, prepared here and run there in two commands
+# (a third where time is left).
 #
 # A session is lent 15 minutes of device time in all, the machine's start (1-2 minutes) included, and a machine is
 # started only with 4 minutes left; so each command runs in about 4.5 minutes, leaving time to start again and rerun
