@@ -117,7 +117,8 @@ def run_sweep(
     """Fly every row of `source` on `engine` and write `out` (Parquet): the input row's number, its columns, its
     flight (module docstring). `skipped` gets each problem of a row left out under `skip_bad_rows`; `in_process` is
     the engine `engine="torch"` flies with (`model_export.torch_engine.TorchEngine`, loaded from `model`), `in_flight`
-    pieces at once; `worker_engine` what each actor of `engine="ray"` flies with (`workers` None: one actor a GPU),
+    pieces at once; `worker_engine` what each actor of `engine="ray"` flies with (`workers` None: as many as the
+    cluster's GPUs hold),
     and, without `in_process`, each of the `workers` processes of `engine="torch"`."""
     import pyarrow as pa
     import pyarrow.compute as pc

@@ -10,8 +10,9 @@ device (sharing one GPU, so that one process's host work overlaps another's flig
 ray --device cuda` flies the torch engine in each Ray actor on a GPU (one actor a GPU, or `--actors-per-gpu K`
 sharing each, so that one actor's host work, checking rows, rolling to rest and writing, overlaps another's flight;
 each engine sizes its batches to its share of the GPU's free memory; `--workers` left out is as many actors as the
-cluster's GPUs hold); `--device cpu` there flies it on each actor's CPU, the numbers of `--engine torch`. Needs the `sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray`
-and the `train` extra (torch) for `--engine torch` and `--device`.
+cluster's GPUs hold); `--device cpu` there flies it on each actor's CPU, the numbers of `--engine torch`. Needs the
+`sweep` extra (pyarrow, tqdm), the `ray` extra for `--engine ray` and the `train` extra (torch) for `--engine torch`
+and `--device`.
 """
 
 from __future__ import annotations
