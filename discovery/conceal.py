@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
-from golfflight.discovery.effects import Context, equivalent_altitude_m
+from golfflight.discovery.effects import DENSITY_ONLY, Context, equivalent_altitude_m
 from golfflight.discovery.model import FlightModel
 from golfflight.discovery.noise import RADAR_NOISE
 from golfflight.discovery.outside import OUTSIDE, air_motion, term_and_weights
@@ -52,6 +52,8 @@ LAUNCH_BIASES = {
     "ball_speed_bias": ("ball_speed_mps", "scale", False),
     "spin_bias": ("spin_rpm", "scale", False),
 }
+AIRS = ("air_density", DENSITY_ONLY)
+"""The two variants of air density: real air (the Reynolds number changes with it) and density alone."""
 KNOBS = {"drag_scale": "drag_scale", "lift_scale": "lift_scale", "spin_decay": "spin_decay_scale"}
 
 
@@ -97,6 +99,9 @@ def conceal(
     if "air_density" in hidden:
         altitude = equivalent_altitude_m(hidden["air_density"]["ratio"], NOMINAL_CONTEXT)
         air = Air.from_conditions(15.0, altitude, 0.0)
+    if DENSITY_ONLY in hidden:
+        ratio = hidden[DENSITY_ONLY]["ratio"]
+        air = Air(NOMINAL_AIR.density_kg_m3 * ratio, NOMINAL_AIR.kinematic_viscosity_m2_s)
     if "wind" in hidden:
         wind = Wind(hidden["wind"]["speed_mps"], hidden["wind"]["from_deg"], profile=wind_profile)
     if "landing_elevation" in hidden:
@@ -150,7 +155,7 @@ def _fly_model(
 ) -> Flight:
     """The true launches flown through the model with the hidden effects, in its flight core."""
     unknown = (
-        set(hidden) - set(KNOBS) - set(LAUNCH_BIASES) - set(OUTSIDE) - {"air_density", "wind", "landing_elevation"}
+        set(hidden) - set(KNOBS) - set(LAUNCH_BIASES) - set(OUTSIDE) - {*AIRS, "wind", "landing_elevation"}
     )
     if unknown or wind_profile != "uniform":
         raise ValueError(f"a model's own flights take library effects, uniform wind and discovery.outside: {unknown}")
@@ -162,11 +167,12 @@ def _fly_model(
     wind = np.zeros((n, 2))
     if "wind" in hidden:
         wind[:] = wind_vector(hidden["wind"]["speed_mps"], hidden["wind"]["from_deg"])[:2]
-    ratio = np.full(n, hidden.get("air_density", {"ratio": 1.0})["ratio"])
+    real, only = (hidden.get(name, {"ratio": 1.0})["ratio"] for name in AIRS)
+    ratio = np.full(n, real * only)
     density = np.full(n, model.density_kg_m3)
     term, weights = term_and_weights(hidden, density * ratio)
     ground = np.full(n, hidden.get("landing_elevation", {"height_m": 0.0})["height_m"])
-    setup = Setup(true.launch(), ratio, density, wind, ground, scale, weights)
+    setup = Setup(true.launch(), ratio, density, wind, ground, scale, weights, viscosity_ratio=np.full(n, 1.0 / real))
     air = air_motion(hidden, Wind.from_components(wind[:, 0], wind[:, 1]))
     return model.fly(setup, term, keep_states=trajectories, air=air)
 

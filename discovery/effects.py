@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from golfflight.discovery.simulator import Correction, Setup
@@ -35,6 +36,21 @@ class Parameter:
 
 Reported = tuple[dict[str, float], dict[str, float]]
 
+Kind = Literal["venue", "monitor", "form"]
+"""What an effect says about the recordings: a condition of the venue (air, wind, ground), a bias of the launch
+monitor's launch values, or the model's form (its coefficients or a learned correction: the recordings' physics
+differs from the model's in form). Venue and monitor findings are what a user acts on; a form finding says the model
+itself differs, whatever the venue."""
+
+KINDS: dict[Kind, str] = {
+    "venue": "a condition of the venue",
+    "monitor": "a bias of the launch monitor",
+    "form": "the model's form",
+}
+
+DENSITY_ONLY = "air_density_only"
+"""The density-only variant of air density (no Reynolds change)."""
+
 
 @dataclass(frozen=True)
 class Effect:
@@ -47,6 +63,7 @@ class Effect:
     summary: str
     correction: Correction | None = None
     """Extra acceleration the simulator adds (the learned correction); library effects have none."""
+    kind: Kind = "form"
 
     @property
     def null(self) -> np.ndarray:
@@ -91,6 +108,17 @@ def _wind(theta: np.ndarray, conditions: Setup) -> Setup:
 
 
 def _density(theta: np.ndarray, conditions: Setup) -> Setup:
+    """Real air `ratio` x as dense: the dynamic pressure scales with it and, at the same temperature, the kinematic
+    viscosity with its inverse, so the Reynolds number scales with it too."""
+    out = _density_only(theta, conditions)
+    ratio = out.viscosity_ratio if out.viscosity_ratio is not None else np.ones(len(out))
+    out.viscosity_ratio = ratio / theta[:, 0]
+    return out
+
+
+def _density_only(theta: np.ndarray, conditions: Setup) -> Setup:
+    """Density `ratio` x the assumed one with the viscosity unchanged: drag, lift and spin torque scaled together
+    and nothing else, as flight models that take density alone (some launch monitors' and rigs') fly thin air."""
     out = conditions.copy()
     out.density_ratio = out.density_ratio * theta[:, 0]
     return out
@@ -152,13 +180,25 @@ LIBRARY: tuple[Effect, ...] = (
         _wind,
         _describe_wind,
         "a steady uniform wind (the air moves at (x, y); reported as speed and the direction it blows from)",
+        kind="venue",
     ),
     Effect(
         "air_density",
         (Parameter("ratio", "1", 1.0, 0.6, 1.3, 0.05, 0.01),),
         _density,
         _describe_density,
-        "the air is thinner or denser than assumed (altitude, temperature, pressure)",
+        "the air is thinner or denser than assumed (altitude, temperature, pressure), with the Reynolds number "
+        "changed as real air changes it",
+        kind="venue",
+    ),
+    Effect(
+        DENSITY_ONLY,
+        (Parameter("ratio", "1", 1.0, 0.6, 1.3, 0.05, 0.01),),
+        _density_only,
+        _describe_density,
+        "the air density differs with the Reynolds number unchanged: drag, lift and spin torque scaled together, "
+        "as flight models that take density alone fly thin air",
+        kind="venue",
     ),
     Effect(
         "launch_angle_bias",
@@ -166,6 +206,7 @@ LIBRARY: tuple[Effect, ...] = (
         _launch("launch_angle_deg", True),
         _single("offset_deg"),
         "the true launch angle = recorded + offset",
+        kind="monitor",
     ),
     Effect(
         "launch_direction_bias",
@@ -173,6 +214,7 @@ LIBRARY: tuple[Effect, ...] = (
         _launch("launch_direction_deg", True),
         _single("offset_deg"),
         "the true launch direction = recorded + offset",
+        kind="monitor",
     ),
     Effect(
         "ball_speed_bias",
@@ -180,6 +222,7 @@ LIBRARY: tuple[Effect, ...] = (
         _launch("ball_speed_mps", False),
         _single("scale"),
         "the true ball speed = recorded x scale",
+        kind="monitor",
     ),
     Effect(
         "spin_bias",
@@ -187,6 +230,7 @@ LIBRARY: tuple[Effect, ...] = (
         _launch("spin_rpm", False),
         _single("scale"),
         "the true spin = recorded x scale",
+        kind="monitor",
     ),
     Effect(
         "spin_axis_bias",
@@ -194,6 +238,7 @@ LIBRARY: tuple[Effect, ...] = (
         _launch("spin_axis_deg", True),
         _single("offset_deg"),
         "the true spin axis = recorded + offset",
+        kind="monitor",
     ),
     Effect(
         "landing_elevation",
@@ -201,6 +246,7 @@ LIBRARY: tuple[Effect, ...] = (
         _ground,
         _single("height_m"),
         "the balls land on ground this high above the tee (negative = below)",
+        kind="venue",
     ),
     Effect(
         "spin_decay",
@@ -208,6 +254,7 @@ LIBRARY: tuple[Effect, ...] = (
         _coefficient(2),
         _single("scale"),
         "spin decays this many times as fast as the model's C_M says",
+        kind="form",
     ),
     Effect(
         "drag_scale",
@@ -215,6 +262,7 @@ LIBRARY: tuple[Effect, ...] = (
         _coefficient(1),
         _single("scale"),
         "the drag coefficient is this many times the model's",
+        kind="form",
     ),
     Effect(
         "lift_scale",
@@ -222,6 +270,7 @@ LIBRARY: tuple[Effect, ...] = (
         _coefficient(0),
         _single("scale"),
         "the lift coefficient is this many times the model's",
+        kind="form",
     ),
 )
 """Every library effect, in report order."""

@@ -2,8 +2,9 @@
 with its own expected error.
 
 `from_bundle` is what users run, flown as the service flies it (the bundle's Flyer from `flight.flyer.load_flyer`:
-forward Euler at the card's dt for the engine's maximum flight time, the card's air; air `ratio` x denser also has
-1/ratio the kinematic viscosity, for the reference world's Reynolds numbers as for the bundle's input scale);
+forward Euler at the card's dt for the engine's maximum flight time, the card's air, or each shot's recorded air with
+the kinematic viscosity the service gives it; the coefficients are read at every shot's own Reynolds numbers,
+`Setup.viscosity`);
 `reference` is the reference world itself (RK4 at 0.1 s, within 2 cm of its 0.01 s flights), a perfect model
 of clean synthetic data that `golfflight prove` uses to measure the method apart from any model error.
 """
@@ -66,10 +67,10 @@ class FlightModel:
     def method(self) -> Literal["euler", "rk4"]:
         return self.flyer.rule.name
 
-    def coefficients_for(self, ratio: np.ndarray) -> CoefficientModel:
-        """The coefficients for shots whose air is `ratio` x denser than the assumed air (1/ratio its kinematic
-        viscosity), per shot."""
-        return self.flyer.in_air(self.flyer.kinematic_viscosity_m2_s / np.asarray(ratio, dtype=float))
+    def coefficients_for(self, setup: Setup) -> CoefficientModel:
+        """The coefficients for a setup's shots, each at the kinematic viscosity of the air it flies in (the
+        recorded or the model's air, times the effects' ratio: `Setup.viscosity`)."""
+        return self.flyer.in_air(setup.viscosity(self.flyer.kinematic_viscosity_m2_s))
 
     def simulate(self, setup: Setup, correction: Correction | None = None, keep_positions: bool = False) -> Flown:
         """Fly a setup's shots through this model (`discovery.simulator.simulate_setup`)."""

@@ -43,9 +43,13 @@ class ExpectedError:
 
 
 def base_conditions(recordings: Recordings, model: FlightModel) -> Setup:
-    """The conditions the model assumes for the recordings: recorded air and wind where present, else its own air."""
+    """The conditions the model assumes for the recordings: recorded air (its density and kinematic viscosity, as the
+    service flies it) and wind where present, else its own air."""
     n = len(recordings)
     density = recordings.density_kg_m3 if recordings.density_kg_m3 is not None else np.full(n, model.density_kg_m3)
+    viscosity = recordings.kinematic_viscosity_m2_s
+    if viscosity is None:
+        viscosity = np.full(n, model.flyer.kinematic_viscosity_m2_s)
     wind = recordings.wind_xy_mps if recordings.wind_xy_mps is not None else np.zeros((n, 2))
     return Setup(
         {k: v.copy() for k, v in recordings.launch.items()},
@@ -54,6 +58,7 @@ def base_conditions(recordings: Recordings, model: FlightModel) -> Setup:
         np.asarray(wind, dtype=float),
         np.zeros(n),
         np.ones((n, 3)),
+        kinematic_viscosity_m2_s=np.asarray(viscosity, dtype=float),
     )
 
 

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from golfflight.discovery.conceal import OUTSIDE_EFFECT, conceal
+from golfflight.discovery.conceal import AIRS, OUTSIDE_EFFECT, conceal
 from golfflight.discovery.diagnose import diagnose
 from golfflight.discovery.effects import EFFECTS, LIBRARY
 from golfflight.discovery.model import FlightModel
@@ -81,7 +81,7 @@ def draw_effect(name: str, rng: np.random.Generator) -> dict[str, float]:
     """A realistic size and direction of one effect, in the report's conventions."""
     if name == "wind":
         return {"speed_mps": float(rng.uniform(2.0, 7.0)), "from_deg": float(rng.uniform(0.0, 360.0))}
-    if name == "air_density":
+    if name in AIRS:
         thinner = rng.random() < 0.75
         return {"ratio": float(1 - rng.uniform(0.05, 0.22) if thinner else 1 + rng.uniform(0.03, 0.08))}
     if name == OUTSIDE_EFFECT:
@@ -139,7 +139,7 @@ def internal(name: str, parameters: dict[str, float]) -> np.ndarray:
     """A hidden or fitted effect as the library's internal parameter vector."""
     if name == "wind":
         return wind_vector(parameters["speed_mps"], parameters["from_deg"])[:2]
-    if name == "air_density":
+    if name in AIRS:
         return np.array([parameters["ratio"]])
     return np.array([next(iter(v for k, v in parameters.items() if k in ("offset_deg", "scale", "height_m")))])
 

@@ -46,6 +46,10 @@ class Recordings:
     wind_xy_mps: np.ndarray | None = None
     trajectories: dict[str, np.ndarray] = field(default_factory=dict)
     source: str = ""
+    kinematic_viscosity_m2_s: np.ndarray | None = None
+    """Per shot where the air is recorded: the kinematic viscosity the service computes from the same conditions
+    (Sutherland's at the recorded temperature over the density), so the model is read at the Reynolds numbers the
+    service reads it at."""
 
     def __len__(self) -> int:
         return self.observed.shape[0]
@@ -77,6 +81,7 @@ class Recordings:
             None if self.wind_xy_mps is None else self.wind_xy_mps[index],
             {k: v for k, v in self.trajectories.items() if k in ids},
             self.source,
+            None if self.kinematic_viscosity_m2_s is None else self.kinematic_viscosity_m2_s[index],
         )
 
 
@@ -96,14 +101,19 @@ def _shot_order(session: np.ndarray, timestamp: np.ndarray) -> np.ndarray:
     return order
 
 
-def _conditions(shots: ShotSet) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """Per-shot density where any air condition is recorded (blanks: 15 degC, sea level, dry) and recorded wind."""
-    density = np.asarray(shots.air().density_kg_m3, dtype=float) if shots.air_recorded() else None
+def _conditions(shots: ShotSet) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray | None]:
+    """Per-shot density and kinematic viscosity where any air condition is recorded (blanks: 15 degC, sea level,
+    dry; `ShotSet.air`, as `golfflight simulate` flies them) and the recorded wind."""
+    density = viscosity = None
+    if shots.air_recorded():
+        air = shots.air()
+        density = np.asarray(air.density_kg_m3, dtype=float)
+        viscosity = np.asarray(air.kinematic_viscosity_m2_s, dtype=float)
     speed, from_deg = shots.column("wind_speed_mps"), shots.column("wind_from_deg")
     wind = None
     if np.isfinite(speed).any():
         wind = wind_vector(np.nan_to_num(speed), np.nan_to_num(from_deg))[:, :2]
-    return density, wind
+    return density, wind, viscosity
 
 
 def from_shot_set(shots: ShotSet, trajectories: dict[str, np.ndarray] | None = None, source: str = "") -> Recordings:
@@ -112,7 +122,7 @@ def from_shot_set(shots: ShotSet, trajectories: dict[str, np.ndarray] | None = N
     session = _text(shots.column("session"), "all")
     ids = shots.column("shot_id")
     shot_id = np.array([f"row{i}" if v is None else str(v) for i, v in enumerate(ids)], dtype=object)
-    density, wind = _conditions(shots)
+    density, wind, viscosity = _conditions(shots)
     recordings = Recordings(
         {name: shots.column(name) for name in LAUNCH_COLUMNS},
         observed,
@@ -124,6 +134,7 @@ def from_shot_set(shots: ShotSet, trajectories: dict[str, np.ndarray] | None = N
         wind,
         trajectories or {},
         source,
+        viscosity,
     )
     return recordings.subset(np.isfinite(observed).any(axis=1))
 

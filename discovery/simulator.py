@@ -22,8 +22,9 @@ CHUNK_SHOTS = 25_000
 so the outcomes are the same, and the memory a batch needs stays bounded (a 100,000-shot diagnosis flies batches of
 up to five times its shots at once)."""
 
-CoefficientsFor = Callable[[np.ndarray], CoefficientModel]
-"""Builds the model's coefficient function for shots whose air density is `ratio` x the assumed one (per shot)."""
+CoefficientsFor = Callable[["Setup"], CoefficientModel]
+"""Builds the model's coefficient function for a setup's shots, each read at the Reynolds numbers of the air it
+flies in (`Setup.viscosity`)."""
 
 Correction = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 """Extra acceleration [N,3] from (air-relative velocity [N,3], spin [N,3], position [N,3], per-shot weights [N,K])."""
@@ -46,6 +47,12 @@ class Setup:
     """Multipliers of C_L, C_D, C_M [N,3]."""
     correction_weights: np.ndarray | None = None
     """Weights [N,K] of an extra-acceleration term (see `discovery.correction`), None = no term."""
+    kinematic_viscosity_m2_s: np.ndarray | None = None
+    """The kinematic viscosity the model assumes for each shot [N] (recorded air, as the service computes it from
+    the temperature and density), None = the model's nominal air."""
+    viscosity_ratio: np.ndarray | None = None
+    """True kinematic viscosity over the assumed one [N] (None = 1): real thinner air has a proportionally larger
+    one (the Reynolds number falls with the density), a density-only change leaves it."""
 
     def __len__(self) -> int:
         return len(self.density_ratio)
@@ -62,6 +69,13 @@ class Setup:
 
     def copy(self) -> Setup:
         return self.take(np.arange(len(self)))
+
+    def viscosity(self, nominal_m2_s: float) -> np.ndarray:
+        """The kinematic viscosity each shot flies in [N]: the assumed one (`nominal_m2_s` where none is set) times
+        the effects' ratio."""
+        assumed = self.kinematic_viscosity_m2_s if self.kinematic_viscosity_m2_s is not None else nominal_m2_s
+        ratio = self.viscosity_ratio if self.viscosity_ratio is not None else 1.0
+        return np.broadcast_to(np.asarray(assumed * ratio, dtype=float), (len(self),)).copy()
 
 
 def concatenate(parts: list[Setup]) -> Setup:
@@ -116,7 +130,7 @@ def fly_setup(
     `air` replaces the setup's uniform wind with air whose motion depends on the ball's height (an outside effect's,
     `discovery.outside.HeightGust`), so the gust acts through the model's own coefficients like any wind."""
     density = setup.density_kg_m3 * setup.density_ratio
-    coefficients = ScaledCoefficients(coefficients_for(setup.density_ratio), setup.coefficient_scale)
+    coefficients = ScaledCoefficients(coefficients_for(setup), setup.coefficient_scale)
     wind = air if air is not None else Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1])
     extra = None if correction is None else WeightedCorrection(correction, setup.correction_weights)
     field = BallInAir(coefficients, density, wind, extra)

@@ -73,7 +73,7 @@ def test_simulator_matches_service_simulate(method):
     conditions = Setup(launch, np.ones(n), np.full(n, float(air.density_kg_m3)), wind, ground, np.ones((n, 3)))
     got = simulate_setup(
         conditions,
-        lambda ratio: ReferenceAerodynamics(CALIBRATED, air.kinematic_viscosity_m2_s / ratio),
+        lambda setup: ReferenceAerodynamics(CALIBRATED, setup.viscosity(air.kinematic_viscosity_m2_s)),
         0.1,
         15.0,
         method,

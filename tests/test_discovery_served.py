@@ -14,13 +14,15 @@ import pytest
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import diagnose
 from golfflight.discovery.model import from_bundle, load_model
-from golfflight.discovery.noise import RADAR_NOISE
+from golfflight.discovery.noise import RADAR_NOISE, base_conditions
 from golfflight.discovery.own_error import measure_own_error, write_own_error
 from golfflight.discovery.recordings import from_shot_set
 from golfflight.discovery.simulator import Setup
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.shots.paths import REPO_ROOT
+from golfflight.shots.records import ShotRecord, ShotSet
+from golfflight.cli import main
 from golfflight.weights_schema.bundle import load_bundle
 
 SHOTS = 200
@@ -111,3 +113,31 @@ def test_the_cards_own_error_is_what_diagnose_expects_of_the_model(tmp_path):
     assert card.schema_version == "1.3" and card.own_error == own
     model = from_bundle(bundle)
     assert model.model_error == own.sigma and "own error" in model.error_source["carry_y_m"]
+
+
+AIRS = {
+    "thin and hot (1,900 m, 35 degC, 20 %)": {"temperature_c": 35.0, "altitude_m": 1900.0, "humidity_pct": 20.0},
+    "cold and dense (-5 degC, 1,035 hPa, 80 %)": {"temperature_c": -5.0, "pressure_hpa": 1035.0, "humidity_pct": 80.0},
+    "ICAO standard": {},
+}
+
+
+@pytest.mark.parametrize("air", AIRS.values(), ids=AIRS.keys())
+def test_diagnose_flies_recorded_air_as_simulate_does(served, air, tmp_path, capsys):
+    """With the air recorded, diagnose's baseline is `golfflight simulate`'s flight in that air (density and the
+    viscosity at its temperature, so the Reynolds numbers too), within 1 mm."""
+    launches = [(70.0, 11.0, 1.0, 2600.0, 4.0), (45.0, 20.0, -2.0, 7000.0, -8.0), (60.0, 14.0, 0.0, 4200.0, 1.0)]
+    names = ("ball_speed_mps", "launch_angle_deg", "launch_direction_deg", "spin_rpm", "spin_axis_deg")
+    rows = [{**dict(zip(names, launch)), **air} for launch in launches]
+    source = tmp_path / "shots.csv"
+    header = list(rows[0])
+    source.write_text(",".join(header) + "\n" + "".join(",".join(str(r[k]) for k in header) + "\n" for r in rows))
+    assert main(["simulate", str(source), "--out", str(tmp_path / "flown.json")]) == 0
+    flown = json.loads((tmp_path / "flown.json").read_text())["results"]
+    records = ShotSet([ShotRecord(shot_id=f"s{i}", carry_y_m=100.0, **row) for i, row in enumerate(rows)])
+    recordings = from_shot_set(records)
+    predicted = served.simulate(base_conditions(recordings, served)).outcomes()
+    assert predicted[:, 0] == pytest.approx([r["landing"]["y_m"] for r in flown], abs=1e-3)
+    assert predicted[:, 1] == pytest.approx([r["landing"]["x_m"] for r in flown], abs=1e-3)
+    assert predicted[:, 2] == pytest.approx([r["apex_m"] for r in flown], abs=1e-3)
+    assert predicted[:, 4] == pytest.approx([r["landing_angle_deg"] for r in flown], abs=1e-4)
