@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from golfflight.discovery import correction as learned
-from golfflight.discovery.effects import LIBRARY, Context
+from golfflight.discovery.effects import AIR_VARIANTS, LIBRARY, Context
 from golfflight.discovery.fit import (
     MAX_FIT_SHOTS,
     SCORED_SHOTS,
@@ -56,7 +56,8 @@ from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from golfflight.discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
 from golfflight.discovery.schema import AirRival, Candidate, Heldout, Located, ModelInfo, Report, ScatterStat, Unlisted
 from golfflight.discovery.simulator import Flown, Setup
-from golfflight.discovery.venue_air import air_rival, air_sentence, with_air
+from golfflight.discovery.physical import restatements
+from golfflight.discovery.venue_air import air_explanations, air_rival, air_sentence, with_air
 from golfflight.flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
 from golfflight.shots.progress import progress_bar, progress_step
 from golfflight.shots.synth import MeasurementNoise
@@ -419,6 +420,9 @@ class Diagnoser:
         null = self.null_candidate()
         singles = self.fit_singles()
         chosen, richer, test = self.choose(null, singles)
+        if chosen is not null:
+            chosen, restated = self.in_physical_terms(chosen, singles + richer, test)
+            richer += restated
         scored = singles + richer
         unlisted, left = None, self.structure_left(chosen) if structure and self.with_correction else []
         if left:
@@ -502,7 +506,11 @@ class Diagnoser:
                 zip(others, linear_starts(self.problem, base.fit, others, self.rows)), key=lambda item: item[1][1]
             )
             names = frozenset(e.name for e in base.fit.effects)
-            fresh = [(o, start) for o, (start, _) in screened if names | {o.name} not in tried]
+            fresh = [
+                (o, start)
+                for o, (start, _) in screened
+                if names | {o.name} not in tried and not {o.name} | names >= set(AIR_VARIANTS)
+            ]
             for other, start in fresh[:EXTENSION_FITS]:
                 tried.add(names | {other.name})
                 extended.append(self.score(fit(self.problem, base.fit.effects + (other,), start, self.rows)))
@@ -536,6 +544,22 @@ class Diagnoser:
                 break
             chosen, bases = extended[0], extended
         return chosen, richer, test
+
+    def in_physical_terms(self, chosen: Scored, scored: list[Scored], test: dict) -> tuple[Scored, list[Scored]]:
+        """The choice with air density in place of its coefficient scales (`discovery.physical`), and, on recordings
+        without air, in place of its main effect (`venue_air.air_explanations`): an air explanation with fewer
+        parameters stands unless the choice beats it beyond doubt and materially. (choice, the explanations
+        fitted)."""
+        known = {frozenset(e.name for e in s.fit.effects): s for s in scored}
+        tried = restatements(self.problem, chosen, self.rows, self.score, known)
+        if self.recordings.density_kg_m3 is None:
+            tried += air_explanations(self.problem, chosen, scored, self.score, self.rows)
+        fresh = list({id(s): s for s in tried if s is not chosen}.values())
+        for simpler in sorted((s for s in fresh if s.fit.k < chosen.fit.k), key=lambda s: s.error):
+            if not self.better(chosen, simpler, COMBINATION_LEVEL)[0]:
+                test.update(in_physical_terms=simpler.fit.name, in_physical_terms_from=chosen.fit.name)
+                return simpler, fresh
+        return chosen, fresh
 
     def try_correction(self, null: Scored, chosen: Scored) -> tuple[Scored, list[Scored], dict]:
         """The learned correction on top of the chosen explanation and alone; it replaces the choice if better. A

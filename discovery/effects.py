@@ -277,6 +277,14 @@ LIBRARY: tuple[Effect, ...] = (
 
 EFFECTS: dict[str, Effect] = {effect.name: effect for effect in LIBRARY}
 
+AIR_VARIANTS: tuple[str, ...] = ("air_density", DENSITY_ONLY)
+"""Air density as real air changes it (the Reynolds number with it) and density alone."""
+
+ALIASES: tuple[str, ...] = ("lift_scale", "drag_scale", "spin_decay")
+"""The coefficient scales air density is made of: air `ratio` x as dense scales drag, lift and the spin torque by
+`ratio` together (exactly so for density alone; real air also moves the Reynolds number). A combination of two or
+more of them that agree is air, stated with one parameter (`discovery.physical`)."""
+
 
 def apply_all(effects: tuple[Effect, ...], theta: np.ndarray, conditions: Setup) -> Setup:
     """Apply several effects; theta [N, sum of their sizes] holds their parameters side by side."""

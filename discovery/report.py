@@ -4,7 +4,7 @@ ambiguities (explanations the data cannot tell apart, and what measurement would
 from __future__ import annotations
 
 import numpy as np
-from golfflight.discovery.effects import Context
+from golfflight.discovery.effects import AIR_VARIANTS, DENSITY_ONLY, Context
 from golfflight.discovery.fit import Fit, Problem, Scored, cluster_bootstrap, per_shot
 from golfflight.discovery.locate import has_structure
 from golfflight.discovery.recordings import OBSERVABLES
@@ -25,7 +25,7 @@ from golfflight.flight.wind import STATION_HEIGHT_M
 MATERIAL = 0.05
 """Share above the expected error that counts as a material excess (as in `discovery.diagnose`)."""
 
-CARRY_ALIKE = {"wind", "air_density", "ball_speed_bias", "landing_elevation", "drag_scale"}
+CARRY_ALIKE = {"wind", "air_density", "air_density_only", "ball_speed_bias", "landing_elevation", "drag_scale"}
 """Effects that all move carry along the line and need the other observables to be told apart."""
 
 LAUNCH_SETTINGS = {
@@ -44,7 +44,7 @@ def effect_results(result: Fit, context: Context) -> list[EffectResult]:
     for effect in result.effects:
         block = slice(start, start + effect.size)
         parameters, uncertainty = effect.describe(result.theta[block], result.covariance[block, block], context)
-        out.append(EffectResult(name=effect.name, parameters=parameters, uncertainty=uncertainty))
+        out.append(EffectResult(name=effect.name, kind=effect.kind, parameters=parameters, uncertainty=uncertainty))
         start += effect.size
     return out
 
@@ -67,7 +67,7 @@ def service_settings(
                     profile="log",
                     reference_height_m=STATION_HEIGHT_M,
                 )
-        elif effect.name == "air_density":
+        elif effect.name in AIR_VARIANTS:
             settings.air = AirDensity(density_kg_m3=p["density_kg_m3"])
             settings.air_as_altitude = AirAltitude(
                 altitude_m=p["equivalent_altitude_m"], temperature_c=context.temperature_c
@@ -174,10 +174,11 @@ def effect_phrase(effect: EffectResult) -> str:
             f"a steady {plus_minus(p['speed_mps'], u['speed_mps'], ' m/s')} wind from "
             f"{plus_minus(direction, u['from_deg'], '°')} (mostly a {kind})"
         )
-    if name == "air_density":
+    if name in AIR_VARIANTS:
         return (
             f"air {plus_minus(p['ratio'], u['ratio'])} times as dense as assumed "
-            f"(as at about {p['equivalent_altitude_m']:.0f} ± {u['equivalent_altitude_m']:.0f} m)"
+            f"(as at about {p['equivalent_altitude_m']:.0f} ± {u['equivalent_altitude_m']:.0f} m"
+            + ("; density alone, the Reynolds number unchanged)" if name == DENSITY_ONLY else ")")
         )
     if name == "landing_elevation":
         where = "below" if p["height_m"] < 0 else "above"
@@ -318,4 +319,15 @@ def statement(
         sentences.append(lead[0].upper() + lead[1:] + explains + ".")
     for item in ambiguities[:1]:
         sentences.append(f"The data cannot firmly tell {item.effects[0]} from {item.effects[1]}: {item.note}.")
-    return " ".join(sentences)
+    return " ".join(sentences) + form_sentence(effects)
+
+
+def form_sentence(effects: list[EffectResult]) -> str:
+    """Where every named effect is of the model's form, that in words: the recordings' physics differs from the
+    model's in form, and no venue condition or launch-monitor bias is claimed (empty otherwise)."""
+    if not effects or any(e.kind != "form" for e in effects):
+        return ""
+    return (
+        " This is the model's form: the recordings' physics differs from the model's own (coefficient scales or a "
+        "learned correction), not a condition of the venue or a bias of the launch monitor."
+    )

@@ -2,13 +2,14 @@
 
 Recordings without air (e.g. `golfflight convert pbp`) are flown in the model's own air (ICAO), so a venue's thinner
 or denser air is a mismatch like any other, and it can look like another effect: with only the apex recorded,
-thinner air and more drag both lower it. Whatever explanation is chosen is therefore set against air density
-explicitly: the chosen explanation with air density in place of its main library effect (air density alone for a
-single effect; in place of the anchor of a pair, keeping the other), fitted through the simulator and judged by the
-tool's own separability test (`report.ambiguity`: the session-bootstrap 95 % interval of the held-out difference).
-Where the data cannot separate them, air is listed first among the rivals with the venue air it implies (density
-ratio and the equivalent standard-atmosphere altitude at 15 degC) and the observables that would separate them;
-where they can, the statement says air is ruled out. Recordings that carry their air get no such comparison: air is
+thinner air and more drag both lower it. Whatever explanation is chosen is therefore set against air density on
+equal terms, in both its variants (real air, whose Reynolds number changes with it, and density alone): air in place
+of every effect it aliases (the coefficient scales), in place of the main library effect, and beside the rest, each
+fitted through the simulator and judged by the tool's own separability test (`report.ambiguity`: the
+session-bootstrap 95 % interval of the held-out difference). Air is ruled out only when every one of them is
+separated from the choice; otherwise air is listed first among the rivals with the venue air it implies (density
+ratio and the equivalent standard-atmosphere altitude at 15 degC) and the observables that would separate them
+(`diagnose` names air itself where an air explanation wins: `Diagnoser.in_physical_terms`). Recordings that carry their air get no such comparison: air is
 not offered as their explanation.
 """
 
@@ -17,14 +18,13 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from golfflight.discovery.effects import EFFECTS, Context, Effect
-from golfflight.discovery.fit import Fit, Problem, Scored, cluster_bootstrap, fit, per_shot
+from golfflight.discovery.effects import ALIASES, AIR_VARIANTS, DENSITY_ONLY, Context
+from golfflight.discovery.fit import Fit, Problem, Scored, cluster_bootstrap, per_shot
 from golfflight.discovery.noise import ExpectedError
+from golfflight.discovery.physical import air_in_place, blocks
 from golfflight.discovery.recordings import LABELS, OBSERVABLES
 from golfflight.discovery.schema import AirRival, Ambiguity
 from golfflight.flight.air import STANDARD_TEMPERATURE_C
-
-AIR: Effect = EFFECTS["air_density"]
 
 HOW_THEY_ACT = {
     "drag_scale": "thin air lowers lift and drag together (and the Reynolds number, so the coefficients are read as "
@@ -39,6 +39,28 @@ TREND_COVARIATES = ("ball_speed_mps", "spin_rpm")
 lift of a ball scale differently with its speed and its spin)."""
 
 
+def air_explanations(
+    problem: Problem, chosen: Scored, scored: list[Scored], score: Callable[[Fit], Scored], rows: np.ndarray
+) -> list[Scored]:
+    """Air density (each variant) set against the chosen explanation on equal terms: in place of every effect it
+    aliases (its coefficient scales) beside the rest, and in place of its main library effect (the first: the best
+    single a pair or a learned correction was built on) beside the rest; air alone where it has no library effect.
+    Each is fitted from the chosen parameters and the single air fit (taken from `scored` where already fitted);
+    best first."""
+    known = {frozenset(e.name for e in s.fit.effects): s for s in scored}
+    library = [e.name for e in chosen.fit.effects if e.correction is None and e.name not in AIR_VARIANTS]
+    aliases = tuple(name for name in library if name in ALIASES)
+    ways = {aliases or tuple(library[:1]), tuple(library[:1])}
+    tried = {}
+    for variant in AIR_VARIANTS:
+        alone = known.get(frozenset([variant]))
+        ratio = float(alone.fit.theta[0]) if alone is not None else 1.0
+        for replaced in ways:
+            found = air_in_place(problem, chosen.fit, list(replaced), variant, ratio, rows, score, known)
+            tried[id(found)] = found
+    return sorted(tried.values(), key=lambda s: s.error)
+
+
 def air_rival(
     problem: Problem,
     chosen: Scored,
@@ -49,37 +71,45 @@ def air_rival(
     expected: ExpectedError,
 ) -> AirRival:
     """Air density against the chosen explanation (whose predictions are `predicted` [N, 5]) on recordings that carry
-    no air: the explanation with air density in place of the chosen main library effect (fitted and scored with
-    `score` where `scored` lacks it), the venue air it implies, whether the data separate the two and the observable
-    that would. They are separated where air is worse beyond doubt on held-out shots AND the two predict some
-    recorded observable further apart (RMS over the shots) than the model's own error there (`expected.model`): a
-    smaller difference can be the model's own error, not the physics (as a richer explanation that removes no more
-    than the model's error of response is not claimed, `Diagnoser.response_error`)."""
-    names = {e.name for e in chosen.fit.effects}
-    rival = chosen if AIR.name in names else _in_place_of_main(problem, chosen, scored, score, rows)
-    block = _air_block(rival.fit)
+    no air: every air explanation of `air_explanations` (fitted and scored with `score` where `scored` lacks it),
+    the best of them reported with the venue air it implies, whether the data separate it from the choice and the
+    observable that would. Air is ruled out only where every air explanation is separated from the choice: worse
+    beyond doubt on held-out shots AND predicting some recorded observable further apart (RMS over the shots) than
+    the model's own error there (`expected.model`): a smaller difference can be the model's own error, not the
+    physics (as a richer explanation that removes no more than the model's error of response is not claimed,
+    `Diagnoser.response_error`)."""
+    named = any(e.name in AIR_VARIANTS for e in chosen.fit.effects)
+    rivals = [chosen] if named else air_explanations(problem, chosen, scored, score, rows)
+    everyone = np.arange(len(problem.recordings))
+    base, count = per_shot(chosen.heldout_z)
+    judged = []
+    for rival in rivals:
+        theirs, _ = per_shot(rival.heldout_z)
+        draws = cluster_bootstrap(theirs - base, count, problem.recordings.session, np.random.default_rng(2))
+        low, high = (float(q) for q in np.quantile(draws, [0.025, 0.975]))
+        difference = problem.predict(rival.fit.effects, rival.fit.theta, everyone)[0] - predicted
+        within = _within_model_error(problem, difference, expected.model)
+        judged.append((rival, (low, high), difference, within, rival is not chosen and low > 0 and not within))
+    separable = all(item[-1] for item in judged)
+    rival, (low, high), difference, within, _ = min(judged, key=lambda item: (item[-1], item[0].error))
+    effect, block = next((e, b) for e, b in blocks(rival.fit) if e.name in AIR_VARIANTS)
     density = float(np.median(problem.base.density_kg_m3))
-    parameters, uncertainty = AIR.describe(
+    parameters, uncertainty = effect.describe(
         rival.fit.theta[block], rival.fit.covariance[block, block], Context(density, STANDARD_TEMPERATURE_C)
     )
-    base, count = per_shot(chosen.heldout_z)
-    theirs, _ = per_shot(rival.heldout_z)
-    draws = cluster_bootstrap(theirs - base, count, problem.recordings.session, np.random.default_rng(2))
-    low, high = (float(q) for q in np.quantile(draws, [0.025, 0.975]))
-    everyone = np.arange(len(problem.recordings))
-    difference = problem.predict(rival.fit.effects, rival.fit.theta, everyone)[0] - predicted
-    within = _within_model_error(problem, difference, expected.model)
-    separable = rival is not chosen and low > 0 and not within
     measurements = _separating(problem, difference)
+    variant = "density alone, the Reynolds number unchanged" if effect.name == DENSITY_ONLY else "real air"
     air = (
         f"air {parameters['ratio']:.3f} ± {uncertainty['ratio']:.3f} times as dense as assumed "
         f"({parameters['ratio'] * density:.3f} kg/m³, as at {parameters['equivalent_altitude_m']:.0f} m in the "
-        f"standard atmosphere at {STANDARD_TEMPERATURE_C:.0f} °C)"
+        f"standard atmosphere at {STANDARD_TEMPERATURE_C:.0f} °C; {variant})"
     )
     if rival is chosen:
         note = f"the recordings carry no air, and the air is named: {air}"
     else:
         note = _note(problem, chosen, rival, air, difference, measurements, (low, high), within)
+        if separable and len(judged) > 1:
+            note += f" (every one of the {len(judged)} air explanations tried is worse beyond doubt)"
     return AirRival(
         explanation=rival.fit.name,
         named=rival is chosen,
@@ -98,7 +128,7 @@ def with_air(ambiguities: list[Ambiguity], chosen: Scored, rival: AirRival | Non
     """The ambiguities with air density first where it is an inseparable rival (any other entry naming it dropped)."""
     if rival is None or rival.named or rival.separable:
         return ambiguities
-    others = [a for a in ambiguities if AIR.name not in a.effects[1].split("+")]
+    others = [a for a in ambiguities if not set(AIR_VARIANTS) & set(a.effects[1].split("+"))]
     first = Ambiguity(
         effects=(chosen.fit.name, rival.explanation),
         score_difference=rival.heldout_error - chosen.error,
@@ -115,42 +145,6 @@ def air_sentence(rival: AirRival | None) -> str:
     if rival is None or not rival.separable:
         return ""
     return f" The recordings carry no air; the venue's air is ruled out as the explanation: {rival.note}."
-
-
-def _air_block(result: Fit) -> slice:
-    """The air-density parameter's place in a fit's parameters."""
-    start = 0
-    for effect in result.effects:
-        if effect is AIR:
-            return slice(start, start + 1)
-        start += effect.size
-    raise ValueError(f"{result.name} has no air density")
-
-
-def _in_place_of_main(
-    problem: Problem, chosen: Scored, scored: list[Scored], score: Callable[[Fit], Scored], rows: np.ndarray
-) -> Scored:
-    """The chosen library effects with air density in place of the first, its main one (the best single effect
-    that a pair or a learned correction was built on; air alone where no library effect is left), taken from `scored`
-    or fitted from the chosen parameters and the single air fit."""
-    known = {frozenset(e.name for e in s.fit.effects): s for s in scored}
-    alone = known[frozenset([AIR.name])]
-    kept = [(e, block) for e, block in _blocks(chosen.fit) if e.correction is None][1:]
-    effects = tuple(e for e, _ in kept) + (AIR,)
-    key = frozenset(e.name for e in effects)
-    if key not in known:
-        start = np.concatenate([chosen.fit.theta[block] for _, block in kept] + [alone.fit.theta])
-        known[key] = score(fit(problem, effects, start, rows))
-    return known[key]
-
-
-def _blocks(result: Fit) -> list[tuple[Effect, slice]]:
-    """Each effect of a fit with its parameters' place in the fit's parameter vector."""
-    out, start = [], 0
-    for effect in result.effects:
-        out.append((effect, slice(start, start + effect.size)))
-        start += effect.size
-    return out
 
 
 def _separating(problem: Problem, difference: np.ndarray) -> list[str]:

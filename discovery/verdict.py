@@ -245,7 +245,7 @@ def rivals(report: Report) -> list[str]:
         out.append(
             f"Venue air ruled out: {_venue_air_words(report, air)} fits held-out shots worse beyond doubt{_worse(report, air)}."
         )
-        others = [c for c in others if "air_density" not in {e.name for e in c.effects}]
+        others = [c for c in others if not {"air_density", "air_density_only"} & {e.name for e in c.effects}]
     if others and not report.ambiguities:
         ruled = min(others, key=lambda c: c.score)
         out.append(

@@ -11,7 +11,7 @@ from golfflight.discovery.html import PLOTS_MISSING, plots_available
 from golfflight.discovery.model import REFERENCE, load_model
 from golfflight.discovery.outputs import write_diagnosis
 from golfflight.discovery.own_error import measure_own_error, write_own_error
-from golfflight.discovery.prove import CAMPAIGNS, CLEAN_SETS, cases, command, prove, read_runs, write_tables
+from golfflight.discovery.prove import CAMPAIGNS, CLEAN_SETS, TRUTHS, cases, command, prove, read_runs, write_tables
 from golfflight.discovery.recordings import read_recordings
 from golfflight.shots.progress import print_line, progress_step
 
@@ -50,10 +50,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     prove.add_argument(
         "--truth",
-        choices=("model", "reference"),
+        choices=TRUTHS,
         default="model",
-        help="hide the effects in the diagnosed model's own flights (default) or in the reference world's (the "
-        "model-form campaign: what the model's own difference from that physics adds)",
+        help="hide the effects in the diagnosed model's own flights (default) or in a world whose form differs (the "
+        "model-form campaign): the reference world's, Ferguson 2022's coefficients', or the model's own in recorded "
+        "venue air that scales density only",
     )
     prove.add_argument(
         "--campaign",

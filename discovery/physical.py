@@ -1,0 +1,63 @@
+"""Explanations in physical terms: a combination of coefficient scales that agree is restated as the one physical
+cause they make together, air density (`effects.ALIASES`), with one parameter instead of several.
+
+Air `ratio` x as dense scales drag, lift and the spin torque by `ratio` at once, so an explanation such as "drag x
+0.83, lift x 0.83" is thin air in other words, and the simpler physical statement stands unless the richer one beats
+it on held-out sessions beyond doubt and by a material share (the rule a pair must pass over a single).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from golfflight.discovery.effects import ALIASES, AIR_VARIANTS, EFFECTS, Effect
+from golfflight.discovery.fit import Fit, Problem, Scored, fit
+
+Score = Callable[[Fit], Scored]
+
+
+def blocks(result: Fit) -> list[tuple[Effect, slice]]:
+    """Each effect of a fit with its parameters' place in the fit's parameter vector."""
+    out, start = [], 0
+    for effect in result.effects:
+        out.append((effect, slice(start, start + effect.size)))
+        start += effect.size
+    return out
+
+
+def aliased(result: Fit) -> list[tuple[Effect, slice]]:
+    """The coefficient scales of a fit that air density is made of."""
+    return [(e, block) for e, block in blocks(result) if e.name in ALIASES]
+
+
+def air_in_place(problem: Problem, result: Fit, replaced: list[str], variant: str, ratio: float, rows: np.ndarray,
+             score: Score, known: dict[frozenset, Scored]) -> Scored:
+    """`result`'s library effects with air density (`variant`, started at `ratio`) in place of the effects named in
+    `replaced` (none: beside them all), fitted and scored, or taken from `known` where already fitted."""
+    kept = [(e, block) for e, block in blocks(result) if e.correction is None and e.name not in replaced]
+    kept = [(e, block) for e, block in kept if e.name not in AIR_VARIANTS]
+    effects = tuple(e for e, _ in kept) + (EFFECTS[variant],)
+    key = frozenset(e.name for e in effects)
+    if key not in known:
+        start = np.concatenate([result.theta[block] for _, block in kept] + [np.array([ratio])])
+        known[key] = score(fit(problem, effects, start, rows))
+    return known[key]
+
+
+def common_ratio(result: Fit) -> float:
+    """The density ratio the fit's aliased coefficient scales agree on: their geometric mean (1 where it has none)."""
+    scales = [result.theta[block][0] for _, block in aliased(result)]
+    return float(np.exp(np.mean(np.log(scales)))) if scales else 1.0
+
+
+def restatements(problem: Problem, chosen: Scored, rows: np.ndarray, score: Score,
+                 known: dict[frozenset, Scored]) -> list[Scored]:
+    """The chosen explanation with air density (each variant) in place of its two or more coefficient scales, best
+    held-out error first; empty where it has fewer than two."""
+    scales = [e.name for e, _ in aliased(chosen.fit)]
+    if len(scales) < 2:
+        return []
+    ratio = float(np.clip(common_ratio(chosen.fit), 0.61, 1.29))
+    tried = [air_in_place(problem, chosen.fit, scales, v, ratio, rows, score, known) for v in AIR_VARIANTS]
+    return sorted(tried, key=lambda s: s.error)
