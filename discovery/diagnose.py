@@ -284,7 +284,9 @@ class Diagnoser:
         scored_shots: int = SCORED_SHOTS,
     ):
         self.started = time.perf_counter()
-        self.recordings, self.model, self.library = recordings, model, LIBRARY
+        self.recordings, self.model = recordings, model
+        self.air_recorded = recordings.density_kg_m3 is not None
+        self.library = tuple(e for e in LIBRARY if not (self.air_recorded and e.name in AIR_VARIANTS))
         self.with_correction, self.estimate_scatter, self.progress = with_correction, estimate_scatter, progress
         self.rng = np.random.default_rng(seed)
         self.step(f"flying {len(recordings):,} recorded shots through the model and its expected error...")
@@ -323,7 +325,7 @@ class Diagnoser:
         )
         rival = (  # recordings without air: the venue's air set against the choice (`discovery.venue_air`)
             air_rival(self.problem, chosen, after.outcomes, selection.scored, self.score, self.rows, start.expected)
-            if selection.systematic and self.recordings.density_kg_m3 is None
+            if selection.systematic and not self.air_recorded
             else None
         )
         report = self.report(located, selection, after, heldout_block, with_air(ambiguities, chosen, rival), rival)
@@ -546,14 +548,16 @@ class Diagnoser:
         return chosen, richer, test
 
     def in_physical_terms(self, chosen: Scored, scored: list[Scored], test: dict) -> tuple[Scored, list[Scored]]:
-        """The choice with air density in place of its coefficient scales (`discovery.physical`), and, on recordings
-        without air, in place of its main effect (`venue_air.air_explanations`): an air explanation with fewer
-        parameters stands unless the choice beats it beyond doubt and materially. (choice, the explanations
+        """On recordings without air: the choice with air density in place of its coefficient scales
+        (`discovery.physical`) and in place of its main effect (`venue_air.air_explanations`); an air explanation
+        with fewer parameters stands unless the choice beats it beyond doubt and materially. Recordings that carry
+        their air get no air explanation at all (the library leaves air out for them). (choice, the explanations
         fitted)."""
+        if self.air_recorded:
+            return chosen, []
         known = {frozenset(e.name for e in s.fit.effects): s for s in scored}
         tried = restatements(self.problem, chosen, self.rows, self.score, known)
-        if self.recordings.density_kg_m3 is None:
-            tried += air_explanations(self.problem, chosen, scored, self.score, self.rows)
+        tried += air_explanations(self.problem, chosen, scored, self.score, self.rows)
         fresh = list({id(s): s for s in tried if s is not chosen}.values())
         for simpler in sorted((s for s in fresh if s.fit.k < chosen.fit.k), key=lambda s: s.error):
             if not self.better(chosen, simpler, COMBINATION_LEVEL)[0]:

@@ -1,0 +1,119 @@
+"""Explanations in physical terms (issue 41): air density is drag, lift and spin torque scaled together, in two
+variants (real air, whose Reynolds number moves with it, and density alone); coefficient scales that agree are
+named as air; every effect says its kind; the model-form campaign's worlds and scores."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from golfflight.discovery.conceal import NOMINAL_CONTEXT, conceal
+from golfflight.discovery.diagnose import diagnose
+from golfflight.discovery.effects import ALIASES, DENSITY_ONLY, EFFECTS, LIBRARY, apply_all, equivalent_altitude_m
+from golfflight.discovery.model import load_model, reference
+from golfflight.discovery.prove import Run, _acted_on, _among, ferguson_world, fitted_as
+from golfflight.discovery.recordings import from_shot_set
+from golfflight.discovery.report import form_sentence
+from golfflight.discovery.schema import EffectResult
+from golfflight.discovery.simulator import Setup
+from golfflight.flight.constants import MPH_TO_MPS
+from golfflight.shots.records import ShotSet
+
+YD = 0.9144
+
+
+def _setup(n: int = 4) -> Setup:
+    launch = {
+        "ball_speed_mps": np.linspace(45.0, 75.0, n),
+        "launch_angle_deg": np.linspace(10.0, 24.0, n),
+        "launch_direction_deg": np.zeros(n),
+        "spin_rpm": np.linspace(2500.0, 8000.0, n),
+        "spin_axis_deg": np.linspace(-5.0, 5.0, n),
+    }
+    return Setup(launch, np.ones(n), np.full(n, 1.225), np.zeros((n, 2)), np.zeros(n), np.ones((n, 3)))
+
+
+def test_density_alone_is_drag_lift_and_spin_torque_scaled_together():
+    """q = C_Q rho |v|^2 multiplies drag, lift and the spin torque alike: air 0.8 x as dense with the viscosity
+    unchanged flies exactly as the three coefficient scales at 0.8."""
+    model, setup, ratio = reference(), _setup(), 0.8
+    thin = model.simulate(apply_all((EFFECTS[DENSITY_ONLY],), np.full((4, 1), ratio), setup)).outcomes()
+    scales = tuple(EFFECTS[name] for name in ALIASES)
+    scaled = model.simulate(apply_all(scales, np.full((4, 3), ratio), setup)).outcomes()
+    np.testing.assert_allclose(thin, scaled, atol=1e-9)
+
+
+def test_real_thin_air_also_moves_the_reynolds_number():
+    """Real air 0.8 x as dense has 1/0.8 the kinematic viscosity: the same shots fly otherwise than density alone."""
+    model, setup = reference(), _setup()
+    theta = np.full((4, 1), 0.8)
+    real = apply_all((EFFECTS["air_density"],), theta, setup)
+    alone = apply_all((EFFECTS[DENSITY_ONLY],), theta, setup)
+    assert real.viscosity(1.5e-5) == pytest.approx(np.full(4, 1.5e-5 / 0.8))
+    assert alone.viscosity(1.5e-5) == pytest.approx(np.full(4, 1.5e-5))
+    apart = model.simulate(real).outcomes()[:, 0] - model.simulate(alone).outcomes()[:, 0]
+    assert np.abs(apart).max() > 0.1, "the Reynolds number changes the carry"
+
+
+def test_every_library_effect_has_a_kind():
+    kinds = {e.name: e.kind for e in LIBRARY}
+    assert {k for k, v in kinds.items() if v == "venue"} == {"wind", "air_density", DENSITY_ONLY, "landing_elevation"}
+    assert {k for k, v in kinds.items() if v == "form"} == set(ALIASES)
+    assert all(v == "monitor" for k, v in kinds.items() if k.endswith("_bias"))
+
+
+def test_the_form_sentence_only_when_every_named_effect_is_of_the_model_form():
+    form = EffectResult(name="drag_scale", kind="form", parameters={"scale": 0.97}, uncertainty={"scale": 0.01})
+    venue = EffectResult(name="wind", kind="venue", parameters={}, uncertainty={})
+    assert "model's form" in form_sentence([form])
+    assert form_sentence([form, venue]) == "" and form_sentence([]) == ""
+
+
+def _density_only_set(seed: int, recorded: bool, ratio: float = 0.776) -> ShotSet:
+    records = conceal({DENSITY_ONLY: {"ratio": ratio}}, 200, seed, model=load_model(None)).shots.records
+    if recorded:
+        air = {"temperature_c": 15.0, "altitude_m": equivalent_altitude_m(ratio, NOMINAL_CONTEXT), "humidity_pct": 0}
+        records = [r.model_copy(update=air) for r in records]
+    return ShotSet(records)
+
+
+def test_density_only_venue_air_concealed_is_named_as_such():
+    """A monitor that flies 1,900 m air as density alone, air left blank: air density alone is named, within 0.03,
+    and it is a venue condition with its service setting."""
+    report = diagnose(from_shot_set(_density_only_set(5, False)), load_model(None), progress=False).report
+    assert [e.name for e in report.effects] == [DENSITY_ONLY] and report.effects[0].kind == "venue"
+    assert report.effects[0].parameters["ratio"] == pytest.approx(0.776, abs=0.03)
+    assert report.air_rival is not None and report.air_rival.named
+    assert report.service_settings.air is not None
+
+
+def test_with_that_air_recorded_no_air_is_found():
+    report = diagnose(from_shot_set(_density_only_set(5, True)), load_model(None), progress=False).report
+    assert report.air_rival is None
+    assert not {"air_density", DENSITY_ONLY} & {e.name for e in report.effects}
+
+
+def test_ferguson_world_flies_a_tour_driver_about_as_published():
+    """Ferguson 2022's coefficients against TrackMan's PGA TOUR driver (171 mph, 10.4 deg, 2,545 rpm): they carry it
+    290.7 yd with a 32.5 yd apex (their published comparison); RK4 at 0.01 s within a few yards of that."""
+    setup = _setup(1)
+    setup.launch.update(
+        ball_speed_mps=np.array([171 * MPH_TO_MPS]),
+        launch_angle_deg=np.array([10.4]),
+        spin_rpm=np.array([2545.0]),
+        spin_axis_deg=np.array([0.0]),
+    )
+    carry, _, apex = ferguson_world().simulate(setup).outcomes()[0, :3]
+    assert carry / YD == pytest.approx(290.7, abs=5) and apex / YD == pytest.approx(32.5, abs=3)
+
+
+def _run(hidden: dict, fitted: dict, kinds: list[str], systematic: bool = True) -> Run:
+    return Run("x", 0, hidden, 300, 4, systematic, "", False, fitted, {}, {}, 1, 1, None, False, {}, {}, [], 1, kinds)
+
+
+def test_campaign_scores_count_either_air_variant_and_the_findings_a_user_acts_on():
+    fitted = {DENSITY_ONLY: {"ratio": 0.8}}
+    assert fitted_as("air_density", fitted) == DENSITY_ONLY and fitted_as("wind", fitted) is None
+    assert _among(_run({"air_density": {"ratio": 0.8}}, fitted, ["venue"]))
+    assert _acted_on(_run({}, {"spin_bias": {}}, ["monitor"]))
+    assert not _acted_on(_run({}, {"unlisted": {}, "drag_scale": {}}, ["form", "form"]))
+    assert not _acted_on(_run({}, {"wind": {}}, ["venue"], systematic=False))
