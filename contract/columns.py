@@ -48,6 +48,9 @@ PASSED_OVER = (
     "club",
     "timestamp",
     "split",
+    "source",
+    "group",
+    "ball",
     "carry_x_m",
     "carry_y_m",
     "apex_m",
@@ -61,7 +64,9 @@ REQUEST_COLUMNS = ("normalized", *LAUNCH_COLUMNS, *AIR_COLUMNS, *WIND_COLUMNS, *
 
 KNOWN_COLUMNS = frozenset({"shot_id", *REQUEST_COLUMNS, *PASSED_OVER})
 
-TEXT_COLUMNS = frozenset({"shot_id", "session", "club", "timestamp", "split", "wind_profile", "ground_surface"})
+TEXT_COLUMNS = frozenset(
+    {"shot_id", "session", "club", "timestamp", "split", "source", "group", "ball", "wind_profile", "ground_surface"}
+)
 """Columns whose cells are words (echoed as text); `normalized` is a flag; every other known column is a number."""
 
 SECTION_COLUMNS = {"air": AIR_COLUMNS, "wind": WIND_COLUMNS, "ground": GROUND_COLUMNS}
@@ -199,6 +204,10 @@ def check(item, csv_columns: bool = True) -> ShotRequest | list[str]:
             problems.append(f"{where}: {message}")
         return problems
 
+
+AIR_DENSITY = "air_density_kg_m3"
+"""The column of the air density a shot was flown in, from its air columns (ICAO standard air where it gives none):
+`simulate` and `sweep` give it between a row's input columns and its flight's."""
 
 ELEVATION_COLUMNS = ("ground_elevation_m", "ground_elevation_ft")
 """Columns that can put the ground off the tee's elevation, so that flat_* columns come back (`result_columns`)."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from golfflight.contract.columns import AIR_DENSITY
 from golfflight.contract.figures import flat_numbers, flight_numbers
 from golfflight.contract.inputs import air_of, conditions_of, ground_of, lands_off_the_flat, launch_of, reference_of
 from golfflight.contract.requests import ShotRequest, TrajectoryRequest
@@ -137,7 +138,8 @@ def _fly_group(
 class ShotColumns:
     """`fly_shots`'s results as columns over the shots, named as `contract.columns.flat_row` names them: `values` holds
     an array for each flight, normalized_* and flat_* column, valid where `present` is True (the shot flew and, for
-    normalized_* and flat_*, asked for that flight); `errors` the error column (None where the shot flew)."""
+    normalized_* and flat_*, asked for that flight), and the air density each shot was flown in (`AIR_DENSITY`, valid
+    for every shot); `errors` the error column (None where the shot flew)."""
 
     values: dict[str, np.ndarray]
     present: dict[str, np.ndarray]
@@ -173,6 +175,8 @@ def fly_columns(engine: FlightEngine, shots: list[ShotRequest]) -> ShotColumns:
             full = np.zeros(n, dtype=column.dtype)
             full[own] = column
             values[prefix + name], present[prefix + name] = full, mask
+    values[AIR_DENSITY] = np.array([c.air.density_kg_m3 for c in conditions[:n]], dtype=float)
+    present[AIR_DENSITY] = np.ones(n, dtype=bool)
     return ShotColumns(values, present, errors)
 
 

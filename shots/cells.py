@@ -1,9 +1,12 @@
 """Cells of a shot export, shared by the loaders: a row that cannot become a record (its drop reason), a cell that
-is not what its column must hold, and the finite-number parse both kinds of file use."""
+is not what its column must hold, the finite-number parse both kinds of file use, and a Date cell's time."""
 
 from __future__ import annotations
 
 import math
+from datetime import datetime
+
+DATE_FORMATS = ("%m/%d/%Y %I:%M:%S %p", "%Y-%m-%d %H:%M:%S", "%Y-%m-%dT%H:%M:%S")
 
 
 class BadRow(Exception):
@@ -30,3 +33,14 @@ def finite_number(text: str, column: str, missing: tuple[str, ...] = ("",)) -> f
     if not math.isfinite(value):
         raise MalformedCell(f"'{column}' is not a number", column, text)
     return value
+
+
+def when(text: str) -> tuple[str, str]:
+    """(timestamp, session) from a Date cell: ISO time and its day, or the raw text and its first word."""
+    for fmt in DATE_FORMATS:
+        try:
+            moment = datetime.strptime(text, fmt)
+        except ValueError:
+            continue
+        return moment.isoformat(), moment.date().isoformat()
+    return text, text.split()[0] if text.split() else ""

@@ -19,12 +19,11 @@ import math
 import os
 from collections.abc import Collection
 from dataclasses import dataclass, field
-from datetime import datetime
 from pathlib import Path
 
 import numpy as np
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from golfflight.shots.cells import BadRow, MalformedCell, finite_number
+from golfflight.shots.cells import BadRow, MalformedCell, finite_number, when
 from golfflight.shots.records import RANGES, RecordError, ShotRecord, reading
 
 SPEED = {"mph": MPH_TO_MPS, "m/s": 1.0, "km/h": 1.0 / 3.6}
@@ -51,7 +50,6 @@ OUTCOME = {
 
 CARRY_LENGTH, CARRY_SIDE = "Carry Flat - Length", "Carry Flat - Side"
 LAST_POINT_TIME, CARRY_TIME = "Last data Point - Time", "Carry Flat - Time"
-DATE_FORMATS = ("%m/%d/%Y %I:%M:%S %p", "%Y-%m-%d %H:%M:%S", "%Y-%m-%dT%H:%M:%S")
 
 
 @dataclass
@@ -186,17 +184,6 @@ def _outcome(cells: list[str], specs: dict[str, tuple[int, float]]) -> dict[str,
     return values
 
 
-def _when(text: str) -> tuple[str, str]:
-    """(timestamp, session) from a Date cell: ISO time and its day, or the raw text and its first word."""
-    for fmt in DATE_FORMATS:
-        try:
-            moment = datetime.strptime(text, fmt)
-        except ValueError:
-            continue
-        return moment.isoformat(), moment.date().isoformat()
-    return text, text.split()[0] if text.split() else ""
-
-
 def load_trackman(path: str | os.PathLike, *, min_tracked_fraction: float | None = 0.9,
                   balls: Collection[str] | None = None, session: str | None = None,
                   lines: tuple[int, int] | None = None, skip_bad_rows: bool = False) -> Conversion:
@@ -260,7 +247,7 @@ def load_trackman(path: str | os.PathLike, *, min_tracked_fraction: float | None
         except BadRow as bad:
             report.drop(str(bad), line)
             continue
-        timestamp, day = _when(cell(cells, "Date")) if cell(cells, "Date") else (None, None)
+        timestamp, day = when(cell(cells, "Date")) if cell(cells, "Date") else (None, None)
         records.append(ShotRecord(shot_id=str(line), session=day or session or path.stem, timestamp=timestamp,
                                   club=cell(cells, "Club") or None, ball=ball or None, **values))
     report.refuse_bad_rows(skip_bad_rows)

@@ -16,6 +16,7 @@ from functools import cached_property
 from typing import TYPE_CHECKING, Protocol
 
 from golfflight.contract.columns import (
+    AIR_DENSITY,
     ELEVATION_COLUMNS,
     REQUEST_COLUMNS,
     TEXT_COLUMNS,
@@ -48,8 +49,9 @@ class Layout:
 
     @cached_property
     def results(self) -> list[str]:
+        """The air density flown, then the flight's columns (as `golfflight simulate` gives them)."""
         flat = any(column in self.columns for column in ELEVATION_COLUMNS)
-        return result_columns(normalized="normalized" in self.columns, flat=flat)
+        return [AIR_DENSITY, *result_columns(normalized="normalized" in self.columns, flat=flat)]
 
     @cached_property
     def echoed(self) -> list[str]:

@@ -33,6 +33,7 @@ import annotated_types
 import numpy as np
 from golfflight.contract.columns import (
     AIR_COLUMNS,
+    AIR_DENSITY,
     GROUND_COLUMNS,
     REQUEST_COLUMNS,
     SECTION_COLUMNS,
@@ -356,7 +357,7 @@ def _made(checked: Checked, rows: np.ndarray, names, make) -> PerShot:
 
 def fly_checked(engine, checked: Checked) -> ShotColumns:
     """The valid rows of `checked` flown as `contract.flying.fly_columns` flies their requests (module docstring),
-    as its columns over those rows."""
+    as its columns over those rows, with the air density each was flown in (`AIR_DENSITY`, as `simulate` gives it)."""
     rows = np.flatnonzero(checked.valid)
     n = len(rows)
     airs = _made(checked, rows, AIR_COLUMNS, lambda request: _section(request, "air"))
@@ -393,7 +394,10 @@ def fly_checked(engine, checked: Checked) -> ShotColumns:
         conditions.plus(replay_air, conditions.take(flats)),
         own_grounds.plus(own_grounds.take(replays), PerShot([None], np.zeros(len(flats), dtype=np.intp))),
     )
-    return _columns(flights, n, replays, flats)
+    flown = _columns(flights, n, replays, flats)
+    flown.values[AIR_DENSITY] = np.array([air.density_kg_m3 for air in air_of_group], dtype=float)[airs.index]
+    flown.present[AIR_DENSITY] = np.ones(n, dtype=bool)
+    return flown
 
 
 def _columns(flights, n: int, replays: np.ndarray, flats: np.ndarray) -> ShotColumns:

@@ -126,6 +126,9 @@ def test_simulate_reads_fahrenheit_and_feet_columns(tmp_path):
     with open(out) as handle:
         imperial, metric, standard = csv.DictReader(handle)
     assert [imperial.pop("row"), metric.pop("row")] == ["0", "1"]
+    given = ("temperature_f", "altitude_ft", "temperature_c", "altitude_m")  # echoed as given, in front
+    assert [imperial.pop(c) for c in given] == ["86.0", "1000.0", "", ""]
+    assert [metric.pop(c) for c in given] == ["", "", "30.0", "304.8"]
     assert imperial == metric and imperial["carry_m"] != standard["carry_m"]
 
 

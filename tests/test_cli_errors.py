@@ -34,6 +34,7 @@ COMMANDS = {
     "convert trackman": lambda f, out: ["convert", "trackman", str(f), "--out", str(out / "o.csv")],
     "convert tourcast": lambda f, out: ["convert", "tourcast", str(f), "--out", str(out / "o.csv")],
     "convert pbp": lambda f, out: ["convert", "pbp", str(f), "--out", str(out / "o.csv")],
+    "convert garmin": lambda f, out: ["convert", "garmin", str(f), "--out", str(out / "o.csv")],
     "train": lambda f, out: ["train", "--data", str(f), "--out", str(out / "run"), "--epochs", "1"],
     "export": lambda f, out: ["export", "--checkpoint", str(f), "--out", str(out / "bundle")],
     "serve": lambda f, out: ["serve", "--model", str(f), "--port", "9"],

@@ -1,8 +1,9 @@
 """`golfflight simulate` says what to fix (issue 31): a file missing a launch column is refused in one line naming
 each missing column, as `golfflight sweep` refuses it (one check for both), with or without --skip-bad-rows; a run
 with --skip-bad-rows of which no row is valid is refused instead of writing an empty file; every result carries the
-input's row number and its launch columns as read, in front of the result's; a shot given no spin names the spin
-columns, not `column 'body'`."""
+input's row number, its launch columns as read and the air it was flown in (its air columns and the density), in
+front of the result's; a canonical shot file is read as is; a shot given no spin names the spin columns, not
+`column 'body'`."""
 
 from __future__ import annotations
 
@@ -12,6 +13,10 @@ import json
 import pytest
 
 from golfflight.cli import main
+from golfflight.contract.columns import KNOWN_COLUMNS, TEXT_COLUMNS
+from golfflight.flight.air import air_density
+from golfflight.flight.conditions import STANDARD
+from golfflight.shots.records import COLUMNS
 
 LAUNCHES = (
     "shot_id,ball_speed_mps,ball_speed_mph,launch_angle_deg,spin_rpm,spin_axis_deg,back_spin_rpm,side_spin_rpm\n"
@@ -101,7 +106,7 @@ def test_csv_results_start_with_the_row_number_and_the_launch_as_read(tmp_path, 
         "back_spin_rpm",
         "side_spin_rpm",
     ]
-    assert header[: 2 + len(launch)] == ["row", "shot_id", *launch] and header[2 + len(launch)] == "landing_x_m"
+    assert header[: 4 + len(launch)] == ["row", "shot_id", *launch, "air_density_kg_m3", "landing_x_m"]
     assert [(r["row"], r["shot_id"]) for r in rows] == [("0", "a"), ("1", "b"), ("4", "e")]  # the data row, from 0
     assert {k: rows[1][k] for k in launch} == {
         "ball_speed_mps": "",
@@ -130,6 +135,36 @@ def test_json_results_start_with_the_row_number_and_the_launch_as_read(tmp_path,
     ]
     assert [r["row"] for r in results] == [0, 2] and results[0]["ball_speed_mph"] == 171
     assert "wind" not in results[1] and results[1]["carry_m"] > 0
+
+
+def test_every_result_says_the_air_it_was_flown_in(tmp_path, capsys):
+    """The air columns as given, then the density flown: the weather's, the one given, or ICAO standard air."""
+    source = written(
+        tmp_path / "launches.csv",
+        "ball_speed_mps,launch_angle_deg,spin_rpm,temperature_c,pressure_hpa,humidity_pct,density_kg_m3\n"
+        "60,12,3000,30,900,50,\n"
+        "60,12,3000,,,,1.05\n"
+        "60,12,3000,,,,\n",
+    )
+    out = tmp_path / "results.csv"
+    assert main(["simulate", str(source), "--out", str(out)]) == 0
+    header, (hot, given, standard) = results_csv(out)
+    air = ["temperature_c", "pressure_hpa", "humidity_pct", "density_kg_m3", "air_density_kg_m3"]
+    assert header[4 : 4 + len(air)] == air and header[4 + len(air)] == "landing_x_m"
+    assert float(hot["air_density_kg_m3"]) == pytest.approx(float(air_density(30.0, 90000.0, 50.0)), rel=1e-12)
+    assert (given["temperature_c"], float(given["air_density_kg_m3"])) == ("", 1.05)
+    assert float(standard["air_density_kg_m3"]) == STANDARD.air.density_kg_m3 == pytest.approx(1.225, abs=1e-4)
+    assert len({hot["carry_m"], given["carry_m"], standard["carry_m"]}) == 3
+    assert main(["simulate", str(source)]) == 0
+    flown = json.loads(capsys.readouterr().out)["results"]
+    written_out = [float(row["air_density_kg_m3"]) for row in (hot, given, standard)]
+    assert [r["air_density_kg_m3"] for r in flown] == written_out
+    assert "temperature_c" in flown[0] and "temperature_c" not in flown[2]
+
+
+def test_a_canonical_shot_file_is_read_as_is():
+    """Every canonical column is one simulate and sweep take: identity and outcome ones are passed over."""
+    assert set(COLUMNS) <= KNOWN_COLUMNS and {"source", "group", "ball"} <= TEXT_COLUMNS
 
 
 def test_a_csv_input_written_as_json_carries_row_and_shot_id(tmp_path, capsys):

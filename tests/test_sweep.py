@@ -149,8 +149,9 @@ def test_the_column_path_gives_fly_shots_numbers_bit_for_bit():
     """The sweep's flat path (`fly_columns`: the engine batch straight into columns) and `fly_shots` (a result
     object a shot, as simulate and the HTTP batch route) fly the same batch: every number equal, not just close,
     each column present exactly where the shot's flat row has it, the same errors (a ground the ball never reaches
-    fails its shot alone)."""
-    from golfflight.contract.columns import cell_value, check, flat_row, request_of_cells
+    fails its shot alone), and the air density each flew in is the one simulate echoes."""
+    from golfflight.commands.simulate import flown_air
+    from golfflight.contract.columns import AIR_DENSITY, cell_value, check, flat_row, request_of_cells
     from golfflight.contract.flying import fly_columns, fly_shots
     from golfflight.flight.bundle_location import model_dir
     from golfflight.flight.engine import FlightEngine
@@ -167,6 +168,7 @@ def test_the_column_path_gives_fly_shots_numbers_bit_for_bit():
     for i, want in enumerate(expected):
         assert columns.errors[i] == want.get("error"), i
         got = {name: values[i].item() for name, values in columns.values.items() if columns.present[name][i]}
+        assert got.pop(AIR_DENSITY) == flown_air(shots[i])[AIR_DENSITY], i
         assert got == {k: v for k, v in want.items() if k != "error"}, i
         assert all(type(got[k]) is type(v) for k, v in want.items() if k != "error"), i
 

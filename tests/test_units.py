@@ -191,7 +191,8 @@ def test_the_csv_columns_carry_the_results_names(tmp_path):
         reader = csv.DictReader(handle)
         header, results = reader.fieldnames, list(reader)
     launch = ["ball_speed_mps", "launch_angle_deg", "spin_rpm", "spin_axis_deg"]
-    assert header == ["row", *launch, *(c for c in result_columns(normalized=False, flat=True) if c != "error")]
+    results_named = (c for c in result_columns(normalized=False, flat=True) if c != "error")
+    assert header == ["row", *launch, "air_density_kg_m3", *results_named]
     assert {"lateral_yd", "roll_yd", "landing_speed_mph", "rest_x_yd", "rest_y_yd", "landing_x_yd",
             "flat_lateral_yd"} <= set(header)
     assert results[0].pop("row") == "0" and results[1].pop("row") == "1"

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from golfflight.shots.garmin import load_garmin
 from golfflight.shots.pbp import load_pbp
 from golfflight.shots.records import trajectories_path, write_shots, write_trajectories
 from golfflight.shots.tourcast import load_tourcast
@@ -14,8 +15,9 @@ SKIP_HELP = "leave out malformed rows (each listed in the report) instead of ref
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser("convert",
-                                   help="convert a real export (TrackMan, TOURCAST, PGA TOUR pbp) to canonical CSV")
+    parser = subparsers.add_parser(
+        "convert", help="convert a real export (TrackMan, TOURCAST, PGA TOUR pbp, Garmin) to canonical CSV"
+    )
     formats = parser.add_subparsers(dest="format", required=True)
 
     trackman = formats.add_parser("trackman", help="a TrackMan CSV export (header row, then a units row)")
@@ -48,6 +50,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      help="leave apex_m blank instead of reading radarData.apexHeight")
     pbp.add_argument("--skip-bad-rows", action="store_true", help=SKIP_HELP)
     pbp.set_defaults(run=run_pbp)
+
+    garmin = formats.add_parser("garmin", help="a Garmin Golf app shot export (Approach R10, R50)")
+    garmin.add_argument("source", help="the Garmin Golf CSV export")
+    garmin.add_argument("--out", required=True, help="canonical CSV to write")
+    garmin.add_argument("--no-air", dest="air", action="store_false",
+                        help="leave the air blank (ICAO standard) instead of each shot's temperature and pressure")
+    garmin.add_argument("--session", help="session id when the file has no Date column (default: the file name)")
+    garmin.add_argument("--skip-bad-rows", action="store_true", help=SKIP_HELP)
+    garmin.set_defaults(run=run_garmin)
 
 
 def _write(conversion: Conversion, out: str) -> int:
@@ -83,3 +94,8 @@ def run_tourcast(args: argparse.Namespace) -> int:
 
 def run_pbp(args: argparse.Namespace) -> int:
     return _write(load_pbp(args.source, apex=args.apex, skip_bad_rows=args.skip_bad_rows), args.out)
+
+
+def run_garmin(args: argparse.Namespace) -> int:
+    conversion = load_garmin(args.source, air=args.air, session=args.session, skip_bad_rows=args.skip_bad_rows)
+    return _write(conversion, args.out)

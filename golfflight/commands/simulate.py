@@ -13,7 +13,9 @@ Output: {"results": [...]} as JSON, or a flat CSV when --out ends in .csv: the r
 (`contract.columns.result_columns`), its points flattened (rest_x_m, rest_x_yd, ...), every length in metres and
 yards, the landing speed in m/s and mph. Each result starts with what matches it to its input: `row`, the input's
 row number from 0 as in `golfflight sweep`'s results (a CSV's data row: its line number less 2, the header being
-line 1; a JSON shot's index), the shot_id where the CSV has one, and the shot's launch columns as read.
+line 1; a JSON shot's index), the shot_id where the CSV has one, the shot's launch columns as read, and the air it
+was flown in: its air columns as given, then `air_density_kg_m3`, the density flown (ICAO standard air, 1.225 kg/m³,
+where the shot gives none).
 
 A bad shot (a value out of range or not a number, an extra cell, a shot_id seen before) refuses the file with its
 line (CSV) or index (JSON) and field; --skip-bad-rows flies the rest and lists each one left out on stderr, and
@@ -30,6 +32,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from golfflight.contract.columns import (
+    AIR_COLUMNS,
+    AIR_DENSITY,
     LAUNCH_COLUMNS,
     cell_value,
     check,
@@ -37,6 +41,8 @@ from golfflight.contract.columns import (
     flat_row,
     request_of_cells,
 )
+from golfflight.contract.inputs import conditions_of
+from golfflight.contract.requests import ShotRequest
 from golfflight.shots.records import reading
 
 
@@ -149,23 +155,31 @@ def refuse_or_skip(name: str, problems: list[str], flyable: int, rows_read: int,
     raise ValueError(f"{name}: {len(problems)} invalid values ({why}):\n  {shown}")
 
 
-def matching(read: Input, kept: list[int]) -> list[dict]:
-    """What matches each flown shot to its input, in front of its result: `row`, its shot_id (where it has one) and
-    its launch columns as read."""
+def flown_air(shot: ShotRequest) -> dict:
+    """The air a shot was flown in: its air columns as given, then the density the engine flew it in (`AIR_DENSITY`),
+    so that a result says which air made its numbers."""
+    given = {} if shot.air is None else shot.air.model_dump(exclude_none=True)
+    return {**given, AIR_DENSITY: float(conditions_of(shot).air.density_kg_m3)}
+
+
+def matching(read: Input, kept: list[int], shots: list[ShotRequest]) -> list[dict]:
+    """What matches each flown shot (`shots`, validated from the inputs `kept`) to its input, in front of its result:
+    `row`, its shot_id (where it has one), its launch columns as read and the air it was flown in (`flown_air`)."""
     return [
         {
             "row": read.rows[i],
             **({"shot_id": read.ids[i]} if read.ids and read.ids[i] is not None else {}),
             **{c: read.shots[i][c] for c in LAUNCH_COLUMNS if read.shots[i].get(c) is not None},
+            **flown_air(shot),
         }
-        for i in kept
+        for i, shot in zip(kept, shots, strict=True)
     ]
 
 
 def write_csv(out: str, fronts: list[dict], results: list[dict]) -> None:
     """The results as a flat CSV: each row's `matching` columns first, then its result's (`flat_row`)."""
     flats = [flat_row(r) for r in results]
-    front = [c for c in ("row", "shot_id", *LAUNCH_COLUMNS) if any(c in f for f in fronts)]
+    front = [c for c in ("row", "shot_id", *LAUNCH_COLUMNS, *AIR_COLUMNS, AIR_DENSITY) if any(c in f for f in fronts)]
     columns = [*front, *dict.fromkeys(key for flat in flats for key in flat)]
     with open(out, "w", newline="") as handle:
         writer = csv.DictWriter(handle, columns)
@@ -185,7 +199,7 @@ def run(args: argparse.Namespace) -> int:
     refuse_or_skip(args.input, read.problems + invalid, len(shots), read.rows_read, args.skip_bad_rows)
     engine = FlightEngine(model_dir(args.model))
     results = [r.model_dump(exclude_none=True) for r in fly_shots(engine, shots)]
-    fronts = matching(read, kept)
+    fronts = matching(read, kept, shots)
     if args.out and args.out.lower().endswith(".csv"):
         write_csv(args.out, fronts, results)
         return 0
