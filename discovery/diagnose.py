@@ -56,7 +56,7 @@ from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from golfflight.discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
 from golfflight.discovery.schema import AirRival, Candidate, Heldout, Located, ModelInfo, Report, ScatterStat, Unlisted
 from golfflight.discovery.simulator import Flown, Setup
-from golfflight.discovery.physical import restatements
+from golfflight.discovery.physical import blocks, restatements
 from golfflight.discovery.venue_air import air_explanations, air_rival, air_sentence, with_air
 from golfflight.flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
 from golfflight.shots.progress import progress_bar, progress_step
@@ -426,12 +426,20 @@ class Diagnoser:
             chosen, restated = self.in_physical_terms(chosen, singles + richer, test)
             richer += restated
         scored = singles + richer
+        within = self.within_form(chosen)
+        if within:
+            chosen, refitted = self.form_instead(null, chosen, within, scored, test)
+            scored += refitted
         unlisted, left = None, self.structure_left(chosen) if structure and self.with_correction else []
         if left:
             library_best = chosen
             chosen, tried, entries = self.try_correction(null, chosen)
             scored += tried
             test.update(entries)
+            if self.within_form(chosen):  # its company within the model's own error: the correction alone, if any
+                alone = [t for t in tried if len(t.fit.effects) == 1 and t.fit.effects[0].correction is not None]
+                against = max(null.error - 1.0, 0.0)
+                chosen = next((t for t in alone if self.better(t, null, SINGLE_LEVEL, against=against)[0]), null)
             if chosen is not library_best:
                 unlisted = learned.summary(chosen.fit, chosen.error, library_best.error)
         unexplained = left if chosen.fit.k and unlisted is None else []
@@ -558,12 +566,53 @@ class Diagnoser:
         known = {frozenset(e.name for e in s.fit.effects): s for s in scored}
         tried = restatements(self.problem, chosen, self.rows, self.score, known)
         tried += air_explanations(self.problem, chosen, scored, self.score, self.rows)
-        fresh = list({id(s): s for s in tried if s is not chosen}.values())
-        for simpler in sorted((s for s in fresh if s.fit.k < chosen.fit.k), key=lambda s: s.error):
+        seen = {id(s) for s in scored}
+        fresh = list({id(s): s for s in tried if id(s) not in seen}.values())
+        simpler_ones = {id(s): s for s in tried if s.fit.k < chosen.fit.k}.values()
+        for simpler in sorted(simpler_ones, key=lambda s: s.error):
             if not self.better(chosen, simpler, COMBINATION_LEVEL)[0]:
                 test.update(in_physical_terms=simpler.fit.name, in_physical_terms_from=chosen.fit.name)
                 return simpler, fresh
         return chosen, fresh
+
+    def within_form(self, chosen: Scored) -> list[str]:
+        """The venue conditions and monitor biases of `chosen` whose own part of its prediction moves every recorded
+        observable by less (RMS over the shots) than the model's own error there (the card's `own_error`, measured
+        where the truth is known): the model's form alone makes differences that large, so they are not claimed.
+        Empty against a model without an own error (the reference world, a controlled bundle)."""
+        own = self.baseline.expected.model
+        if not chosen.fit.k or not any(own.values()):
+            return []
+        rows, recorded = np.arange(len(self.scored)), self.problem.recordings.observed_names
+        within = []
+        for effect, block in blocks(chosen.fit):
+            if effect.kind == "form":
+                continue
+            without = chosen.fit.theta.copy()
+            without[block] = effect.null
+            both = self.problem.predict(chosen.fit.effects, np.stack([chosen.fit.theta, without]), rows)
+            part = np.sqrt(np.nanmean((both[0] - both[1]) ** 2, axis=0))
+            if all(part[OBSERVABLES.index(name)] < own.get(name, 0.0) for name in recorded):
+                within.append(effect.name)
+        return within
+
+    def form_instead(
+        self, null: Scored, chosen: Scored, within: list[str], scored: list[Scored], test: dict
+    ) -> tuple[Scored, list[Scored]]:
+        """The choice without its effects `within` the model's own error (refitted), or an explanation of the
+        model's form alone (coefficient scales), whichever scores best among those that beat the model as is; the
+        model as is where none does (the learned correction, the model's form too, is tried after). (choice, the
+        refit)."""
+        test["within_model_form"] = "+".join(within)
+        options = [s for s in scored if s.fit.k and all(e.kind == "form" for e in s.fit.effects)]
+        kept = [(e, block) for e, block in blocks(chosen.fit) if e.name not in within]
+        refitted = []
+        if kept:
+            start = np.concatenate([chosen.fit.theta[block] for _, block in kept])
+            refitted.append(self.score(fit(self.problem, tuple(e for e, _ in kept), start, self.rows)))
+        against = max(null.error - 1.0, 0.0)
+        passing = [s for s in options + refitted if self.better(s, null, SINGLE_LEVEL, against=against)[0]]
+        return min(passing, key=lambda s: s.score, default=null), refitted
 
     def try_correction(self, null: Scored, chosen: Scored) -> tuple[Scored, list[Scored], dict]:
         """The learned correction on top of the chosen explanation and alone; it replaces the choice if better. A

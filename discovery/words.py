@@ -39,7 +39,7 @@ COVARIATE_WORDS = {
 EFFECT_WORDS = {
     "wind": "wind",
     "air_density": "air density",
-    "air_density_only": "air density alone (no Reynolds change)",
+    "air_density_only": "air density alone",
     "launch_angle_bias": "launch angle reading",
     "launch_direction_bias": "launch direction reading",
     "ball_speed_bias": "ball speed reading",

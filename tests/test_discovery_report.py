@@ -185,9 +185,14 @@ def test_the_verdict_names_the_rivals_apex_alone_cannot_separate_and_what_to_rec
     assert report.effects[0].parameters["ratio"] == pytest.approx(0.912, abs=0.02)
     assert re.match(r"Apex [\d.]+ ± [\d.]+ m lower than the model: air density explains it, though", found.headline)
     assert len(found.rivals) == len(report.ambiguities) >= 1
-    assert all("not recorded" in line and "m apart" in line for line in found.rivals)
-    rivals = ", ".join(line.split(" (")[0].lower() for line in found.rivals)
-    assert found.record_next == [f"Record carry along the line (m): it would separate air density from {rivals}."]
+    assert all("not recorded" in line and " apart" in line for line in found.rivals)
+    by_carry = [line.split(" (")[0].lower() for line in found.rivals if "carry is not recorded" in line]
+    by_angle = [line.split(" (")[0].lower() for line in found.rivals if "landing angle is not recorded" in line]
+    assert by_angle == ["air density alone"], "the density-only variant differs from real air in the landing angle"
+    assert found.record_next == [
+        f"Record landing angle (deg): it would separate air density from {', '.join(by_angle)}.",
+        f"Record carry along the line (m): it would separate air density from {', '.join(by_carry)}.",
+    ]
 
 
 def test_a_clean_set_reads_as_no_mismatch():
