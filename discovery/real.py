@@ -286,7 +286,7 @@ def with_and_without_air(sets: list[RealSet]) -> list[RealSet]:
     for item in sets:
         out.append(item)
         if item.recordings.density_kg_m3 is not None:
-            concealed = replace(item.recordings, density_kg_m3=None)
+            concealed = replace(item.recordings, density_kg_m3=None, kinematic_viscosity_m2_s=None)
             title, caveat = f"{item.title}, air concealed", f"{item.caveat}; its air concealed"
             out.append(RealSet(item.key + NO_AIR, title, concealed, caveat, item.use))
     return out
