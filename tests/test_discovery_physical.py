@@ -11,7 +11,8 @@ from golfflight.discovery.diagnose import diagnose
 from golfflight.discovery.effects import ALIASES, DENSITY_ONLY, EFFECTS, LIBRARY, apply_all, equivalent_altitude_m
 from golfflight.discovery.model import load_model, reference
 from golfflight.discovery.prove import Run, _acted_on, _among, ferguson_world, fitted_as
-from golfflight.discovery.recordings import from_shot_set
+from golfflight.discovery.noise import base_conditions
+from golfflight.discovery.recordings import OBSERVABLES, from_shot_set
 from golfflight.discovery.report import form_sentence
 from golfflight.discovery.schema import EffectResult
 from golfflight.discovery.simulator import Setup
@@ -117,3 +118,32 @@ def test_campaign_scores_count_either_air_variant_and_the_findings_a_user_acts_o
     assert _acted_on(_run({}, {"spin_bias": {}}, ["monitor"]))
     assert not _acted_on(_run({}, {"unlisted": {}, "drag_scale": {}}, ["form", "form"]))
     assert not _acted_on(_run({}, {"wind": {}}, ["venue"], systematic=False))
+
+
+LOW_ENDS = {
+    "wind": np.array([2.0 * np.sin(np.radians(45.0)), 2.0 * np.cos(np.radians(45.0))]),
+    "air_density": np.array([0.95]),
+    DENSITY_ONLY: np.array([0.95]),
+    "launch_angle_bias": np.array([0.7]),
+    "launch_direction_bias": np.array([1.0]),
+    "ball_speed_bias": np.array([0.985]),
+    "spin_bias": np.array([0.94]),
+    "spin_axis_bias": np.array([2.0]),
+    "landing_elevation": np.array([-3.0]),
+}
+"""The smallest size `prove` hides of each venue condition and monitor bias (`prove.draw_effect`)."""
+
+
+def test_the_smallest_hidden_venue_and_monitor_effects_move_more_than_the_model_s_own_error():
+    """`Diagnoser.within_form` takes a venue or monitor effect that moves every observable by less than the model's
+    own error for the model's form: at the smallest size the proofs hide, each moves some observable by more."""
+    model = load_model(None)
+    recordings = from_shot_set(conceal({}, 300, 0, model=model).shots)
+    base = base_conditions(recordings, model)
+    null = model.simulate(base).outcomes()
+    own = np.array([model.model_error[name] for name in OBSERVABLES])
+    assert {e.name for e in LIBRARY if e.kind != "form"} == set(LOW_ENDS)
+    for name, theta in LOW_ENDS.items():
+        moved = model.simulate(apply_all((EFFECTS[name],), np.repeat(theta[None], len(recordings), 0), base))
+        ratio = np.sqrt(np.nanmean((moved.outcomes() - null) ** 2, axis=0)) / own
+        assert ratio.max() > 1.1, f"{name}: {np.round(ratio, 2)}"

@@ -60,7 +60,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--campaign",
         choices=CAMPAIGNS,
         default="library",
-        help="every library effect, the pair and the effects outside the library (default), or three effects at once",
+        help="every library effect, the pair and the effects outside the library (default), two effects at once "
+        "(pairs) or three (triples)",
     )
     prove.add_argument("--seeds", type=int, default=4, help="concealed sets per case")
     prove.add_argument("--clean-sets", type=int, default=CLEAN_SETS, help="clean sets (false-alarm count)")
