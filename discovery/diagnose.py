@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from golfflight.discovery import correction as learned
-from golfflight.discovery.effects import AIR_VARIANTS, LIBRARY, Context
+from golfflight.discovery.effects import AIR_VARIANTS, LIBRARY, Context, Effect
 from golfflight.discovery.fit import (
     MAX_FIT_SHOTS,
     SCORED_SHOTS,
@@ -580,21 +580,25 @@ class Diagnoser:
         observable by less (RMS over the shots) than the model's own error there (the card's `own_error`, measured
         where the truth is known): the model's form alone makes differences that large, so they are not claimed.
         Empty against a model without an own error (the reference world, a controlled bundle)."""
-        own = self.baseline.expected.model
-        if not chosen.fit.k or not any(own.values()):
+        if not chosen.fit.k or not any(self.baseline.expected.model.values()):
             return []
-        rows, recorded = np.arange(len(self.scored)), self.problem.recordings.observed_names
-        within = []
-        for effect, block in blocks(chosen.fit):
-            if effect.kind == "form":
-                continue
-            without = chosen.fit.theta.copy()
-            without[block] = effect.null
-            both = self.problem.predict(chosen.fit.effects, np.stack([chosen.fit.theta, without]), rows)
-            part = np.sqrt(np.nanmean((both[0] - both[1]) ** 2, axis=0))
-            if all(part[OBSERVABLES.index(name)] < own.get(name, 0.0) for name in recorded):
-                within.append(effect.name)
-        return within
+        return [
+            effect.name
+            for effect, block in blocks(chosen.fit)
+            if effect.kind != "form" and self.share_of_own_error(chosen, effect, block) < 1.0
+        ]
+
+    def share_of_own_error(self, candidate: Scored, effect: Effect, block: slice) -> float:
+        """How far one effect of a candidate (its parameters at `block`) moves the candidate's predictions (with and
+        without it, RMS over the shots), in units of the model's own error, on the recorded observable it moves
+        most."""
+        own, recorded = self.baseline.expected.model, self.problem.recordings.observed_names
+        without = candidate.fit.theta.copy()
+        without[block] = effect.null
+        rows = np.arange(len(self.scored))
+        both = self.problem.predict(candidate.fit.effects, np.stack([candidate.fit.theta, without]), rows)
+        part = np.sqrt(np.nanmean((both[0] - both[1]) ** 2, axis=0))
+        return max(part[OBSERVABLES.index(name)] / max(own.get(name, 0.0), 1e-12) for name in recorded)
 
     def form_instead(
         self, null: Scored, chosen: Scored, within: list[str], scored: list[Scored], test: dict
