@@ -440,7 +440,7 @@ class Diagnoser:
                 alone = [t for t in tried if len(t.fit.effects) == 1 and t.fit.effects[0].correction is not None]
                 against = max(null.error - 1.0, 0.0)
                 chosen = next((t for t in alone if self.better(t, null, SINGLE_LEVEL, against=against)[0]), null)
-            if chosen is not library_best:
+            if any(learned.is_correction(e) for e in chosen.fit.effects):
                 unlisted = learned.summary(chosen.fit, chosen.error, library_best.error)
         unexplained = left if chosen.fit.k and unlisted is None else []
         systematic = structure and chosen is not null
