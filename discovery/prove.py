@@ -379,17 +379,18 @@ def _measure_rows(runs: list[Run], truth: Truth) -> list[str]:
     errors = [e for r in hidden for e in r.parameter_error.values()]
     fractions = [r.explained_fraction for r in hidden if r.explained_fraction is not None]
     rows = []
+    form_rows = []
     if clean and truth == "model":
         rows.append(f"| false alarms on clean sets | {sum(r.systematic for r in clean)} of {len(clean)} | 0 |")
     elif clean:
-        rows += [
+        form_rows += [
             f"| clean sets called systematic (the model's form differs from this world's) | "
             f"{sum(r.systematic for r in clean)} of {len(clean)} | - |",
             f"| clean sets naming no venue condition and no monitor bias | "
             f"{_share([not _acted_on(r) for r in clean])} | ≥ 90 % |",
         ]
     if library and truth != "model":
-        rows.append(
+        form_rows.append(
             "| hidden library effect named (alone or beside others), parameter within 10 % | "
             f"{_share([_among(r) and _within(r) for r in library])} | ≥ 70 % |"
         )
@@ -438,6 +439,8 @@ def _measure_rows(runs: list[Run], truth: Truth) -> list[str]:
             f"| excess held-out error removed (median; min) | {np.median(fractions):.1%}; {min(fractions):.1%} "
             "| ≥ 70 % |"
         )
+    if truth != "model":  # the targets above are the model's own flights'; a world of another form has its own two
+        rows = form_rows + [row.rsplit("|", 2)[0] + "| - |" for row in rows]
     return rows
 
 

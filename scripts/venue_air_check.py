@@ -75,7 +75,7 @@ def main() -> None:
     summary = (
         f"Density-only air at {RATIO} x ICAO concealed in the served model's flights, {args.shots} shots a set: air "
         f"left blank, air named or listed first within {TOLERANCE} in {passed[False]} of {args.seeds}; air recorded, "
-        f"no air finding and nothing systematic in {passed[True]} of {args.seeds}."
+        f"no air finding in {passed[True]} of {args.seeds}."
     )
     print(summary)
     out = Path(args.out)
