@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from golfflight.discovery import correction as learned
-from golfflight.discovery.effects import AIR_VARIANTS, LIBRARY, Context, Effect
+from golfflight.discovery.effects import AIR_VARIANTS, LIBRARY, REYNOLDS_SCALE, Context, Effect
 from golfflight.discovery.fit import (
     MAX_FIT_SHOTS,
     SCORED_SHOTS,
@@ -150,6 +150,15 @@ def _mean_sq(z: np.ndarray) -> float:
 
 def _rms(values: np.ndarray) -> float:
     return float(np.sqrt(np.nanmean(values**2)))
+
+
+def library_for(air_recorded: bool) -> tuple[Effect, ...]:
+    """The effects offered: the whole library for recordings without air; for recordings that carry their air, no
+    air density (with the air recorded there is no air finding) but the Reynolds scale (`effects.REYNOLDS_SCALE`,
+    the model's form: how the recordings' physics reads that air)."""
+    if not air_recorded:
+        return LIBRARY
+    return tuple(e for e in LIBRARY if e.name not in AIR_VARIANTS) + (REYNOLDS_SCALE,)
 
 
 def outlier_mask(residual: np.ndarray) -> np.ndarray:
@@ -286,7 +295,7 @@ class Diagnoser:
         self.started = time.perf_counter()
         self.recordings, self.model = recordings, model
         self.air_recorded = recordings.density_kg_m3 is not None
-        self.library = tuple(e for e in LIBRARY if not (self.air_recorded and e.name in AIR_VARIANTS))
+        self.library = library_for(self.air_recorded)
         self.with_correction, self.estimate_scatter, self.progress = with_correction, estimate_scatter, progress
         self.rng = np.random.default_rng(seed)
         self.step(f"flying {len(recordings):,} recorded shots through the model and its expected error...")

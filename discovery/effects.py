@@ -275,7 +275,29 @@ LIBRARY: tuple[Effect, ...] = (
 )
 """Every library effect, in report order."""
 
-EFFECTS: dict[str, Effect] = {effect.name: effect for effect in LIBRARY}
+
+
+def _reynolds(theta: np.ndarray, conditions: Setup) -> Setup:
+    """The coefficients read at `scale` x the Reynolds number the assumed air gives (its viscosity / scale)."""
+    out = conditions.copy()
+    ratio = out.viscosity_ratio if out.viscosity_ratio is not None else np.ones(len(out))
+    out.viscosity_ratio = ratio / theta[:, 0]
+    return out
+
+
+REYNOLDS_SCALE = Effect(
+    "reynolds_scale",
+    (Parameter("scale", "1", 1.0, 0.5, 2.0, 0.1, 0.02),),
+    _reynolds,
+    _single("scale"),
+    "the recordings' physics reads the coefficients at this many times the Reynolds number the recorded air gives "
+    "(a flight model that takes the recorded density alone: scale = ICAO density / recorded density)",
+    kind="form",
+)
+"""For recordings that carry their air, in place of the air variants: what can still differ about the air is how the
+recordings' physics reads it. Real air and density alone differ by exactly this (`discovery.physical`)."""
+
+EFFECTS: dict[str, Effect] = {effect.name: effect for effect in (*LIBRARY, REYNOLDS_SCALE)}
 
 AIR_VARIANTS: tuple[str, ...] = ("air_density", DENSITY_ONLY)
 """Air density as real air changes it (the Reynolds number with it) and density alone."""

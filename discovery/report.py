@@ -185,6 +185,11 @@ def effect_phrase(effect: EffectResult) -> str:
         return f"landing ground {plus_minus(abs(p['height_m']), u['height_m'], ' m')} {where} the tee"
     if name == "unlisted":
         return "a learned extra acceleration (see unlisted)"
+    if name == "reynolds_scale":
+        return (
+            f"the coefficients read at {plus_minus(p['scale'], u['scale'])} times the Reynolds number of the recorded "
+            "air (1 / the density ratio for a flight model that takes density alone)"
+        )
     if "offset_deg" in p:
         return f"a {name.replace('_', ' ')} of {plus_minus(p['offset_deg'], u['offset_deg'], '°')} (true − recorded)"
     what = {

@@ -40,6 +40,7 @@ EFFECT_WORDS = {
     "wind": "wind",
     "air_density": "air density",
     "air_density_only": "air density alone",
+    "reynolds_scale": "Reynolds number",
     "launch_angle_bias": "launch angle reading",
     "launch_direction_bias": "launch direction reading",
     "ball_speed_bias": "ball speed reading",

@@ -87,10 +87,15 @@ def test_density_only_venue_air_concealed_is_named_as_such():
     assert report.service_settings.air is not None
 
 
-def test_with_that_air_recorded_no_air_is_found():
+def test_with_that_air_recorded_no_air_is_found_but_how_the_air_was_read():
+    """The same venue with its air recorded: no air finding; the model flies the recorded air with the Reynolds change
+    and the recordings without it, so the difference is the model's form, a Reynolds scale of 1 / 0.776."""
     report = diagnose(from_shot_set(_density_only_set(5, True)), load_model(None), progress=False).report
     assert report.air_rival is None
     assert not {"air_density", DENSITY_ONLY} & {e.name for e in report.effects}
+    assert [(e.name, e.kind) for e in report.effects] == [("reynolds_scale", "form")]
+    assert report.effects[0].parameters["scale"] == pytest.approx(1 / 0.776, abs=0.05)
+    assert "model's form" in report.statement
 
 
 def test_ferguson_world_flies_a_tour_driver_about_as_published():
