@@ -12,9 +12,12 @@ the best singles is combined with the other effects that most reduce its lineari
 pair beats the best single, each of the best pairs with a third (triples). A candidate replaces a simpler one only if
 its held-out error is lower beyond doubt (the lower end of a session-bootstrap interval of the improvement is above
 zero) and by a material share, and, against a controlled model, by more than the model's own error of response to
-the simpler explanation (`Diagnoser.response_error`). Structure the library explanation leaves (the test run again
-on its residuals) leads to the learned correction; a library effect stays beside it only if it beats the correction
-alone beyond doubt.
+the simpler explanation (`Diagnoser.response_error`). The choice is then stated in physical terms: coefficient
+scales that agree as air density, and on recordings without air, air set against it on equal terms
+(`Diagnoser.in_physical_terms`); a venue condition or monitor bias that moves no recorded observable by more than
+the model's own error is left to the model's form (`Diagnoser.within_form`). Structure the library explanation
+leaves (the test run again on its residuals) leads to the learned correction; a library effect stays beside it only
+if it beats the correction alone beyond doubt.
 """
 
 from __future__ import annotations
@@ -446,7 +449,7 @@ class Diagnoser:
             scored += tried
             test.update(entries)
             if self.within_form(chosen):  # its company within the model's own error: the correction alone, if any
-                alone = [t for t in tried if len(t.fit.effects) == 1 and t.fit.effects[0].correction is not None]
+                alone = [t for t in tried if len(t.fit.effects) == 1 and learned.is_correction(t.fit.effects[0])]
                 against = max(null.error - 1.0, 0.0)
                 chosen = next((t for t in alone if self.better(t, null, SINGLE_LEVEL, against=against)[0]), null)
             if any(learned.is_correction(e) for e in chosen.fit.effects):

@@ -109,8 +109,13 @@ def _wind(theta: np.ndarray, conditions: Setup) -> Setup:
 
 def _density(theta: np.ndarray, conditions: Setup) -> Setup:
     """Real air `ratio` x as dense: the dynamic pressure scales with it and, at the same temperature, the kinematic
-    viscosity with its inverse, so the Reynolds number scales with it too."""
-    out = _density_only(theta, conditions)
+    viscosity with its inverse, so the Reynolds number scales with it too (density alone, then the Reynolds scale)."""
+    return _reynolds(theta, _density_only(theta, conditions))
+
+
+def _reynolds(theta: np.ndarray, conditions: Setup) -> Setup:
+    """The coefficients read at `scale` x the Reynolds number the assumed air gives (its viscosity / scale)."""
+    out = conditions.copy()
     ratio = out.viscosity_ratio if out.viscosity_ratio is not None else np.ones(len(out))
     out.viscosity_ratio = ratio / theta[:, 0]
     return out
@@ -275,14 +280,6 @@ LIBRARY: tuple[Effect, ...] = (
 )
 """Every library effect, in report order."""
 
-
-
-def _reynolds(theta: np.ndarray, conditions: Setup) -> Setup:
-    """The coefficients read at `scale` x the Reynolds number the assumed air gives (its viscosity / scale)."""
-    out = conditions.copy()
-    ratio = out.viscosity_ratio if out.viscosity_ratio is not None else np.ones(len(out))
-    out.viscosity_ratio = ratio / theta[:, 0]
-    return out
 
 
 REYNOLDS_SCALE = Effect(
