@@ -31,10 +31,18 @@ def aliased(result: Fit) -> list[tuple[Effect, slice]]:
     return [(e, block) for e, block in blocks(result) if e.name in ALIASES]
 
 
-def air_in_place(problem: Problem, result: Fit, replaced: list[str], variant: str, ratio: float, rows: np.ndarray,
-             score: Score, known: dict[frozenset, Scored]) -> Scored:
+def air_in_place(
+    problem: Problem,
+    result: Fit,
+    replaced: list[str],
+    variant: str,
+    ratio: float,
+    rows: np.ndarray,
+    score: Score,
+    known: dict[frozenset, Scored],
+) -> Scored:
     """`result`'s library effects with air density (`variant`, started at `ratio`) in place of the effects named in
-    `replaced` (none: beside them all), fitted and scored, or taken from `known` where already fitted."""
+    `replaced` (the rest kept beside it), fitted and scored, or taken from `known` where already fitted."""
     kept = [(e, block) for e, block in blocks(result) if e.correction is None and e.name not in replaced]
     kept = [(e, block) for e, block in kept if e.name not in AIR_VARIANTS]
     effects = tuple(e for e, _ in kept) + (EFFECTS[variant],)
@@ -51,8 +59,9 @@ def common_ratio(result: Fit) -> float:
     return float(np.exp(np.mean(np.log(scales)))) if scales else 1.0
 
 
-def restatements(problem: Problem, chosen: Scored, rows: np.ndarray, score: Score,
-                 known: dict[frozenset, Scored]) -> list[Scored]:
+def restatements(
+    problem: Problem, chosen: Scored, rows: np.ndarray, score: Score, known: dict[frozenset, Scored]
+) -> list[Scored]:
     """The chosen explanation with air density (each variant) in place of its two or more coefficient scales, best
     held-out error first; empty where it has fewer than two."""
     scales = [e.name for e, _ in aliased(chosen.fit)]

@@ -1,16 +1,16 @@
 """Venue air as an explanation when the recordings carry none.
 
-Recordings without air (e.g. `golfflight convert pbp`) are flown in the model's own air (ICAO), so a venue's thinner
-or denser air is a mismatch like any other, and it can look like another effect: with only the apex recorded,
-thinner air and more drag both lower it. Whatever explanation is chosen is therefore set against air density on
-equal terms, in both its variants (real air, whose Reynolds number changes with it, and density alone): air in place
-of every effect it aliases (the coefficient scales), in place of the main library effect, and beside the rest, each
-fitted through the simulator and judged by the tool's own separability test (`report.ambiguity`: the
-session-bootstrap 95 % interval of the held-out difference). Air is ruled out only when every one of them is
-separated from the choice; otherwise air is listed first among the rivals with the venue air it implies (density
-ratio and the equivalent standard-atmosphere altitude at 15 degC) and the observables that would separate them
-(`diagnose` names air itself where an air explanation wins: `Diagnoser.in_physical_terms`). Recordings that carry their air get no such comparison: air is
-not offered as their explanation.
+Recordings without air (e.g. `golfflight convert pbp`) are flown in the model's own air (ICAO), so a venue's thinner or
+denser air is a mismatch like any other, and it can look like another effect: with only the apex recorded, thinner air
+and more drag both lower it. Whatever explanation is chosen is therefore set against air density on equal terms, in both
+its variants (real air, whose Reynolds number changes with it, and density alone): air in place of every effect it
+aliases (the coefficient scales), and in place of the main library effect, the rest kept beside it, each fitted through
+the simulator and judged by the tool's own separability test (`report.ambiguity`: the session-bootstrap 95 % interval of
+the held-out difference). Air is ruled out only when every one of them is separated from the choice; otherwise air is
+listed first among the rivals with the venue air it implies (density ratio and the equivalent standard-atmosphere
+altitude at 15 degC) and the observables that would separate them (`diagnose` names air itself where an air explanation
+wins: `Diagnoser.in_physical_terms`). Recordings that carry their air get no such comparison: air is not offered as
+their explanation.
 """
 
 from __future__ import annotations
