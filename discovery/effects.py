@@ -116,8 +116,7 @@ def _density(theta: np.ndarray, conditions: Setup) -> Setup:
 def _reynolds(theta: np.ndarray, conditions: Setup) -> Setup:
     """The coefficients read at `scale` x the Reynolds number the assumed air gives (its viscosity / scale)."""
     out = conditions.copy()
-    ratio = out.viscosity_ratio if out.viscosity_ratio is not None else np.ones(len(out))
-    out.viscosity_ratio = ratio / theta[:, 0]
+    out.viscosity_ratio = out.viscosity_ratio / theta[:, 0]
     return out
 
 

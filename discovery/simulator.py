@@ -51,8 +51,12 @@ class Setup:
     """The kinematic viscosity the model assumes for each shot [N] (recorded air, as the service computes it from
     the temperature and density), None = the model's nominal air."""
     viscosity_ratio: np.ndarray | None = None
-    """True kinematic viscosity over the assumed one [N] (None = 1): real thinner air has a proportionally larger
-    one (the Reynolds number falls with the density), a density-only change leaves it."""
+    """True kinematic viscosity over the assumed one [N] (ones where not given): real thinner air has a
+    proportionally larger one (the Reynolds number falls with the density), a density-only change leaves it."""
+
+    def __post_init__(self) -> None:
+        if self.viscosity_ratio is None:
+            self.viscosity_ratio = np.ones(len(self.density_ratio))
 
     def __len__(self) -> int:
         return len(self.density_ratio)
@@ -74,8 +78,7 @@ class Setup:
         """The kinematic viscosity each shot flies in [N]: the assumed one (`nominal_m2_s` where none is set) times
         the effects' ratio."""
         assumed = self.kinematic_viscosity_m2_s if self.kinematic_viscosity_m2_s is not None else nominal_m2_s
-        ratio = self.viscosity_ratio if self.viscosity_ratio is not None else 1.0
-        return np.broadcast_to(np.asarray(assumed * ratio, dtype=float), (len(self),)).copy()
+        return assumed * self.viscosity_ratio
 
 
 def concatenate(parts: list[Setup]) -> Setup:
