@@ -2,7 +2,9 @@
 served model's own flights) and the clean and library sets of `prove --truth ferguson`, concealed and diagnosed by
 the checkout this script is run in, so that the tables of docs/discovery.md have a "before".
 
-    git worktree add /tmp/before 90503c4 && cd /tmp/before && python /path/to/scripts/prove_before.py --out FILE.json
+    git worktree add /tmp/before 90503c4 && cd /tmp/before && python - --out FILE.json < /path/to/scripts/prove_before.py
+
+(read from standard input, so that the checkout in the current folder is the one imported, not an installed one).
 
 It uses only what that commit already had (`prove.run_case`, `prove.draw_effect`, `conceal`, `diagnose`), with the
 pairs and the Ferguson world spelled out here as `prove.PAIRS` and `prove.ferguson_world` spell them now; the output
