@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
-from golfflight.discovery.effects import DENSITY_ONLY, Context, equivalent_altitude_m
+from golfflight.discovery.effects import AIR_VARIANTS, DENSITY_ONLY, Context, equivalent_altitude_m
 from golfflight.discovery.model import FlightModel
 from golfflight.discovery.noise import RADAR_NOISE
 from golfflight.discovery.outside import OUTSIDE, air_motion, term_and_weights
@@ -52,8 +52,6 @@ LAUNCH_BIASES = {
     "ball_speed_bias": ("ball_speed_mps", "scale", False),
     "spin_bias": ("spin_rpm", "scale", False),
 }
-AIRS = ("air_density", DENSITY_ONLY)
-"""The two variants of air density: real air (the Reynolds number changes with it) and density alone."""
 KNOBS = {"drag_scale": "drag_scale", "lift_scale": "lift_scale", "spin_decay": "spin_decay_scale"}
 
 
@@ -155,7 +153,7 @@ def _fly_model(
 ) -> Flight:
     """The true launches flown through the model with the hidden effects, in its flight core."""
     unknown = (
-        set(hidden) - set(KNOBS) - set(LAUNCH_BIASES) - set(OUTSIDE) - {*AIRS, "wind", "landing_elevation"}
+        set(hidden) - set(KNOBS) - set(LAUNCH_BIASES) - set(OUTSIDE) - {*AIR_VARIANTS, "wind", "landing_elevation"}
     )
     if unknown or wind_profile != "uniform":
         raise ValueError(f"a model's own flights take library effects, uniform wind and discovery.outside: {unknown}")
@@ -167,7 +165,7 @@ def _fly_model(
     wind = np.zeros((n, 2))
     if "wind" in hidden:
         wind[:] = wind_vector(hidden["wind"]["speed_mps"], hidden["wind"]["from_deg"])[:2]
-    real, only = (hidden.get(name, {"ratio": 1.0})["ratio"] for name in AIRS)
+    real, only = (hidden.get(name, {"ratio": 1.0})["ratio"] for name in AIR_VARIANTS)
     ratio = np.full(n, real * only)
     density = np.full(n, model.density_kg_m3)
     term, weights = term_and_weights(hidden, density * ratio)

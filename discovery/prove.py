@@ -23,9 +23,9 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from golfflight.discovery.conceal import AIRS, NOMINAL_AIR, NOMINAL_CONTEXT, OUTSIDE_EFFECT, conceal
+from golfflight.discovery.conceal import NOMINAL_AIR, NOMINAL_CONTEXT, OUTSIDE_EFFECT, conceal
 from golfflight.discovery.diagnose import diagnose
-from golfflight.discovery.effects import DENSITY_ONLY, EFFECTS, LIBRARY, equivalent_altitude_m
+from golfflight.discovery.effects import AIR_VARIANTS, DENSITY_ONLY, EFFECTS, LIBRARY, equivalent_altitude_m
 from golfflight.discovery.model import MIN_T_MAX_S, FlightModel
 from golfflight.discovery.outside import HEIGHT_GUST, HIGH_SPIN_LIFT_LOSS, LOW_SPEED_DRAG, OUTSIDE
 from golfflight.discovery.recordings import from_shot_set
@@ -60,10 +60,9 @@ CLEAN_SETS = 40
 
 Truth = Literal["model", "reference", "ferguson", "density-only"]
 TRUTHS: tuple[Truth, ...] = ("model", "reference", "ferguson", "density-only")
-FORM_WORLDS: tuple[Truth, ...] = ("reference", "ferguson", "density-only")
-"""Truth worlds that differ from the diagnosed model in form (the model-form campaign): the reference world,
-Ferguson 2022's closed-form coefficients, and the model itself in venue air that scales density only (recorded, so
-the model flies it with the Reynolds change real air has)."""
+"""The worlds effects are hidden in: the diagnosed model's own flights, and those that differ from it in form (the
+model-form campaign): the reference world, Ferguson 2022's closed-form coefficients, and the model itself in venue
+air that scales density only (recorded, so the model flies it with the Reynolds change real air has)."""
 
 VENUE_RATIOS = (0.75, 0.95)
 """The density-only world's venue air, as a share of ICAO density (about 500 to 2,600 m)."""
@@ -105,7 +104,7 @@ def draw_effect(name: str, rng: np.random.Generator) -> dict[str, float]:
     """A realistic size and direction of one effect, in the report's conventions."""
     if name == "wind":
         return {"speed_mps": float(rng.uniform(2.0, 7.0)), "from_deg": float(rng.uniform(0.0, 360.0))}
-    if name in AIRS:
+    if name in AIR_VARIANTS:
         thinner = rng.random() < 0.75
         return {"ratio": float(1 - rng.uniform(0.05, 0.22) if thinner else 1 + rng.uniform(0.03, 0.08))}
     if name == OUTSIDE_EFFECT:
@@ -145,7 +144,7 @@ def cases(truth: Truth = "model", campaign: Campaign = "library") -> list[tuple[
         return [("clean", ())] + [("+".join(group), group) for group in (PAIRS if campaign == "pairs" else TRIPLES)]
     library = [(e.name, (e.name,)) for e in LIBRARY]
     if truth == "density-only":  # the air is recorded there: an air finding is wrong by construction
-        library = [(name, effects) for name, effects in library if name not in AIRS]
+        library = [(name, effects) for name, effects in library if name not in AIR_VARIANTS]
     if truth == "reference":
         library.append((LOG_WIND, ("wind",)))
     outside = (OUTSIDE_EFFECT, HEIGHT_GUST) if truth == "reference" else OUTSIDE
@@ -165,7 +164,7 @@ def internal(name: str, parameters: dict[str, float]) -> np.ndarray:
     """A hidden or fitted effect as the library's internal parameter vector."""
     if name == "wind":
         return wind_vector(parameters["speed_mps"], parameters["from_deg"])[:2]
-    if name in AIRS:
+    if name in AIR_VARIANTS:
         return np.array([parameters["ratio"]])
     return np.array([next(iter(v for k, v in parameters.items() if k in ("offset_deg", "scale", "height_m")))])
 
@@ -199,8 +198,8 @@ def fitted_as(name: str, fitted: dict[str, dict[str, float]]) -> str | None:
     """The fitted effect that stands for the hidden `name`: itself, or for air either variant; None if not fitted."""
     if name in fitted:
         return name
-    if name in AIRS:
-        return next((other for other in AIRS if other in fitted), None)
+    if name in AIR_VARIANTS:
+        return next((other for other in AIR_VARIANTS if other in fitted), None)
     return None
 
 
