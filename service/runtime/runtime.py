@@ -15,7 +15,7 @@ import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Callable, Literal
 
 from golfflight.contract.bay import CONDITION_FIELDS, PUTTER, in_bay
 from golfflight.contract.flying import flown_shot
@@ -89,6 +89,7 @@ class BayRuntime:
         self.feed = ShotFeed()
         self.metrics = ServiceMetrics(self.model_labels)
         self._simulation_seconds = {kind: self.metrics.simulation_seconds.labels(kind) for kind in ("shot", "batch")}
+        self._reporters: dict[str, Callable[[], dict]] = {}
 
     def model_labels(self) -> dict[str, str] | None:
         """The loaded model's variant and ONNX SHA-256 and the package version (/metrics' info labels)."""
@@ -129,6 +130,15 @@ class BayRuntime:
         """What is degraded while shots still fly (GET /healthz): the bay file's problem, if any."""
         problem = self.bay.problem
         return {"bay": problem} if problem else {}
+
+    def add_reporter(self, name: str, report: Callable[[], dict]) -> None:
+        """Have GET /healthz show `report()` under `name` (an adapter's own figures, e.g. Open Connect's connectors
+        and refusals), without the runtime importing the adapter."""
+        self._reporters[name] = report
+
+    def reports(self) -> dict[str, dict]:
+        """Each reporter's figures now, by name."""
+        return {name: report() for name, report in self._reporters.items()}
 
     def fly(self, request: ShotRequest, source: Source, *, show: bool = True, shot_number: int | None = None,
             club_data: dict | None = None, flat: bool = True) -> Flown:

@@ -38,7 +38,8 @@ async def healthz(runtime: BayRuntime = Depends(bay_runtime)) -> JSONResponse:
         "load_seconds": engine.load_seconds,
     }
     problems = runtime.problems()
-    answer = {"status": "degraded" if problems else "ready", "model": model, "version": __version__}
+    answer = {"status": "degraded" if problems else "ready", "model": model, "version": __version__,
+              **runtime.reports()}
     return JSONResponse({**answer, "problems": problems} if problems else answer)
 
 
