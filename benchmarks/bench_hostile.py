@@ -1,8 +1,8 @@
 """HTTP single shots while Open Connect connectors misbehave: does a hostile (or broken) program on the bay's machine,
 which needs no key to reach the Open Connect port, hold up the HTTP service?
 
-python benchmarks/bench_hostile.py [--flood-mb 20] [--hostile-s 10] [--quiet-s 5] [--label after] [--tree DIR]
-                                   [--no-write]
+python benchmarks/bench_hostile.py [--flood-mb 20] [--hostile-s 10] [--quiet-s 5] [--connector-shots 20]
+                                   [--label after] [--tree DIR] [--no-write]
 
 Starts `golfflight serve --port P --connect-port Q` in a subprocess, as a user would (of this checkout, or of
 --tree DIR: e.g. `git archive HEAD | tar -x -C DIR` for a before run while the checkout changes), waits for GET
@@ -15,6 +15,11 @@ milliseconds, and the scenario would measure nothing. Timing starts once every h
 connectors run in processes of their own, so the timed client has this process (and its GIL) to itself. After each
 flood stops (its sockets closed), the time to a GET /healthz on a new connection is taken.
 
+Then Open Connect's places (issue 42): a hostile program holds every place (16 sockets), (d) idle or (e) each
+trickling a byte a second, and connects again whenever one is closed; once it holds them, a connector connects and
+sends a shot --connector-shots times, 0.25 s apart, a new connection each time, and the time from its connect to its
+shot's reply is taken, with the reply's Code (200: it got in; 503: it was refused).
+
 Prints a table and writes the `hostile` section of results.json: rows carry --label (e.g. "before" / "after"), and
 a run replaces only the rows of its own label, so the section can hold a before and an after run.
 """
@@ -25,6 +30,7 @@ import argparse
 import json
 import multiprocessing
 import os
+import select
 import socket
 import subprocess
 import sys
@@ -58,6 +64,12 @@ FLOOD_CAP_S = 300.0
 """A flood still going after this long is stopped (and the run says so)."""
 TARGETS = {"p99_ms": 50.0, "max_ms": 250.0, "resets": 0, "healthz_after_s": 1.0}
 """During (b), on the 2-core machine: HTTP single shot p99 and max, connection resets, /healthz after the flood."""
+PLACES = 16
+"""The sockets the hostile program of (d) and (e) holds: every place Open Connect has (`limits.MAX_CONNECTIONS`)."""
+CONNECTOR_TARGET_S = 1.0
+"""During (d) and (e): every connector's shot answered Code 200 within this long of its connect."""
+CONNECTOR_GAP_S = 0.25
+"""Between two connectors' shots in (d) and (e): time for the hostile program to take back the place it lost."""
 
 
 def flood(port: int, unit: bytes, total_bytes: int, least_s: float, writing, report) -> None:
@@ -113,6 +125,102 @@ def never_read(port: int, stop, writing, report) -> None:
         finally:
             sock.close()
     report.send((written // len(CONNECT_SHOT), connections))
+
+
+def hold_places(port: int, trickle: bool, stop, holding, report) -> None:
+    """Hold PLACES sockets to the Open Connect port, sending nothing or (`trickle`) a byte of a heartbeat a second on
+    each, connecting again whenever one is closed, until `stop`; sets `holding` once all are connected; reports the
+    connections used."""
+    sockets = [socket.create_connection((HOST, port)) for _ in range(PLACES)]
+    connections, sent = PLACES, 0
+    holding.set()
+    next_byte = time.monotonic()
+    while not stop.is_set():
+        readable, _, _ = select.select(sockets, [], [], 0.05)
+        for sock in readable:
+            if not _still_open(sock):
+                sockets[sockets.index(sock)] = socket.create_connection((HOST, port))
+                connections += 1
+        if trickle and time.monotonic() >= next_byte:
+            for sock in sockets:
+                _send_quietly(sock, HEARTBEAT[sent % len(HEARTBEAT) : sent % len(HEARTBEAT) + 1])
+            sent, next_byte = sent + 1, next_byte + 1.0
+    for sock in sockets:
+        sock.close()
+    report.send(connections)
+
+
+def _still_open(sock: socket.socket) -> bool:
+    """Read what the server wrote (a refusal); False, with the socket closed, once the server has closed it."""
+    try:
+        if sock.recv(65536):
+            return True
+    except OSError:
+        pass
+    sock.close()
+    return False
+
+
+def _send_quietly(sock: socket.socket, data: bytes) -> None:
+    """Send `data`, ignoring a socket the server has just closed (it is replaced at its next read)."""
+    try:
+        sock.send(data)
+    except OSError:
+        pass
+
+
+def connector_shot(port: int) -> tuple[float, int]:
+    """A connector connecting and sending a shot at once: (seconds from its connect to the reply, the reply's Code;
+    0 when the connection closed without one)."""
+    started = time.perf_counter()
+    with socket.create_connection((HOST, port), timeout=HTTP_TIMEOUT_S) as sock:
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        sock.sendall(CONNECT_SHOT)
+        data = b""
+        while True:
+            try:
+                received = sock.recv(65536)
+            except ConnectionResetError:
+                received = b""
+            data += received
+            try:
+                reply, _ = json.JSONDecoder().raw_decode(data.decode())
+                return time.perf_counter() - started, reply["Code"]
+            except ValueError:
+                if not received:
+                    return time.perf_counter() - started, 0
+
+
+def places_scenario(connect: int, trickle: bool, shots: int, base_url: str) -> dict:
+    """(d) or (e): connector shots while a hostile program holds every place; the figures of one row (less its
+    name and label)."""
+    context = multiprocessing.get_context("spawn")
+    report_out, report_in = context.Pipe(duplex=False)
+    stop, holding = context.Event(), context.Event()
+    holder = context.Process(target=hold_places, args=(connect, trickle, stop, holding, report_in))
+    holder.start()
+    assert holding.wait(timeout=60), "the hostile program did not connect"
+    time.sleep(3.0 if trickle else 1.0)  # every place taken (and, trickling, a few bytes into each)
+    evicted_before = evictions(base_url)
+    timed = []
+    for _ in range(shots):
+        timed.append(connector_shot(connect))
+        time.sleep(CONNECTOR_GAP_S)
+    evicted = evictions(base_url)
+    stop.set()
+    connections = report_out.recv()
+    holder.join()
+    ms = np.asarray([seconds for seconds, _ in timed]) * 1e3
+    return {"unit": "ms", "connector_shots": shots, "answered": sum(code == 200 for _, code in timed),
+            "codes": sorted({code for _, code in timed}), "p50": float(np.percentile(ms, 50)),
+            "max": float(ms.max()), "hostile_connections": connections,
+            "evicted": None if evicted is None else evicted - evicted_before}
+
+
+def evictions(base_url: str) -> int | None:
+    """Open Connect's evictions since the service started (GET /healthz), or None where it does not say."""
+    answer = httpx.get(base_url + "/healthz", timeout=HTTP_TIMEOUT_S).json()
+    return answer.get("open_connect", {}).get("evicted")
 
 
 @dataclass
@@ -258,16 +366,35 @@ def run(args: argparse.Namespace) -> list[dict]:
             timed, figures = flood_scenario(client, connect, unit, args, never_reader)
             row = timed.row(scenario, args.label) | figures | {"healthz_after_s": healthz_seconds(base_url)}
             rows.append(row)
+        for scenario, trickle in ((f"(d) {PLACES} idle sockets held", False),
+                                  (f"(e) {PLACES} sockets trickling a byte a second", True)):
+            print(f"{scenario} ...", flush=True)
+            figures = places_scenario(connect, trickle, args.connector_shots, base_url)
+            rows.append({"name": f"{scenario} [{args.label}]", "label": args.label, "scenario": scenario} | figures)
     finally:
         client.close()
         process.terminate()
         process.wait(timeout=60)
+    rows.append(targets_row(rows, args.label))
+    rows.append(places_targets_row(rows, args.label))
+    return rows
+
+
+def targets_row(rows: list[dict], label: str) -> dict:
+    """Whether (b) met TARGETS."""
     during = rows[1]
     met = (during["p99"] <= TARGETS["p99_ms"] and during["max"] <= TARGETS["max_ms"]
            and during["resets"] + during["timeouts"] == TARGETS["resets"]
            and during["healthz_after_s"] <= TARGETS["healthz_after_s"])
-    rows.append({"name": f"targets during (b) [{args.label}]", "label": args.label, "targets": TARGETS, "met": met})
-    return rows
+    return {"name": f"targets during (b) [{label}]", "label": label, "targets": TARGETS, "met": met}
+
+
+def places_targets_row(rows: list[dict], label: str) -> dict:
+    """Whether every connector's shot in (d) and (e) was answered Code 200 within CONNECTOR_TARGET_S."""
+    places = [row for row in rows if "connector_shots" in row]
+    met = all(row["answered"] == row["connector_shots"] and row["max"] <= CONNECTOR_TARGET_S * 1e3 for row in places)
+    return {"name": f"targets during (d), (e) [{label}]", "label": label,
+            "targets": {"connector_max_s": CONNECTOR_TARGET_S, "answered": "all, Code 200"}, "met": met}
 
 
 def print_rows(rows: list[dict]) -> None:
@@ -275,18 +402,37 @@ def print_rows(rows: list[dict]) -> None:
     print("| scenario | shots | p50 | p99 | max | resets / timeouts | flood | /healthz after |")
     print("|---|---:|---:|---:|---:|---:|---|---:|")
     for row in rows:
-        if "met" in row:
+        if row.get("targets") == TARGETS:
             print(f"| {row['name']}: p99 <= {TARGETS['p99_ms']:g} ms, max <= {TARGETS['max_ms']:g} ms, no reset, "
                   f"/healthz <= {TARGETS['healthz_after_s']:g} s | {'met' if row['met'] else 'NOT met'} |||||||")
-            continue
-        flood_text = (f"{row['flood_mb']:.1f} MB in {row['flood_s']:.1f} s, {row['flood_connections']} connections"
-                      if "flood_mb" in row else "")
-        if "never_reader_connections" in row:
-            flood_text += (f"; never-reader: {row['never_reader_shots_written']:,} shots written, "
-                           f"{row['never_reader_connections']} connections")
-        healthz = f"{row['healthz_after_s'] * 1e3:.0f} ms" if "healthz_after_s" in row else ""
-        print(f"| {row['name']} | {row['shots']:,} | {row['p50']:.1f} ms | {row['p99']:.1f} ms | {row['max']:.1f} ms "
-              f"| {row['resets']} / {row['timeouts']} | {flood_text} | {healthz} |")
+        elif "shots" in row:
+            print_http_row(row)
+    print_places(rows)
+
+
+def print_http_row(row: dict) -> None:
+    flood_text = (f"{row['flood_mb']:.1f} MB in {row['flood_s']:.1f} s, {row['flood_connections']} connections"
+                  if "flood_mb" in row else "")
+    if "never_reader_connections" in row:
+        flood_text += (f"; never-reader: {row['never_reader_shots_written']:,} shots written, "
+                       f"{row['never_reader_connections']} connections")
+    healthz = f"{row['healthz_after_s'] * 1e3:.0f} ms" if "healthz_after_s" in row else ""
+    print(f"| {row['name']} | {row['shots']:,} | {row['p50']:.1f} ms | {row['p99']:.1f} ms | {row['max']:.1f} ms "
+          f"| {row['resets']} / {row['timeouts']} | {flood_text} | {healthz} |")
+
+
+def print_places(rows: list[dict]) -> None:
+    """The table of (d) and (e): a new connector's shot while a hostile program holds every place."""
+    print(f"\nA new connector's shot (connect to reply) while a hostile program holds all {PLACES} places\n")
+    print("| scenario | answered Code 200 | codes | p50 | max | hostile connections | evicted (/healthz) |")
+    print("|---|---:|---|---:|---:|---:|---:|")
+    for row in rows:
+        if "connector_shots" in row:
+            print(f"| {row['name']} | {row['answered']} of {row['connector_shots']} | {row['codes']} "
+                  f"| {row['p50']:.1f} ms | {row['max']:.1f} ms | {row['hostile_connections']} | {row['evicted']} |")
+        elif "connector_max_s" in row.get("targets", {}):
+            print(f"| {row['name']}: every shot Code 200 within {CONNECTOR_TARGET_S:g} s "
+                  f"| {'met' if row['met'] else 'NOT met'} ||||||")
 
 
 def write_section(rows: list[dict], label: str) -> None:
@@ -305,6 +451,7 @@ def main() -> None:
     parser.add_argument("--flood-mb", type=float, default=20.0, help="megabytes each flooder writes")
     parser.add_argument("--hostile-s", type=float, default=10.0, help="seconds each flood lasts at least")
     parser.add_argument("--quiet-s", type=float, default=5.0, help="seconds of (a)")
+    parser.add_argument("--connector-shots", type=int, default=20, help="connectors' shots in (d) and (e) each")
     parser.add_argument("--label", default="this tree", help="what is measured (rows of other labels are kept)")
     parser.add_argument("--tree", type=Path, default=REPO, help="the checkout whose service is measured")
     parser.add_argument("--no-write", action="store_true", help="leave benchmarks/results.json as it is")

@@ -56,6 +56,7 @@ def create_app(
         if tcp:  # taken before the model loads: a port that cannot be had stops the startup at once
             await tcp.start(connect, listening=False)
             runtime.bay.on_player_change(lambda changed: _tell(tcp, changed))
+            runtime.add_reporter("open_connect", tcp.health)  # /healthz: connectors, refusals, evictions
         loading = asyncio.get_running_loop().run_in_executor(None, runtime.load)  # the event loop stays free
         try:
             # Loaded before either port accepts (uvicorn binds HTTP's once this startup returns): the first request

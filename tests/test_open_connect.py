@@ -160,8 +160,9 @@ def test_any_bytes_are_answered_or_passed_over_never_raised(data):
     for item in items:
         assert isinstance(item, bytes | Refused | None)
         if item is not None:
-            reply = reply_to(item, lambda message: GSProReply(Code=200, Message="flown"))
+            reply, valid = reply_to(item, lambda message: GSProReply(Code=200, Message="flown"))
             assert reply is None or reply.Code in (200, 500)
+            assert valid == (reply is None or reply.Code == 200)  # a valid message is answered (here: 200) or not
 
 
 WHITESPACE = st.sampled_from([b"", b" ", b"\n", b"\r\n", b"\t", b"\x0b", b"\x0c"])
@@ -195,14 +196,16 @@ GSPRO_VALUES = st.none() | st.booleans() | st.integers(-10, 10**6) | st.floats(a
     })
 )
 def test_a_message_read_once_by_pydantic_gets_the_reply_pythons_json_reading_gives(message):
-    """reply_to validates straight from the bytes; the reply is the one json.loads + validation gives."""
+    """reply_to validates straight from the bytes; the reply (and the message's validity) is the one json.loads +
+    validation gives."""
     item = json.dumps(message).encode()
 
     def answer(message):
         return GSProReply(Code=200, Message="flown", ShotNumber=message.ShotNumber)
 
     fast, slow = reply_to(item, answer), _read_by_python(item, answer)
-    assert (fast and fast.model_dump()) == (slow and slow.model_dump())
+    assert fast.valid == slow.valid
+    assert (fast.reply and fast.reply.model_dump()) == (slow.reply and slow.reply.model_dump())
 
 
 @pytest.fixture(scope="module")
@@ -295,6 +298,45 @@ def test_out_of_range_values_name_the_field_and_its_range(connector):
     reply = connector.reply()
     assert reply["Code"] == 500 and "BallData.Speed: Input should be a finite number" in reply["Message"]
     assert connector.still_open()
+
+
+def test_a_shot_number_past_32_bits_is_refused_with_the_range_it_has(service, connector):
+    http, _ = service
+    for number in (2**31, -1):
+        reply, _, _ = connector.fly(shot(number))
+        says = f"ShotNumber: Input should be a whole number from 0 to 2147483647 (got {number})"
+        assert reply["Code"] == 500 and says in reply["Message"], reply
+        assert http.post("/v1/gspro", json=shot(number)).json()["Message"] == reply["Message"]
+    reply, _, _ = connector.fly(shot(2**31 - 1))
+    assert reply["Code"] == 200 and reply["ShotNumber"] == 2**31 - 1
+
+
+BOM = b"\xef\xbb\xbf"
+"""A UTF-8 byte order mark, which a connector built on .NET's UTF8Encoding may write before its JSON."""
+
+
+def test_a_byte_order_mark_before_an_object_is_skipped_wherever_the_stream_is_cut():
+    stream = BOM + encoded(shot(70)) + b" " + BOM + encoded(HEARTBEAT)
+    for cut in range(len(stream) + 1):
+        framer = ObjectFramer()
+        found = framer.feed(stream[:cut]) + framer.feed(stream[cut:])
+        assert found == [encoded(shot(70)), encoded(HEARTBEAT)], cut
+
+
+def test_a_byte_order_mark_before_a_shot_gets_the_shots_one_reply_as_over_http(service, connector):
+    http, _ = service
+    connector.send(BOM + encoded(shot(71)))
+    reply = connector.reply()
+    assert reply["Code"] == 200 and reply["ShotNumber"] == 71, reply
+    data = BOM + encoded(shot(72)) + BOM + encoded(HEARTBEAT)
+    for i in range(len(data)):  # a byte at a time: the mark cut too
+        connector.send(data[i : i + 1])
+        time.sleep(0.0005)
+    later = connector.reply()
+    assert later["Code"] == 200 and later["ShotNumber"] == 72, later
+    assert connector.reply(timeout_s=0.3) is None  # one reply per shot, none for the heartbeat
+    over_http = http.post("/v1/gspro", content=BOM + encoded(shot(71)), headers={"content-type": "application/json"})
+    assert over_http.status_code == 200 and over_http.json()["Flight"] == reply["Flight"]
 
 
 def test_an_object_over_the_size_limit_is_refused_and_skipped(connector):

@@ -23,6 +23,7 @@ from golfflight.service.open_connect.limits import (
     MESSAGE_BURST,
     UNREAD_LIMIT_S,
     UNREAD_REPLY_BYTES,
+    ConnectorLimits,
 )
 from golfflight.service.open_connect.server import ConnectAddress, OpenConnectServer
 
@@ -34,10 +35,10 @@ EMPTY = b'{"a":{}}'
 
 
 class Served:
-    """An OpenConnectServer with the real engine's answer, on an event loop of its own thread (the loop `golfflight
-    serve` runs: uvloop where installed)."""
+    """An OpenConnectServer with the real engine's answer and `limits` (default the module's), on an event loop of
+    its own thread (the loop `golfflight serve` runs: uvloop where installed)."""
 
-    def __init__(self, engine: FlightEngine):
+    def __init__(self, engine: FlightEngine, limits: ConnectorLimits | None = None):
         if fast_io()["loop"] == "uvloop":
             import uvloop
 
@@ -46,7 +47,7 @@ class Served:
             self.loop = asyncio.new_event_loop()
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
         self.thread.start()
-        self.server = OpenConnectServer(lambda message: fly_message(engine, message))
+        self.server = OpenConnectServer(lambda message: fly_message(engine, message), limits)
         self.on_loop(self.server.start(ConnectAddress(0)))
         self.port = self.server.port
 
@@ -193,10 +194,11 @@ def test_a_connector_is_answered_within_a_second_after_a_flood_on_another_connec
     sock.close()
 
 
-def test_one_connection_more_than_the_limit_gets_a_refusal_and_a_close(served):
+def test_one_connection_more_than_the_limit_while_every_connector_plays_gets_a_refusal_and_a_close(served):
     connected = [connect(served.port) for _ in range(MAX_CONNECTIONS)]
-    for sock in connected:
-        sock.sendall(encoded(HEARTBEAT))
+    for number, sock in enumerate(connected):  # a shot answered: each has sent a valid message just now
+        sock.sendall(encoded(shot(number)))
+        assert objects(sock.recv(2048))[0]["Code"] == 200
     extra = connect(served.port)
     data, _ = until_closed(extra, timeout_s=5)
     refusal(data, f"{MAX_CONNECTIONS} connectors are connected")

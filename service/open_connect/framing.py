@@ -12,6 +12,10 @@ decides: the rest of the object completes it (one object, one reply), while a ne
 complete the open one as valid JSON) gets the unfinished one refused once and is read from a clean start. Giving up
 at the pause instead refused the piece and then framed its remainder as stray bytes and stray objects: five
 replies for one delayed shot.
+
+A UTF-8 byte order mark before an object is skipped, as `POST /v1/gspro` (Python's `json.loads` of bytes) skips it
+before a body: a connector that writes one (.NET's UTF8Encoding with its preamble) gets its shot's one reply, where
+the mark used to be refused as stray bytes, a second reply to the one shot.
 """
 
 from __future__ import annotations
@@ -23,6 +27,8 @@ from dataclasses import dataclass
 
 MAX_MESSAGE_BYTES = 64 * 1024
 """Largest object accepted; an Open Connect message is about 600 bytes."""
+BOM = b"\xef\xbb\xbf"
+"""The UTF-8 byte order mark, skipped where an object may begin."""
 
 _IN_OBJECT = re.compile(rb'[{}"]')
 _IN_STRING = re.compile(rb'["\\]')
@@ -54,6 +60,7 @@ class ObjectFramer:
         self._reset()
 
     def _reset(self) -> None:
+        self._held = b""  # the first bytes of a BOM that ended the last piece, between objects
         self._object = bytearray()
         self._depth = 0
         self._in_string = False
@@ -86,6 +93,7 @@ class ObjectFramer:
 
     def feed(self, data: bytes) -> list[bytes | Refused]:
         """Complete objects and refusals found in `data` (plus what earlier calls left unfinished)."""
+        data, self._held = self._held + data, b""
         whole = self._whole_object(data)
         if whole is not None:
             return [whole]
@@ -113,6 +121,7 @@ class ObjectFramer:
         if self._depth or self._stalled or len(data) > self.limit:
             return None
         text = data.strip(b" \t\r\n")
+        text = text.removeprefix(BOM).lstrip(b" \t\r\n")
         if not (text.startswith(b"{") and text.endswith(b"}")):
             return None
         try:
@@ -138,16 +147,22 @@ class ObjectFramer:
         return True
 
     def _top_level(self, data: bytes, position: int, found: list[bytes | Refused]) -> int:
-        """Skip whitespace; open the next object, or refuse the stray bytes up to it."""
+        """Skip whitespace and a byte order mark; open the next object, or refuse the stray bytes up to it."""
         start = _NOT_SPACE.search(data, position)
         if start is None:
             return len(data)
-        if data[start.start()] == ord("{"):
+        begin = start.start()
+        if data[begin] == ord("{"):
             self._depth, self._object = 1, bytearray(b"{")
-            return start.start() + 1
-        end = data.find(b"{", start.start())
+            return begin + 1
+        if data.startswith(BOM, begin):
+            return begin + len(BOM)
+        if BOM.startswith(data[begin:]):  # a mark cut by the end of the piece: its rest comes with the next
+            self._held = data[begin:]
+            return len(data)
+        end = data.find(b"{", begin)
         end = len(data) if end < 0 else end
-        stray = _quote(data[start.start() : end].rstrip())
+        stray = _quote(data[begin:end].rstrip())
         found.append(Refused(f"expected a JSON object starting with '{{', got {stray}"))
         return end
 

@@ -23,7 +23,18 @@ from golfflight.service.open_connect.framing import MAX_MESSAGE_BYTES
 
 MAX_CONNECTIONS = 16
 """Connectors connected at once. A bay has one launch monitor and one connector; 16 leaves room for several bays on
-one service and for a connector's reconnect overlapping its old connection. One more is refused (Code 503, closed)."""
+one service and for a connector's reconnect overlapping its old connection. One more takes the place of the
+connection that has gone longest without a valid message (`server.OpenConnectServer.admit`), which gets Code 503 and
+a close; only when every place is PROTECTED_S-fresh is the new one refused instead (Code 503, closed)."""
+
+PROTECTED_S = 60.0
+"""How long a valid message (a shot, a heartbeat, any message that validates) keeps its connection's place against
+new connections once all MAX_CONNECTIONS are taken. Nothing is closed for being quiet while a place is free: a golfer
+may not hit for minutes and some connectors send no heartbeat, so any idle timeout would drop real connectors. Under
+pressure, a connection that never sent a valid message (an idle socket, one trickling bytes that never make a
+message, a new connection that has sent nothing yet) gives way first, the oldest first; then one quiet longer than
+this, the quietest first. A minute covers a connector's heartbeats (every few seconds) and a golfer's shots, so a
+flood of new connections cannot push out a bay that is playing."""
 
 MESSAGES_PER_S = 200.0
 """Messages (objects, and refused pieces of input) a connection may send a second on average: a token bucket
@@ -90,10 +101,19 @@ class ConnectorLimits:
     unread_limit_s: float = UNREAD_LIMIT_S
     linger_s: float = LINGER_S
     linger_bytes: int = LINGER_BYTES
+    protected_s: float = PROTECTED_S
 
     def too_many_connections(self) -> str:
         return (f"{self.max_connections} connectors are connected to this golfflight already (the most it takes at "
-                "once): close one, or connect again after one has left")
+                f"once), each with a message in the last {self.protected_s:g} s: close one, or connect again after "
+                "one has left")
+
+    def evicted(self, quiet_s: float, ever: bool) -> str:
+        """Why a connection `quiet_s` seconds without a valid message (`ever`: it sent one before that) was closed."""
+        since = f"for {quiet_s:.0f} s" if ever else f"since it connected {quiet_s:.0f} s ago"
+        return (f"closed to make room for a new connection: {self.max_connections} were connected (the most this "
+                f"golfflight takes at once) and this one had sent no valid message {since}: connect again and send "
+                "your shots")
 
     def too_many_messages(self) -> str:
         return (f"more than {self.message_burst} messages at once or {self.messages_per_s:g} a second on this "

@@ -26,6 +26,16 @@ connector that never reads, and p99 75 ms, max 130 ms under heartbeats, 2,502 an
 two loops share the GIL: a thread busy framing holds it for up to the interpreter's switch interval (5 ms) each time
 the HTTP thread, which lets go of it at every system call and every ONNX Runtime call of a flight, wants it back.
 The turns also keep `answer` on the loop the rest of the service runs on, so it need not be thread-safe.
+
+Places: MAX_CONNECTIONS connections are served at once, and nothing is closed for being quiet (a golfer may not hit
+for minutes; some connectors send no heartbeat). A new connection when every place is taken is admitted on
+probation: it takes the place of the connection that gives way first (`Connection.gives_way`: never a valid message,
+the oldest first; then the quietest), which gets Code 503 saying why and a close; a connection with a valid message
+in the last `limits.PROTECTED_S` never gives way, and when all are so, the new one is refused instead. So sixteen
+sockets held idle, or trickling bytes that make no message, lose their places to the next connector, while a flood of
+new connections pushes out only its own (they never send a message) and never a connector that is playing. A program
+that sends valid messages on sixteen sockets looks like sixteen connectors: with no authentication, nothing tells
+them apart.
 """
 
 from __future__ import annotations
@@ -41,7 +51,7 @@ from dataclasses import dataclass
 from golfflight.contract.gspro import GSProReply
 from golfflight.service.open_connect.framing import ObjectFramer, Refused
 from golfflight.service.open_connect.limits import ConnectorLimits, TokenBucket
-from golfflight.service.open_connect.replies import Answer, encoded, player_information, reply_to
+from golfflight.service.open_connect.replies import Answer, Replied, encoded, player_information, reply_to
 
 CONNECT_HOST_ENV = "GOLFFLIGHT_CONNECT_HOST"
 CONNECT_PORT_ENV = "GOLFFLIGHT_CONNECT_PORT"
@@ -112,6 +122,8 @@ class OpenConnectServer:
         self.connections: set[Connection] = set()  # served now; each leaves when it closes or is refused
         self.refused: set[Connection] = set()  # refused (Code 503), their refusal on its way, until closed
         self.refusals = RefusalLog()
+        self.refused_total = 0  # connections refused or closed for a limit (Code 503), since start
+        self.evicted_total = 0  # connections closed for a new one's place (Code 503), since start
         self._waiting: deque[Connection] = deque()  # connections with input left, in the order their turns come
         self._turn: asyncio.Handle | None = None  # the next turn of all Open Connect work, scheduled
 
@@ -162,11 +174,25 @@ class OpenConnectServer:
             if not connection.transport.is_closing():  # one dropped (`_drop_unread`) leaves at the loop's next turn
                 connection.transport.write(data)
 
+    def health(self) -> dict:
+        """Open Connect's figures for GET /healthz: connections served now, the most served at once, and since start
+        the connections refused or closed for a limit (Code 503) and those closed to make room for a new one."""
+        return {"connected": len(self.connections), "max_connections": self.limits.max_connections,
+                "refused": self.refused_total, "evicted": self.evicted_total}
+
+    def refuse(self, connection: Connection, logged: str, message: str) -> None:
+        """Refuse `connection` for a limit: Code 503 `message`, then the close; `logged` goes to the log (at most
+        once per LOG_EVERY_S)."""
+        self.refusals.warning(logged)
+        self.refused_total += 1
+        connection.refuse(message)
+
     def admit(self, connection: Connection) -> None:
-        """Serve a new connection (its buffers bounded), or refuse it when MAX_CONNECTIONS are served already."""
-        if len(self.connections) >= self.limits.max_connections:
-            self.refusals.warning(f"a connection refused, {self.limits.max_connections} connected already")
-            connection.refuse(self.limits.too_many_connections())
+        """Serve a new connection (its buffers bounded), in the place of one that gives way when MAX_CONNECTIONS
+        are served already (`_make_room`), or refuse it when none does."""
+        if len(self.connections) >= self.limits.max_connections and not self._make_room():
+            logged = f"a connection refused, {self.limits.max_connections} connected already, each of them playing"
+            self.refuse(connection, logged, self.limits.too_many_connections())
             return
         self.connections.add(connection)
         transport = connection.transport
@@ -175,6 +201,25 @@ class OpenConnectServer:
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, self.limits.send_buffer_bytes)
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, self.limits.receive_buffer_bytes)
         transport.set_write_buffer_limits(high=self.limits.unread_reply_bytes)
+
+    def _make_room(self) -> bool:
+        """Free a place for a new connection: end one closing already (its connector left, or it was dropped), or
+        close the one that gives way first (Code 503 saying why); False when every connection is protected (a valid
+        message in the last `limits.PROTECTED_S`)."""
+        leaving = next((connection for connection in self.connections if connection.transport.is_closing()), None)
+        if leaving is not None:  # aborted: a close may wait for ever on replies its connector does not read
+            leaving.transport.abort()
+            self.connections.discard(leaving)
+            return True
+        now = time.monotonic()
+        exposed = [connection for connection in self.connections if not connection.protected(now)]
+        if not exposed:
+            return False
+        quitting = min(exposed, key=Connection.gives_way)
+        self.refusals.warning("a connection closed to make room for a new one")
+        self.evicted_total += 1
+        quitting.refuse(self.limits.evicted(now - quitting.last_heard, quitting.last_message is not None))
+        return True
 
     def busy(self) -> bool:
         """Whether some connection waits for its turn (then a new arrival waits too, behind it)."""
@@ -195,21 +240,22 @@ class OpenConnectServer:
             self._waiting.popleft().work(deadline)
         self._turn = self._loop.call_soon(self._take_turn) if self._waiting else None
 
-    def reply(self, item: bytes | Refused) -> GSProReply | None:
+    def reply(self, item: bytes | Refused) -> Replied:
         """`reply_to`, with any unexpected failure answered (and logged) instead of ending the connection."""
         try:
             return reply_to(item, self.answer)
         except Exception:
             log.exception("GSPro Open Connect: answering a message failed")
-            return GSProReply(Code=500, Message=INTERNAL_ERROR)
+            return Replied(GSProReply(Code=500, Message=INTERNAL_ERROR), False)
 
 
 class Connection(asyncio.Protocol):
     """One connector's connection. What arrives is framed PIECE_BYTES at a time and answered in order: at once while
     no other connection waits, up to TURN_S, then in the server's turns; while input is left for a later turn, or
     the connector leaves its replies unread, the socket is not read. A pause of PAUSE_S mid-object marks it stalled
-    (`ObjectFramer.stall`). Refused (too many connections, messages or bytes): one Code 503, then the close
-    (`refuse`); replies left unread UNREAD_LIMIT_S: dropped."""
+    (`ObjectFramer.stall`). Refused (too many connections, messages or bytes) or giving its place to a new one: one
+    Code 503, then the close (`refuse`); replies left unread UNREAD_LIMIT_S: dropped. `last_message` (time.monotonic) is when it last sent a
+    valid message: what keeps its place when a new connection needs one (`OpenConnectServer.admit`)."""
 
     def __init__(self, server: OpenConnectServer):
         self.server = server
@@ -227,6 +273,22 @@ class Connection(asyncio.Protocol):
         self._unread: asyncio.TimerHandle | None = None  # UNREAD_LIMIT_S of replies left unread
         self._ending: asyncio.TimerHandle | None = None  # LINGER_S after a refusal
         self._lingered = 0  # bytes dropped since the refusal
+        self.admitted = time.monotonic()
+        self.last_message: float | None = None
+
+    @property
+    def last_heard(self) -> float:
+        """When it last sent a valid message, or, having sent none, connected (time.monotonic)."""
+        return self.admitted if self.last_message is None else self.last_message
+
+    def protected(self, now: float) -> bool:
+        """Whether its place is kept against new connections: a valid message in the last PROTECTED_S."""
+        return self.last_message is not None and now - self.last_message < self.limits.protected_s
+
+    def gives_way(self) -> tuple[bool, float]:
+        """Its order in giving its place to a new connection, lowest first: a connection that never sent a valid
+        message (the oldest first) before one that did (the quietest first)."""
+        return self.last_message is not None, self.last_heard
 
     def connection_made(self, transport: asyncio.Transport) -> None:
         self.transport = transport
@@ -304,8 +366,7 @@ class Connection(asyncio.Protocol):
                 piece = self._input[self._at : self._at + PIECE_BYTES]
                 self._at += len(piece)
                 if not self.bytes.take(len(piece)):
-                    self.server.refusals.warning("a connector sent bytes too fast: closed")
-                    self.refuse(self.limits.too_many_bytes())
+                    self.server.refuse(self, "a connector sent bytes too fast: closed", self.limits.too_many_bytes())
                     break
                 self._items.extend(self.framer.feed(piece))
             else:
@@ -316,10 +377,11 @@ class Connection(asyncio.Protocol):
 
     def _answer(self, item: bytes | Refused) -> None:
         if not self.messages.take():
-            self.server.refusals.warning("a connector sent messages too fast: closed")
-            self.refuse(self.limits.too_many_messages())
+            self.server.refuse(self, "a connector sent messages too fast: closed", self.limits.too_many_messages())
             return
-        reply = self.server.reply(item)
+        reply, valid = self.server.reply(item)
+        if valid:
+            self.last_message = time.monotonic()
         if reply is not None:
             self.transport.write(encoded(reply))
 
