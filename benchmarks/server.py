@@ -95,13 +95,14 @@ class Server:
 
 
 def start(
-    workers: int = 1, model: str | None = None, env: dict[str, str] | None = None, tree: Path = REPO
+    workers: int = 1, model: str | None = None, env: dict[str, str] | None = None, tree: Path = REPO,
+    args: list[str] = (),
 ) -> Server:
     """Start `golfflight serve` of the checkout `tree` (default this one; another for an A/B run) on a free loopback
-    port; returns once every worker answers /healthz."""
+    port, with `args` added to its command line; returns once every worker answers /healthz."""
     port = free_port()
     command = [sys.executable, "-m", "golfflight", "serve", "--host", HOST, "--port", str(port)]
-    command += ["--workers", str(workers)] + (["--model", model] if model else [])
+    command += ["--workers", str(workers)] + (["--model", model] if model else []) + list(args)
     process = subprocess.Popen(command, cwd=tree, env={**os.environ, **(env or {})}, stdout=subprocess.DEVNULL)
     server = Server(process, f"http://{HOST}:{port}", port)
     deadline = time.monotonic() + 60

@@ -16,14 +16,14 @@ from typing import Annotated
 from golfflight.contract.bay import BayConditions, in_bay
 from golfflight.contract.flying import flown_shot
 from golfflight.contract.inputs import spin_from_components
-from golfflight.contract.refusals import describe_errors
+from golfflight.contract.refusals import describe_errors, encodable
 from golfflight.contract.requests import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotRequest
 from golfflight.contract.results import ShotResult
 from golfflight.flight import limits
 from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.engine import FlightEngine, FlightError, Launch
 from golfflight.flight.limits import Range
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 
 def _spelled_as_fields(data, fields) -> dict:
@@ -83,6 +83,32 @@ class GSProBallData(_Lenient):
     CarryDistance: float | None = Field(None, description="the monitor's own carry; not used")
 
 
+MAX_CLUB_DATA_FIELDS = 24
+"""Most ClubData values kept for the screens (GSPro's ClubData has ten); longer text is cut to MAX_CLUB_TEXT."""
+MAX_CLUB_TEXT = 40
+
+ClubValue = float | int | str | bool | None
+"""A ClubData value as the screens show it."""
+
+
+def club_values(club_data: dict | None) -> dict[str, ClubValue] | None:
+    """A connector's ClubData as the screens keep it: its plain values (numbers, text cut short and made writable as
+    UTF-8, flags), at most MAX_CLUB_DATA_FIELDS of them; nested objects are left out. A lone surrogate (a JSON
+    escape such as \\ud800) would otherwise reach the viewer's event, which cannot be written out."""
+    if not club_data:
+        return None
+    kept: dict[str, ClubValue] = {}
+    for key, value in club_data.items():
+        if len(kept) == MAX_CLUB_DATA_FIELDS:
+            break
+        name = encodable(str(key)[:MAX_CLUB_TEXT])
+        if isinstance(value, str):
+            kept[name] = encodable(value[:MAX_CLUB_TEXT])
+        elif value is None or isinstance(value, (bool, int, float)):
+            kept[name] = value
+    return kept or None
+
+
 class GSProOptions(_Lenient):
     ContainsBallData: bool = True
     ContainsClubData: bool = False
@@ -91,17 +117,35 @@ class GSProOptions(_Lenient):
     IsHeartBeat: bool = False
 
 
+SHOT_NUMBER_MAX = 2**31 - 1
+"""The largest ShotNumber: GSPro keeps it in a 32-bit signed integer."""
+
+
 class GSProMessage(_Lenient):
-    """One Open Connect v1 message (ClubData is kept for the bay's screens and not used: the flight needs the ball
-    only)."""
+    """One Open Connect v1 message (ClubData is kept for the bay's screens, as `club_values` makes it, and not used:
+    the flight needs the ball only)."""
 
     DeviceID: str | None = None
     Units: str | None = None
-    ShotNumber: int | None = Field(None, ge=0, le=2**31 - 1)
+    ShotNumber: int | None = Field(None, ge=0, le=SHOT_NUMBER_MAX)
     APIversion: str | None = None
     BallData: GSProBallData | None = None
-    ClubData: dict | None = None
+    ClubData: dict[str, ClubValue] | None = None
     ShotDataOptions: GSProOptions = Field(default_factory=GSProOptions)
+
+    @field_validator("ClubData", mode="before")
+    @classmethod
+    def _club_data_shown(cls, value):
+        return club_values(value) if isinstance(value, dict) else value
+
+    @field_validator("ShotNumber", mode="before")
+    @classmethod
+    def _shot_number_in_range(cls, value):
+        """Refuse a ShotNumber out of range with the range written out: a bound quoted the usual way
+        (`flight.limits.limit_text`, four significant digits) would read "less than or equal to 2147000000"."""
+        if isinstance(value, int) and not isinstance(value, bool) and not 0 <= value <= SHOT_NUMBER_MAX:
+            raise ValueError(f"Input should be a whole number from 0 to {SHOT_NUMBER_MAX}")
+        return value
 
     @model_validator(mode="before")
     @classmethod
@@ -158,7 +202,7 @@ def shot_number_of(data) -> int | None:
         return None
     for key, value in data.items():
         if isinstance(key, str) and key.casefold() == "shotnumber":
-            valid = isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= 2**31 - 1
+            valid = isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= SHOT_NUMBER_MAX
             return value if valid else None
     return None
 

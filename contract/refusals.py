@@ -19,15 +19,15 @@ def _quoted(text: str) -> str:
     return text if len(text) <= QUOTED_CHARS else text[: QUOTED_CHARS - 1] + "…"
 
 
-def _encodable(text: str) -> str:
+def encodable(text: str) -> str:
     """`text` with its lone surrogates (which a JSON escape such as \\ud800 puts into a request's text, but which no
     UTF-8 body can carry out) written as backslash escapes, the six characters \\ud800."""
     return text.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 def _shown(part):
-    """A value or a field name as a refusal shows it: text cut (`_quoted`) and UTF-8 encodable (`_encodable`)."""
-    return _encodable(_quoted(part)) if isinstance(part, str) else part
+    """A value or a field name as a refusal shows it: text cut (`_quoted`) and UTF-8 encodable (`encodable`)."""
+    return encodable(_quoted(part)) if isinstance(part, str) else part
 
 
 def _plain(value):
@@ -59,7 +59,7 @@ def _msg(error: dict) -> str:
     limit = (error.get("ctx") or {}).get(bound[0]) if bound else None
     if isinstance(limit, int | float) and not isinstance(limit, bool):
         return f"Input should be {bound[1]} {limit_text(limit, high=bound[2])}"
-    return _encodable(error["msg"].removeprefix("Value error, "))
+    return encodable(error["msg"].removeprefix("Value error, "))
 
 
 def describe_error(error: dict, ranges: dict[str, Range] = RANGES) -> dict:
@@ -99,7 +99,7 @@ def not_json(reason: str, text: str, position: int) -> str:
     where = json.JSONDecodeError(reason, text, position)
     place = f"line {where.lineno} column {where.colno}"
     place = f"the end of the body ({place})" if position >= len(text) else place
-    return f"the body is not valid JSON: {_encodable(reason)} at {place}"
+    return f"the body is not valid JSON: {encodable(reason)} at {place}"
 
 
 def describe_errors(errors, ranges: dict[str, Range] = RANGES) -> list[dict]:

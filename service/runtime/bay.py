@@ -4,11 +4,15 @@ or not at all, `shots.files.write_text_atomic`).
 
 A file broken or removed while serving never stops a shot: the last good bay stays in force and `problem` says what
 is wrong with the file (GET /healthz shows it as "degraded") until a PUT or PATCH writes it again. Only at start does
-a broken file stop the server (`BayFileError`): there is no good bay to keep yet.
+a broken file stop the server (`BayFileError`): there is no good bay to keep yet. The file is read on the shots'
+path, so only a regular file of at most MAX_BAY_FILE_BYTES is read, opened without blocking: a FIFO in its place
+would hang every shot waiting for a writer, a link to /dev/zero would be read for ever, a 1 GB file for seconds.
 """
 
 from __future__ import annotations
 
+import os
+import stat
 import threading
 from collections.abc import Callable
 from pathlib import Path
@@ -19,6 +23,13 @@ from pydantic import ValidationError
 
 BAY_FILE_ENV = "GOLFFLIGHT_BAY_FILE"
 """Where `golfflight serve --bay FILE` tells its worker processes the bay file is."""
+
+MAX_BAY_FILE_BYTES = 64 * 1024
+"""Largest bay file read: bay conditions written by PUT /v1/bay take well under a kilobyte."""
+
+KINDS = {stat.S_IFDIR: "a directory", stat.S_IFIFO: "a FIFO (named pipe)", stat.S_IFCHR: "a character device",
+         stat.S_IFBLK: "a block device", stat.S_IFSOCK: "a socket"}
+"""What a bay file that is not a regular file is, as the refusal says it."""
 
 PlayerListener = Callable[[Player], None]
 """Told of the new player whenever the bay's player changes (Open Connect sends connectors Code 201)."""
@@ -53,11 +64,13 @@ class Bay:
             self._refresh()
             return self._problem
 
-    def _file_stamp(self) -> int | None:
+    def _file_stamp(self) -> tuple[int, int, int] | None:
+        """When, how long and which file (a replaced file is another inode): a change of any is read again."""
         try:
-            return self.path.stat().st_mtime_ns
+            info = self.path.stat()
         except OSError:
             return None
+        return info.st_mtime_ns, info.st_size, info.st_ino
 
     def _refresh(self) -> None:
         """Re-read the bay file if it changed since it was last read or written; a file that is gone or broken
@@ -81,9 +94,24 @@ class Bay:
         self._problem = None
         self._replace(conditions)
 
+    def _bytes(self) -> bytes:
+        """The bay file's bytes: a regular file of at most MAX_BAY_FILE_BYTES, opened without blocking (a FIFO
+        would wait for a writer); BayFileError for anything else, OSError when it cannot be read."""
+        descriptor = os.open(self.path, os.O_RDONLY | os.O_NONBLOCK)
+        with open(descriptor, "rb") as file:
+            info = os.fstat(descriptor)
+            if not stat.S_ISREG(info.st_mode):
+                kind = KINDS.get(stat.S_IFMT(info.st_mode), "not a file")
+                raise BayFileError(f"{self.path}: is {kind}, not a regular file: a bay file is JSON text")
+            data = file.read(MAX_BAY_FILE_BYTES + 1)
+        if len(data) > MAX_BAY_FILE_BYTES:
+            raise BayFileError(f"{self.path}: {info.st_size:,} bytes, over the {MAX_BAY_FILE_BYTES:,} a bay file may "
+                               "have (bay conditions take under a kilobyte)")
+        return data
+
     def _read(self) -> BayConditions:
         try:
-            return BayConditions.model_validate_json(self.path.read_bytes())
+            return BayConditions.model_validate_json(self._bytes())
         except ValidationError as error:
             problems = "; ".join(
                 f"{'.'.join(str(p) for p in e['loc']) or 'body'}: {e['msg']}" for e in error.errors(include_url=False))

@@ -1,8 +1,11 @@
 """A feed entry as the viewer's server-sent event: the shot's launch, the result answered, and the path of the
 flight that result was read from, resampled for drawing. Rendered once per shot, off the shot's own path (by the
-first stream that sends it)."""
+first stream that sends it). A shot whose event cannot be rendered is left out of every stream and logged: one bad
+event must not cut the stream, nor, kept among the shots a reconnecting page is sent, every stream after it."""
 
 from __future__ import annotations
+
+import logging
 
 import numpy as np
 from golfflight.contract.inputs import launch_of
@@ -14,6 +17,8 @@ from golfflight.service.viewer.event import LaunchNumbers, ShotEvent
 
 VIEW_RATE_HZ = 30.0
 """Rate of the drawn path between the states it must pass through: smooth on screen."""
+
+log = logging.getLogger(__name__)
 
 MAX_POINTS = 800
 """Most points an event's path carries: the rate is lowered for a long flight and roll so that it fits."""
@@ -55,5 +60,12 @@ def render(entry: Entry) -> str:
 
 
 def frame(entry: Entry) -> str:
-    """The entry's event, rendered on first use and kept (the entry keeps only that text after)."""
-    return entry.frame if entry.frame is not None else entry.rendered(render(entry))
+    """The entry's event, rendered on first use and kept (the entry keeps only that text after); empty, and logged
+    once, when it cannot be rendered."""
+    if entry.frame is not None:
+        return entry.frame
+    try:
+        return entry.rendered(render(entry))
+    except Exception:  # noqa: BLE001 - the shot is left off the screens, the stream and the bay go on
+        log.exception("viewer: shot %d cannot be shown (left out of the live stream)", entry.id)
+        return entry.rendered("")

@@ -14,7 +14,7 @@ from fastapi.responses import JSONResponse, Response, StreamingResponse
 from golfflight.service.runtime import BayRuntime
 from golfflight.service.runtime.feed import TooManyViewers
 from golfflight.service.viewer.page import ASSETS, PAGE_PATH, SECURITY_HEADERS
-from golfflight.service.viewer.session_csv import session_csv
+from golfflight.service.viewer.session_csv import session_csv_slices
 from golfflight.service.viewer.stream import events, last_event_id
 
 EVENTS_PATH = "/v1/events"
@@ -63,7 +63,7 @@ async def shot_events(request: Request, last_event: str | None = Header(None, al
 async def session(request: Request) -> Response:
     """The session's shots (every shot the bay's screens were sent since the service started, the last 10,000) as
     CSV in `golfflight simulate`'s columns: launch and conditions in, the result out, with the shot's id, time,
-    source and club."""
-    text = session_csv(list(_runtime(request).feed.session))
+    source and club. Streamed from a snapshot in short slices (`session_csv_slices`): shots keep flying meanwhile."""
+    snapshot = list(_runtime(request).feed.session)
     headers = {"content-disposition": 'attachment; filename="golfflight-session.csv"', "cache-control": "no-store"}
-    return Response(text, media_type="text/csv; charset=utf-8", headers=headers)
+    return StreamingResponse(session_csv_slices(snapshot), media_type="text/csv; charset=utf-8", headers=headers)

@@ -1,13 +1,21 @@
 """The session's shots as CSV (GET /v1/session.csv), in `golfflight simulate`'s columns: the launch in SI and the
 conditions flown in as simulate reads them, then the result as simulate writes it, so a session can be flown again
 (`golfflight simulate session.csv`) or opened in a spreadsheet. Who hit it, when and from where ride along in
-columns simulate passes over (`session`, `club`, `timestamp`)."""
+columns simulate passes over (`session`, `club`, `timestamp`).
+
+The download is built on the event loop in slices of at most SLICE_S, each followed by a turn of the loop, over a
+snapshot of the session taken when it is asked for: 10,000 shots take 1 to 3 s of pure Python, which in one piece
+held every shot (HTTP and Open Connect) for that long. A thread would not help: it holds the GIL for the
+interpreter's switch interval (5 ms) each time the loop's flight lets go of it for an ONNX Runtime call, hundreds of
+times per shot."""
 
 from __future__ import annotations
 
+import asyncio
 import csv
 import io
-from collections.abc import Iterable
+import time
+from collections.abc import AsyncIterator, Sequence
 from datetime import UTC, datetime
 
 from golfflight.contract.columns import AIR_COLUMNS, GROUND_COLUMNS, WIND_COLUMNS, flat_row
@@ -18,6 +26,10 @@ from golfflight.service.runtime.feed import SessionShot
 SHOT_COLUMNS = ("shot_id", "timestamp", "session", "club", "putt", "shot_number")
 """Who, when and where from: `session` is the source (http, batch, gspro-http, open-connect), `club` the GSPro club
 code of the bay's player when the shot was hit."""
+
+SLICE_S = 0.002
+"""Longest the download works at once before it lets the loop answer shots: a shot waits at most this much per
+download in progress."""
 
 LAUNCH_COLUMNS = ("ball_speed_mps", "launch_angle_deg", "launch_direction_deg", "spin_rpm", "spin_axis_deg")
 
@@ -40,12 +52,28 @@ def _row(shot: SessionShot) -> dict:
     return {**own, **request_cells(shot.request), **flat_row(shot.result.model_dump(exclude_none=True))}
 
 
-def session_csv(shots: Iterable[SessionShot]) -> str:
-    """The shots as CSV text, one row each, columns in the order they first appear."""
-    rows = [_row(shot) for shot in shots]
-    columns = list(dict.fromkeys(name for row in ([dict.fromkeys(SHOT_COLUMNS)] + rows) for name in row))
+async def session_csv_slices(shots: Sequence[SessionShot], slice_s: float = SLICE_S) -> AsyncIterator[str]:
+    """The shots as CSV text, one row each, columns in the order they first appear, in pieces, each made in at most
+    about `slice_s` with a turn of the event loop between two: the rows first (their columns, in the order they first appear, are known only once all are made), then
+    the text."""
+    rows: list[dict] = []
+    columns = dict.fromkeys(SHOT_COLUMNS)
+    deadline = time.perf_counter() + slice_s
+    for shot in shots:
+        rows.append(_row(shot))
+        columns.update(dict.fromkeys(rows[-1]))
+        if time.perf_counter() >= deadline:
+            await asyncio.sleep(0)
+            deadline = time.perf_counter() + slice_s
     out = io.StringIO()
-    writer = csv.DictWriter(out, columns, restval="", lineterminator="\n")
+    writer = csv.DictWriter(out, list(columns), restval="", lineterminator="\n")
     writer.writeheader()
-    writer.writerows(rows)
-    return out.getvalue()
+    for row in rows:
+        writer.writerow(row)
+        if time.perf_counter() >= deadline:
+            yield out.getvalue()
+            out.seek(0)
+            out.truncate()
+            await asyncio.sleep(0)
+            deadline = time.perf_counter() + slice_s
+    yield out.getvalue()

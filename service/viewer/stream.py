@@ -85,8 +85,9 @@ async def events(
             if ends is not None:
                 wait = min(wait, ends - now)
             entry = await viewer.next(max(wait, 0.0))
-            if entry is not None:
-                yield frame(entry)
+            text = "" if entry is None else frame(entry)
+            if text:  # empty: nothing came, or a shot that cannot be shown (`frame`)
+                yield text
                 quiet_since = time.monotonic()
     finally:
         feed.unsubscribe(viewer)

@@ -1,0 +1,158 @@
+"""A bay that cannot be knocked over (issue 42): the session download leaves the loop to the shots, one odd byte in a
+connector's ClubData neither blanks the screen nor cuts the stream, a bay file that is not a regular file is a
+broken bay file, a Host the bay does not answer to is refused without a key, and stalled HTTP requests are closed."""
+
+from __future__ import annotations
+
+import asyncio
+import csv
+import io
+import json
+import os
+import socket
+import time
+from functools import partial
+from pathlib import Path
+
+import httpx
+import pytest
+from golfflight.contract.flying import flown_shot
+from golfflight.contract.requests import ShotRequest
+from golfflight.service.app import create_app
+from golfflight.service.runtime.bay import Bay, BayFileError
+from golfflight.service.runtime.feed import ShotFeed
+from golfflight.service.viewer import routes as viewer_routes
+from golfflight.service.viewer.session_csv import session_csv_slices
+from golfflight.service.viewer.stream import events
+from servers import keyed_service, running
+from test_viewer import KEY, KEYED, next_event
+
+
+def _session(engine, shots: int) -> ShotFeed:
+    feed = ShotFeed()
+    request = ShotRequest(ball_speed_mps=60.0, launch_angle_deg=14.0, spin_rpm=5000.0)
+    result, flight = flown_shot(engine, request, keep_states=True)
+    for _ in range(shots):
+        feed.publish("http", request, result, flight.states, flight.flight_time_s)
+    return feed
+
+
+async def _download_and_count_turns(feed: ShotFeed, slice_s: float) -> tuple[str, int]:
+    """The CSV and how many turns another task got while it was made."""
+    turns, done = 0, False
+
+    async def other_task():
+        nonlocal turns
+        while not done:
+            turns += 1
+            await asyncio.sleep(0)
+
+    ticker = asyncio.create_task(other_task())
+    await asyncio.sleep(0)
+    turns = 0
+    text = "".join([piece async for piece in session_csv_slices(list(feed.session), slice_s)])
+    done = True
+    await ticker
+    return text, turns
+
+
+def test_the_session_download_lets_the_loop_run_while_it_is_made(engine):
+    feed = _session(engine, 2000)
+    text, turns = asyncio.run(_download_and_count_turns(feed, slice_s=0.001))
+    rows = list(csv.DictReader(io.StringIO(text)))
+    assert len(rows) == 2000 and rows[0]["session"] == "http" and float(rows[-1]["ball_speed_mps"]) == 60.0
+    assert turns >= 10, f"the loop ran {turns} times while 2,000 rows were made"
+
+
+def _tcp_shot(port: int, text: bytes) -> dict:
+    """One connector message (its JSON text as given) over TCP and its reply (Code 201 pushes passed over)."""
+    with socket.create_connection(("127.0.0.1", port), timeout=10) as connector:
+        connector.sendall(text)
+        received, decoder = "", json.JSONDecoder()
+        while True:
+            received += connector.recv(65536).decode()
+            while received.strip():
+                try:
+                    message, end = decoder.raw_decode(received.lstrip())
+                except ValueError:
+                    break
+                received = received.lstrip()[end:]
+                if message.get("Code") != 201:
+                    return message
+
+
+def _shot_text(number: int, club_data: str = "") -> bytes:
+    ball = '{"Speed": 102.0, "VLA": 24.0, "HLA": -1.5, "TotalSpin": 8600.0, "SpinAxis": 2.0}'
+    club = f', "ClubData": {club_data}' if club_data else ""
+    return f'{{"ShotNumber": {number}, "APIversion": "1", "BallData": {ball}{club}}}'.encode()
+
+
+def test_a_lone_surrogate_in_club_data_neither_blanks_the_screen_nor_cuts_the_stream(monkeypatch):
+    monkeypatch.setattr(viewer_routes, "events", partial(events, lifetime_s=60))
+    with keyed_service(KEY) as (http, port, _), httpx.Client(base_url=http.base_url, timeout=10) as viewer:
+        with viewer.stream("GET", "/v1/events", headers=KEYED) as stream:
+            lines = stream.iter_lines()
+            odd = _tcp_shot(port, _shot_text(1, r'{"Sp\ud800eed": "fast\udc00", "Loft": 24.5}'))
+            assert odd["Code"] == 200
+            assert [_tcp_shot(port, _shot_text(n))["Code"] for n in (2, 3)] == [200, 200]
+            received = [next_event(lines) for _ in range(3)]
+        assert [event.shot_number for event in received] == [1, 2, 3]
+        assert received[0].club_data == {r"Sp\ud800eed": r"fast\udc00", "Loft": 24.5}
+        with viewer.stream("GET", "/v1/events", headers=KEYED) as stream:  # a reconnect gets the kept shots
+            lines = stream.iter_lines()
+            assert [next_event(lines).shot_number for _ in range(3)] == [1, 2, 3]
+
+
+def test_a_shot_that_cannot_be_shown_is_left_out_and_the_stream_goes_on(engine, caplog):
+    async def stream() -> list[str]:
+        feed = ShotFeed()
+        viewer = feed.subscribe()
+        request = ShotRequest(ball_speed_mps=60.0, launch_angle_deg=14.0, spin_rpm=5000.0)
+        result, flight = flown_shot(engine, request, keep_states=True)
+        feed.publish("http", request, result, flight.states, flight.flight_time_s, club_data={"odd": "\ud800"})
+        feed.publish("http", request, result, flight.states, flight.flight_time_s)
+        return [text async for text in events(feed, viewer, lifetime_s=0.3)]
+
+    frames = asyncio.run(stream())
+    assert [text.split("\n")[0] for text in frames[1:]] == ["id: 2"]
+    assert "shot 1 cannot be shown" in caplog.text
+
+
+def _fifo(path: Path) -> None:
+    os.mkfifo(path)
+
+
+def _dev_zero(path: Path) -> None:
+    path.symlink_to("/dev/zero")
+
+
+def _sparse_gigabyte(path: Path) -> None:
+    with path.open("wb") as file:
+        file.truncate(2**30)
+
+
+@pytest.mark.parametrize("replacement, named", [(_fifo, "FIFO"), (_dev_zero, "character device"),
+                                                (_sparse_gigabyte, "1,073,741,824 bytes")])
+def test_a_bay_file_that_is_not_a_small_regular_file_is_a_broken_bay_file(tmp_path, replacement, named):
+    path = tmp_path / "bay.json"
+    shot = {"ball_speed_mps": 60.0, "launch_angle_deg": 14.0, "spin_rpm": 5000.0}
+    with running(create_app(bay=path)) as http:
+        assert http.put("/v1/bay", json={"air": {"altitude_m": 1600.0}}).status_code == 200
+        good = http.post("/v1/shots", json=shot).json()
+        staged = tmp_path / "staged"
+        replacement(staged)
+        os.replace(staged, path)
+        started = time.monotonic()
+        answer = http.post("/v1/shots", json=shot)
+        seconds = time.monotonic() - started
+        health = http.get("/healthz").json()
+    assert answer.status_code == 200 and answer.json() == good, "the last good bay stays in force"
+    assert seconds < 5.0, f"a shot took {seconds:.1f} s"
+    assert health["status"] == "degraded" and named in health["problems"]["bay"]
+
+
+def test_a_bay_file_that_is_a_fifo_stops_the_start_with_its_name(tmp_path):
+    path = tmp_path / "bay.json"
+    os.mkfifo(path)
+    with pytest.raises(BayFileError, match="FIFO"):
+        Bay(path)
