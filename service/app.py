@@ -17,15 +17,17 @@ from fastapi import FastAPI
 from golfflight.contract.bay import Player
 from golfflight.flight.bundle_location import model_dir
 from golfflight.service.api.app import http_app
-from golfflight.service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
+from golfflight.service.api.guards import ALLOWED_HOSTS_ENV, API_KEY_ENV, CORS_ORIGINS_ENV
 from golfflight.service.open_connect.server import ConnectAddress, OpenConnectServer
 from golfflight.service.runtime import BayRuntime
 from golfflight.service.runtime.bay import BAY_FILE_ENV, Bay
+from golfflight.service.runtime.parent_watch import exit_with_parent
 from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.viewer.page import PUBLIC_PATHS
 
 
-def _origins(text: str | None) -> list[str]:
+def _listed(text: str | None) -> list[str]:
+    """The items of a comma-separated setting (origins, host names)."""
     return [origin.strip() for origin in (text or "").split(",") if origin.strip()]
 
 
@@ -36,6 +38,7 @@ def create_app(
     cors_origins: list[str] | None = None,
     connect: ConnectAddress | None = None,
     bay: str | os.PathLike | None = None,
+    allowed_hosts: list[str] | None = None,
 ) -> FastAPI:
     """The service for a model bundle (default: `flight.bundle_location.model_dir()`).
 
@@ -43,15 +46,18 @@ def create_app(
     `cors_origins` (default the comma-separated $GOLFFLIGHT_CORS_ORIGINS) are the browser origins allowed; none means
     CORS stays off. `connect` (default from $GOLFFLIGHT_CONNECT_PORT and _HOST) also listens for GSPro Open Connect
     over TCP there. `bay` (default $GOLFFLIGHT_BAY_FILE) is the file the bay's conditions are kept in
-    (`service.runtime.bay`); none keeps them in memory only."""
+    (`service.runtime.bay`); none keeps them in memory only. Without an API key, only requests to this machine's names
+    and `allowed_hosts` (default the comma-separated $GOLFFLIGHT_ALLOWED_HOSTS) are answered."""
     bay = bay if bay is not None else os.environ.get(BAY_FILE_ENV) or None
     runtime = BayRuntime(model_dir(model), Bay(bay))
     api_key = api_key if api_key is not None else os.environ.get(API_KEY_ENV, "")
-    cors_origins = cors_origins if cors_origins is not None else _origins(os.environ.get(CORS_ORIGINS_ENV))
+    cors_origins = cors_origins if cors_origins is not None else _listed(os.environ.get(CORS_ORIGINS_ENV))
     connect = connect if connect is not None else ConnectAddress.from_env()
+    allowed_hosts = allowed_hosts if allowed_hosts is not None else _listed(os.environ.get(ALLOWED_HOSTS_ENV))
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
+        exit_with_parent()  # a worker of `serve --workers N` ends with its supervisor, however that dies
         tcp = OpenConnectServer(lambda message: runtime.fly_gspro(message, "open-connect")) if connect else None
         if tcp:  # taken before the model loads: a port that cannot be had stops the startup at once
             await tcp.start(connect, listening=False)
@@ -72,7 +78,7 @@ def create_app(
             runtime.stop()
 
     return http_app(runtime, lifespan=lifespan, api_key=api_key, cors_origins=cors_origins,
-                    more_routers=[viewer_routes.router], open_paths=PUBLIC_PATHS)
+                    more_routers=[viewer_routes.router], open_paths=PUBLIC_PATHS, allowed_hosts=allowed_hosts)
 
 
 def _tell(tcp: OpenConnectServer, player: Player) -> None:

@@ -33,6 +33,7 @@ def test_health_reports_the_loaded_model_and_the_card(client):
     health = client.get("/healthz").json()
     assert health["status"] == "ready"
     assert health["model"]["variant"] == card.variant and health["model"]["sha256"] == card.onnx.sha256
+    assert str(model_dir()) not in client.get("/healthz").text  # no key needed: where the model lives is not shown
     assert client.get("/v1/model").json()["onnx"]["sha256"] == card.onnx.sha256
     assert client.get("/docs").status_code == 200 and "/v1/shots/batch" in client.get("/openapi.json").json()["paths"]
 

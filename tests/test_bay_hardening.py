@@ -10,21 +10,29 @@ import io
 import json
 import os
 import socket
+import subprocess
+import sys
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from functools import partial
 from pathlib import Path
 
 import httpx
 import pytest
+import uvicorn
+from golfflight.commands.serve import fast_io
 from golfflight.contract.flying import flown_shot
 from golfflight.contract.requests import ShotRequest
+from golfflight.service.api.http_protocol import DeadlineHttpProtocol
 from golfflight.service.app import create_app
 from golfflight.service.runtime.bay import Bay, BayFileError
 from golfflight.service.runtime.feed import ShotFeed
 from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.viewer.session_csv import session_csv_slices
 from golfflight.service.viewer.stream import events
-from servers import keyed_service, running
+from servers import free_port, keyed_service, running
 from test_viewer import KEY, KEYED, next_event
 
 
@@ -156,3 +164,97 @@ def test_a_bay_file_that_is_a_fifo_stops_the_start_with_its_name(tmp_path):
     os.mkfifo(path)
     with pytest.raises(BayFileError, match="FIFO"):
         Bay(path)
+
+
+def test_without_a_key_a_page_reached_by_dns_rebinding_can_neither_change_the_bay_nor_read_the_session():
+    rebound = {"host": "evil.example.com"}
+    with running(create_app(api_key="", cors_origins=[], allowed_hosts=["bay-pc.local"])) as http:
+        assert http.patch("/v1/bay", json={"player": {"club": "PT"}}, headers=rebound).status_code == 403
+        refused = http.get("/v1/session.csv", headers=rebound)
+        assert refused.status_code == 403 and "evil.example.com" in refused.json()["detail"]
+        assert "GOLFFLIGHT_ALLOWED_HOSTS" in refused.json()["detail"]
+        assert http.get("/v1/bay").json()["player"]["club"] != "PT"
+        port = http.base_url.port
+        for host in (f"localhost:{port}", f"127.0.0.1:{port}", "[::1]", "BAY-PC.local.", "127.0.0.1"):
+            assert http.get("/v1/bay", headers={"host": host}).status_code == 200, host
+        assert http.get("/healthz", headers=rebound).status_code == 200  # health checkers hold no names
+
+
+def test_with_a_key_the_key_is_the_guard_and_any_host_is_answered():
+    with running(create_app(api_key="k", cors_origins=[])) as http:
+        assert http.get("/v1/bay", headers={"host": "golf.example.com", "x-api-key": "k"}).status_code == 200
+
+
+class _QuickDeadlines(DeadlineHttpProtocol):
+    head_timeout_s = 0.5
+    body_timeout_s = 0.5
+
+
+@contextmanager
+def _served_with_quick_deadlines() -> Iterator[int]:
+    """The service on a free loopback port, its request deadlines half a second: the port."""
+    port = free_port()
+    app = create_app(api_key="", cors_origins=[])
+    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning",
+                                           **{**fast_io(), "http": _QuickDeadlines}))
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    try:
+        deadline = time.monotonic() + 60
+        while not server.started:
+            assert time.monotonic() < deadline and thread.is_alive(), "the service did not start"
+            time.sleep(0.05)
+        yield port
+    finally:
+        server.should_exit = True
+        thread.join(timeout=10)
+
+
+def _closed_after(sock: socket.socket) -> tuple[bytes, float]:
+    """What the server sends until it closes the connection, and how long that took."""
+    started, received = time.monotonic(), b""
+    while chunk := sock.recv(65536):
+        received += chunk
+    return received, time.monotonic() - started
+
+
+@pytest.mark.parametrize("sent", [b"", b"GET /healthz HTTP/1.1\r\nhost: localhost\r\n",
+                                  b"POST /v1/shots HTTP/1.1\r\nhost: localhost\r\ncontent-type: application/json\r\n"
+                                  b"content-length: 80\r\n\r\n{\"ball_speed_mps\": 6"])
+def test_a_request_that_stalls_is_closed_at_its_deadline_and_the_service_answers_on(sent):
+    with _served_with_quick_deadlines() as port:
+        with socket.create_connection(("127.0.0.1", port), timeout=30) as stalled:
+            stalled.sendall(sent)
+            received, seconds = _closed_after(stalled)
+        assert received.startswith(b"HTTP/1.1 408") and 0.4 <= seconds < 20
+        assert httpx.get(f"http://127.0.0.1:{port}/healthz", timeout=30).status_code == 200
+
+
+def test_a_keep_alive_client_is_not_cut_by_the_deadlines():
+    with _served_with_quick_deadlines() as port, httpx.Client(base_url=f"http://127.0.0.1:{port}") as http:
+        for _ in range(3):
+            assert http.post("/v1/shots", json={"ball_speed_mps": 60.0, "launch_angle_deg": 14.0,
+                                                "spin_rpm": 5000.0}).status_code == 200
+            time.sleep(0.7)  # longer than either deadline, shorter than uvicorn's keep-alive
+
+
+def test_serve_raises_its_open_files_limit_to_the_hard_one():
+    script = ("import resource\n"
+              "soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)\n"
+              "resource.setrlimit(resource.RLIMIT_NOFILE, (min(1024, hard), hard))\n"
+              "from golfflight.commands.serve import open_files_raised\n"
+              "print(open_files_raised(), *resource.getrlimit(resource.RLIMIT_NOFILE))\n")
+    raised, soft, hard = map(int, subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                                                 check=True).stdout.split())
+    assert raised == soft == hard
+
+
+def test_a_body_nested_too_deeply_is_refused_as_that_on_every_route():
+    body = b'{"a": ' + b"[" * 5000 + b"]" * 5000 + b"}"
+    json_body = {"content-type": "application/json"}
+    with running(create_app(api_key="", cors_origins=[])) as http:
+        for method, path in (("POST", "/v1/shots"), ("POST", "/v1/shots/batch"), ("PATCH", "/v1/bay")):
+            refused = http.request(method, path, content=body, headers=json_body)
+            assert refused.status_code == 422 and "nested too deeply" in refused.json()["detail"][0]["msg"], path
+        gspro = http.post("/v1/gspro", content=body, headers=json_body).json()
+        assert gspro["Code"] == 500 and "nested too deeply" in gspro["Message"]

@@ -69,10 +69,12 @@ def test_serve_refuses_a_busy_http_port_in_one_line_before_saying_it_serves(caps
     assert err.count("\n") == 1 and f"--port: 127.0.0.1:{port} is in use" in err and "another port with --port" in err
 
 
-def test_serve_names_uvloop_and_httptools_where_they_import_and_falls_back_where_not(monkeypatch):
+def test_serve_names_uvloop_where_it_imports_and_httptools_with_request_deadlines(monkeypatch):
     from golfflight.commands import serve
+    from golfflight.service.api.http_protocol import DeadlineHttpProtocol
 
-    assert serve.fast_io() == {"loop": "uvloop", "http": "httptools"}  # runtime dependencies of the serving install
+    # runtime dependencies of the serving install; httptools with deadlines for a request's head and body
+    assert serve.fast_io() == {"loop": "uvloop", "http": DeadlineHttpProtocol}
     real = serve.importlib.import_module
 
     def without_uvloop(name: str):
@@ -81,4 +83,4 @@ def test_serve_names_uvloop_and_httptools_where_they_import_and_falls_back_where
         return real(name)
 
     monkeypatch.setattr(serve.importlib, "import_module", without_uvloop)
-    assert serve.fast_io() == {"loop": "asyncio", "http": "httptools"}
+    assert serve.fast_io() == {"loop": "asyncio", "http": DeadlineHttpProtocol}

@@ -40,6 +40,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="allow browser calls from this origin, e.g. https://sim.example.com (repeatable; default: CORS off)",
     )
     parser.add_argument(
+        "--allowed-host",
+        action="append",
+        metavar="NAME",
+        help="without an API key, also answer requests to this host name, e.g. bay-pc.local (repeatable; default: "
+        "only localhost, 127.0.0.1, ::1 and the address listened on, so that no web page can reach the bay by DNS "
+        "rebinding)",
+    )
+    parser.add_argument(
         "--connect-port",
         type=int,
         metavar="PORT",
@@ -88,21 +96,37 @@ def _listenable(host: str, port: int, option: str) -> None:
         raise ValueError(f"{option}: cannot listen on {host}:{port}: {error.strerror or error}") from None
 
 
-def fast_io() -> dict[str, str]:
-    """uvicorn's event loop and HTTP parser: uvloop and httptools (C, about 0.6 ms less per request than asyncio
-    and h11: docs/benchmarks.md) where they are installed, as the serving install has them; asyncio and h11
-    otherwise (uvloop has no Windows build). Named, not left to uvicorn's "auto", so what serves is what was chosen."""
-    def installed(name: str) -> bool:
-        try:
-            importlib.import_module(name)
-        except ImportError:
-            return False
-        return True
+def fast_io() -> dict[str, object]:
+    """uvicorn's event loop and HTTP protocol: uvloop (C, about 0.6 ms less per request than asyncio with h11:
+    docs/benchmarks.md) where it is installed, asyncio otherwise (uvloop has no Windows build); and httptools (a
+    dependency of the serving install) with deadlines for a request's head and body
+    (`service.api.http_protocol`). Named, not left to uvicorn's "auto", so what serves is what was chosen."""
+    from golfflight.service.api.http_protocol import DeadlineHttpProtocol
 
-    return {
-        "loop": "uvloop" if installed("uvloop") else "asyncio",
-        "http": "httptools" if installed("httptools") else "h11",
-    }
+    try:
+        importlib.import_module("uvloop")
+    except ImportError:
+        loop = "asyncio"
+    else:
+        loop = "uvloop"
+    return {"loop": loop, "http": DeadlineHttpProtocol}
+
+
+def open_files_raised() -> int | None:
+    """Raise this process's soft limit on open files to its hard limit (its workers inherit it) and return it; None
+    where there is no such limit (Windows). Each connection is a file: under the common soft limit of 1,024, a
+    program holding a thousand stalled requests left /healthz and the connector no descriptor to be answered on."""
+    try:
+        import resource
+    except ImportError:
+        return None
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    wanted = max(soft, 2**20) if hard == resource.RLIM_INFINITY else hard
+    try:
+        resource.setrlimit(resource.RLIMIT_NOFILE, (wanted, hard))
+    except (ValueError, OSError):  # the system would not: serve under the limit there is
+        return soft
+    return wanted
 
 
 def run(args: argparse.Namespace) -> int:
@@ -110,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
 
     from golfflight.flight.bundle_check import verify_bundle
     from golfflight.flight.bundle_location import MODEL_ENV, model_dir
-    from golfflight.service.api.guards import API_KEY_ENV, CORS_ORIGINS_ENV
+    from golfflight.service.api.guards import ALLOWED_HOSTS_ENV, API_KEY_ENV, CORS_ORIGINS_ENV
     from golfflight.service.open_connect.server import CONNECT_HOST_ENV, CONNECT_PORT_ENV
     from golfflight.service.runtime.bay import BAY_FILE_ENV, Bay
     from golfflight.service.runtime.metrics import shared_across_workers
@@ -127,6 +151,8 @@ def run(args: argparse.Namespace) -> int:
         os.environ[BAY_FILE_ENV] = os.path.abspath(args.bay)
     if args.cors_origin:
         os.environ[CORS_ORIGINS_ENV] = ",".join(args.cors_origin)
+    if args.allowed_host:
+        os.environ[ALLOWED_HOSTS_ENV] = ",".join(args.allowed_host)
     _listenable(args.host, args.port, "--port")  # before the line saying it serves there
     connect = "off"
     if args.connect_port is not None:
@@ -152,6 +178,7 @@ def run(args: argparse.Namespace) -> int:
             f"{args.connect_port} can send shots (the protocol has no key)",
             file=sys.stderr,
         )
+    open_files_raised()
     with shared_across_workers(args.workers):  # GET /metrics sums every worker's counts
         uvicorn.run(
             "golfflight.service.app:create_app",

@@ -24,7 +24,7 @@ from fastapi import APIRouter, FastAPI
 from fastapi.middleware.cors import CORSMiddleware
 from golfflight.service.api import errors
 from golfflight.service.api.direct import DirectLanes
-from golfflight.service.api.guards import MAX_BODY_BYTES, ApiKey, BodyLimit
+from golfflight.service.api.guards import MAX_BODY_BYTES, ApiKey, BodyLimit, HostCheck
 from golfflight.service.api.paths import SIMULATION_PATHS
 from golfflight.service.api.request_metrics import RequestMetrics
 from golfflight.service.api.routes import bay as bay_routes
@@ -43,9 +43,11 @@ def http_app(
     cors_origins: Sequence[str] = (),
     more_routers: Sequence[APIRouter] = (),
     open_paths: frozenset[str] = frozenset(),
+    allowed_hosts: Sequence[str] = (),
 ) -> FastAPI:
     """The HTTP app over `runtime`: its own routers and `more_routers` (the viewer's), `api_key` required on every
-    route but /healthz and `open_paths` when given, CORS for `cors_origins`, `lifespan` run around serving."""
+    route but /healthz and `open_paths` when given (without one, only requests to this machine's names and
+    `allowed_hosts` are answered: `guards.HostCheck`), CORS for `cors_origins`, `lifespan` run around serving."""
     app = FastAPI(
         title="golfflight",
         version=__version__,
@@ -60,6 +62,8 @@ def http_app(
     app.add_middleware(DirectLanes, routes=[route for router in routers for route in router.routes])  # innermost
     if api_key:
         app.add_middleware(ApiKey, key=api_key, open_paths=open_paths)
+    else:
+        app.add_middleware(HostCheck, allowed=frozenset(allowed_hosts))
     if cors_origins:
         app.add_middleware(
             CORSMiddleware,

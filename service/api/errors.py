@@ -17,8 +17,11 @@ from golfflight.service.api.paths import GSPRO_PATH
 from golfflight.service.runtime import NotReady
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-NOT_JSON = "the body is not JSON text in UTF-8"
+NOT_JSON = "the body is not JSON text in UTF-8 (or UTF-16 or UTF-32, which are read too)"
 """FastAPI's 400 for a body it cannot even decode, said as a 422 like every other refusal of a body."""
+NESTED_TOO_DEEPLY = ("the body is not valid JSON: nested too deeply to read (a request nests its objects and "
+                     "lists four levels deep at most)")
+"""FastAPI's 400 for a body whose nesting exhausted Python's JSON parser (about a thousand levels)."""
 JSON_CONTENT_TYPE = "the body must be JSON: send content-type: application/json"
 """The refusal (415) of a body sent without a JSON content type, followed by what was sent."""
 
@@ -64,9 +67,10 @@ async def invalid_request(request: Request, error: RequestValidationError) -> JS
 async def http_error(request: Request, error: StarletteHTTPException) -> Response:
     if error.status_code != 400:
         return await http_exception_handler(request, error)
+    message = NESTED_TOO_DEEPLY if isinstance(error.__cause__, RecursionError) else NOT_JSON
     if request.url.path == GSPRO_PATH:
-        return _gspro_error(NOT_JSON)
-    return JSONResponse({"detail": [body_detail(NOT_JSON, "json_invalid")]}, 422)
+        return _gspro_error(message)
+    return JSONResponse({"detail": [body_detail(message, "json_invalid")]}, 422)
 
 
 async def not_ready(request: Request, error: NotReady) -> JSONResponse:

@@ -1,7 +1,8 @@
-"""Pure ASGI guards in front of the routes: a request-body size limit and an optional API key.
+"""Pure ASGI guards in front of the routes: a request-body size limit, an optional API key, and without a key a
+check of the Host header against the names the service answers to.
 
-Both answer before FastAPI parses anything, so an oversized or unauthenticated request costs the worker a few
-microseconds, not a JSON parse. Neither ever logs a header or the key.
+All answer before FastAPI parses anything, so an oversized, unauthenticated or misdirected request costs the worker
+a few microseconds, not a JSON parse. None ever logs a header or the key.
 """
 
 from __future__ import annotations
@@ -20,6 +21,13 @@ CORS_ORIGINS_ENV = "GOLFFLIGHT_CORS_ORIGINS"
 
 MAX_BODY_BYTES = 8 * 1024 * 1024
 """Largest request body accepted (a full 10,000-shot batch with every option is about 4.5 MB)."""
+
+ALLOWED_HOSTS_ENV = "GOLFFLIGHT_ALLOWED_HOSTS"
+"""Environment variable with the comma-separated host names, beyond LOOPBACK_HOSTS and the listening address, that
+the service answers to without an API key (e.g. the bay PC's name on the venue's network)."""
+
+LOOPBACK_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
+"""Host names always answered: the machine itself."""
 
 OPEN_PATHS = frozenset({"/healthz"})
 """Routes always answered without the API key (load balancers and health checks hold no secret); the assembly adds
@@ -94,3 +102,47 @@ class ApiKey:
             return
         message = "missing or wrong API key: send it in the X-API-Key header (or Authorization: Bearer)"
         await _send_json(send, 401, {"detail": message}, [(b"www-authenticate", b'Bearer realm="golfflight"')])
+
+
+def host_name(header: bytes) -> str:
+    """The name in a Host header, lower case, without its port, its IPv6 brackets or a final dot."""
+    text = header.decode("latin-1").strip().lower()
+    if text.startswith("["):
+        return text[1:].partition("]")[0]
+    return text.rpartition(":")[0].rstrip(".") if text.count(":") == 1 else text.rstrip(".")
+
+
+class HostCheck:
+    """Without an API key, answers only requests whose Host names this machine: LOOPBACK_HOSTS, the address the
+    request arrived on (the bound address, or the machine's address on the network when bound to 0.0.0.0) and
+    `allowed`. DNS rebinding (a web page whose own name comes to point at 127.0.0.1) reaches the port from the
+    browser of anyone at the bay PC, with that page's name as the Host: it is refused here, 403 before any route,
+    so it can neither change the bay nor read the session. OPEN_PATHS and requests with no Host (no browser sends
+    one without) pass."""
+
+    def __init__(self, app, allowed: frozenset[str] = frozenset()):
+        self.app = app
+        self._allowed = LOOPBACK_HOSTS | {host_name(name.encode()) for name in allowed}
+
+    def _answered(self, scope) -> bool:
+        header = dict(scope["headers"]).get(b"host")
+        if header is None or scope["path"] in OPEN_PATHS:
+            return True
+        name = host_name(header)
+        server = scope.get("server")
+        return name in self._allowed or (server is not None and name == str(server[0]).lower())
+
+    async def __call__(self, scope, receive, send):
+        if scope["type"] != "http" or self._answered(scope):
+            await self.app(scope, receive, send)
+            return
+        sent = _shown(dict(scope["headers"])[b"host"])
+        message = (f"Host {sent!r} is not a name this golfflight answers to without an API key (this machine's: "
+                   f"{', '.join(sorted(self._allowed))} or the address it listens on): add it to "
+                   f"${ALLOWED_HOSTS_ENV} (serve --allowed-host), or set ${API_KEY_ENV}")
+        await _send_json(send, 403, {"detail": message})
+
+
+def _shown(header: bytes) -> str:
+    """A Host header as a refusal quotes it: cut to 80 characters."""
+    return header.decode("latin-1")[:80]

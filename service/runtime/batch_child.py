@@ -1,6 +1,7 @@
 """What the batch child process of each server process runs (`service.runtime.batch_process` starts and feeds it):
 load the bundle at a lower CPU priority, then fly each validated batch request body it is sent and encode its
-result. It imports the shot contract and the engine only, never the HTTP package."""
+result; end as soon as its server has gone. It imports the shot contract and the engine only, never the HTTP
+package."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from golfflight.contract.flying import flown_shots
 from golfflight.contract.requests import BatchRequest
 from golfflight.contract.results import BatchResult, ShotResult
 from golfflight.flight.engine import EulerStates, FlightEngine
+from golfflight.service.runtime.parent_watch import exit_with_parent
 
 BATCH_NICE = 19
 """How much lower the batch process's CPU priority is (Linux nice increment): a single shot waiting for a core
@@ -25,19 +27,21 @@ _engine: FlightEngine | None = None
 
 
 def start(bundle_dir: str) -> None:
-    """Child initializer: lower the priority, ignore the terminal's Ctrl-C (the parent decides when the child
-    stops, after its in-flight batch), load the bundle."""
+    """Child initializer: end with the server, lower the priority, ignore the terminal's Ctrl-C and SIGTERM (the
+    parent decides when the child stops, after its in-flight batch), load the bundle."""
     global _engine
+    exit_with_parent()
     os.nice(BATCH_NICE)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     _engine = FlightEngine(bundle_dir)
 
 
-def ready() -> str:
-    """The loaded model's ONNX hash: the parent checks the child serves the same model it does."""
+def ready() -> tuple[str, int]:
+    """The loaded model's ONNX hash and this process's id: the parent checks the child serves the same model it
+    does, and watches the process."""
     assert _engine is not None
-    return _engine.sha256
+    return _engine.sha256, os.getpid()
 
 
 def parse_batch(body: bytes) -> BatchRequest:

@@ -37,11 +37,6 @@ PLAYER_SOURCES = frozenset({"http", "gspro-http", "open-connect"})
 GSPRO_SOURCES = frozenset({"gspro-http", "open-connect"})
 """Shots from a launch monitor's connector: with the putter selected they are putts, as in GSPro."""
 
-MAX_CLUB_DATA_FIELDS = 24
-"""Most ClubData values kept for the screens (GSPro's ClubData has ten); longer text is cut to MAX_CLUB_TEXT."""
-MAX_CLUB_TEXT = 40
-
-
 class NotReady(Exception):
     """A simulation was asked for before the model was loaded (HTTP: 503; Open Connect: Code 503)."""
 
@@ -55,22 +50,6 @@ class Flown:
     result: ShotResult
     flight: ShotFlight
     entry: Entry | None
-
-
-def club_values(club_data: dict | None) -> dict | None:
-    """A connector's ClubData as the screens keep it: its plain values (numbers, text cut short, flags), at most
-    MAX_CLUB_DATA_FIELDS of them; nested objects are left out."""
-    if not club_data:
-        return None
-    kept = {}
-    for key, value in club_data.items():
-        if len(kept) == MAX_CLUB_DATA_FIELDS:
-            break
-        if isinstance(value, str):
-            kept[str(key)[:MAX_CLUB_TEXT]] = value[:MAX_CLUB_TEXT]
-        elif value is None or isinstance(value, (bool, int, float)):
-            kept[str(key)[:MAX_CLUB_TEXT]] = value
-    return kept or None
 
 
 class BayRuntime:
@@ -89,7 +68,7 @@ class BayRuntime:
         self.feed = ShotFeed()
         self.metrics = ServiceMetrics(self.model_labels)
         self._simulation_seconds = {kind: self.metrics.simulation_seconds.labels(kind) for kind in ("shot", "batch")}
-        self._reporters: dict[str, Callable[[], dict]] = {}
+        self._reporters: dict[str, Callable[[], dict]] = {"batch_process": self.batches.health}
 
     def model_labels(self) -> dict[str, str] | None:
         """The loaded model's variant and ONNX SHA-256 and the package version (/metrics' info labels)."""
@@ -127,9 +106,10 @@ class BayRuntime:
         self.batches.stop()
 
     def problems(self) -> dict[str, str]:
-        """What is degraded while shots still fly (GET /healthz): the bay file's problem, if any."""
-        problem = self.bay.problem
-        return {"bay": problem} if problem else {}
+        """What is degraded while shots still fly (GET /healthz): the bay file's problem, the batch process's (dead
+        and restarting), if any."""
+        problems = {"bay": self.bay.problem, "batch": self.batches.problem}
+        return {name: problem for name, problem in problems.items() if problem}
 
     def add_reporter(self, name: str, report: Callable[[], dict]) -> None:
         """Have GET /healthz show `report()` under `name` (an adapter's own figures, e.g. Open Connect's connectors
@@ -159,7 +139,7 @@ class BayRuntime:
         if show:
             entry = self.feed.publish(source, request, result, flight.states, flight.flight_time_s,
                                       shot_number=shot_number, player=player, putt=putt,
-                                      club_data=club_values(club_data))
+                                      club_data=club_data)
         return Flown(request, result, flight, entry)
 
     def fly_gspro(self, message: GSProMessage, source: Source = "gspro-http") -> GSProReply:

@@ -24,17 +24,17 @@ router = APIRouter()
 
 @router.get("/healthz")
 async def healthz(runtime: BayRuntime = Depends(bay_runtime)) -> JSONResponse:
-    """Ready (200) once the model is loaded, with its variant and hash; "degraded" (still 200: every shot flies)
+    """Ready (200) once the model is loaded, with its variant and hash (not its directory: no key is needed here,
+    and where the model lives is no caller's business); "degraded" (still 200: every shot flies)
     with `problems` saying what to repair, e.g. a bay file broken while serving; 503 while loading or if it
     failed."""
     if runtime.engine is None:
         status = "failed" if runtime.error else "loading"
-        return JSONResponse({"status": status, "error": runtime.error, "model_dir": str(runtime.bundle_dir)}, 503)
+        return JSONResponse({"status": status, "error": runtime.error}, 503)
     engine = runtime.engine
     model = {
         "variant": engine.variant,
         "sha256": engine.sha256,
-        "dir": str(runtime.bundle_dir),
         "load_seconds": engine.load_seconds,
     }
     problems = runtime.problems()
