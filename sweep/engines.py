@@ -18,8 +18,10 @@ from collections import deque
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from contextlib import contextmanager
+from multiprocessing import forkserver
 
 from golfflight.sweep.flyer import Flyer
+from golfflight.sweep.stopping import exit_with_driver, group_signals_held
 
 PIECES_PER_WORKER = 2
 """Pieces queued per local worker: one flying and one waiting, so a worker never idles while the driver writes."""
@@ -38,7 +40,9 @@ _flyer: Flyer | None = None
 
 
 def _start_worker(bundle_dir: str, sha256: str, source, make: Callable | None) -> None:
+    """A local pool's worker: bound to the driver's life first (`sweep.stopping.exit_with_driver`), then its flyer."""
     global _flyer
+    exit_with_driver()
     _flyer = Flyer(bundle_dir, sha256, source, make_engine=make)
 
 
@@ -53,12 +57,14 @@ def local_tables(source, bundle_dir: str, sha256: str, workers: int, make: Calla
     GPU taken, in each worker, never in the server)."""
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(WORKER_IMPORTS)
-    pool = ProcessPoolExecutor(
-        workers,
-        mp_context=context,
-        initializer=_start_worker,
-        initargs=(bundle_dir, sha256, source, make),
-    )
+    with group_signals_held():  # the fork server and the resource tracker outlive a hangup to the process group
+        forkserver.ensure_running()
+        pool = ProcessPoolExecutor(
+            workers,
+            mp_context=context,
+            initializer=_start_worker,
+            initargs=(bundle_dir, sha256, source, make),
+        )
     try:
         pending = deque()
         for piece in source.pieces():
@@ -67,8 +73,22 @@ def local_tables(source, bundle_dir: str, sha256: str, workers: int, make: Calla
                 yield pending.popleft().result()
         while pending:
             yield pending.popleft().result()
+    except BaseException:  # a refused row, a failed write, a signal (`sweep.stopping`), or closed before the end
+        _stop_workers(pool)
+        raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Kill the pool's workers mid-piece: a sweep that stops early wants none of their results, and a piece can take
+    seconds. A worker killed while it sends a result leaves half a message in the results' pipe, and the pool's
+    manager thread would wait for the rest for ever (`shutdown` and the interpreter's exit with it): the driver closes
+    its own copy of the pipe's write end, the only one left, so that the reader meets the pipe's end instead. Both
+    are ProcessPoolExecutor's private attributes (Python 3.14's `terminate_workers` reads `_processes` too)."""
+    for process in list((pool._processes or {}).values()):
+        process.kill()
+    pool._result_queue._writer.close()
 
 
 def in_process_tables(source, flyer: Flyer, in_flight: int = PIECES_IN_FLIGHT) -> Iterator:

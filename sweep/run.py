@@ -4,22 +4,23 @@ one Parquet file, whole or not at all.
 Memory stays bounded: each result table is written as a row group as soon as it arrives (pyarrow's ParquetWriter)
 and dropped. A row the request model refuses stops the sweep with every problem of that piece, each naming the
 row's place in the input, its column and the allowed range, and nothing is written; with `skip_bad_rows` such rows
-are left out and each is reported, and a piece of which no row is valid is skipped whole (and counted). The file is written beside its target and renamed over it at the end
-(`shots.files.write_atomic`).
+are left out and each is reported, and a piece of which no row is valid is skipped whole (and counted). The file is
+written beside its target and renamed over it at the end (`sweep.output.write_whole`, which also removes what a
+killed sweep to the same file left, and names the file where a write fails).
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator
-from contextlib import closing
+from contextlib import closing, contextmanager, suppress
 from dataclasses import dataclass
 from typing import Literal
 
 from golfflight.flight.bundle_location import model_dir
-from golfflight.shots.files import write_atomic
 from golfflight.sweep.engines import PIECES_IN_FLIGHT
 from golfflight.sweep.flyer import PROBLEM, ROW, ColumnsEngine, Flyer, Layout
+from golfflight.sweep.output import clear_stale, write_whole, writing
 from golfflight.sweep.sources import Source
 
 SHOWN_PROBLEMS = 20
@@ -89,6 +90,25 @@ def _text_columns(schema) -> list[str]:
     return [field.name for field in schema if pa.types.is_string(field.type)]
 
 
+@contextmanager
+def _parquet_writer(path: str, out: str, schema) -> Iterator:
+    """pyarrow's ParquetWriter on `path`, the temporary file of `out`, an OSError opening or closing it named as
+    writing `out` (`sweep.output.writing`). Where the sweep stops early the file is thrown away, and what stopped it
+    is what is told, not a failure to close it."""
+    import pyarrow.parquet as pq
+
+    with writing(out):
+        writer = pq.ParquetWriter(path, schema, use_dictionary=_text_columns(schema))
+    try:
+        yield writer
+    except BaseException:
+        with suppress(OSError):
+            writer.close()
+        raise
+    with writing(out):
+        writer.close()
+
+
 def _refused(source: Source, table, start: int) -> list[str]:
     """One line per problem of the refused rows of `table`, whose first row is input row `start`."""
     lines = []
@@ -113,16 +133,17 @@ def run_sweep(
     in_process: ColumnsEngine | None = None,
     worker_engine: WorkerEngine = WorkerEngine(),
     in_flight: int = PIECES_IN_FLIGHT,
+    notice: Callable[[str], None] = print,
 ) -> Summary:
     """Fly every row of `source` on `engine` and write `out` (Parquet): the input row's number, its columns, its
     flight (module docstring). `skipped` gets each problem of a row left out under `skip_bad_rows`; `in_process` is
     the engine `engine="torch"` flies with (`model_export.torch_engine.TorchEngine`, loaded from `model`), `in_flight`
     pieces at once; `worker_engine` what each actor of `engine="ray"` flies with (`workers` None: as many as the
     cluster's GPUs hold),
-    and, without `in_process`, each of the `workers` processes of `engine="torch"`."""
+    and, without `in_process`, each of the `workers` processes of `engine="torch"`. `notice` gets a line for each
+    temporary file of `out` found from an earlier sweep (`sweep.output.clear_stale`)."""
     import pyarrow as pa
     import pyarrow.compute as pc
-    import pyarrow.parquet as pq
     from tqdm import tqdm
 
     started = time.perf_counter()
@@ -132,7 +153,7 @@ def run_sweep(
     def write(path: str) -> None:
         tables = _tables(source, engine, workers, model, ray_address, in_process, worker_engine, in_flight)
         bar = tqdm(total=source.total_rows, unit="shot", unit_scale=True, disable=not progress, desc="sweep")
-        with closing(tables), bar, pq.ParquetWriter(path, schema, use_dictionary=_text_columns(schema)) as writer:
+        with closing(tables), bar, _parquet_writer(path, out, schema) as writer:
             for table in tables:
                 start, count = counts["rows"], table.num_rows
                 table = table.add_column(0, ROW, pa.array(range(start, start + count), pa.int64()))
@@ -151,7 +172,8 @@ def run_sweep(
                 if problems:
                     table = table.filter(pc.is_null(table[PROBLEM]))
                 if table.num_rows:
-                    writer.write_table(table.drop_columns([PROBLEM]))
+                    with writing(out):
+                        writer.write_table(table.drop_columns([PROBLEM]))
                 counts["chunks"] += 1
                 counts["chunks_skipped"] += int(none_valid)
                 counts["rows"] += count
@@ -160,5 +182,6 @@ def run_sweep(
                 counts["failed"] += table.num_rows - table["error"].null_count
                 bar.update(count)
 
-    write_atomic(out, write)
+    clear_stale(out, notice)
+    write_whole(out, write)
     return Summary(**counts, seconds=time.perf_counter() - started)

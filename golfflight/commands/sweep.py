@@ -160,6 +160,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         from golfflight.sweep.run import run_sweep
         from golfflight.sweep.sources import open_source
+        from golfflight.sweep.stopping import Interrupted, stopped_by_signals
     except ImportError as missing:  # an install without the sweep package
         raise ValueError(f"needs the sweep extra: pip install 'golfflight[sweep]' ({missing})") from None
     require_extras("sweep", *({"ray": ["ray"], "torch": ["train"]}.get(args.engine, [])))
@@ -172,19 +173,26 @@ def run(args: argparse.Namespace) -> int:
     source = open_source(args.launches, args.grid, chunk_rows)
     torch_engine, worker_engine = _engines(args)
     workers = 1 if torch_engine is not None else args.workers or (None if worker_engine.gpus else os.cpu_count() or 1)
-    summary = run_sweep(
-        source,
-        args.out,
-        args.engine,
-        workers,
-        args.model,
-        args.ray_address,
-        args.skip_bad_rows,
-        progress=not args.no_progress,
-        skipped=lambda problem: print(f"golfflight sweep: skipped: {problem}", file=sys.stderr),
-        in_process=torch_engine,
-        worker_engine=worker_engine,
-    )
+    try:
+        with stopped_by_signals():
+            summary = run_sweep(
+                source,
+                args.out,
+                args.engine,
+                workers,
+                args.model,
+                args.ray_address,
+                args.skip_bad_rows,
+                progress=not args.no_progress,
+                skipped=lambda problem: print(f"golfflight sweep: skipped: {problem}", file=sys.stderr),
+                in_process=torch_engine,
+                worker_engine=worker_engine,
+                notice=lambda line: print(f"golfflight sweep: {line}", file=sys.stderr),
+            )
+    except Interrupted as stop:
+        print(f"golfflight sweep: stopped by {stop.name}: nothing written to {args.out}, no temporary file or worker "
+              "left", file=sys.stderr)
+        return stop.status
     whole = (
         f", {summary.chunks_skipped:,} of {summary.chunks:,} chunks skipped whole for want of a valid row"
         if summary.chunks_skipped
