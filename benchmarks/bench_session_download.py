@@ -88,13 +88,13 @@ def scenario(http: RawHttp, connect_port: int, seconds_long: float) -> tuple[dic
 def run(args: argparse.Namespace) -> list[dict]:
     connect_port = _free_port()
     server = start(tree=args.tree, args=["--connect-port", str(connect_port)])
-    http = RawHttp(server.port, "/v1/shots", json.dumps(SHOT).encode())
     rows = []
     try:
         shown = RawHttp(server.port, "/v1/shots?viewer=true", json.dumps(SHOT).encode())
         for _ in range(args.shots):
             shown.post()
         shown.close()
+        http = RawHttp(server.port, "/v1/shots", json.dumps(SHOT).encode())
         for name, downloaders in (("(a) quiet", 0), (f"(b) {args.downloaders} clients looping the download",
                                                       args.downloaders)):
             context = multiprocessing.get_context("spawn")
@@ -115,8 +115,8 @@ def run(args: argparse.Namespace) -> list[dict]:
                          "downloads": sum(r[0] for r in reports),
                          "download_median_s": float(np.median([r[1] for r in reports if r[1]])) if reports else None,
                          "download_bytes": reports[0][2] if reports else None})
-    finally:
         http.close()
+    finally:
         server.stop()
     return rows
 

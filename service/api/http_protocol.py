@@ -4,8 +4,10 @@ uvicorn closes a connection idle between requests (its keep-alive timeout) but g
 a client that sends half a request line, or a header a minute, or a body a byte at a time, holds its connection and
 a file descriptor for as long as it likes. On a bay PC under a 1,024 open-files limit, 1,100 such requests made
 /healthz unanswerable and reset the connector (issue 42). Here a request's head (request line and headers) must
-arrive within HEAD_TIMEOUT_S of its first byte, or of the connection opening, and its body within BODY_TIMEOUT_S of
-the head; past either the connection is closed, with a 408 when no answer has begun.
+arrive within HEAD_TIMEOUT_S of its first byte, and its body within BODY_TIMEOUT_S of the head; past either the
+connection is closed with a 408. A connection that sends nothing at all is closed silently after HEAD_TIMEOUT_S, as
+uvicorn closes one idle between requests: a 408 nobody asked for would be read as the answer to the client's next
+request.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ class DeadlineHttpProtocol(HttpToolsProtocol):
     def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
         self._deadline: asyncio.TimerHandle | None = None
         super().connection_made(transport)
-        self._arm(self.head_timeout_s)
+        self._arm(self.head_timeout_s, requested=False)
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._disarm()
@@ -44,30 +46,33 @@ class DeadlineHttpProtocol(HttpToolsProtocol):
 
     def on_message_begin(self) -> None:
         super().on_message_begin()
-        self._arm(self.head_timeout_s)
+        self._arm(self.head_timeout_s, requested=True)
 
     def on_headers_complete(self) -> None:
         super().on_headers_complete()
-        self._arm(self.body_timeout_s)
+        self._arm(self.body_timeout_s, requested=True)
 
     def on_message_complete(self) -> None:
         self._disarm()
         super().on_message_complete()
 
-    def _arm(self, seconds: float) -> None:
+    def _arm(self, seconds: float, requested: bool) -> None:
+        """Close the connection in `seconds` unless disarmed first (`requested`: a request has begun)."""
         self._disarm()
-        self._deadline = self.loop.call_later(seconds, self._too_late)
+        self._deadline = self.loop.call_later(seconds, self._too_late, requested)
 
     def _disarm(self) -> None:
         if self._deadline is not None:
             self._deadline.cancel()
             self._deadline = None
 
-    def _too_late(self) -> None:
-        """Close a connection whose request did not arrive in time (a 408 first, when nothing was answered yet)."""
+    def _too_late(self, requested: bool) -> None:
+        """Close a connection whose request did not arrive in time: with a 408 once a request had begun
+        (`requested`) and its answer had not, silently when it never sent one."""
         self._deadline = None
         if self.transport.is_closing():
             return
-        if self.cycle is None or self.cycle.response_complete or not self.cycle.response_started:
+        answered = self.cycle is not None and self.cycle.response_started and not self.cycle.response_complete
+        if requested and not answered:  # the cycle is the last request's until this one's head is complete
             self.transport.write(TIMED_OUT)
         self.transport.close()
