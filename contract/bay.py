@@ -3,8 +3,9 @@ player at the mat (GSPro's club and handedness) and the units the bay's screen s
 sends ball data only (GSPro Open Connect has no field for the weather or the green): in a simulator the course's
 conditions and the club selected come from the simulator, here from the bay.
 
-Validated by the same request models and limits as a shot's conditions; a shot's own conditions win, field by field
-(`in_bay`). The server keeps one, changed live and stored in a file (`service.runtime.bay.Bay`). A partial update
+Validated by the same request models and limits as a shot's conditions; a shot's own conditions win (`in_bay`): its
+air quantity by quantity (a shot giving only a temperature keeps the bay's altitude; `{}` is standard air), its wind and ground whole (a
+wind or a ground is one thing: a green's stimp means nothing on the shot's rough). The server keeps one, changed live and stored in a file (`service.runtime.bay.Bay`). A partial update
 (`BayUpdate`, PATCH /v1/bay) replaces the parts it names and leaves the rest; the player's two fields merge one by
 one.
 """
@@ -87,8 +88,30 @@ class BayUpdate(Strict):
         return BayConditions.model_validate({**dict(bay), **parts})
 
 
+AIR_QUANTITIES = (("temperature_c", "temperature_f"), ("altitude_m", "altitude_ft", "pressure_hpa"),
+                  ("humidity_pct",))
+"""The air's weather quantities, each in the forms a request may give it (a density replaces them all)."""
+
+
+def air_in_bay(own: AirRequest, bay: AirRequest) -> AirRequest:
+    """A shot's air over the bay's, quantity by quantity: each quantity the shot gives (in any of its forms) replaces
+    the bay's, the others stay the bay's; a density given by the shot replaces the bay's air whole, and the shot's
+    weather replaces a density the bay gives. An empty air (`{}`) is the standard atmosphere, the bay's air aside."""
+    given = own.model_dump(exclude_none=True)
+    if not given or "density_kg_m3" in given:
+        return own
+    kept = {name: value for name, value in bay.model_dump(exclude_none=True).items() if name != "density_kg_m3"}
+    for forms in AIR_QUANTITIES:
+        if any(form in given for form in forms):
+            kept = {name: value for name, value in kept.items() if name not in forms}
+    return AirRequest(**kept, **given)
+
+
 def in_bay(shot: ShotRequest, bay: BayConditions) -> ShotRequest:
-    """The shot with the bay's air, wind and ground wherever it gives none of its own."""
+    """The shot with the bay's air, wind and ground wherever it gives none of its own (its air merged quantity by
+    quantity, `air_in_bay`)."""
     updates = {name: getattr(bay, name) for name in CONDITION_FIELDS
                if getattr(shot, name) is None and getattr(bay, name) is not None}
+    if shot.air is not None and bay.air is not None:
+        updates["air"] = air_in_bay(shot.air, bay.air)
     return shot.model_copy(update=updates) if updates else shot

@@ -117,6 +117,9 @@ class GSProOptions(_Lenient):
     IsHeartBeat: bool = False
 
 
+UNITS = {"yards": "Yards", "meters": "Meters"}
+"""GSPro Open Connect's `Units`, by their folded spelling."""
+
 SHOT_NUMBER_MAX = 2**31 - 1
 """The largest ShotNumber: GSPro keeps it in a 32-bit signed integer."""
 
@@ -137,6 +140,16 @@ class GSProMessage(_Lenient):
     @classmethod
     def _club_data_shown(cls, value):
         return club_values(value) if isinstance(value, dict) else value
+
+    @field_validator("Units")
+    @classmethod
+    def _units_known(cls, value: str | None) -> str | None:
+        """GSPro's two unit systems, in any letter case. They change no number read here (BallData is mph and
+        degrees either way, as in GSPro) nor answered (the flight comes in yards and metres both); anything else is
+        refused rather than ignored, as a connector sending it expects something that will not happen."""
+        if value is not None and value.casefold() not in UNITS:
+            raise ValueError(f"Units must be {' or '.join(UNITS.values())} (GSPro Open Connect's two), got {value!r}")
+        return value
 
     @field_validator("ShotNumber", mode="before")
     @classmethod

@@ -63,6 +63,7 @@ def create_app(
             await tcp.start(connect, listening=False)
             runtime.bay.on_player_change(lambda changed: _tell(tcp, changed))
             runtime.add_reporter("open_connect", tcp.health)  # /healthz: connectors, refusals, evictions
+        watching = asyncio.create_task(runtime.bay.watch())  # an edit of the bay file, a club change in it above all
         loading = asyncio.get_running_loop().run_in_executor(None, runtime.load)  # the event loop stays free
         try:
             # Loaded before either port accepts (uvicorn binds HTTP's once this startup returns): the first request
@@ -72,6 +73,7 @@ def create_app(
                 await tcp.listen()
             yield
         finally:
+            watching.cancel()
             if tcp:
                 await tcp.close()
             await loading

@@ -79,6 +79,16 @@ CLUB_NAMES: tuple[str, ...] = tuple(club.name for club in CLUBS)
 
 _NUMBERED = {"wood": (3, 5), "iron": (3, 4, 5, 6, 7, 8, 9)}
 
+GSPRO_NEAREST: dict[str, str] = {
+    **{f"w{n}": "3-wood" for n in (2, 4)},
+    **{f"w{n}": "5-wood" for n in (6, 7)},
+    **{f"h{n}": "Hybrid" for n in range(2, 8)},
+    **{f"i{n}": "3-iron" for n in (1, 2)},
+}
+"""GSPro's club codes (a bay's player) with no launch of their own here, in `club_key` form -> the nearest club
+that has one: W2 and W4 fly as the 3-wood, W6 and W7 as the 5-wood, H2-H7 as the hybrid, I1 and I2 as the 3-iron.
+The putter (PT) has no flight to start from."""
+
 CLUB_ALIASES: dict[str, str] = {
     **{alias: "Driver" for alias in ("driver", "dr", "d", "1w", "1wood", "w1")},
     **{
@@ -88,13 +98,15 @@ CLUB_ALIASES: dict[str, str] = {
         for alias in (f"{number}{kind}", f"{number}{kind[0]}", f"{kind[0]}{number}")
     },
     **{alias: "Hybrid" for alias in ("hybrid", "hy", "hyb", "h", "rescue")},
+    **GSPRO_NEAREST,
     **{alias: "PW" for alias in ("pw", "pitchingwedge", "pitching", "p")},
     **{alias: "GW" for alias in ("gw", "gapwedge", "gap", "aw", "approachwedge", "approach", "uw", "utilitywedge")},
     **{alias: "SW" for alias in ("sw", "sandwedge", "sand")},
     **{alias: "LW" for alias in ("lw", "lobwedge", "lob")},
 }
 """What a golfer types, in `club_key` form -> the canonical name: `dr`, `3w`, `7i`, `7 iron`, `7-Iron`, `pw`, `sand
-wedge`, and the shape of GSPro's club codes (`DR`, `W3`, `I7`, `PW`, ...). Every canonical name is its own alias."""
+wedge`, and every GSPro club code but the putter (`DR`, `W3`, `H4`, `I7`, `PW`, ...; `GSPRO_NEAREST`). Every canonical
+name is its own alias."""
 
 
 def club_key(text: str) -> str:

@@ -22,7 +22,7 @@ def free_port() -> int:
 
 
 @contextmanager
-def running(app, ready_path: str = "/healthz", timeout_s: float = 20.0) -> Iterator[httpx.Client]:
+def running(app, ready_path: str = "/healthz", timeout_s: float = 120.0) -> Iterator[httpx.Client]:
     """Serve `app` on a free loopback port until the block ends; yields a keep-alive client, once `ready_path`
     answers 200 (or any answer, for apps whose model is meant to fail)."""
     port = free_port()

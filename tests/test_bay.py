@@ -32,14 +32,14 @@ def test_a_shot_takes_the_bays_conditions_only_where_it_has_none():
     assert in_bay(bare, bay).air == bay.air and in_bay(bare, bay).ground == bay.ground
     own = ShotRequest(**SEVEN_IRON, air=AirRequest(temperature_c=10.0))
     filled = in_bay(own, bay)
-    assert filled.air == AirRequest(temperature_c=10.0) and filled.wind == bay.wind
+    assert filled.air == AirRequest(altitude_m=1600.0, temperature_c=10.0) and filled.wind == bay.wind
     assert in_bay(bare, BayConditions()) is bare
 
 
 def test_the_bay_file_is_kept_whole_and_read_back(tmp_path):
     path = tmp_path / "bay" / "bay.json"
     bay = Bay(path)
-    assert bay.conditions == BayConditions() and not path.exists()
+    assert bay.conditions == BayConditions() and Bay(path).conditions == BayConditions(), "created at once"
     conditions = BayConditions(wind=WindRequest(speed_mps=3.0, from_deg=90.0), units="metric")
     bay.set(conditions)
     assert Bay(path).conditions == conditions
@@ -168,3 +168,28 @@ def test_a_scripted_connector_session_flies_every_shot_in_the_bay():
                                 spin_rpm=spin, spin_axis_deg=ball["SpinAxis"], **bay)
                 assert reply["Flight"]["carry_m"] == pytest.approx(explicit["carry_m"], abs=0.01)
                 assert reply["Flight"]["total_m"] == pytest.approx(explicit["total_m"], abs=0.01)
+
+
+def test_a_shots_own_air_replaces_the_bays_quantity_by_quantity():
+    """Issue 43: a shot's `{"temperature_c": 20}` discarded the bay's altitude."""
+    bay = BayConditions(air=AirRequest(altitude_m=1600.0, temperature_c=30.0, humidity_pct=40.0))
+    shot = ShotRequest(ball_speed_mps=60.0, launch_angle_deg=14.0, spin_rpm=5000.0, air={"temperature_f": 68.0})
+    assert in_bay(shot, bay).air == AirRequest(altitude_m=1600.0, temperature_f=68.0, humidity_pct=40.0)
+    pressure = shot.model_copy(update={"air": AirRequest(pressure_hpa=900.0)})
+    assert in_bay(pressure, bay).air == AirRequest(pressure_hpa=900.0, temperature_c=30.0, humidity_pct=40.0)
+    dense = shot.model_copy(update={"air": AirRequest(density_kg_m3=1.0)})
+    assert in_bay(dense, bay).air == AirRequest(density_kg_m3=1.0)
+    thin_bay = BayConditions(air=AirRequest(density_kg_m3=1.0))
+    assert in_bay(shot, thin_bay).air == AirRequest(temperature_f=68.0)
+
+
+def test_a_connectors_shot_carries_its_flat_figures_and_unknown_units_are_refused():
+    """Issue 43: Open Connect replies left out `flat`, and `Units` "furlongs" was taken without a word."""
+    with running(create_app(api_key="", cors_origins=[])) as http:
+        assert http.put("/v1/bay", json={"ground": {"surface": "fairway", "elevation_m": -5.0}}).status_code == 200
+        reply = http.post("/v1/gspro", json=OPEN_CONNECT_SHOT).json()
+        assert reply["Code"] == 200 and reply["Flight"]["flat"]["carry_m"] < reply["Flight"]["carry_m"]
+        assert len(json.dumps(reply, separators=(",", ":"))) < 2048, "inside MLM2PRO-GSPro-Connector's recv(2048)"
+        refused = http.post("/v1/gspro", json={**OPEN_CONNECT_SHOT, "Units": "furlongs"}).json()
+        assert refused["Code"] == 500 and "Units must be Yards or Meters" in refused["Message"]
+        assert http.post("/v1/gspro", json={**OPEN_CONNECT_SHOT, "Units": "Meters"}).json()["Code"] == 200

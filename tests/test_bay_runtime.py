@@ -10,7 +10,11 @@ import codecs
 import csv
 import io
 import json
+import os
+import signal
 import socket
+import subprocess
+import sys
 import time
 
 import httpx
@@ -19,6 +23,7 @@ import pytest
 from golfflight.service.app import create_app
 from golfflight.service.open_connect.server import ConnectAddress
 from golfflight.service.viewer.event import ShotEvent
+from golfflight.shots.files import write_text_atomic
 
 from tests.servers import free_port, running
 
@@ -241,3 +246,66 @@ def test_a_refused_connector_message_names_its_shot_over_tcp_and_http(bay_servic
     over_http = http.post("/v1/gspro", json=bad).json()
     for reply in (tcp, over_http):
         assert reply["Code"] == 500 and reply["ShotNumber"] == 42 and "BallData.Speed" in reply["Message"]
+
+
+def test_a_club_changed_in_the_bay_file_reaches_a_connector_at_once_apart_from_any_shot(tmp_path):
+    """Issue 43: the 201 used to go out at the next shot, 3.5 ms ahead of its 200, and a connector that reads once
+    per shot took it for its reply; now the file is watched and the 201 comes within 2 s, on its own."""
+    path, port = tmp_path / "bay.json", free_port()
+    with running(create_app(connect=ConnectAddress(port), bay=path)) as http:
+        assert json.loads(path.read_text()) == {"player": {"club": "DR", "handed": "RH"}, "units": "imperial"}
+        connector = Connector(port)
+        assert connector.reply(message(1, BALLS[0]))["Code"] == 200
+        write_text_atomic(path, json.dumps({"player": {"club": "I7", "handed": "RH"}}))
+        started, told = time.monotonic(), []
+        while not told and time.monotonic() - started < 2.0:
+            told = connector.objects(0.1)
+        assert told == [{"Code": 201, "Message": "GSPro Player Information", "Player": {"Handed": "RH", "Club": "I7"}}]
+        connector.socket.sendall(message(2, BALLS[1]))
+        replies = []
+        while not replies:  # read once per shot: the first object is this shot's reply
+            replies = connector.objects(5.0)
+        assert [reply["Code"] for reply in replies] == [200] and replies[0]["ShotNumber"] == 2
+        assert http.get("/v1/bay").json()["player"]["club"] == "I7"
+        connector.close()
+
+
+def test_the_servers_log_says_when_connectors_come_and_go_the_bay_file_breaks_and_heals_and_a_limit_refuses(tmp_path):
+    """Issue 43: the log held only the start line after all of these."""
+    http_port, tcp_port, bay, log = free_port(), free_port(), tmp_path / "bay.json", tmp_path / "serve.log"
+    command = [sys.executable, "-m", "golfflight", "serve", "--port", str(http_port), "--connect-port", str(tcp_port),
+               "--bay", str(bay)]
+    env = {key: value for key, value in os.environ.items() if key != "GOLFFLIGHT_API_KEY"}
+    with open(log, "w") as output:
+        server = subprocess.Popen(command, stdout=output, stderr=subprocess.STDOUT, env=env)
+    try:
+        base = f"http://127.0.0.1:{http_port}"
+        deadline = time.monotonic() + 90
+        while not _ready(base):
+            assert time.monotonic() < deadline and server.poll() is None, log.read_text()
+            time.sleep(0.1)
+        connector = Connector(tcp_port)
+        assert connector.reply(message(1, BALLS[0]))["Code"] == 200
+        connector.close()
+        bay.write_text("{not json")
+        time.sleep(1.0)  # the watch reads it
+        assert httpx.put(f"{base}/v1/bay", json=BAY).status_code == 200
+        flood = Connector(tcp_port)
+        flood.socket.sendall(b'{"a":{}}' * 1000)  # past the burst of 100 messages: refused and closed
+        time.sleep(1.0)
+        flood.close()
+    finally:
+        server.send_signal(signal.SIGTERM)
+        server.wait(60)
+    text = log.read_text()
+    for said in ("a connector connected from 127.0.0.1:", "a connector from 127.0.0.1:", "left (0 connected)",
+                 "bay file: " + str(bay) + ": not bay conditions", "is bay conditions again",
+                 "sent messages too fast: closed"):
+        assert said in text, f"{said!r} not in the log:\n{text}"
+
+
+def _ready(base: str) -> bool:
+    try:
+        return httpx.get(base + "/healthz", timeout=5).status_code == 200
+    except httpx.TransportError:
+        return False

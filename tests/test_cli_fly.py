@@ -187,3 +187,15 @@ def test_the_viewer_offers_gspros_clubs_by_their_codes():
     offered = [part.split('"', 1)[0] for part in menu.split('<option value="')[1:]]
     assert offered == list(GSPRO_CLUBS) and all(name in menu for name in GSPRO_CLUBS.values())
     assert "<!--" not in menu
+
+
+def test_every_gspro_club_code_but_the_putter_names_a_club_to_fly():
+    """Issue 43: `fly --club H4` was refused though the bay takes GSPro's codes; each now flies as the nearest club
+    with a launch of its own, and the putter still says what it takes."""
+    from golfflight.contract.bay import GSPRO_CLUBS
+    from golfflight.shots.clubs import CLUB_NAMES, canonical_club_name
+
+    assert {canonical_club_name(code) for code in GSPRO_CLUBS if code != "PT"} <= set(CLUB_NAMES)
+    assert canonical_club_name("H4") == "Hybrid" and canonical_club_name("w2") == "3-wood"
+    with pytest.raises(ValueError, match="unknown club 'PT'"):
+        canonical_club_name("PT")

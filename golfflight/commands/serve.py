@@ -14,6 +14,7 @@ across restarts; a file that is not bay conditions stops the start with one line
 from __future__ import annotations
 
 import argparse
+import copy
 import errno
 import importlib
 import ipaddress
@@ -112,6 +113,18 @@ def fast_io() -> dict[str, object]:
     return {"loop": loop, "http": DeadlineHttpProtocol}
 
 
+def logging_config() -> dict:
+    """uvicorn's logging, plus golfflight's own loggers at INFO through uvicorn's handler: a bay's log says when a
+    connector connects or leaves, when the bay file breaks or heals and when a limit refuses (each throttled where a
+    hostile program could repeat it), in the same format as uvicorn's lines. Without this only warnings reached
+    standard error, through Python's last-resort handler."""
+    from uvicorn.config import LOGGING_CONFIG
+
+    config = copy.deepcopy(LOGGING_CONFIG)
+    config["loggers"]["golfflight"] = {"handlers": ["default"], "level": "INFO", "propagate": False}
+    return config
+
+
 def open_files_raised() -> int | None:
     """Raise this process's soft limit on open files to its hard limit (its workers inherit it) and return it; None
     where there is no such limit (Windows). Each connection is a file: under the common soft limit of 1,024, a
@@ -188,6 +201,7 @@ def run(args: argparse.Namespace) -> int:
             workers=args.workers,
             access_log=False,
             log_level="warning",
+            log_config=logging_config(),
             timeout_graceful_shutdown=GRACEFUL_SHUTDOWN_S,
             **fast_io(),
         )

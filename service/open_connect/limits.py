@@ -2,7 +2,9 @@
 
 Open Connect has no authentication: any program on the bay's machine (or on the network, with `--connect-host`) can
 open the port. Real connectors send a shot every few seconds at most, a heartbeat every few seconds, a shot again
-after 5 s without a reply (up to 10 times), and reconnect after 5 s when dropped (NOTES.md §8). The bounds below
+after 5 s without a reply (up to 10 times: MLM2PRO-GSPro-Connector's early src/gspro_connect.py,
+github.com/springbok/MLM2PRO-GSPro-Connector), and reconnect after 5 s when dropped (another open connector's
+public source). The bounds below
 sit far above that and far below what costs the service anything; each is refused as `server` says (Code 500 for a
 message refused while the connection goes on, Code 503 and a close for a connection refused or ended).
 

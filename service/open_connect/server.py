@@ -68,29 +68,38 @@ TURN_S = 0.001
 """Open Connect's work (every connection's together) in one turn of the event loop, before everything else that is
 ready runs (HTTP requests among them): a turn lasts TURN_S plus at most one piece's framing or one shot's flight."""
 LOG_EVERY_S = 10.0
-"""Least time between two log lines about one kind of refusal: a hostile program's loop is refused hundreds of
-times a second and would fill the log; each line says how many were not logged since the last."""
+"""Least time between two log lines about one kind of event (a connector coming or going, a refusal): a hostile
+program's loop connects and is refused hundreds of times a second and would fill the log; each line says how many
+were not logged since the last."""
 INTERNAL_ERROR = "internal error while answering this message (the server log has the details)"
 
 log = logging.getLogger(__name__)
 
 
-class RefusalLog:
-    """Logs each kind of refusal (its message) at most once per LOG_EVERY_S, with the count of those not logged."""
+class ThrottledLog:
+    """Logs each kind of event (its message) at most once per LOG_EVERY_S, with the count of those not logged: a
+    connector's coming and going, each kind of refusal."""
 
     def __init__(self):
         self._last: dict[str, float] = {}
         self._unlogged: dict[str, int] = {}
 
     def warning(self, message: str) -> None:
+        self._log(logging.WARNING, message, message)
+
+    def info(self, message: str, kind: str) -> None:
+        """`message` at INFO, throttled with every other message of its `kind`."""
+        self._log(logging.INFO, message, kind)
+
+    def _log(self, level: int, message: str, kind: str) -> None:
         now = time.monotonic()
-        if message in self._last and now - self._last[message] < LOG_EVERY_S:
-            self._unlogged[message] = self._unlogged.get(message, 0) + 1
+        if kind in self._last and now - self._last[kind] < LOG_EVERY_S:
+            self._unlogged[kind] = self._unlogged.get(kind, 0) + 1
             return
-        self._last[message] = now
-        unlogged = self._unlogged.pop(message, 0)
+        self._last[kind] = now
+        unlogged = self._unlogged.pop(kind, 0)
         more = f" ({unlogged:,} more since the last such line)" if unlogged else ""
-        log.warning("GSPro Open Connect: %s%s", message, more)
+        log.log(level, "GSPro Open Connect: %s%s", message, more)
 
 
 @dataclass(frozen=True)
@@ -121,7 +130,7 @@ class OpenConnectServer:
         self._loop: asyncio.AbstractEventLoop | None = None
         self.connections: set[Connection] = set()  # served now; each leaves when it closes or is refused
         self.refused: set[Connection] = set()  # refused (Code 503), their refusal on its way, until closed
-        self.refusals = RefusalLog()
+        self.events = ThrottledLog()  # connectors coming and going, refusals: logged, throttled
         self.refused_total = 0  # connections refused or closed for a limit (Code 503), since start
         self.evicted_total = 0  # connections closed for a new one's place (Code 503), since start
         self._waiting: deque[Connection] = deque()  # connections with input left, in the order their turns come
@@ -183,7 +192,7 @@ class OpenConnectServer:
     def refuse(self, connection: Connection, logged: str, message: str) -> None:
         """Refuse `connection` for a limit: Code 503 `message`, then the close; `logged` goes to the log (at most
         once per LOG_EVERY_S)."""
-        self.refusals.warning(logged)
+        self.events.warning(logged)
         self.refused_total += 1
         connection.refuse(message)
 
@@ -216,7 +225,7 @@ class OpenConnectServer:
         if not exposed:
             return False
         quitting = min(exposed, key=Connection.gives_way)
-        self.refusals.warning("a connection closed to make room for a new one")
+        self.events.warning("a connection closed to make room for a new one")
         self.evicted_total += 1
         quitting.refuse(self.limits.evicted(now - quitting.last_heard, quitting.last_message is not None))
         return True
@@ -247,6 +256,12 @@ class OpenConnectServer:
         except Exception:
             log.exception("GSPro Open Connect: answering a message failed")
             return Replied(GSProReply(Code=500, Message=INTERNAL_ERROR), False)
+
+
+def _peer(transport: asyncio.Transport) -> str:
+    """The connection's other end as host:port, for the log."""
+    peer = transport.get_extra_info("peername")
+    return f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) and len(peer) >= 2 else "an unknown address"
 
 
 class Connection(asyncio.Protocol):
@@ -293,6 +308,9 @@ class Connection(asyncio.Protocol):
     def connection_made(self, transport: asyncio.Transport) -> None:
         self.transport = transport
         self.server.admit(self)
+        if self in self.server.connections:
+            self.server.events.info(f"a connector connected from {_peer(transport)} "
+                                    f"({len(self.server.connections)} connected)", "connected")
 
     def data_received(self, data: bytes) -> None:
         if self._ending is not None:  # refused: what still comes is dropped, up to LINGER_BYTES
@@ -325,7 +343,10 @@ class Connection(asyncio.Protocol):
         for timer in (self._pause, self._unread, self._ending):
             if timer is not None:
                 timer.cancel()
-        self.server.connections.discard(self)
+        if self in self.server.connections:
+            self.server.connections.discard(self)
+            self.server.events.info(f"a connector from {_peer(self.transport)} left "
+                                    f"({len(self.server.connections)} connected)", "left")
         self.server.refused.discard(self)
 
     def close(self) -> None:
@@ -413,6 +434,6 @@ class Connection(asyncio.Protocol):
             (self.transport.resume_reading if on else self.transport.pause_reading)()
 
     def _drop_unread(self) -> None:
-        self.server.refusals.warning(f"a connector left its replies unread {self.limits.unread_limit_s:g} s: dropped")
+        self.server.events.warning(f"a connector left its replies unread {self.limits.unread_limit_s:g} s: dropped")
         self._unread = None
         self.transport.abort()

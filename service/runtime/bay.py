@@ -7,10 +7,17 @@ is wrong with the file (GET /healthz shows it as "degraded") until a PUT or PATC
 a broken file stop the server (`BayFileError`): there is no good bay to keep yet. The file is read on the shots'
 path, so only a regular file of at most MAX_BAY_FILE_BYTES is read, opened without blocking: a FIFO in its place
 would hang every shot waiting for a writer, a link to /dev/zero would be read for ever, a 1 GB file for seconds.
+
+An edit of the file is also looked for every WATCH_S while the service runs (`watch`), not only at the next shot: a
+change of player made there reaches connectors as Code 201 at once, apart from any shot's reply (noticed at the
+next shot instead, the 201 went out 3.5 ms ahead of that shot's Code 200, and a connector that reads once per
+shot took it for its reply). The file breaking and healing is logged, once each.
 """
 
 from __future__ import annotations
 
+import asyncio
+import logging
 import os
 import stat
 import threading
@@ -23,6 +30,12 @@ from pydantic import ValidationError
 
 BAY_FILE_ENV = "GOLFFLIGHT_BAY_FILE"
 """Where `golfflight serve --bay FILE` tells its worker processes the bay file is."""
+
+log = logging.getLogger(__name__)
+
+WATCH_S = 0.25
+"""How often the bay file is looked at for an edit (one `stat`): a club changed there reaches connectors well
+within a second."""
 
 MAX_BAY_FILE_BYTES = 64 * 1024
 """Largest bay file read: bay conditions written by PUT /v1/bay take well under a kilobyte."""
@@ -52,6 +65,21 @@ class Bay:
         self._listeners: list[PlayerListener] = []
         if self.path is not None and self._file_stamp() is not None:
             self._conditions, self._stamp = self._read(), self._file_stamp()
+        elif self.path is not None:  # created now, as `serve --bay FILE` says: the file to edit is there at once
+            try:
+                self._set(self._conditions)
+            except OSError as error:
+                raise BayFileError(f"{self.path}: cannot be created ({error.strerror or error})") from None
+
+    async def watch(self, every_s: float = WATCH_S) -> None:
+        """Look at the bay file every `every_s` until cancelled, reading it when it changed (a player changed there is
+        told to the listeners at once); nothing to do without a file."""
+        if self.path is None:
+            return
+        while True:
+            await asyncio.sleep(every_s)
+            with self._lock:
+                self._refresh()
 
     def on_player_change(self, listener: PlayerListener) -> None:
         """Call `listener` with the new player after each change of the bay's player (from any source)."""
@@ -80,8 +108,8 @@ class Bay:
         stamp = self._file_stamp()
         if stamp is None:
             if self._stamp is not None:
-                self._problem = (f"{self.path}: the bay file is gone; the last good bay stays in force until "
-                                 "PUT /v1/bay writes it again")
+                self._broken(f"{self.path}: the bay file is gone; the last good bay stays in force until PUT /v1/bay "
+                             "writes it again")
             return
         if stamp == self._stamp:
             return
@@ -89,10 +117,18 @@ class Bay:
         try:
             conditions = self._read()
         except (BayFileError, OSError) as error:
-            self._problem = f"{error}; the last good bay stays in force until PUT /v1/bay writes the file again"
+            self._broken(f"{error}; the last good bay stays in force until PUT /v1/bay writes the file again")
             return
-        self._problem = None
+        self._broken(None)
         self._replace(conditions)
+
+    def _broken(self, problem: str | None) -> None:
+        """Set the file's problem (None: none), logging the moment it breaks and the moment it heals."""
+        if problem and problem != self._problem:
+            log.warning("bay file: %s", problem)
+        elif problem is None and self._problem is not None:
+            log.info("bay file: %s is bay conditions again; in force now", self.path)
+        self._problem = problem
 
     def _bytes(self) -> bytes:
         """The bay file's bytes: a regular file of at most MAX_BAY_FILE_BYTES, opened without blocking (a FIFO
@@ -148,6 +184,7 @@ class Bay:
     def _set(self, conditions: BayConditions) -> BayConditions:
         if self.path is not None:
             write_text_atomic(self.path, conditions.model_dump_json(indent=2, exclude_none=True) + "\n")
-            self._stamp, self._problem = self._file_stamp(), None
+            self._stamp = self._file_stamp()
+            self._broken(None)
         self._replace(conditions)
         return conditions

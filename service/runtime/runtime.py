@@ -150,7 +150,7 @@ class BayRuntime:
                               ShotNumber=message.ShotNumber)
         try:
             flown = self.fly(shot_request(message), source, shot_number=message.ShotNumber,
-                             club_data=message.ClubData, flat=False)
+                             club_data=message.ClubData)
         except (ValueError, FlightError) as error:
             return failed_reply(message, error)
         return shot_reply(message, flown.result)
