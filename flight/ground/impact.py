@@ -1,20 +1,35 @@
-"""Penner's impact of a spinning ball on turf (Can. J. Phys. 80, 931 (2002)), one ball or many.
+"""The impact of a spinning ball on turf, one ball or many: Penner's tilted contact plane (Can. J. Phys. 80, 931
+(2002)), a turf that soaks up spin, and Coulomb friction that grips or lets the ball slip.
 
-The turf gives under the ball, so it bounces off a contact plane tilted back towards it by the critical angle
-theta_c: the normal n' = cos(tilt) n - sin(tilt) t, t the direction of the incoming tangential velocity. Against
-that plane it is a rigid-body impact: the normal speed comes back times e(v_n) (Penner's restitution, scaled per
-surface) and friction drives the contact point's slip towards zero, rolling at exit (Penner's
-v_t' = 5/7 v_t - 2/7 R omega) unless the Coulomb limit mu (1 + e) v_n stops it first (Biber et al. 2023: many
-balls leave the turf still slipping). Back spin is reduced, or reversed into a ball that runs back.
+1. Tilt. The turf gives under the ball, so it bounces off a contact plane tilted back towards it by Penner's critical
+   angle theta_c: the normal n' = cos(tilt) n - sin(tilt) t, t the direction of the incoming tangential velocity.
+   Penner's fit grows the tilt linearly with the impact speed and with theta_1, the incoming angle from the normal:
+   tilt = theta_c (v / 18.6 m/s)(theta_1 / 44 deg), theta_c being the surface's value at his typical approach
+   landing (18.6 m/s at 44 degrees from the normal). A ball dropping straight down is not kicked sideways (theta_1 =
+   0), a steep wedge meets a gentler wall than a fast, shallow drive, and the later touches of a ball running on
+   (theta_1 near 90 degrees) tilt most: the fit, applied as published, takes speed out of a ball skipping across the
+   turf, which is what holds a drive that lands on a green to a few tens of yards. (It starts from a landing: a ball
+   already rolling, v_n = 0, would still see a tilt.) The tilt is capped at theta_1, so the tangential
+   speed against the tilted plane, v sin(theta_1 - tilt), never turns negative: taking theta_1 as the landing angle
+   from the horizontal instead makes that sine negative on shallow landings and "kills all rollout" of drivers (an
+   open simulator's bug).
+2. Restitution. Against the tilted plane the normal speed comes back times Penner's e(v_n), scaled per surface.
+3. Spin friction. A ball pressed into turf touches it over a patch, not a point, and the turf's torque takes spin out
+   of it beyond what the friction force at the contact point does: an angular impulse against the spin's component
+   along the plane, of at most spin_friction x R x the normal impulse, that stops the spin but never reverses it.
+   Angular momentum about the contact point is what a ball rolls off with (5/7 v_t - 2/7 R omega); friction at the
+   contact point cannot change it, so without this torque a steep wedge would keep every bit of its back spin's
+   pull and roll back tens of metres.
+4. Grip or slip (Cross, "Grip-slip behavior of a bouncing ball", Am. J. Phys. 70, 1093 (2002); Biber et al.,
+   "Measurements and linearized models for golf ball bounce on a green", Sports Engineering (2023)). Coulomb
+   friction drives the contact point's slip towards zero: the ball leaves rolling (it grips: Penner's v_t' =
+   5/7 v_t - 2/7 R omega) only if friction mu (1 + e) v_n suffices, and otherwise still slipping, as most of Biber et
+   al.'s 1,000 measured bounces do. Slipping, a ball keeps its back spin only above a threshold set by the friction
+   and the spin friction: Haake's 721 filmed impacts on 18 greens (Aston PhD 1989; Science and Golf II, 1994) found
+   firm, freely drained greens let it keep back spin above about 350 rad/s, and softer greens turn it into top spin.
 
-The tilt grows with the depth the ball presses into the turf: Penner's fit grows theta_c with impact speed and
-angle; here it grows in proportion to the normal speed up to theta_c at REFERENCE_NORMAL_SPEED_MPS and no further
-(faster, a steep wedge would meet a wall and shoot back metres), so a ball skimming the ground at a shallow angle is
-not thrown up by a crater it never made. It is capped at theta_1, the incoming angle from the normal, so the
-tangential speed against the tilted plane, v sin(theta_1 - tilt), never turns negative: taking theta_1 as the
-landing angle from the horizontal instead makes that sine negative on every landing shallower than theta_c and
-"kills all rollout" of drivers (an open simulator's bug); and a vertical drop is not kicked sideways. Energy never
-grows: |normal| shrinks by e <= 1 and the friction impulse opposes the slip and never overshoots it.
+Energy never grows: |normal| shrinks by e <= 1, the spin friction shrinks |omega| and the friction impulse opposes
+the slip and never overshoots it.
 """
 
 from __future__ import annotations
@@ -29,9 +44,13 @@ from golfflight.flight.ground.vectors import TINY, add, atan2, cos, cross, dot, 
 PENNER_MAX_NORMAL_SPEED_MPS = 20.0
 """Penner's restitution fit holds up to 20 m/s normal speed; faster impacts keep its value there (about 0.12)."""
 
-REFERENCE_NORMAL_SPEED_MPS = 13.0
-"""Normal speed from which the contact plane tilts by the surface's full critical angle: that of a typical
-approach-shot landing in Penner's data (about 18.6 m/s at 44 degrees)."""
+PENNER_REFERENCE_SPEED_MPS = 18.6
+"""Impact speed at which the contact plane tilts by the surface's critical angle (with PENNER_REFERENCE_ANGLE_DEG):
+Penner's typical approach-shot landing."""
+
+PENNER_REFERENCE_ANGLE_DEG = 44.0
+"""Incoming angle from the normal at which the contact plane tilts by the surface's critical angle (with
+PENNER_REFERENCE_SPEED_MPS): Penner's typical approach-shot landing, 46 degrees below the horizontal."""
 
 SPIN_PER_IMPULSE = BALL_MASS_KG * BALL_RADIUS_M / BALL_INERTIA_KG_M2
 """Change of spin (rad/s) per unit tangential speed change (m/s) from an impulse at the contact point: m R / I."""
@@ -43,6 +62,22 @@ def penner_restitution(normal_speed_mps):
     return 0.510 - 0.0375 * v + 0.000903 * v * v
 
 
+def penner_tilt(critical_angle_deg, speed_mps, incoming_rad):
+    """Penner's tilt of the contact plane (rad): theta_c (v / 18.6 m/s)(theta_1 / 44 deg), capped at theta_1 (the
+    incoming angle from the normal, `incoming_rad`) so the ball never meets a wall steeper than its own path."""
+    per_unit = math.radians(1.0) / (PENNER_REFERENCE_SPEED_MPS * math.radians(PENNER_REFERENCE_ANGLE_DEG))
+    return minimum(critical_angle_deg * per_unit * speed_mps * incoming_rad, incoming_rad)
+
+
+def _soak_spin(spin: tuple, contact_normal: tuple, normal_impulse, surface: Surface) -> tuple:
+    """The spin after the turf's torque: its component along the contact plane shrunk by at most spin_friction x R x
+    the normal impulse (per unit mass, m/s) x m / I, down to zero and no further."""
+    along_plane = add(spin, contact_normal, -dot(spin, contact_normal))
+    size = norm(along_plane)
+    soaked = minimum(surface.spin_friction * normal_impulse * SPIN_PER_IMPULSE, size)
+    return add(spin, along_plane, -soaked / maximum(size, TINY))
+
+
 def impact_components(velocity: tuple, spin: tuple, normal: tuple, surface: Surface) -> tuple[tuple, tuple]:
     """Velocity and spin just after an impact, as (x, y, z) tuples of floats (one ball) or [N] arrays (a batch;
     `surface` then holds floats or [N] arrays): the ball hits the ground with `velocity` and `spin` against a plane
@@ -51,16 +86,16 @@ def impact_components(velocity: tuple, spin: tuple, normal: tuple, surface: Surf
     tangential = add(velocity, normal, normal_speed)
     tangential_speed = norm(tangential)
     along = times(1.0 / maximum(tangential_speed, TINY), tangential)
-    depth = minimum(normal_speed / REFERENCE_NORMAL_SPEED_MPS, 1.0)
-    critical = surface.critical_angle_deg * (math.pi / 180.0)
-    tilt = minimum(critical * depth, atan2(tangential_speed, normal_speed))
+    tilt = penner_tilt(surface.critical_angle_deg, norm(velocity), atan2(tangential_speed, normal_speed))
     contact_normal = add(times(cos(tilt), normal), along, -sin(tilt))
     incoming = -dot(velocity, contact_normal)
     restitution = minimum(maximum(surface.restitution_scale * penner_restitution(incoming), 0.0), 1.0)
+    normal_impulse = (1.0 + restitution) * incoming
+    spin = _soak_spin(spin, contact_normal, normal_impulse, surface)
     sliding = add(velocity, contact_normal, incoming)
     slip = add(sliding, cross(contact_normal, spin), BALL_RADIUS_M)
     slip_speed = norm(slip)
-    impulse = minimum(2.0 / 7.0 * slip_speed, surface.friction * (1.0 + restitution) * incoming)
+    impulse = minimum(2.0 / 7.0 * slip_speed, surface.friction * normal_impulse)
     friction = times(-impulse / maximum(slip_speed, TINY), slip)
     velocity_out = add(add(sliding, friction), contact_normal, restitution * incoming)
     spin_out = add(spin, cross(contact_normal, friction), -SPIN_PER_IMPULSE)

@@ -1,6 +1,7 @@
 """Bounce and roll to rest: the ground phase of a batch of landed balls, on a plane through each landing point.
 
-Bounces: an impact (`flight.ground.impact`), then a hop under gravity alone, solved exactly (a parabola back to the
+Bounces: an impact (`flight.ground.impact`: Penner's tilted contact plane, the turf's torque on the spin, friction that
+grips or lets the ball slip), then a hop under gravity alone, solved exactly (a parabola back to the
 plane): hops are short and slow (a driver's first is about 0.5 s at 15 m/s), drag would take a few per cent of a
 hop's length, and a closed form needs no steps and no coefficient model. A ball whose rebound leaves the plane at
 less than MIN_HOP_SPEED_MPS stays down and rolls.
@@ -10,6 +11,12 @@ about the contact point kept: v = 5/7 v_t - 2/7 R n x omega), then decelerates b
 c_r g cos(phi) and grass drag k v against its motion, plus 5/7 of gravity along a slope. Level ground is solved in
 closed form; a slope is stepped (ROLL_STEP_S, midpoint steps) until the ball stops, which it does on any slope the
 surface holds (`holding_slope_deg`; steeper slopes are refused).
+
+No wind acts on the ground phase. A ball on the ground sits in the grass's boundary layer: the log profile
+(`flight.wind`) gives 1 % of the reference wind at the ball's centre (21 mm over z0 = 20 mm), 0.08 m/s in an 8 m/s
+wind, whose drag is about 1e-5 g, under a thousandth of the fastest green's rolling resistance (0.04 g at stimp 14).
+On a hop the wind changes the air's push on the ball by as much as the ball's own drag, which the hops leave out
+(above): a few per cent of a hop's length.
 
 The formulas are written once on (x, y, z) tuples of floats or arrays (`flight.ground.vectors`): `ground_phase` runs
 them on a batch, `ground_phase_one` on one ball's plain floats (the engine's one-shot latency path, where NumPy's

@@ -1,15 +1,26 @@
-"""The one table of ground surfaces and their parameters (Penner's impact model plus rolling resistance).
+"""The one table of ground surfaces and their parameters (the impact of `flight.ground.impact` plus rolling resistance).
 
 Parameters per surface: `restitution_scale` multiplies Penner's normal restitution e(v_n) (1 = his fairway);
-`critical_angle_deg` is Penner's theta_c, the angle the turf tilts the contact plane towards the incoming ball at
-a normal speed of 13 m/s (in proportion to it otherwise, `flight.ground.impact`); `friction` is the kinetic
-(Coulomb) friction coefficient that caps the tangential impulse of an impact; `rolling_resistance` is the rolling
-deceleration on level ground in units of g, and `grass_drag_per_s` a further deceleration in proportion to the
-rolling speed (grass the ball brushes through: a fast roll slows sooner). The fairway row is fitted on THE PLAYERS
-2020 rest positions (`golfflight ground-fit`, docs/ground.md); the other rows are anchors from the literature
-(Penner 2002, libgolf, openfairway; docs/ground.md), not measurements, but for the firm fairway: the fitted
-fairway with Penner's restitution, the fit's least rolling resistance and half its grass drag, set by that rule and
-not tuned. A green's rolling resistance comes from its stimpmeter reading.
+`critical_angle_deg` is Penner's theta_c, the angle the turf tilts the contact plane towards the incoming ball at his
+typical approach landing, 18.6 m/s at 44 degrees from the normal (in proportion to the speed and to that angle
+otherwise); `friction` is the kinetic (Coulomb) friction coefficient that caps the tangential impulse of an impact,
+and `spin_friction` the same for the turf's torque on the spin; `rolling_resistance` is the rolling deceleration on
+level ground in units of g, and `grass_drag_per_s` a further deceleration in proportion to the rolling speed (grass
+the ball brushes through: a fast roll slows sooner).
+
+Where the rows come from (docs/ground.md says more):
+- fairway: fitted on THE PLAYERS 2020 rest positions (`golfflight ground-fit`), friction held at 0.5 (openfairway's
+  fairway) and spin friction at 0 (with the green's 0.07 the fit's error grows);
+- firm_fairway: the fitted fairway with Penner's restitution, the fit's least rolling resistance and grass drag
+  0.8 /s, set by that rule and not tuned;
+- rough: the fitted fairway times the anchors' rough-to-fairway ratios (ROUGH_OVER_FAIRWAY): every parameter soaks up
+  at least as much as the fairway's, so a landing runs less far in the rough;
+- green: a firm, freely drained tour green. Penner's theta_c of about 15 degrees; libgolf's green-to-fairway
+  restitution (0.3-0.4 against 0.4-0.5: about three quarters); friction plus spin friction 0.165, so that at Penner's
+  typical landing a ball keeps its back spin through the bounce only above 347 rad/s (Haake: about 350 rad/s on such
+  greens), of it spin friction 0.07 so that no tour club spins back more than a few yards (docs/ground.md); rolling
+  resistance from the stimpmeter reading, no grass drag, so the reading maps exactly;
+- bunker: anchors (Penner's soft-turf tilt and more, libgolf's and openfairway's figures), not measurements.
 """
 
 from __future__ import annotations
@@ -43,6 +54,7 @@ class Surface:
     restitution_scale: float | np.ndarray
     critical_angle_deg: float | np.ndarray
     friction: float | np.ndarray
+    spin_friction: float | np.ndarray
     rolling_resistance: float | np.ndarray
     grass_drag_per_s: float | np.ndarray
 
@@ -56,12 +68,31 @@ class Surface:
         return Surface(*(np.array([getattr(s, f.name) for s in surfaces], dtype=float) for f in fields(Surface)))
 
 
+FAIRWAY = Surface(0.6631, 0.000549, 0.5, 0.0, 0.1296, 1.322)
+"""The fitted fairway (`golfflight ground-fit`, docs/ground.md)."""
+
+ROUGH_OVER_FAIRWAY = {
+    "restitution_scale": 0.25 / 0.45,
+    "critical_angle_deg": 0.35 / 0.29,
+    "friction": 0.62 / 0.50,
+    "rolling_resistance": 0.095 / 0.050,
+    "grass_drag_per_s": 0.0032 / 0.0017,
+}
+"""The rough's parameters over the fairway's in the anchors: libgolf's restitution (rough 0.2-0.3, fairway 0.4-0.5,
+mid-ranges) and openfairway's critical angle, kinetic friction, rolling friction and grass drag."""
+
+
+def scaled(base: Surface, ratios: dict[str, float]) -> Surface:
+    """`base` with some parameters multiplied by `ratios` (by name)."""
+    return replace(base, **{name: getattr(base, name) * ratio for name, ratio in ratios.items()})
+
+
 SURFACES: dict[str, Surface] = {
-    "fairway": Surface(0.6627, 0.00067, 0.5, 0.1301, 1.321),
-    "firm_fairway": Surface(1.0, 0.0, 0.4, 0.08, 0.8),
-    "rough": Surface(0.55, 20.0, 0.62, 0.35, 1.5),
-    "green": Surface(0.75, 20.6, 0.58, float(green_rolling_resistance(DEFAULT_STIMP_FT)), 0.0),
-    "bunker": Surface(0.2, 30.0, 0.8, 1.0, 3.0),
+    "fairway": FAIRWAY,
+    "firm_fairway": Surface(1.0, 0.0, 0.4, 0.0, 0.08, 0.8),
+    "rough": scaled(FAIRWAY, ROUGH_OVER_FAIRWAY),
+    "green": Surface(0.75, 15.0, 0.095, 0.07, float(green_rolling_resistance(DEFAULT_STIMP_FT)), 0.0),
+    "bunker": Surface(0.2, 30.0, 0.8, 0.0, 1.0, 3.0),
 }
 """Surface presets by name; `surface(name, ...)` overrides any parameter."""
 
