@@ -43,21 +43,17 @@ LAUNCH_COLUMNS = (
     "back_spin_rpm",
     "side_spin_rpm",
 )
-PASSED_OVER = (
-    "session",
-    "club",
-    "timestamp",
-    "split",
-    "source",
-    "group",
-    "ball",
-    "carry_x_m",
-    "carry_y_m",
-    "apex_m",
-    "flight_time_s",
-    "landing_angle_deg",
-)
-"""Canonical shot-record columns that say nothing about the launch or its conditions."""
+IDENTITY_COLUMNS = ("session", "player", "source", "club", "timestamp", "shot_number", "split", "group", "ball")
+"""Who, when, where from: canonical shot-record columns and the bay session's (GET /v1/session.csv) that say nothing
+about the launch or its conditions; `simulate` passes them over and echoes them in front of each result."""
+OBSERVED_COLUMNS = ("carry_x_m", "carry_y_m", "apex_m", "flight_time_s", "landing_angle_deg")
+"""Canonical shot-record outcome columns: passed over, not echoed (a result's own columns take some of the names)."""
+PASSED_OVER = (*IDENTITY_COLUMNS, *OBSERVED_COLUMNS)
+"""Columns that say nothing about the launch or its conditions."""
+
+PUTT = "putt"
+"""`simulate`'s column (and the session CSV's) for a putt: 1, true or yes rolls the ball on the shot's ground from the
+start, as a bay's shot with the putter does; `sweep` flies no putts and refuses the column."""
 
 REQUEST_COLUMNS = ("normalized", *LAUNCH_COLUMNS, *AIR_COLUMNS, *WIND_COLUMNS, *GROUND_COLUMNS)
 """Every column that goes into a shot's request."""
@@ -65,7 +61,8 @@ REQUEST_COLUMNS = ("normalized", *LAUNCH_COLUMNS, *AIR_COLUMNS, *WIND_COLUMNS, *
 KNOWN_COLUMNS = frozenset({"shot_id", *REQUEST_COLUMNS, *PASSED_OVER})
 
 TEXT_COLUMNS = frozenset(
-    {"shot_id", "session", "club", "timestamp", "split", "source", "group", "ball", "wind_profile", "ground_surface"}
+    {"shot_id", "session", "player", "club", "timestamp", "split", "source", "group", "ball", "wind_profile",
+     "ground_surface"}
 )
 """Columns whose cells are words (echoed as text); `normalized` is a flag; every other known column is a number."""
 
@@ -85,8 +82,9 @@ REQUIRED_COLUMNS = (("ball_speed_mps", "ball_speed_mph"), ("launch_angle_deg",),
 absence would otherwise surface as one problem a row, or a chunk of rows of which none could fly)."""
 
 
-def unknown_columns(columns: list[str]) -> list[str]:
-    return [c for c in columns if c not in KNOWN_COLUMNS]
+def unknown_columns(columns: list[str], also: frozenset[str] = frozenset()) -> list[str]:
+    """The columns neither read, passed over, an earlier run's result (`EARLIER_RESULTS`) nor among `also`."""
+    return [c for c in columns if c not in KNOWN_COLUMNS and c not in EARLIER_RESULTS and c not in also]
 
 
 def missing_columns(columns: list[str]) -> list[str]:
@@ -94,9 +92,10 @@ def missing_columns(columns: list[str]) -> list[str]:
     return [" or ".join(forms) for forms in REQUIRED_COLUMNS if not any(c in columns for c in forms)]
 
 
-def columns_message(source: str, columns: list[str]) -> str | None:
+def columns_message(source: str, columns: list[str], also: frozenset[str] = frozenset()) -> str | None:
     """Why a table with these columns cannot be read, in one line, or None: no columns, or the launch columns it
-    misses and the unknown ones it has. `simulate` and `sweep` check a file's header with it before reading a row."""
+    misses and the unknown ones it has (`also`: more columns the reader takes). `simulate` and `sweep` check a file's
+    header with it before reading a row."""
     if not columns:
         return f"{source} line 1: no header row; launch columns are {', '.join(LAUNCH_COLUMNS)}"
     problems = []
@@ -105,7 +104,7 @@ def columns_message(source: str, columns: list[str]) -> str | None:
         problems.append(
             f"missing columns: {', '.join(missing)} (every row needs a ball speed, a launch angle and a spin)"
         )
-    unknown = unknown_columns(columns)
+    unknown = unknown_columns(columns, also)
     if unknown:
         problems.append(f"unknown columns {unknown}; launch columns are {', '.join(LAUNCH_COLUMNS)}")
     return f"{source}: {'; '.join(problems)}" if problems else None
@@ -251,3 +250,21 @@ def result_columns(normalized: bool, flat: bool) -> list[str]:
     if flat:
         names += _flat_names(FlatFlight.model_fields, "flat_")
     return [*names, "error"]
+
+
+EARLIER_RESULTS = frozenset({"row", AIR_DENSITY, *result_columns(normalized=True, flat=True)})
+"""The columns `simulate` writes besides its input's: a file with a result in it (simulate's own output, the bay's
+session CSV) flies again, its earlier results passed over and not echoed (the new flight writes its own)."""
+
+
+def condition_cells(request: ShotRequest, given_only: bool = False) -> dict:
+    """A request's conditions (air, wind, ground) as the columns that give them, each as the request has it: every
+    value, defaults included (a wind's profile), or with `given_only` those the request was given."""
+    cells = {}
+    for section, columns in SECTION_COLUMNS.items():
+        part = getattr(request, section)
+        if part is not None:
+            named = {name: column for column, name in columns.items()}
+            values = part.model_dump(exclude_none=True, exclude_unset=given_only)
+            cells.update({named[k]: v for k, v in values.items() if k in named})
+    return cells

@@ -80,7 +80,7 @@ def create_app(
             runtime.stop()
 
     return http_app(runtime, lifespan=lifespan, api_key=api_key, cors_origins=cors_origins,
-                    more_routers=[viewer_routes.router], open_paths=PUBLIC_PATHS, allowed_hosts=allowed_hosts)
+                    more_routers=viewer_routes.ROUTERS, open_paths=PUBLIC_PATHS, allowed_hosts=allowed_hosts)
 
 
 def _tell(tcp: OpenConnectServer, player: Player) -> None:

@@ -68,7 +68,7 @@ def test_the_session_download_lets_the_loop_run_while_it_is_made(engine):
     feed = _session(engine, 2000)
     text, turns = asyncio.run(_download_and_count_turns(feed, slice_s=0.001))
     rows = list(csv.DictReader(io.StringIO(text)))
-    assert len(rows) == 2000 and rows[0]["session"] == "http" and float(rows[-1]["ball_speed_mps"]) == 60.0
+    assert len(rows) == 2000 and rows[0]["source"] == "http" and float(rows[-1]["ball_speed_mps"]) == 60.0
     assert turns >= 10, f"the loop ran {turns} times while 2,000 rows were made"
 
 
@@ -122,7 +122,7 @@ def test_a_shot_that_cannot_be_shown_is_left_out_and_the_stream_goes_on(engine, 
         return [text async for text in events(feed, viewer, lifetime_s=0.3)]
 
     frames = asyncio.run(stream())
-    assert [text.split("\n")[0] for text in frames[1:]] == ["id: 2"]
+    assert [text.split("\n")[0] for text in frames[1:]] == ["event: session", "id: 2"]  # the stream's session first
     assert "shot 1 cannot be shown" in caplog.text
 
 

@@ -90,9 +90,11 @@ class Connector:
 def shot_events(http: httpx.Client, count: int) -> list[ShotEvent]:
     """The kept shots' events (a viewer opening now gets every kept shot)."""
     found = []
+    kind = None
     with http.stream("GET", "/v1/events") as stream:
         for line in stream.iter_lines():
-            if line.startswith("data: "):
+            kind = line.removeprefix("event: ") if line.startswith("event: ") else kind
+            if line.startswith("data: ") and kind == "shot":  # a stream opens with the session's event
                 found.append(ShotEvent.model_validate_json(line.removeprefix("data: ")))
                 if len(found) == count:
                     return found
@@ -212,7 +214,7 @@ def test_the_sessions_shots_download_as_simulates_csv(bay_service):
     answer = http.get("/v1/session.csv")
     assert answer.status_code == 200 and answer.headers["content-type"].startswith("text/csv")
     rows = list(csv.DictReader(io.StringIO(answer.text)))
-    assert [row["session"] for row in rows] == ["open-connect", "http"] and rows[0]["club"] == "I7"
+    assert [row["source"] for row in rows] == ["open-connect", "http"] and rows[0]["club"] == "I7"
     assert float(rows[1]["ball_speed_mps"]) == pytest.approx(150.0 * 0.44704)
     assert float(rows[1]["wind_speed_mph"]) == 10.0 and float(rows[1]["wind_from_deg"]) == 90.0
     assert float(rows[0]["carry_m"]) > 100 and rows[0]["rest_x_m"] and rows[0]["shot_id"] == "1"

@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from golfflight.contract.columns import TEXT_COLUMNS
 from golfflight.sweep.grid import Grid, GridError, parse_axis
 
 from golfflight.cli import main
@@ -51,11 +52,12 @@ def write_csv(path, rows: list[dict]):
 
 
 def simulated(tmp_path, source) -> list[dict]:
-    """`golfflight simulate`'s CSV results for `source`, numbers as floats."""
+    """`golfflight simulate`'s CSV results for `source`, numbers as floats (words, as the echoed wind profile or
+    surface, as text)."""
     out = tmp_path / "simulated.csv"
     assert main(["simulate", str(source), "--out", str(out)]) == 0
     with open(out) as handle:
-        return [{k: v if k in ("shot_id", "error") else float(v) for k, v in r.items() if v != ""}
+        return [{k: v if k in ("shot_id", "error") or k in TEXT_COLUMNS else float(v) for k, v in r.items() if v != ""}
                 for r in csv.DictReader(handle)]
 
 
@@ -66,7 +68,9 @@ def assert_same_as_simulate(swept: list[dict], expected: list[dict], sample: int
         row, want = swept[i], expected[i]
         assert row["shot_id"] == want["shot_id"] and row["row"] == i
         for key, value in want.items():
-            if key != "shot_id":
+            if isinstance(value, str):
+                assert row[key] == value, (i, key)
+            else:
                 assert row[key] == pytest.approx(value, rel=1e-9, abs=1e-9), (i, key)
         flown = {k for k, v in row.items() if v is not None and k.startswith(("normalized_", "flat_"))}
         assert flown == {k for k in want if k.startswith(("normalized_", "flat_"))}, i

@@ -64,10 +64,13 @@ def pick_club(page, code: str) -> None:
 
 
 def next_event(lines, deadline_s: float = 5.0) -> ShotEvent:
-    """The next shot event from an SSE stream's lines (validated against the event model)."""
-    started = time.monotonic()
+    """The next shot event from an SSE stream's lines (validated against the event model); other events (the
+    session's) are passed over."""
+    started, kind = time.monotonic(), None
     for line in lines:
-        if line.startswith("data: "):
+        if line.startswith("event: "):
+            kind = line.removeprefix("event: ")
+        if line.startswith("data: ") and kind == "shot":
             return ShotEvent.model_validate_json(line.removeprefix("data: "))
         assert time.monotonic() - started < deadline_s, "no shot event in time"
     raise AssertionError("the stream ended before a shot event")
@@ -150,8 +153,9 @@ def test_a_stream_ends_after_its_lifetime_and_lets_its_viewer_go(engine):
         return feed, frames, time.monotonic() - started
 
     feed, frames, seconds = asyncio.run(stream())
-    assert frames[0].startswith("retry: ") and frames[1].startswith("id: 1\nevent: shot\ndata: {")
-    assert len(frames) == 2 and 0.3 <= seconds < 1.0 and feed.viewers == ()
+    assert frames[0].startswith("retry: ") and frames[1].startswith("event: session\ndata: {\"id\":1,")
+    assert frames[2].startswith("id: 1\nevent: shot\ndata: {")
+    assert len(frames) == 3 and 0.3 <= seconds < 1.0 and feed.viewers == ()
 
 
 def test_the_page_is_open_but_the_stream_needs_the_key_and_neither_is_in_the_openapi(service):

@@ -97,8 +97,9 @@ def test_a_quiet_stream_sends_keep_alive_comments(engine):
         return [frame async for frame in events(feed, viewer, lifetime_s=0.55, keepalive_s=0.1)]
 
     frames = asyncio.run(stream())
-    assert frames[0].startswith("retry: ") and frames[1].startswith("id: 1\n")
-    assert 3 <= frames.count(KEEPALIVE_FRAME) <= 6 and len(frames) == 2 + frames.count(KEEPALIVE_FRAME)
+    assert frames[0].startswith("retry: ") and frames[1].startswith("event: session\n")
+    assert frames[2].startswith("id: 1\n")
+    assert 3 <= frames.count(KEEPALIVE_FRAME) <= 6 and len(frames) == 3 + frames.count(KEEPALIVE_FRAME)
     assert KEEPALIVE_S <= 15
 
 
@@ -113,7 +114,8 @@ def test_a_stream_ends_promptly_when_the_server_shuts_down():
         return frames, time.monotonic() - started, feed
 
     frames, seconds, feed = asyncio.run(stream())
-    assert frames == ["retry: 500\n\n"] and 0.3 <= seconds < 1.2 and feed.viewers == ()
+    assert frames[0] == "retry: 500\n\n" and frames[1].startswith("event: session\n") and len(frames) == 2
+    assert 0.3 <= seconds < 1.2 and feed.viewers == ()
     assert serving_server()() is False  # pytest's main thread runs no uvicorn server: never seen as stopping
 
 
@@ -291,8 +293,11 @@ def test_the_narrow_layout_keeps_the_lateral_column_and_whole_dots():
         assert lateral.is_visible() and lateral.bounding_box()["x"] + lateral.bounding_box()["width"] <= 390
         for view in ("#dispersion",):
             box = page.locator(view).bounding_box()
-            for dot in page.locator(f"{view} circle.dot").all():
-                b = dot.bounding_box()  # each dot whole, inside its picture
+            dots = page.eval_on_selector_all(  # read at once: the view redraws when the session's summary comes
+                f"{view} circle.dot", "ds => ds.map(d => { const r = d.getBoundingClientRect(); "
+                "return {x: r.x, width: r.width, height: r.height}; })")
+            assert dots
+            for b in dots:  # each dot whole, inside its picture
                 assert box["x"] <= b["x"] and b["x"] + b["width"] <= box["x"] + box["width"]
                 assert abs(b["width"] - b["height"]) < 0.5
         for ring in page.locator("#dispersion circle.rest-dot").all():  # rings in the club's colour, not dark
@@ -473,8 +478,9 @@ def test_the_session_csv_downloads_with_the_key():
             page.click("#download-csv")
         saved = download.value
         text = Path(saved.path()).read_text()
-        assert saved.suggested_filename == "golfflight-session.csv"
+        assert saved.suggested_filename == "golfflight-session-1.csv"
         assert text == http.get("/v1/session.csv", headers=KEYED).text
         rows = list(csv.DictReader(io.StringIO(text)))
-        assert [row["session"] for row in rows] == ["open-connect", "http"] and rows[0]["club"] == "DR"
+        assert [row["source"] for row in rows] == ["open-connect", "http"] and rows[0]["club"] == "DR"
+        assert [row["session"] for row in rows] == ["1", "1"]
         assert http.get("/v1/session.csv").status_code == 401 and errors == []  # the page sent the key

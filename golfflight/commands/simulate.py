@@ -4,18 +4,21 @@ Input: JSON (one shot, a list of shots, or {"shots": [...]}, in the HTTP request
 (one row per shot, the request's launch fields as columns plus optional flat conditions: temperature_c,
 altitude_m, pressure_hpa, humidity_pct, density_kg_m3, wind_speed_mps or wind_speed_mph, wind_from_deg, wind_profile,
 wind_reference_height_m, normalized, and the ground: ground_surface, stimp_ft, ground_elevation_m or
-ground_elevation_ft, slope_deg, slope_dir_deg). A canonical shot file works as is: its identity and outcome columns are
-passed over, its shot_id echoed. A CSV's header is checked before any row is read: a missing launch column (a ball
-speed, the launch angle, a spin) or an unknown one refuses the file in one line (`contract.columns.columns_message`,
-as `golfflight sweep` does).
+ground_elevation_ft, slope_deg, slope_dir_deg), and `putt` (1, true or yes: the ball rolls on the shot's ground from
+the start, as a bay's shot with the putter does). A canonical shot file works as is: its identity and outcome columns
+are passed over, its shot_id and identity columns (session, player, source, club, timestamp, shot_number, split,
+group, ball) echoed. So does a file with results in it, simulate's own output or the bay's session
+(GET /v1/session.csv): its result columns are passed over, not echoed, and it flies to the same carries. A CSV's
+header is checked before any row is read: a missing launch column (a ball speed, the launch angle, a spin) or an
+unknown one refuses the file in one line (`contract.columns.columns_message`, as `golfflight sweep` does).
 
 Output: {"results": [...]} as JSON, or a flat CSV when --out ends in .csv: the result's fields as columns
 (`contract.columns.result_columns`), its points flattened (rest_x_m, rest_x_yd, ...), every length in metres and
 yards, the landing speed in m/s and mph. Each result starts with what matches it to its input: `row`, the input's
 row number from 0 as in `golfflight sweep`'s results (a CSV's data row: its line number less 2, the header being
-line 1; a JSON shot's index), the shot_id where the CSV has one, the shot's launch columns as read, and the air it
-was flown in: its air columns as given, then `air_density_kg_m3`, the density flown (ICAO standard air, 1.225 kg/m³,
-where the shot gives none).
+line 1; a JSON shot's index), the shot_id and identity columns where the CSV has them, the shot's launch columns as
+read, `putt` where the CSV has it, its wind and ground columns, and the air it was flown in: its air columns as given,
+then `air_density_kg_m3`, the density flown (ICAO standard air, 1.225 kg/m³, where the shot gives none).
 
 A bad shot (a value out of range or not a number, an extra cell, a shot_id seen before) refuses the file with its
 line (CSV) or index (JSON) and field; --skip-bad-rows flies the rest and lists each one left out on stderr, and
@@ -34,16 +37,25 @@ from pathlib import Path
 from golfflight.contract.columns import (
     AIR_COLUMNS,
     AIR_DENSITY,
+    GROUND_COLUMNS,
+    IDENTITY_COLUMNS,
     LAUNCH_COLUMNS,
+    PUTT,
+    WIND_COLUMNS,
     cell_value,
     check,
     columns_message,
+    condition_cells,
     flat_row,
+    is_flag_set,
     request_of_cells,
 )
 from golfflight.contract.inputs import conditions_of
 from golfflight.contract.requests import ShotRequest
 from golfflight.shots.records import reading
+
+ECHOED_CONDITIONS = (*WIND_COLUMNS, *GROUND_COLUMNS)
+"""The condition columns echoed as read (the air's come with `flown_air`)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -60,13 +72,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 @dataclass
 class Input:
     """The shots of an input as read, before validation: request dicts, each with its input row number (from 0), its
-    place in messages ("FILE line N", "FILE shot N") and its shot id (CSV only: None where the file has none), and
-    the problems found while reading (extra cells, repeated shot ids) of `rows_read` rows in all."""
+    place in messages ("FILE line N", "FILE shot N"), its shot id (CSV only: None where the file has none), the
+    cells it echoes (CSV only: identity columns and `putt`, as read) and whether it is a putt, and the problems found
+    while reading (extra cells, repeated shot ids) of `rows_read` rows in all."""
 
     shots: list = field(default_factory=list)
     rows: list[int] = field(default_factory=list)
     places: list[str] = field(default_factory=list)
     ids: list[str | None] = field(default_factory=list)
+    echoed: list[dict] = field(default_factory=list)
+    putts: list[bool] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)
     rows_read: int = 0
 
@@ -77,7 +92,7 @@ def shots_from_csv(path: Path) -> Input:
     read = Input()
     with reading(path), open(path, newline="") as handle:
         reader = csv.DictReader(handle)
-        refused = columns_message(str(path), list(reader.fieldnames or []))
+        refused = columns_message(str(path), list(reader.fieldnames or []), also=frozenset({PUTT}))
         if refused:
             raise ValueError(refused)
         seen: dict[str, int] = {}
@@ -99,6 +114,10 @@ def shots_from_csv(path: Path) -> Input:
             read.rows.append(row)
             read.places.append(place)
             read.ids.append(shot_id)
+            echoed = {c: cells[c] for c in (*IDENTITY_COLUMNS, PUTT) if cells.get(c) is not None}
+            conditions = {c: cell_value(cells.get(c)) for c in ECHOED_CONDITIONS}
+            read.echoed.append({**echoed, **{c: v for c, v in conditions.items() if v is not None}})
+            read.putts.append(is_flag_set((cells.get(PUTT) or "").strip()))
     return read
 
 
@@ -164,22 +183,32 @@ def flown_air(shot: ShotRequest) -> dict:
 
 def matching(read: Input, kept: list[int], shots: list[ShotRequest]) -> list[dict]:
     """What matches each flown shot (`shots`, validated from the inputs `kept`) to its input, in front of its result:
-    `row`, its shot_id (where it has one), its launch columns as read and the air it was flown in (`flown_air`)."""
-    return [
-        {
+    `row`, its shot_id and identity cells (where it has them), its launch columns as read, `putt` as read, its wind and
+    ground columns as read (a JSON shot's: as given), and the air it was flown in (`flown_air`)."""
+    fronts = []
+    for i, shot in zip(kept, shots, strict=True):
+        given = {c: v for c, v in condition_cells(shot, given_only=True).items() if c in ECHOED_CONDITIONS}
+        echoed = read.echoed[i] if read.echoed else given
+        fronts.append({
             "row": read.rows[i],
             **({"shot_id": read.ids[i]} if read.ids and read.ids[i] is not None else {}),
+            **{c: v for c, v in echoed.items() if c not in ECHOED_CONDITIONS},
             **{c: read.shots[i][c] for c in LAUNCH_COLUMNS if read.shots[i].get(c) is not None},
+            **{c: v for c, v in echoed.items() if c in ECHOED_CONDITIONS},
             **flown_air(shot),
-        }
-        for i, shot in zip(kept, shots, strict=True)
-    ]
+        })
+    return fronts
+
+
+FRONT_COLUMNS = ("row", "shot_id", *IDENTITY_COLUMNS, *LAUNCH_COLUMNS, PUTT, *WIND_COLUMNS, *GROUND_COLUMNS,
+                 *AIR_COLUMNS, AIR_DENSITY)
+"""The order of a result row's `matching` columns (those that some row has)."""
 
 
 def write_csv(out: str, fronts: list[dict], results: list[dict]) -> None:
     """The results as a flat CSV: each row's `matching` columns first, then its result's (`flat_row`)."""
     flats = [flat_row(r) for r in results]
-    front = [c for c in ("row", "shot_id", *LAUNCH_COLUMNS, *AIR_COLUMNS, AIR_DENSITY) if any(c in f for f in fronts)]
+    front = [c for c in FRONT_COLUMNS if any(c in f for f in fronts)]
     columns = [*front, *dict.fromkeys(key for flat in flats for key in flat)]
     with open(out, "w", newline="") as handle:
         writer = csv.DictWriter(handle, columns)
@@ -187,8 +216,26 @@ def write_csv(out: str, fronts: list[dict], results: list[dict]) -> None:
         writer.writerows({**f, **flat} for f, flat in zip(fronts, flats, strict=True))
 
 
+def fly_all(engine, shots: list[ShotRequest], putts: list[bool]) -> list[dict]:
+    """Each shot's result as a dict, in order: the putts rolled one by one as the bay rolls them
+    (`flown_shot(..., putt=True)`), the rest in engine batches (`fly_shots`)."""
+    from golfflight.contract.flying import flown_shot, fly_shots
+    from golfflight.contract.results import ShotFailure
+    from golfflight.flight.engine import FlightError
+
+    results: list = [None] * len(shots)
+    full = [i for i, putt in enumerate(putts) if not putt]
+    for i, result in zip(full, fly_shots(engine, [shots[i] for i in full]), strict=True):
+        results[i] = result
+    for i in (i for i, putt in enumerate(putts) if putt):
+        try:
+            results[i] = flown_shot(engine, shots[i], putt=True)[0]
+        except FlightError as error:
+            results[i] = ShotFailure(error=str(error))
+    return [r.model_dump(exclude_none=True) for r in results]
+
+
 def run(args: argparse.Namespace) -> int:
-    from golfflight.contract.flying import fly_shots
     from golfflight.flight.bundle_location import model_dir
     from golfflight.flight.engine import FlightEngine
 
@@ -198,7 +245,8 @@ def run(args: argparse.Namespace) -> int:
     shots, kept, invalid = validate(read.shots, read.places, from_csv)
     refuse_or_skip(args.input, read.problems + invalid, len(shots), read.rows_read, args.skip_bad_rows)
     engine = FlightEngine(model_dir(args.model))
-    results = [r.model_dump(exclude_none=True) for r in fly_shots(engine, shots)]
+    putts = [read.putts[i] if read.putts else False for i in kept]
+    results = fly_all(engine, shots, putts)
     fronts = matching(read, kept, shots)
     if args.out and args.out.lower().endswith(".csv"):
         write_csv(args.out, fronts, results)

@@ -6,6 +6,11 @@ screen draws the very flight whose numbers the player got; nothing is flown agai
 a few appends: a slow or dead viewer only loses the oldest shots it has not been sent yet (its queue drops them).
 An entry's event text is rendered once, by the first viewer stream that sends it (`service.viewer`), and only that
 text is kept after. Everything here runs on the service's event loop thread.
+
+The shots also go to the current session (`sessions`), whose shots the session's CSV and summary read. Starting a new
+session empties the screens: the kept shots are let go and every open viewer drops the shots it had not sent yet and
+announces the new session (the viewer's `session` event) before any shot of it; a viewer that opens or reconnects
+announces the current session first, then gets that session's kept shots only.
 """
 
 from __future__ import annotations
@@ -14,18 +19,19 @@ import asyncio
 import time
 from collections import deque
 from dataclasses import dataclass
-from typing import Literal, NamedTuple
+from typing import Literal
 
 from golfflight.contract.bay import Player
 from golfflight.contract.requests import ShotRequest
 from golfflight.contract.results import ShotResult
 from golfflight.flight.engine import EulerStates
+from golfflight.service.runtime.sessions import MAX_SESSIONS, MAX_SHOTS, Session, Sessions, SessionShot
 
 HISTORY = 50
 """Shots kept for viewers that open (or reconnect) later, and the length of each viewer's queue."""
 
-SESSION_SHOTS = 10_000
-"""Shots kept for the session's download (GET /v1/session.csv): a long range session; the oldest go first."""
+SESSION_SHOTS = MAX_SHOTS
+"""Shots kept over all sessions for their downloads (GET /v1/session.csv) and summaries; the oldest go first."""
 
 MAX_VIEWERS = 16
 """Event streams open at once; one more is refused with 503 (a bay has a screen or two)."""
@@ -62,25 +68,14 @@ class Entry:
         return frame
 
 
-class SessionShot(NamedTuple):
-    """One shot of the session as its download lists it: when, where from, who hit it, what flew, what came out."""
-
-    id: int
-    received_unix_s: float
-    source: Source
-    shot_number: int | None
-    player: Player | None
-    putt: bool
-    request: ShotRequest
-    result: ShotResult
-
-
 class Viewer:
-    """One open stream's queue of shots to send: bounded, the oldest dropped when full."""
+    """One open stream's queue of shots to send: bounded, the oldest dropped when full; and the session to announce
+    before any of them (the stream's first event, and the event that empties a screen)."""
 
-    def __init__(self, capacity: int):
+    def __init__(self, capacity: int, session: Session):
         self.pending: deque[Entry] = deque(maxlen=capacity)
         self.dropped = 0
+        self.session: Session | None = session
         self._wake = asyncio.Event()
 
     def offer(self, entry: Entry) -> None:
@@ -89,27 +84,52 @@ class Viewer:
         self.pending.append(entry)
         self._wake.set()
 
-    async def next(self, timeout_s: float) -> Entry | None:
-        """The next shot to send, or None when none came within `timeout_s`."""
-        if not self.pending:
+    def restart(self, session: Session) -> None:
+        """A new session: the shots not sent yet are the old session's, let go; the session is announced next."""
+        self.pending.clear()
+        self.session = session
+        self._wake.set()
+
+    async def next(self, timeout_s: float) -> Entry | Session | None:
+        """The session to announce, else the next shot to send, or None when none came within `timeout_s`."""
+        if self.session is None and not self.pending:
             self._wake.clear()
             try:
                 async with asyncio.timeout(timeout_s):
                     await self._wake.wait()
             except TimeoutError:
                 return None
+        if self.session is not None:
+            session, self.session = self.session, None
+            return session
         return self.pending.popleft() if self.pending else None
 
 
 class ShotFeed:
-    """The last `history` shots, the open viewers' queues, and the session's shots (the last `session`)."""
+    """The last `history` shots of the current session, the open viewers' queues, and the sessions (`sessions`:
+    at most `max_sessions`, their shots at most `max_shots` in all)."""
 
-    def __init__(self, history: int = HISTORY, max_viewers: int = MAX_VIEWERS, session: int = SESSION_SHOTS):
+    def __init__(self, history: int = HISTORY, max_viewers: int = MAX_VIEWERS, max_shots: int = SESSION_SHOTS,
+                 max_sessions: int = MAX_SESSIONS):
         self._history: deque[Entry] = deque(maxlen=history)
-        self.session: deque[SessionShot] = deque(maxlen=session)
+        self.sessions = Sessions(max_shots, max_sessions)
         self._viewers: set[Viewer] = set()
         self._max_viewers = max_viewers
         self._next_id = 1
+
+    @property
+    def session(self) -> deque[SessionShot]:
+        """The current session's shots kept, oldest first."""
+        return self.sessions.current.shots
+
+    def start_session(self, player: str | None = None) -> Session:
+        """A new session, now the current one: the screens empty (the kept shots let go, each open viewer's unsent
+        ones too) and every open viewer announces it next."""
+        session = self.sessions.start(player)
+        self._history.clear()
+        for viewer in self._viewers:
+            viewer.restart(session)
+        return session
 
     @property
     def history(self) -> int:
@@ -129,18 +149,18 @@ class ShotFeed:
         entry = Entry(self._next_id, source, time.time(), request, result, states, flight_time_s, **details)
         self._next_id += 1
         self._history.append(entry)
-        self.session.append(SessionShot(entry.id, entry.received_unix_s, source, entry.shot_number, entry.player,
-                                        entry.putt, request, result))
+        self.sessions.add(SessionShot(entry.id, entry.received_unix_s, source, entry.shot_number, entry.player,
+                                      entry.putt, request, result))
         for viewer in self._viewers:
             viewer.offer(entry)
         return entry
 
     def subscribe(self, after_id: int | None = None) -> Viewer:
-        """A new viewer's queue, holding the kept shots after `after_id` (all of them without one, or when the id
-        is from before a restart); TooManyViewers when MAX_VIEWERS are open."""
+        """A new viewer's queue, announcing the current session, then holding its kept shots after `after_id` (all
+        of them without one, or when the id is from before a restart); TooManyViewers when MAX_VIEWERS are open."""
         if len(self._viewers) >= self._max_viewers:
             raise TooManyViewers(f"{self._max_viewers} viewers are open already")
-        viewer = Viewer(self._history.maxlen)
+        viewer = Viewer(self._history.maxlen, self.sessions.current)
         resume = after_id is not None and after_id < self._next_id
         for entry in self._history:
             if not resume or entry.id > after_id:

@@ -1,4 +1,6 @@
-"""The payload of the viewer's event stream (`GET /v1/events`): one `ShotEvent` per shot, as JSON.
+"""The payload of the viewer's event stream (`GET /v1/events`): one `ShotEvent` per shot (`event: shot`), and the
+session the screens show (`event: session`, a `contract.session.SessionInfo`: first on every stream and whenever a new
+session starts, when a screen empties), as JSON.
 
 The JSON Schema beside this file (event.schema.json) is generated from these models by
 `python -m golfflight.service.viewer`; a test keeps it current. The stream is left out of the OpenAPI document (an
@@ -9,12 +11,14 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Annotated
 
 from golfflight.contract.bay import Player
 from golfflight.contract.requests import AirRequest, GroundRequest, WindRequest
 from golfflight.contract.results import ShotResult
+from golfflight.contract.session import SessionInfo
 from golfflight.service.runtime.feed import Source
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, Field, TypeAdapter
 
 SCHEMA_PATH = Path(__file__).with_name("event.schema.json")
 
@@ -54,6 +58,15 @@ class ShotEvent(BaseModel):
                                          "level fairway at the tee's height)")
 
 
+ViewerEvent = Annotated[
+    ShotEvent | SessionInfo,
+    Field(description="An event of GET /v1/events: `event: shot` carries a ShotEvent, `event: session` a SessionInfo "
+          "(the session the screens show: first on every stream, and again when a new session starts and the screens "
+          "empty)."),
+]
+
+
 def schema_text() -> str:
-    """The event's JSON Schema as written to SCHEMA_PATH."""
-    return json.dumps(ShotEvent.model_json_schema(), indent=2, sort_keys=True) + "\n"
+    """The events' JSON Schema as written to SCHEMA_PATH."""
+    schema = {"title": "ViewerEvent", **TypeAdapter(ViewerEvent).json_schema()}
+    return json.dumps(schema, indent=2, sort_keys=True) + "\n"

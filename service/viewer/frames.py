@@ -1,5 +1,6 @@
 """A feed entry as the viewer's server-sent event: the shot's launch, the result answered, and the path of the
-flight that result was read from, resampled for drawing. Rendered once per shot, off the shot's own path (by the
+flight that result was read from, resampled for drawing; and a session's announcement (`event: session`, no id: a
+stream's Last-Event-ID stays a shot's). Rendered once per shot, off the shot's own path (by the
 first stream that sends it). A shot whose event cannot be rendered is left out of every stream and logged: one bad
 event must not cut the stream, nor, kept among the shots a reconnecting page is sent, every stream after it."""
 
@@ -13,6 +14,7 @@ from golfflight.contract.results import TrajectoryPoint
 from golfflight.contract.trajectory import resample
 from golfflight.flight.engine import EulerStates
 from golfflight.service.runtime.feed import Entry
+from golfflight.service.runtime.sessions import Session
 from golfflight.service.viewer.event import LaunchNumbers, ShotEvent
 
 VIEW_RATE_HZ = 30.0
@@ -59,9 +61,16 @@ def render(entry: Entry) -> str:
     return f"id: {entry.id}\nevent: shot\ndata: {event.model_dump_json(exclude_none=True)}\n\n"
 
 
-def frame(entry: Entry) -> str:
+def session_frame(session: Session) -> str:
+    """A session's server-sent event (type `session`, its SessionInfo as JSON, as the current session)."""
+    return f"event: session\ndata: {session.info(current=True).model_dump_json(exclude_none=True)}\n\n"
+
+
+def frame(entry: Entry | Session) -> str:
     """The entry's event, rendered on first use and kept (the entry keeps only that text after); empty, and logged
-    once, when it cannot be rendered."""
+    once, when it cannot be rendered. A session is announced as it is now (its shots counted when sent)."""
+    if isinstance(entry, Session):
+        return session_frame(entry)
     if entry.frame is not None:
         return entry.frame
     try:

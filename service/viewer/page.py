@@ -1,7 +1,8 @@
-"""The viewer page and its script and style, shipped in `static/` (package data) and read once at import; the page's
-club menu is filled in from GSPro's club codes (`contract.bay.GSPRO_CLUBS`: the value a code, the label its name), the
-clubs the bay's player can select (`PATCH /v1/bay {"player": {"club": CODE}}`) and each shot's event names, and the
-bay form's ground menu from the surfaces a request may name (`flight.ground.SURFACES`)."""
+"""The viewer page, its scripts (`viewer.js`; `session.js`: the session's events, summary and "New session") and
+style, shipped in `static/` (package data) and read once at import; the page's club menu is filled in from GSPro's
+club codes (`contract.bay.GSPRO_CLUBS`: the value a code, the label its name), the clubs the bay's player can select
+(`PATCH /v1/bay {"player": {"club": CODE}}`) and each shot's event names, and the bay form's ground menu from the
+surfaces a request may name (`flight.ground.SURFACES`)."""
 
 from __future__ import annotations
 
@@ -50,6 +51,7 @@ ASSETS: dict[str, tuple[bytes, str]] = {
     for name, media_type in (
         ("viewer.html", "text/html; charset=utf-8"),
         ("viewer.js", "text/javascript; charset=utf-8"),
+        ("session.js", "text/javascript; charset=utf-8"),
         ("viewer.css", "text/css; charset=utf-8"),
     )
 }

@@ -1,6 +1,6 @@
-"""GET /viewer (the live shot viewer page, its script and style), GET /v1/events (its server-sent event stream) and
-GET /v1/session.csv (the session's shots): the viewer's adapter on the bay runtime, mounted by the service's
-assembly (`service.app`).
+"""GET /viewer (the live shot viewer page, its scripts and style), GET /v1/events (its server-sent event stream) and
+the sessions' routes (`sessions`: start one, list them, a session's CSV and summary): the viewer's adapter on the bay
+runtime, mounted by the service's assembly (`service.app`).
 
 The page and the stream are left out of the OpenAPI document: the page is no API, and an endless stream is no
 operation a client or a fuzzer can call and validate; the stream's payload has its JSON Schema in
@@ -13,14 +13,16 @@ from fastapi import APIRouter, Header, Request
 from fastapi.responses import JSONResponse, Response, StreamingResponse
 from golfflight.service.runtime import BayRuntime
 from golfflight.service.runtime.feed import TooManyViewers
+from golfflight.service.viewer import sessions
 from golfflight.service.viewer.page import ASSETS, PAGE_PATH, SECURITY_HEADERS
-from golfflight.service.viewer.session_csv import session_csv_slices
 from golfflight.service.viewer.stream import events, last_event_id
 
 EVENTS_PATH = "/v1/events"
-SESSION_PATH = "/v1/session.csv"
 
 router = APIRouter()
+
+ROUTERS = (router, sessions.router)
+"""The viewer's routers, for the service's assembly to mount."""
 
 
 def _runtime(request: Request) -> BayRuntime:
@@ -48,7 +50,8 @@ async def asset(name: str) -> Response:
 
 @router.get(EVENTS_PATH, include_in_schema=False)
 async def shot_events(request: Request, last_event: str | None = Header(None, alias="last-event-id")) -> Response:
-    """Every shot flown from now on (and the kept ones, or those after Last-Event-ID) as server-sent events."""
+    """The current session, then every shot flown from now on (and its kept ones, or those after Last-Event-ID) as
+    server-sent events; a new session is announced as it starts."""
     runtime = _runtime(request)
     runtime.ready_engine()
     try:
@@ -57,13 +60,3 @@ async def shot_events(request: Request, last_event: str | None = Header(None, al
         return JSONResponse({"detail": f"{error}: close one and try again"}, 503)
     headers = {"cache-control": "no-store", "x-accel-buffering": "no"}
     return StreamingResponse(events(runtime.feed, viewer), media_type="text/event-stream", headers=headers)
-
-
-@router.get(SESSION_PATH, response_class=Response, responses={200: {"content": {"text/csv": {}}}})
-async def session(request: Request) -> Response:
-    """The session's shots (every shot the bay's screens were sent since the service started, the last 10,000) as
-    CSV in `golfflight simulate`'s columns: launch and conditions in, the result out, with the shot's id, time,
-    source and club. Streamed from a snapshot in short slices (`session_csv_slices`): shots keep flying meanwhile."""
-    snapshot = list(_runtime(request).feed.session)
-    headers = {"content-disposition": 'attachment; filename="golfflight-session.csv"', "cache-control": "no-store"}
-    return StreamingResponse(session_csv_slices(snapshot), media_type="text/csv; charset=utf-8", headers=headers)

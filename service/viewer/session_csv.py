@@ -1,7 +1,8 @@
-"""The session's shots as CSV (GET /v1/session.csv), in `golfflight simulate`'s columns: the launch in SI and the
-conditions flown in as simulate reads them, then the result as simulate writes it, so a session can be flown again
-(`golfflight simulate session.csv`) or opened in a spreadsheet. Who hit it, when and from where ride along in
-columns simulate passes over (`session`, `club`, `timestamp`).
+"""A session's shots as CSV (GET /v1/session.csv), in `golfflight simulate`'s columns: the launch in SI and the
+conditions flown in as simulate reads them, `putt` for a putt (simulate rolls it as the bay did), then the result as
+simulate writes it, so a session can be flown again (`golfflight simulate session.csv`: the same carries) or opened
+in a spreadsheet. Who hit it, when and from where ride along in columns simulate passes over and echoes (`session`,
+`player`, `source`, `club`, `timestamp`, `shot_number`); simulate passes over the result columns too.
 
 The download is built on the event loop in slices of at most SLICE_S, each followed by a turn of the loop, over a
 snapshot of the session taken when it is asked for: 10,000 shots take 1 to 3 s of pure Python, which in one piece
@@ -18,14 +19,15 @@ import time
 from collections.abc import AsyncIterator, Sequence
 from datetime import UTC, datetime
 
-from golfflight.contract.columns import AIR_COLUMNS, GROUND_COLUMNS, WIND_COLUMNS, flat_row
+from golfflight.contract.columns import PUTT, condition_cells, flat_row
 from golfflight.contract.inputs import launch_of
 from golfflight.contract.requests import ShotRequest
-from golfflight.service.runtime.feed import SessionShot
+from golfflight.service.runtime.sessions import SessionShot
 
-SHOT_COLUMNS = ("shot_id", "timestamp", "session", "club", "putt", "shot_number")
-"""Who, when and where from: `session` is the source (http, batch, gspro-http, open-connect), `club` the GSPro club
-code of the bay's player when the shot was hit."""
+SHOT_COLUMNS = ("shot_id", "timestamp", "session", "player", "source", "club", "shot_number", PUTT)
+"""Who, when and where from: `session` is the session's id, `player` its player's name, `source` where the shot came
+in (http, batch, gspro-http, open-connect), `club` the GSPro club code of the bay's player when the shot was hit,
+`putt` 1 for a putt."""
 
 SLICE_S = 0.002
 """Longest the download works at once before it lets the loop answer shots: a shot waits at most this much per
@@ -35,32 +37,33 @@ LAUNCH_COLUMNS = ("ball_speed_mps", "launch_angle_deg", "launch_direction_deg", 
 
 
 def request_cells(request: ShotRequest) -> dict:
-    """A request's launch (SI) and conditions as simulate's input columns (`contract.columns`)."""
+    """A request's launch (SI), its conditions and its `normalized` flag as simulate's input columns
+    (`contract.columns`)."""
     cells = dict(zip(LAUNCH_COLUMNS, launch_of(request), strict=True))
-    for part, columns in ((request.air, AIR_COLUMNS), (request.wind, WIND_COLUMNS), (request.ground, GROUND_COLUMNS)):
-        if part is not None:
-            named = {field: column for column, field in columns.items()}
-            cells.update({named[k]: v for k, v in part.model_dump(exclude_none=True).items() if k in named})
-    return cells
+    if request.normalized:
+        cells["normalized"] = 1
+    return {**cells, **condition_cells(request)}
 
 
-def _row(shot: SessionShot) -> dict:
+def _row(shot: SessionShot, player: str | None) -> dict:
     when = datetime.fromtimestamp(shot.received_unix_s, UTC).isoformat(timespec="milliseconds")
     club = "" if shot.player is None else shot.player.club
-    own = {"shot_id": shot.id, "timestamp": when, "session": shot.source, "club": club, "putt": int(shot.putt),
-           "shot_number": "" if shot.shot_number is None else shot.shot_number}
+    own = {"shot_id": shot.id, "timestamp": when, "session": shot.session, "player": player or "",
+           "source": shot.source, "club": club, "shot_number": "" if shot.shot_number is None else shot.shot_number,
+           PUTT: int(shot.putt)}
     return {**own, **request_cells(shot.request), **flat_row(shot.result.model_dump(exclude_none=True))}
 
 
-async def session_csv_slices(shots: Sequence[SessionShot], slice_s: float = SLICE_S) -> AsyncIterator[str]:
-    """The shots as CSV text, one row each, columns in the order they first appear, in pieces, each made in at most
-    about `slice_s` with a turn of the event loop between two: the rows first (their columns, in the order they first appear, are known only once all are made), then
-    the text."""
+async def session_csv_slices(shots: Sequence[SessionShot], slice_s: float = SLICE_S,
+                             player: str | None = None) -> AsyncIterator[str]:
+    """The shots (of a session played by `player`) as CSV text, one row each, in pieces, each made in at most about
+    `slice_s` with a turn of the event loop between two: the rows first (their columns, in the order they first
+    appear, are known only once all are made), then the text."""
     rows: list[dict] = []
     columns = dict.fromkeys(SHOT_COLUMNS)
     deadline = time.perf_counter() + slice_s
     for shot in shots:
-        rows.append(_row(shot))
+        rows.append(_row(shot, player))
         columns.update(dict.fromkeys(rows[-1]))
         if time.perf_counter() >= deadline:
             await asyncio.sleep(0)

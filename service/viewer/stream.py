@@ -66,9 +66,9 @@ async def events(
     keepalive_s: float = KEEPALIVE_S,
     stopping: Callable[[], bool] | None = None,
 ) -> AsyncIterator[str]:
-    """The viewer's shots as server-sent events, with a keep-alive comment after every `keepalive_s` without one,
-    until `lifetime_s` has passed (None: until the client goes or the server shuts down); unsubscribes it however
-    it ends."""
+    """The viewer's session (first, and again whenever a new one starts) and shots as server-sent events, with a
+    keep-alive comment after every `keepalive_s` without one, until `lifetime_s` has passed (None: until the client
+    goes or the server shuts down); unsubscribes it however it ends."""
     stopping = serving_server() if stopping is None else stopping
     ends = None if lifetime_s is None else time.monotonic() + lifetime_s
     try:

@@ -19,15 +19,21 @@ const BAY_POLL_MS = 30_000;       // how often the bay is read again (another sc
 
 // The behind-the-golfer camera: a perspective camera at the golfer's eye, behind the tee on the target line, looking
 // down that line and tilted down just enough to keep the tee in the picture, so the horizon (the target line's
-// vanishing point) is in view and a shot reads as an arc receding to its landing.
+// vanishing point) is in view and a shot reads as an arc receding to its landing. These are the golfer's camera; a
+// shot that climbs out of its picture widens it (`behindCamera`).
 const CAMERA_HEIGHT_M = 1.6;      // above the tee
 const CAMERA_BACK_M = 3;          // behind the tee
-const CAMERA_FOV_DEG = 55;        // vertical field of view: from the tee, 28° below level, to a pitching wedge's 22°
+const CAMERA_FOV_DEG = 55;        // vertical field of view: from the tee, 28° below level, to 24° above level
 const CAMERA_PITCH_DEG = 3.5;     // below level: the tee 6 % of the picture above its bottom, the sky up to 24°
 const TEE_Z_M = 0.01;             // the ball on its tee (README: a 1 cm tee)
 const FAIRWAY_HALF_M = 20;
 const FAR_GROUND_M = 5000;        // where the fairway's edges are drawn to: a pixel or two short of the horizon
 const LABEL_GAP_PX = 14;          // a distance label closer than this to the one kept before it is left out
+const APEX_MARGIN = 0.07;         // the highest point of any shot shown stays this part of the picture below its top
+const MAX_FOV_DEG = 90;           // wider than this the picture bends too much: the camera steps back instead
+const SIDE_MARGIN_PX = 4;         // every shot shown stays this far inside the behind view's left and right edges
+const PIN_STORE = "golfflight-pin-m";  // the pin's distance down the target line, metres ("" or absent: no pin)
+const FLAG_PX = 16;               // the pin's flagstick as drawn, pixels: a symbol, readable at any distance
 
 // Every SVG's viewBox is its rendered size in CSS pixels (`frame`), so the labels' font sizes (viewer.css) are the
 // sizes on screen at any width, and margins are worked out from the labels' measured widths.
@@ -184,6 +190,7 @@ function onBlock(block) {
   }
   if (id !== null) state.lastId = Number(id);
   if (kind === "shot" && data.length) addShot(JSON.parse(data.join("\n")));
+  else if (kind === "session" && data.length) onSession(JSON.parse(data.join("\n")));  // session.js
 }
 
 /** A shot from the stream. Its club is its event's (the bay's player when it was flown, kept by the service, so a
@@ -204,6 +211,7 @@ function addShot(event) {
     requestAnimationFrame(tick);
   }
   if (club && state.bay && state.bay.player && club !== state.bay.player.club) readBaySoon();
+  readSummarySoon();  // session.js: the session's summary with this shot
 }
 
 let bayRead = null;
@@ -211,6 +219,67 @@ let bayRead = null;
 /** GET /v1/bay once, shortly (a burst of kept shots on a reload asks once). */
 function readBaySoon() {
   if (bayRead === null) bayRead = setTimeout(() => { bayRead = null; loadBay(); }, 300);
+}
+
+// ---- the pin: a flag on the target line at a distance the golfer sets (the header's "Pin" field), kept in this
+// browser's localStorage in metres, drawn in every view, and the last shot's rest measured to it -------------
+
+/** The pin's distance down the target line, metres, or null when none is set. */
+function pinMetres() {
+  const stored = Number(localStorage.getItem(PIN_STORE) || NaN);
+  return Number.isFinite(stored) && stored > 0 ? stored : null;
+}
+
+/** The pin field typed in (the page's units): a distance from 1 to 1,000 sets the pin, an empty field takes it
+ * away; anything else puts the field back as it was. */
+function setPin(text) {
+  const value = Number(text.trim());
+  if (text.trim() === "") localStorage.setItem(PIN_STORE, "");
+  else if (Number.isFinite(value) && value >= 1 && value <= 1000) {
+    localStorage.setItem(PIN_STORE, String(value * (imperial() ? YARD_M : 1)));
+  }
+  showPin(true);
+  render();
+}
+
+/** The pin field and its unit in the page's units; a field being typed in is left alone unless `always`. */
+function showPin(always = false) {
+  const input = document.getElementById("pin");
+  document.getElementById("pin-unit").textContent = distUnit();
+  if (!always && document.activeElement === input && input.dataset.units === state.units) return;
+  const pin = pinMetres();
+  input.value = pin === null ? "" : String(Number((pin / (imperial() ? YARD_M : 1)).toFixed(1)));
+  input.dataset.units = state.units;
+}
+
+/** The last shot's "To pin" tile: how far its rest lies from the pin (its landing for a shot without a rest);
+ * hidden while no pin is set. */
+function showToPin(shot) {
+  const tile = document.getElementById("n-to-pin");
+  const pin = pinMetres();
+  tile.parentElement.hidden = pin === null;
+  const flight = shot && shot.event.flight;
+  const end = flight && (flight.rest || flight.landing);
+  const metres = pin === null || !end ? null : Math.hypot(end.x_m, end.y_m - pin);
+  setNumber("n-to-pin", fixed(metres === null ? null : metres / (imperial() ? YARD_M : 1)), distUnit());
+}
+
+/** The pin as a symbol standing on (x, y), FLAG_PX high whatever the view's scale: a hole, a stick, a flag. */
+function drawFlag(svg, x, y, metres) {
+  const group = el(svg, "g", { class: "pin", "data-m": metres.toFixed(2) });
+  el(group, "ellipse", { class: "pin-hole", cx: x, cy: y, rx: 3, ry: 1.5 });
+  el(group, "line", { class: "pin-stick", x1: x, y1: y, x2: x, y2: y - FLAG_PX });
+  el(group, "polygon", { class: "pin-flag", points: `${x},${y - FLAG_PX} ${x + 9},${y - FLAG_PX + 3.5} ${x},${y - FLAG_PX + 7}` });
+  return group;
+}
+
+/** The pin's label, "pin 150 yd", beside its flag: right of it, or left of it where the right has no room; left out
+ * (null) where neither has room among the labels kept. */
+function pinLabel(svg, kept, W, H, x, y, metres) {
+  const text = `pin ${unitLabel(metres)}`;
+  const at = { class: "label scale pin-label", y: y - FLAG_PX + 7 };
+  return placeLabel(svg, kept, W, H, { ...at, x: x + 12 }, text)
+    || placeLabel(svg, kept, W, H, { ...at, x: x - 4, "text-anchor": "end" }, text);
 }
 
 // ---- drawing ------------------------------------------------------------------------------------------------
@@ -261,12 +330,12 @@ function groundElevation() {
   return newest ? elevationOf(newest.event.ground) : 0;
 }
 
-/** The scene's size in metres: downrange to a round number of the unit shown, height (from the lowest point: a
- * green below the tee), lateral spread, and the ground's elevation. */
+/** The scene's size in metres: downrange to a round number of the unit shown (the pin included), height (from the
+ * lowest point: a green below the tee), lateral spread, and the ground's elevation. */
 function extent() {
   const step = 50 * (imperial() ? YARD_M : 1);
   const ground = groundElevation();
-  let far = 0, high = 0, low = Math.min(0, ground), wide = 0;
+  let far = pinMetres() || 0, high = 0, low = Math.min(0, ground), wide = 0;
   for (const shot of state.shots) {
     for (const p of shot.event.flight.trajectory) {
       far = Math.max(far, p.y_m); high = Math.max(high, p.z_m); low = Math.min(low, p.z_m); wide = Math.max(wide, Math.abs(p.x_m));
@@ -278,6 +347,22 @@ function extent() {
     high: Math.max(low + 10, high + (high - low) * 0.15),
     wide: Math.max(15, wide * 1.2),
   };
+}
+
+/** A round step for a scale in the unit shown (1, 2 or 5 times a power of ten yards or metres), in metres: the
+ * smallest at least `least` metres. */
+function niceStep(least) {
+  const unit = imperial() ? YARD_M : 1;
+  for (let power = 1; power < 1e6; power *= 10) {
+    for (const m of [1, 2, 5]) if (m * power * unit >= least) return m * power * unit;
+  }
+  return 1e6 * unit;  // (never a sensible scale: no tick of it is drawn)
+}
+
+/** A lateral distance as a golfer reads it: "10 yd L", "10 yd R", "0" on the target line. */
+function lateralLabel(metres) {
+  const size = Math.round(Math.abs(metres) / (imperial() ? YARD_M : 1));
+  return size === 0 ? "0" : `${size} ${distUnit()} ${metres < 0 ? "L" : "R"}`;
 }
 
 function points(list, project) {
@@ -380,32 +465,30 @@ function placeLabel(svg, kept, W, H, attrs, text) {
  * (direction 0, spin axis 0, no crosswind) stays on it, and every shot an arc receding to where it lands. The ground
  * is a plane at the bay's elevation (the tee at 0); distance lines cross it every 50 yd (or 50 m), receding to the
  * horizon; a line's label, at the picture's right edge, is left out when it would come closer than LABEL_GAP_PX to the
- * one kept before it. What was drawn is kept on `window.golfflightViewer.behind`. */
+ * one kept before it. A shot that would leave the golfer's picture widens the camera (`behindCamera`), and level
+ * lines at the last shot's apex give the heights (`drawBehindHeights`). What was drawn is kept on
+ * `window.golfflightViewer.behind`. */
 function drawBehind(svg, box) {
   svg.replaceChildren();
   const [W, H] = frame(svg, 1);
-  const pitch = (CAMERA_PITCH_DEG * Math.PI) / 180;
-  const focal = H / 2 / Math.tan((CAMERA_FOV_DEG * Math.PI) / 360);
-  const cos = Math.cos(pitch), sin = Math.sin(pitch);
-  const project = (p) => {
-    const ahead = p.y_m + CAMERA_BACK_M, up = p.z_m - CAMERA_HEIGHT_M;
-    const depth = Math.max(ahead * cos - up * sin, 0.1);  // along the camera's axis
-    return [W / 2 + (focal * p.x_m) / depth, H / 2 - (focal * (ahead * sin + up * cos)) / depth];
-  };
-  const horizon = H / 2 - focal * Math.tan(pitch);
+  const camera = behindCamera(W, H);
+  const project = behindProjection(W, H, camera);
+  const horizon = H / 2 - camera.focal * Math.tan(camera.pitch);
   const ground = box.ground;
   const on = (x, y) => ({ x_m: x, y_m: y, z_m: ground });
   const defs = el(svg, "defs");
   const sky = el(defs, "linearGradient", { id: "sky", x1: 0, y1: 0, x2: 0, y2: 1 });
   el(sky, "stop", { offset: "0", "stop-color": "#0f2740" });
   el(sky, "stop", { offset: "1", "stop-color": "#3d6d8f" });
-  el(svg, "rect", { class: "sky", x: 0, y: 0, width: W, height: horizon });
-  el(svg, "rect", { class: "rough", x: 0, y: horizon, width: W, height: H - horizon });
-  const fairway = [on(-FAIRWAY_HALF_M, -CAMERA_BACK_M / 2), on(FAIRWAY_HALF_M, -CAMERA_BACK_M / 2), on(FAIRWAY_HALF_M, FAR_GROUND_M), on(-FAIRWAY_HALF_M, FAR_GROUND_M)];
+  const skyline = Math.min(Math.max(horizon, 0), H);  // a widened camera may tilt the horizon out of the picture
+  el(svg, "rect", { class: "sky", x: 0, y: 0, width: W, height: skyline });
+  el(svg, "rect", { class: "rough", x: 0, y: skyline, width: W, height: H - skyline });
+  const near = -Math.min(camera.back, CAMERA_BACK_M) / 2;  // the fairway from halfway between the golfer and the tee
+  const fairway = [on(-FAIRWAY_HALF_M, near), on(FAIRWAY_HALF_M, near), on(FAIRWAY_HALF_M, FAR_GROUND_M), on(-FAIRWAY_HALF_M, FAR_GROUND_M)];
   el(svg, "polygon", { class: "fairway", points: points(fairway, project) });
   for (let x = -2 * FAIRWAY_HALF_M; x <= 2 * FAIRWAY_HALF_M; x += FAIRWAY_HALF_M / 2) {  // receding to the horizon
     if (x === 0) continue;
-    const [x1, y1] = project(on(x, -CAMERA_BACK_M / 2)), [x2, y2] = project(on(x, FAR_GROUND_M));
+    const [x1, y1] = project(on(x, near)), [x2, y2] = project(on(x, FAR_GROUND_M));
     el(svg, "line", { class: Math.abs(x) === FAIRWAY_HALF_M ? "lane edge" : "lane", x1, y1, x2, y2 });
   }
   el(svg, "line", { class: "horizon", x1: 0, y1: horizon, x2: W, y2: horizon });
@@ -425,11 +508,142 @@ function drawBehind(svg, box) {
   const [gx, gy] = project(on(0, 0));
   el(svg, "line", { class: "target-line", x1: gx, y1: gy, x2: W / 2, y2: horizon });
   el(svg, "circle", { class: "tee", cx: tx, cy: ty, r: 3 });
-  drawShots(svg, project, `${W} ${H} ${ground}`);
+  const heights = drawBehindHeights(svg, project, W, H, kept);
+  const pin = pinMetres();
+  if (pin !== null) {
+    const [px, py] = project(on(0, pin));
+    drawFlag(svg, px, py, pin);
+    pinLabel(svg, kept, W, H, px, py, pin);
+  }
+  drawShots(svg, project, `${W} ${H} ${ground} ${camera.focal} ${camera.pitch} ${camera.back}`);
   (window.golfflightViewer ||= {}).behind = {
-    width: W, height: H, tee: [tx, ty], vanishing: [W / 2, horizon], labels, ground_m: ground,
-    camera: { height_m: CAMERA_HEIGHT_M, back_m: CAMERA_BACK_M, fov_deg: CAMERA_FOV_DEG, pitch_deg: CAMERA_PITCH_DEG },
+    width: W, height: H, tee: [tx, ty], vanishing: [W / 2, horizon], labels, heights, ground_m: ground,
+    camera: { height_m: CAMERA_HEIGHT_M, back_m: camera.back, fov_deg: camera.fov_deg, pitch_deg: camera.pitch_deg },
   };
+}
+
+/** The behind view's projection for `camera` ({back, pitch, focal}: metres behind the tee, radians down, pixels):
+ * a point (x_m, y_m, z_m) to its [x, y] in a W x H picture. Its y depends on the point's distance and height only,
+ * so a level line across the target line is level in the picture. */
+function behindProjection(W, H, camera) {
+  const cos = Math.cos(camera.pitch), sin = Math.sin(camera.pitch);
+  return (p) => {
+    const ahead = p.y_m + camera.back, up = p.z_m - CAMERA_HEIGHT_M;
+    const depth = Math.max(ahead * cos - up * sin, 0.1);  // along the camera's axis
+    return [W / 2 + (camera.focal * p.x_m) / depth, H / 2 - (camera.focal * (ahead * sin + up * cos)) / depth];
+  };
+}
+
+/** A camera `back` metres behind the tee with the focal length `focal` (pixels), or null where none holds the shots
+ * shown: of the tilts that keep the steepest point they reach (`high`: its angle above level from there, radians)
+ * APEX_MARGIN of the picture below its top and the lowest (`low`, the tee's as a rule) no lower than `bottom`, the
+ * one nearest the golfer's CAMERA_PITCH_DEG. {back, pitch, focal, fov_deg, pitch_deg}. */
+function framedCamera(H, back, focal, [low, high], bottom) {
+  const mostDown = Math.atan((H / 2 - H * APEX_MARGIN - 0.5) / focal) - high;
+  const mostUp = -Math.atan((bottom - H / 2) / focal) - low;
+  if (mostUp > mostDown) return null;
+  const pitch = Math.min(mostDown, Math.max(mostUp, (CAMERA_PITCH_DEG * Math.PI) / 180));
+  return { back, pitch, focal, fov_deg: (Math.atan(H / 2 / focal) * 360) / Math.PI, pitch_deg: (pitch * 180) / Math.PI };
+}
+
+/** The lowest and the steepest angles above level, radians, at which a camera `back` metres behind the tee sees the
+ * tee and the shots shown. */
+function angleRange(back) {
+  let low = Math.atan2(TEE_Z_M - CAMERA_HEIGHT_M, back), high = low;
+  for (const shot of state.shots) {
+    for (const p of shot.event.flight.trajectory) {
+      const angle = Math.atan2(p.z_m - CAMERA_HEIGHT_M, p.y_m + back);
+      low = Math.min(low, angle);
+      high = Math.max(high, angle);
+    }
+  }
+  return [low, high];
+}
+
+/** Whether every point of every shot shown lies inside the behind view through `camera`: APEX_MARGIN of the height
+ * below its top, no lower than `bottom` (pixels down), SIDE_MARGIN_PX inside its sides, and in front of the camera. */
+function behindFits(W, H, camera, bottom = H) {
+  const project = behindProjection(W, H, camera);
+  const cos = Math.cos(camera.pitch), sin = Math.sin(camera.pitch);
+  for (const shot of state.shots) {
+    for (const p of shot.event.flight.trajectory) {
+      if ((p.y_m + camera.back) * cos - (p.z_m - CAMERA_HEIGHT_M) * sin < 0.5) return false;
+      const [x, y] = project(p);
+      if (y < H * APEX_MARGIN - 1 || y > bottom || Math.abs(x - W / 2) > W / 2 - SIDE_MARGIN_PX) return false;
+    }
+  }
+  return true;
+}
+
+/** The behind view's camera for the shots shown: the golfer's (CAMERA_*) while every shot fits its picture with
+ * APEX_MARGIN of sky above the highest; otherwise the least change that holds them all with the tee no lower than
+ * the golfer's camera shows it: a wider field of view (up to MAX_FOV_DEG), tilted as little from the golfer's as
+ * that allows (`framedCamera`), and beyond that the camera stepping back along the target line (a shot launched
+ * very steeply, or sent far off line). A high wedge (85 mph, 30°, 10,000 rpm) climbs to 25° above the golfer's
+ * eye, above the 20.6° the golfer's camera holds under its margin: 59° of view, tilted 1.3° down, holds it. */
+function behindCamera(W, H) {
+  const key = `${W} ${H} ${state.shots.map((s) => `${s.event.id}@${s.event.received_unix_s}`).join(" ")}`;
+  if (behindCamera.kept && behindCamera.kept.key === key) return behindCamera.kept.camera;  // the same shots
+  const camera = fitBehindCamera(W, H);
+  behindCamera.kept = { key, camera };
+  return camera;
+}
+
+/** `behindCamera`, worked out: the golfer's camera, or the search for the least change that holds every shot. */
+function fitBehindCamera(W, H) {
+  const focal = H / 2 / Math.tan((CAMERA_FOV_DEG * Math.PI) / 360);
+  const golfer = { back: CAMERA_BACK_M, pitch: (CAMERA_PITCH_DEG * Math.PI) / 180, focal, fov_deg: CAMERA_FOV_DEG, pitch_deg: CAMERA_PITCH_DEG };
+  if (behindFits(W, H, golfer)) return golfer;
+  const bottom = behindProjection(W, H, golfer)({ x_m: 0, y_m: 0, z_m: TEE_Z_M })[1];  // where the golfer sees the tee
+  const widest = H / 2 / Math.tan((MAX_FOV_DEG * Math.PI) / 360);
+  const fits = (camera) => camera !== null && behindFits(W, H, camera, bottom + 2);
+  let back = CAMERA_BACK_M;
+  for (; back < 200; back *= 2) {
+    const range = angleRange(back);
+    if (!fits(framedCamera(H, back, widest, range, bottom))) continue;
+    let good = widest, bad = focal;  // the longest focal length that fits, found by halving (to 1/10,000 of H)
+    for (let i = 0; i < 14; i++) {
+      const mid = (good + bad) / 2;
+      if (fits(framedCamera(H, back, mid, range, bottom))) good = mid;
+      else bad = mid;
+    }
+    return framedCamera(H, back, good, range, bottom);
+  }
+  // nothing sensible holds them (a ball launched nearly straight up): the widest, farthest camera, level
+  return { back, pitch: 0, focal: widest, fov_deg: MAX_FOV_DEG, pitch_deg: 0 };
+}
+
+/** Heights in the behind view: level lines every round step (10 yd for a wedge or a driver) up to the highest shot
+ * shown, standing in the upright plane across the target line at the last shot's apex, so that its apex (marked
+ * once it has flown) reads off them; labelled at the left edge under a caption saying how far out that plane is:
+ * [{text, line_y, box}]. */
+function drawBehindHeights(svg, project, W, H, kept) {
+  const newest = latest();
+  if (!newest || !newest.event.flight.trajectory.length) return [];
+  let apex = newest.event.flight.trajectory[0], high = 0;
+  for (const p of newest.event.flight.trajectory) if (p.z_m > apex.z_m) apex = p;
+  for (const shot of state.shots) for (const p of shot.event.flight.trajectory) high = Math.max(high, p.z_m);
+  const step = niceStep(high / 5);  // four or five levels at most
+  const levels = [];
+  for (let z = step; z <= high + 1e-6; z += step) levels.push([z, project({ x_m: 0, y_m: apex.y_m, z_m: z })[1]]);
+  if (!levels.length) return [];
+  placeLabel(svg, kept, W, H, { class: "label scale height-caption", x: 6, y: 16 }, `heights ${unitLabel(apex.y_m)} out`);
+  const labels = [];
+  let lastY = Infinity;
+  for (const [z, y] of levels) {
+    el(svg, "line", { class: "height-line", x1: 0, y1: y, x2: W, y2: y, "data-m": z.toFixed(2) });
+    if (lastY - y < LABEL_GAP_PX) continue;
+    const label = placeLabel(svg, kept, W, H, { class: "label scale height", x: 6, y: y - 3 }, unitLabel(z));
+    if (!label) continue;
+    lastY = y;
+    const b = label.getBBox();
+    labels.push({ text: label.textContent, line_y: y, box: [b.x, b.y, b.width, b.height] });
+  }
+  if (!playing()) {
+    const [ax, ay] = project(apex);
+    el(svg, "line", { class: "apex-mark", x1: ax - 7, y1: ay, x2: ax + 7, y2: ay });
+  }
+  return labels;
 }
 
 /** From the side: downrange to the right, height up, one scale for both; the tee at 0 and the ground at its
@@ -441,10 +655,7 @@ function drawSide(svg, box) {
   const heightStep = imperial() ? 10 * YARD_M : 10;
   const heights = [];
   for (let k = Math.ceil(box.low / heightStep); k * heightStep <= box.high; k++) if (k !== 0) heights.push(k * heightStep);
-  const lines = [];
-  for (let y = 0; y <= box.far + 1e-6; y += box.step) lines.push(y);
-  const texts = lines.map(unitLabel);
-  const widths = texts.map((text) => textWidth(svg, text));
+  const { lines, texts, widths } = alongTicks(svg, box);
   const heightWidth = Math.max(0, ...heights.map((z) => textWidth(svg, unitLabel(z))));
   const left = Math.max(heightWidth + 10, widths[0] / 2 + 4), right = widths[widths.length - 1] / 2 + 6;
   const top = 10, bottom = 24;
@@ -452,12 +663,7 @@ function drawSide(svg, box) {
   const base = H - bottom + box.low * scale;  // z = 0
   const project = (p) => [left + p.y_m * scale, base - p.z_m * scale];
   const kept = [];
-  const stride = Math.max(1, Math.ceil((Math.max(...widths) + 10) / (box.step * scale)));
-  lines.forEach((y, n) => {
-    const x = left + y * scale;
-    el(svg, "line", { class: "grid", x1: x, y1: top - 2, x2: x, y2: H - bottom });
-    if (n % stride === 0) placeLabel(svg, kept, W, H, { class: "label along", x, y: H - 7, "text-anchor": "middle" }, texts[n]);
-  });
+  drawAlong(svg, kept, [W, H], { lines, texts, widths }, { left, scale, top: top - 2, bottom: H - bottom, step: box.step });
   for (const z of heights) {
     const y = base - z * scale;
     el(svg, "line", { class: "grid faint", x1: left, y1: y, x2: W - right, y2: y });
@@ -466,25 +672,104 @@ function drawSide(svg, box) {
   const groundY = base - box.ground * scale;
   el(svg, "line", { class: "ground-line", x1: left, y1: groundY, x2: W - right, y2: groundY });
   if (Math.abs(box.ground) * scale >= 1) el(svg, "line", { class: "ground-line tee-box", x1: left - 4, y1: base, x2: left + 6, y2: base });
+  const pin = pinMetres();
+  if (pin !== null) drawFlag(svg, ...project({ x_m: 0, y_m: pin, z_m: box.ground }), pin);
   drawShots(svg, project, `${W} ${H} ${scale} ${base}`);
 }
 
-/** From above: downrange to the right, the golfer's right downwards, one scale for both. */
+/** The distance lines downrange (every box.step from the tee to box.far) with their labels and the labels'
+ * measured widths, for the side and top views' margins. */
+function alongTicks(svg, box) {
+  const lines = [];
+  for (let y = 0; y <= box.far + 1e-6; y += box.step) lines.push(y);
+  const texts = lines.map(unitLabel);
+  return { lines, texts, widths: texts.map((text) => textWidth(svg, text)) };
+}
+
+/** The distance lines as upright grid lines from `top` to `bottom` at left + y * scale, labelled under the picture
+ * every one, every other one, ... as their labels' widths allow: never crammed, never cut. */
+function drawAlong(svg, kept, [W, H], { lines, texts, widths }, { left, scale, top, bottom, step }) {
+  const stride = Math.max(1, Math.ceil((Math.max(...widths) + 10) / (step * scale)));
+  lines.forEach((y, n) => {
+    const x = left + y * scale;
+    el(svg, "line", { class: "grid", x1: x, y1: top, x2: x, y2: bottom, "data-m": y.toFixed(2) });
+    if (n % stride === 0) placeLabel(svg, kept, W, H, { class: "label along", x, y: H - 7, "text-anchor": "middle" }, texts[n]);
+  });
+}
+
+/** From above: downrange to the right, the golfer's right downwards, one scale for both. Distances are labelled
+ * under the picture as in the side view, and lateral lines every round step either side of the target line
+ * ("10 yd L" above it, "10 yd R" below) at its left; the pin stands on the target line with its distance. */
 function drawTop(svg, box) {
   svg.replaceChildren();
   const [W, H] = frame(svg, 0.3125, 150);
-  const left = Math.max(46, Math.max(textWidth(svg, "left"), textWidth(svg, "right")) + 10), right = 14;
-  const scale = Math.min((W - left - right) / box.far, (H - 20) / (2 * box.wide));
-  const project = (p) => [left + p.y_m * scale, H / 2 + p.x_m * scale];
-  el(svg, "rect", { class: "fairway", x: left, y: H / 2 - FAIRWAY_HALF_M * scale, width: box.far * scale, height: 2 * FAIRWAY_HALF_M * scale, opacity: 0.5 });
-  for (let y = 0; y <= box.far + 1e-6; y += box.step) {
-    const x = left + y * scale;
-    el(svg, "line", { class: "grid", x1: x, y1: 0, x2: x, y2: H });
+  const along = alongTicks(svg, box);
+  const sideWidth = textWidth(svg, lateralLabel(-100 * (imperial() ? YARD_M : 1)));  // the widest lateral label
+  const left = Math.max(sideWidth + 10, along.widths[0] / 2 + 4), right = along.widths[along.widths.length - 1] / 2 + 6;
+  const top = 8, bottom = H - 22, mid = (top + bottom) / 2;
+  const scale = Math.min((W - left - right) / box.far, (bottom - top) / (2 * box.wide));
+  const project = (p) => [left + p.y_m * scale, mid + p.x_m * scale];
+  const fairwayTop = Math.max(top, mid - FAIRWAY_HALF_M * scale), fairwayBottom = Math.min(bottom, mid + FAIRWAY_HALF_M * scale);
+  el(svg, "rect", { class: "fairway", x: left, y: fairwayTop, width: box.far * scale, height: fairwayBottom - fairwayTop, opacity: 0.5 });
+  const kept = [];
+  drawAlong(svg, kept, [W, H], along, { left, scale, top, bottom, step: box.step });
+  const step = niceStep((LABEL_GAP_PX + 4) / scale);  // lateral lines at least a label's height and a gap apart
+  for (let x = step; x * scale <= mid - top + 1e-6; x += step) {
+    for (const signed of [-x, x]) {
+      const y = mid + signed * scale;
+      el(svg, "line", { class: "grid faint lateral", x1: left, y1: y, x2: W - right, y2: y, "data-m": signed.toFixed(2) });
+      placeLabel(svg, kept, W, H, { class: "label lateral", x: left - 6, y: y + 4, "text-anchor": "end" }, lateralLabel(signed));
+    }
   }
-  el(svg, "line", { class: "target-line", x1: left, y1: H / 2, x2: W - right, y2: H / 2 });
-  el(svg, "text", { class: "label", x: 4, y: 16 }, "left");
-  el(svg, "text", { class: "label", x: 4, y: H - 7 }, "right");
-  drawShots(svg, project, `${W} ${H} ${scale}`);
+  el(svg, "line", { class: "target-line", x1: left, y1: mid, x2: W - right, y2: mid });
+  const pin = pinMetres();
+  if (pin !== null) {
+    const [px, py] = project({ x_m: 0, y_m: pin, z_m: 0 });
+    drawFlag(svg, px, py, pin);
+    pinLabel(svg, kept, W, H, px, py, pin);
+  }
+  drawShots(svg, project, `${W} ${H} ${scale} ${mid}`);
+}
+
+/** The dispersion view's lateral half-width and the step of its lateral scale, metres, for `inner` pixels across:
+ * the smallest round step whose labels stand apart, the half-width widened to that step where the shots spread
+ * less, so that a labelled line stands either side of the target line (none where even that cannot be). */
+function dispersionLateral(svg, wide, inner) {
+  let step = niceStep(0);
+  for (let tries = 0; tries < 40; tries++, step = niceStep(step * 1.01)) {
+    const half = Math.max(wide, step);
+    if ((step * inner) / (2 * half) >= textWidth(svg, lateralLabel(-half)) + 10) return { wide: half, step };
+  }
+  return { wide, step: Infinity };
+}
+
+/** The dispersion view's scales: distance lines across it labelled at its left, lateral lines along it every round
+ * step either side of the target line labelled under it ("10 yd L", "0", "10 yd R"), the target line and the pin
+ * with its distance. Returns the labels' boxes kept (`placeLabel`). */
+function drawDispersionAxes(svg, { S, pad, wide, step, lines, project }) {
+  const kept = [];
+  for (const y of lines) {
+    const [, py] = project(0, y);
+    el(svg, "line", { class: "grid", x1: pad, y1: py, x2: S - pad, y2: py, "data-m": y.toFixed(2) });
+    placeLabel(svg, kept, S, S, { class: "label along", x: pad - 6, y: py + 4, "text-anchor": "end" }, unitLabel(y));
+  }
+  const bottom = S - pad;
+  placeLabel(svg, kept, S, S, { class: "label lateral", x: S / 2, y: bottom + 21, "text-anchor": "middle" }, lateralLabel(0));
+  for (let x = step; x <= wide + 1e-6; x += step) {
+    for (const signed of [-x, x]) {
+      const [px] = project(signed, 0);
+      el(svg, "line", { class: "grid faint lateral", x1: px, y1: pad / 2, x2: px, y2: bottom + 4, "data-m": signed.toFixed(2) });
+      placeLabel(svg, kept, S, S, { class: "label lateral", x: px, y: bottom + 21, "text-anchor": "middle" }, lateralLabel(signed));
+    }
+  }
+  el(svg, "line", { class: "target-line", x1: S / 2, y1: pad / 2, x2: S / 2, y2: bottom });
+  const pin = pinMetres();
+  if (pin !== null) {
+    const [px, py] = project(0, pin);
+    drawFlag(svg, px, py, pin);
+    pinLabel(svg, kept, S, S, px, py, pin);
+  }
+  return kept;
 }
 
 /** Landing points (filled) and rest points (rings) per club, seen from behind; a putt has its rest point only. */
@@ -496,16 +781,10 @@ function drawDispersion(svg, box) {
   const pad = Math.max(24, ...lines.map((y) => textWidth(svg, unitLabel(y)) + 10));
   const clubs = [...new Set(state.shots.map((s) => s.club))];
   const colour = (club) => CLUB_COLOURS[clubs.indexOf(club) % CLUB_COLOURS.length];
-  const wide = Math.max(box.wide, box.far / 8);
+  const { wide, step } = dispersionLateral(svg, Math.max(box.wide, box.far / 8), S - 2 * pad);
   const sx = (S - 2 * pad) / (2 * wide), sy = (S - 2 * pad) / box.far;
   const project = (x, y) => [S / 2 + x * sx, S - pad - y * sy];
-  const kept = [];
-  for (const y of lines) {
-    const [, py] = project(0, y);
-    el(svg, "line", { class: "grid", x1: pad, y1: py, x2: S - pad, y2: py });
-    placeLabel(svg, kept, S, S, { class: "label", x: pad - 6, y: py + 4, "text-anchor": "end" }, unitLabel(y));
-  }
-  el(svg, "line", { class: "target-line", x1: S / 2, y1: pad / 2, x2: S / 2, y2: S - pad });
+  const kept = drawDispersionAxes(svg, { S, pad, wide, step, lines, project });
   // rest rings first and in the club's colour (CSSOM: a stroke attribute loses to the .dot rule, which drew them
   // dark over the landing dots as half discs), then the landing dots, whole, on top
   for (const shot of state.shots) {
@@ -520,6 +799,7 @@ function drawDispersion(svg, box) {
     const [x, y] = project(flight.landing.x_m, flight.landing.y_m);
     el(svg, "circle", { class: "dot", cx: x, cy: y, r: 5, fill: colour(shot.club), "data-shot": shot.event.id });
   }
+  drawSummary(svg, project, colour);  // session.js: the session's ellipses per club, and its summary table
   const legend = document.getElementById("legend");
   legend.replaceChildren();
   for (const club of clubs) {
@@ -657,7 +937,7 @@ function showTable() {
     if (shot.event.putt) row.dataset.putt = "1";
     const cells = [
       shot.event.id, SOURCES[shot.event.source], null,
-      `${speedText(launch.ball_speed_mps)} ${speedUnit()}`, `${fixed(launch.launch_angle_deg)}°`, rpm(launch.spin_rpm),
+      speedText(launch.ball_speed_mps), `${fixed(launch.launch_angle_deg)}°`, rpm(launch.spin_rpm),
       fixed(distance(flight, "carry")), fixed(distance(flight, "total")), fixed(distance(flight, "apex")),
       `${fixed(flight.landing_angle_deg)}°`, side(distance(flight, "lateral")).join(" ").trim(),
     ];
@@ -673,8 +953,9 @@ function showTable() {
     body.appendChild(row);
   }
   const head = document.querySelectorAll("#shots th");
-  for (const [index, name] of [[6, "carry"], [7, "total"], [8, "apex"], [10, "lateral"]]) {
-    head[index].textContent = `${name} (${distUnit()})`;
+  // the units in the headers, not in every cell: the columns stay narrow enough for a phone's 400 px
+  for (const [index, name, unit] of [[3, "ball speed", speedUnit()], [6, "carry"], [7, "total"], [8, "apex"], [10, "lateral"]]) {
+    head[index].textContent = `${name} (${unit || distUnit()})`;
   }
 }
 
@@ -691,6 +972,8 @@ function render() {
   const box = drawViews();
   drawDispersion(document.getElementById("dispersion"), box);
   showNumbers(latest());
+  showPin();
+  showToPin(latest());
   showTable();
   for (const button of document.querySelectorAll(".units button")) {
     button.setAttribute("aria-pressed", String(button.dataset.units === state.units));
@@ -956,7 +1239,7 @@ async function downloadSession() {
     const url = URL.createObjectURL(await response.blob());
     const link = document.createElement("a");
     link.href = url;
-    link.download = "golfflight-session.csv";
+    link.download = `golfflight-session-${session.shown ? session.shown.id : "current"}.csv`;
     document.body.appendChild(link);
     link.click();
     link.remove();
@@ -978,6 +1261,8 @@ document.addEventListener("DOMContentLoaded", () => {
     button.addEventListener("click", () => setUnits(button.dataset.units));
   }
   document.getElementById("download-csv").addEventListener("click", downloadSession);
+  const pin = document.getElementById("pin");
+  pin.addEventListener("change", () => setPin(pin.value));
   document.getElementById("key-form").addEventListener("submit", (event) => {
     event.preventDefault();
     state.key = document.getElementById("key").value;
