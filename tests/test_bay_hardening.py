@@ -33,7 +33,7 @@ from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.viewer.session_csv import session_csv_slices
 from golfflight.service.viewer.stream import events
 from servers import free_port, keyed_service, running
-from test_viewer import KEY, KEYED, next_event
+from test_viewer import KEY, KEYED, next_event, reply_over_tcp
 
 
 def _session(engine, shots: int) -> ShotFeed:
@@ -72,23 +72,6 @@ def test_the_session_download_lets_the_loop_run_while_it_is_made(engine):
     assert turns >= 10, f"the loop ran {turns} times while 2,000 rows were made"
 
 
-def _tcp_shot(port: int, text: bytes) -> dict:
-    """One connector message (its JSON text as given) over TCP and its reply (Code 201 pushes passed over)."""
-    with socket.create_connection(("127.0.0.1", port), timeout=10) as connector:
-        connector.sendall(text)
-        received, decoder = "", json.JSONDecoder()
-        while True:
-            received += connector.recv(65536).decode()
-            while received.strip():
-                try:
-                    message, end = decoder.raw_decode(received.lstrip())
-                except ValueError:
-                    break
-                received = received.lstrip()[end:]
-                if message.get("Code") != 201:
-                    return message
-
-
 def _shot_text(number: int, club_data: str = "") -> bytes:
     ball = '{"Speed": 102.0, "VLA": 24.0, "HLA": -1.5, "TotalSpin": 8600.0, "SpinAxis": 2.0}'
     club = f', "ClubData": {club_data}' if club_data else ""
@@ -100,9 +83,9 @@ def test_a_lone_surrogate_in_club_data_neither_blanks_the_screen_nor_cuts_the_st
     with keyed_service(KEY) as (http, port, _), httpx.Client(base_url=http.base_url, timeout=10) as viewer:
         with viewer.stream("GET", "/v1/events", headers=KEYED) as stream:
             lines = stream.iter_lines()
-            odd = _tcp_shot(port, _shot_text(1, r'{"Sp\ud800eed": "fast\udc00", "Loft": 24.5}'))
+            odd = reply_over_tcp(port, _shot_text(1, r'{"Sp\ud800eed": "fast\udc00", "Loft": 24.5}'))
             assert odd["Code"] == 200
-            assert [_tcp_shot(port, _shot_text(n))["Code"] for n in (2, 3)] == [200, 200]
+            assert [reply_over_tcp(port, _shot_text(n))["Code"] for n in (2, 3)] == [200, 200]
             received = [next_event(lines) for _ in range(3)]
         assert [event.shot_number for event in received] == [1, 2, 3]
         assert received[0].club_data == {r"Sp\ud800eed": r"fast\udc00", "Loft": 24.5}

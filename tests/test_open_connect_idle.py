@@ -8,33 +8,18 @@ from __future__ import annotations
 import socket
 import threading
 import time
-from collections.abc import Iterator
 
 import pytest
-from golfflight.flight.bundle_location import model_dir
-from golfflight.flight.engine import FlightEngine
 from golfflight.service.app import create_app
 from golfflight.service.open_connect.limits import MAX_CONNECTIONS, ConnectorLimits
 from golfflight.service.open_connect.server import ConnectAddress
 
 from tests.servers import free_port, running
 from tests.test_open_connect import HEARTBEAT, encoded, shot
-from tests.test_open_connect_limits import Served, connect, objects, refusal, until_closed
+from tests.test_open_connect_limits import Served, connect, objects, refusal, served, until_closed  # noqa: F401 (served: a fixture)
 
 EVICTED = "closed to make room for a new connection"
 """What the Code 503 of a connection that gave its place says."""
-
-
-@pytest.fixture(scope="module")
-def engine() -> FlightEngine:
-    return FlightEngine(model_dir())
-
-
-@pytest.fixture()
-def served(engine) -> Iterator[Served]:
-    served = Served(engine)
-    yield served
-    served.close()
 
 
 def held(served: Served, count: int) -> list[socket.socket]:

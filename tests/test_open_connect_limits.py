@@ -13,7 +13,6 @@ from collections.abc import Callable, Iterator
 
 import pytest
 from golfflight.contract.gspro import fly_message
-from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine
 from golfflight.service.open_connect.framing import MAX_MESSAGE_BYTES
 from golfflight.service.open_connect.limits import (
@@ -66,11 +65,6 @@ class Served:
         self.loop.call_soon_threadsafe(self.loop.stop)
         self.thread.join(timeout=10)
         self.loop.close()
-
-
-@pytest.fixture(scope="module")
-def engine() -> FlightEngine:
-    return FlightEngine(model_dir())
 
 
 @pytest.fixture()

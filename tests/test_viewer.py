@@ -42,8 +42,13 @@ def service():
 
 def gspro_over_tcp(port: int, number: int, ball: dict) -> dict:
     """A connector's shot over TCP and its reply (the player information GSPro pushes, Code 201, passed over)."""
-    with socket.create_connection(("127.0.0.1", port), timeout=5) as connector:
-        connector.sendall(json.dumps({"ShotNumber": number, "APIversion": "1", "BallData": ball}).encode())
+    return reply_over_tcp(port, json.dumps({"ShotNumber": number, "APIversion": "1", "BallData": ball}).encode())
+
+
+def reply_over_tcp(port: int, text: bytes) -> dict:
+    """One connector message, its JSON text as given, over TCP and its reply (Code 201 pushes passed over)."""
+    with socket.create_connection(("127.0.0.1", port), timeout=10) as connector:
+        connector.sendall(text)
         received, decoder = "", json.JSONDecoder()
         while True:
             received += connector.recv(65536).decode()
