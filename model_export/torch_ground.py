@@ -2,9 +2,9 @@
 were flown, so that a GPU's sweep does not wait on one CPU core for them.
 
 The physics is the engine's own, not written again: the impact (`flight.ground.impact.impact_components`: Penner's
-tilt, the turf's torque on the spin, grip or slip), the hop, the rolling velocity, the level roll's closed form and the
-slope's step (`flight.ground.phase`) are formulas on (x, y, z) tuples whose components may be torch tensors
-(`flight.ground.vectors` dispatches their few functions).
+tilt and its cap, the turf's damping of the spin, grip or slip), the hop, the rolling velocity, the level roll's
+closed form and the slope's step (`flight.ground.phase`) are formulas on (x, y, z) tuples whose components may be
+torch tensors (`flight.ground.vectors` dispatches their few functions).
 What is torch's here is only the batch's bookkeeping, as `flight.ground.phase.ground_phase` keeps it in NumPy: which
 balls still bounce, which roll on a slope, their states gathered and scattered by index. No path is kept (a sweep
 keeps none). The planes' normals and the surfaces' parameters come in as tensors: slopes are checked where a

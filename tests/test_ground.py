@@ -1,8 +1,8 @@
 """The ground phase (flight.ground) against hand-worked cases and published numbers: a dead drop, back spin, slopes,
 the stimpmeter, shallow driver landings, energy at every impact (hypothesis), batch against one by one, Penner's
-tilt, the turf's torque on the spin, Haake's back-spin threshold, Biber et al.'s slipping lift-off, the rough against
-the fairway and the wind a ball on the ground feels (tests/test_ground_anchors.py: whole shots against the tour
-tables)."""
+tilt and its cap, the pitch mark's wall, the turf's damping of the spin, Haake's back-spin threshold, Biber et al.'s
+slipping lift-off, the rough against the fairway and the wind a ball on the ground feels
+(tests/test_ground_anchors.py: whole shots against the tour tables)."""
 
 from __future__ import annotations
 
@@ -208,26 +208,54 @@ def test_one_ball_on_plain_floats_is_the_batch():
 
 def test_penners_tilt_grows_with_the_speed_and_the_angle_from_the_normal():
     """theta_c (v / 18.6 m/s)(theta_1 / 44 deg): the surface's angle at Penner's typical landing, twice it at twice
-    the speed, half at half the angle, none for a ball dropping straight down, and never past theta_1."""
+    the speed, half at half the angle, none for a ball dropping straight down, and never past theta_1 or the turf's
+    cap: a downwind drive (34.9 m/s, 60.7 deg from the normal) on a green of theta_c 20 would meet
+    20 x (34.9 / 18.6) x (60.7 / 44) = 51.8 deg, and meets the green's 38."""
     at = math.radians(44.0)
     assert penner_tilt(15.0, 18.6, at) == pytest.approx(math.radians(15.0))
     assert penner_tilt(15.0, 37.2, at) == pytest.approx(math.radians(30.0))
     assert penner_tilt(15.0, 18.6, at / 2) == pytest.approx(math.radians(7.5))
     assert penner_tilt(15.0, 30.0, 0.0) == 0.0
     assert penner_tilt(30.0, 40.0, math.radians(60.0)) == pytest.approx(math.radians(60.0))  # 88 deg, capped
+    drive = math.radians(60.7)
+    assert penner_tilt(20.0, 34.9, drive) == pytest.approx(math.radians(20.0 * 34.9 / 18.6 * 60.7 / 44.0))
+    assert penner_tilt(20.0, 34.9, drive, 38.0) == pytest.approx(math.radians(38.0))
+    assert penner_tilt(20.0, 18.6, at, 38.0) == pytest.approx(math.radians(20.0))  # under the cap: Penner's
+    assert surface("green").max_tilt_deg == 38.0 and SURFACES["fairway"].max_tilt_deg == 90.0
 
 
-def test_the_turfs_torque_takes_spin_out_of_a_dropped_ball_and_never_reverses_it():
+def test_the_pitch_marks_wall_takes_forward_speed_and_leaves_the_spin():
+    """A 7-iron's landing, 24.6 m/s at 50 deg below the horizontal (40 deg from the normal) with 619 rad/s of back
+    spin, on turf of theta_c 20 with no restitution, friction or spin damping: the wall tilts by
+    20 x (24.6 / 18.6) x (40 / 44) = 24.05 deg, the ball meets it 15.95 deg from its normal and leaves along it at
+    24.6 sin 15.95 deg = 6.761 m/s, 6.175 m/s forward and 2.755 m/s up, its spin untouched: the wall's push runs
+    through the ball's centre. Coulomb friction at the contact point cannot do that: it takes 5/2 of a metre per
+    second's worth of R omega for every metre per second of forward speed."""
+    turf = Surface(0.0, 20.0, 0.0, 0.0, 0.05, 0.0, 38.0)
+    velocity, spin = landing(24.6, 50.0, 619.0 / RPM_TO_RADPS)
+    out, spin_out = impact(velocity, spin, np.array([[0.0, 0.0, 1.0]]), turf)
+    tilt = math.radians(20.0 * 24.6 / 18.6 * 40.0 / 44.0)
+    along = 24.6 * math.sin(math.radians(40.0) - tilt)
+    assert math.degrees(tilt) == pytest.approx(24.05, abs=0.005) and along == pytest.approx(6.761, abs=5e-4)
+    np.testing.assert_allclose(out[0], [0.0, along * math.cos(tilt), along * math.sin(tilt)], atol=1e-12)
+    np.testing.assert_allclose(out[0], [0.0, 6.175, 2.755], atol=5e-4)
+    np.testing.assert_allclose(spin_out, spin, atol=1e-9)
+
+
+def test_the_turfs_torque_damps_a_share_of_the_spin_and_never_reverses_it():
     """A ball dropped at 5 m/s on turf without tilt or friction: e = 0.510 - 0.0375 x 5 + 0.000903 x 25 = 0.345075,
-    normal impulse (1 + e) 5 = 6.725 m/s, so spin friction 0.1 takes 0.1 x 6.725 x 2.5 / R = 78.8 rad/s of its
-    spin; a slower spin is stopped, not reversed."""
-    turf = Surface(1.0, 0.0, 0.0, 0.1, 0.1, 0.0)
-    soaked = 0.1 * (1.0 + 0.345075) * 5.0 * 2.5 / BALL_RADIUS_M
-    for spin_radps, after in ((300.0, 300.0 - soaked), (50.0, 0.0)):
-        out, spin_out = impact(np.array([[0.0, 0.0, -5.0]]), np.array([[spin_radps, 0.0, 0.0]]),
-                               np.array([[0.0, 0.0, 1.0]]), turf)
-        assert spin_out[0, 0] == pytest.approx(after, abs=1e-9)
-        np.testing.assert_allclose(out[0], [0.0, 0.0, 0.345075 * 5.0], atol=1e-12)
+    normal impulse (1 + e) 5 = 6.725375 m/s, so a spin damping of 0.1 s/m takes the share 0.6725375 of its spin,
+    whatever the spin (300 rad/s keeps 98.24, 50 keeps 16.37), and 0.2 s/m (a share of 1.345) stops it without
+    reversing it."""
+    impulse = (1.0 + 0.345075) * 5.0
+    for damping, share in ((0.1, 0.1 * impulse), (0.2, 1.0)):
+        turf = Surface(1.0, 0.0, 0.0, damping, 0.1, 0.0)
+        for spin_radps in (300.0, 50.0):
+            out, spin_out = impact(np.array([[0.0, 0.0, -5.0]]), np.array([[spin_radps, 0.0, 0.0]]),
+                                   np.array([[0.0, 0.0, 1.0]]), turf)
+            assert spin_out[0, 0] == pytest.approx(spin_radps * (1.0 - share), abs=1e-9)
+            np.testing.assert_allclose(out[0], [0.0, 0.0, 0.345075 * 5.0], atol=1e-12)
+    assert 300.0 * (1.0 - 0.1 * impulse) == pytest.approx(98.24, abs=0.005)
 
 
 def spin_after(where: Surface, back_spin_radps: float, speed: float = 18.6, from_normal_deg: float = 44.0):
@@ -241,8 +269,15 @@ def test_a_firm_green_lets_a_ball_keep_back_spin_above_about_350_rad_s_and_softe
     """Haake (721 filmed impacts on 18 greens): on firm, freely drained greens the ball keeps back spin through the
     bounce if it came in with more than about 350 rad/s; on the others it leaves with top spin. At Penner's typical
     landing (18.6 m/s, 44 degrees from the normal) the green keeps 370 rad/s as back spin and turns 330 into top
-    spin; the fairway and the rough turn even 800 rad/s into top spin."""
+    spin; the fairway and the rough turn even 800 rad/s into top spin. By hand: the green's wall tilts by its 20 deg,
+    the ball meets it at 18.6 cos 24 deg = 16.992 m/s, e = 0.75 (0.510 - 0.0375 x 16.992 + 0.000903 x 16.992^2) =
+    0.10015, the normal impulse is 1.10015 x 16.992 = 18.694 m/s; the turf damps the share 0.015 x 18.694 = 0.2804 of
+    the spin and friction, sliding throughout, takes 0.115 x 18.694 = 2.150 m/s at the contact point, 2.5 / R x 2.150
+    = 251.9 rad/s: the spin turns over at 251.9 / (1 - 0.2804) = 350.1 rad/s."""
     assert spin_after(surface("green"), 330.0)[1] < 0.0 < spin_after(surface("green"), 370.0)[1]
+    threshold = 2.5 / BALL_RADIUS_M * 0.115 * 18.694 / (1.0 - 0.015 * 18.694)
+    assert threshold == pytest.approx(350.1, abs=0.1)
+    assert spin_after(surface("green"), threshold - 0.5)[1] < 0.0 < spin_after(surface("green"), threshold + 0.5)[1]
     for name in ("fairway", "rough"):
         assert spin_after(SURFACES[name], 800.0)[1] < 0.0
 
@@ -259,11 +294,12 @@ def test_a_wedge_leaves_a_firm_green_still_slipping_and_the_fairway_rolling():
 
 def test_the_rough_soaks_up_at_least_what_the_fairway_does():
     """The rough is the fitted fairway times the anchors' rough-to-fairway ratios: less restitution, no less tilt,
-    friction, rolling resistance or grass drag."""
+    friction, spin damping, rolling resistance or grass drag."""
     rough, fairway = SURFACES["rough"], SURFACES["fairway"]
     assert rough == scaled(fairway, ROUGH_OVER_FAIRWAY)
     assert rough.restitution_scale < fairway.restitution_scale
-    for name in ("critical_angle_deg", "friction", "spin_friction", "rolling_resistance", "grass_drag_per_s"):
+    for name in ("critical_angle_deg", "max_tilt_deg", "friction", "spin_damping_s_per_m", "rolling_resistance",
+                 "grass_drag_per_s"):
         assert getattr(rough, name) >= getattr(fairway, name), name
 
 

@@ -1,7 +1,7 @@
 """The ground phase against its anchors (docs/ground.md, scripts/ground_anchors.py): the tour tables' clubs flown
 through the shipped engine onto greens of stimp 8-14, the fitted fairway and the rough, calm and in 8 m/s of head-
 or tailwind. A few representative shots per bound: the steepest, spinniest wedges for spin-back, both tours' drivers
-for the run on a green."""
+for the run on a green, the calm PGA 7-iron and PW on every green of the grid."""
 
 from __future__ import annotations
 
@@ -57,6 +57,19 @@ def test_a_calm_level_fairway_runs_what_the_tour_tables_say(engine, club, low, h
     assert low <= grid["PGA", club, "calm", "fairway"].run_yd <= high
 
 
+GRID_GREENS = {f"green {stimp:g}": surface("green", stimp) for stimp in anchors.STIMPS_FT}
+
+
+@pytest.mark.parametrize(("club", "low", "high"), [("7-iron", -5.0, 7.0), ("PW", -5.0, 5.0)])
+def test_a_calm_green_holds_a_tour_approach_as_well_as_a_fairway(engine, club, low, high):
+    """TrackMan's 2023 PGA table runs the 7-iron 7 yd past its carry and the PW 4, on a fairway; a green of any speed
+    from stimp 8 to 14 holds the same steep, spinning landing at least as well: the 7-iron checks within 7 yd, the PW
+    within 5 either way (a little spin-back allowed, no more than the wedges' bound)."""
+    grid = anchors.fly_grid(engine, {"PGA": clubs("PGA", club)}, {"calm": anchors.WINDS["calm"]}, GRID_GREENS)
+    runs = [run.run_yd for run in grid.values()]
+    assert len(runs) == len(anchors.STIMPS_FT) and low <= min(runs) and max(runs) <= high, runs
+
+
 def test_the_checks_read_the_grid():
     """`checks` on a grid worked by hand: the worst spin-back, the longest driver on a green, the rough's excess."""
     run = anchors.Run
@@ -70,9 +83,15 @@ def test_the_checks_read_the_grid():
         ("PGA", "Driver", "calm", "rough"): run(280.0, 9.0),
         ("PGA", "7-iron", "calm", "rough"): run(175.0, 8.0),
         ("PGA", "PW", "calm", "rough"): run(135.0, -2.0),
+        ("PGA", "7-iron", "calm", "green 8"): run(175.0, 4.5),
+        ("PGA", "7-iron", "calm", "green 14"): run(175.0, 5.5),
+        ("PGA", "PW", "calm", "green 8"): run(135.0, 3.0),
+        ("PGA", "PW", "calm", "green 14"): run(135.0, -1.0),
     }
     found = anchors.checks(grid)
     assert found.worst_spin_back_yd == -3.0 and found.longest_green_driver_yd == 35.0
     assert found.rough_over_fairway_yd == pytest.approx(1.0)
     assert found.fairway_calm_yd == {"Driver": 15.0, "7-iron": 7.0, "PW": 4.0}
-    assert "| worst spin-back" in anchors.checks_table(found)
+    assert found.green_calm_yd == {"7-iron": (4.5, 5.5), "PW": (-1.0, 3.0)}
+    text = anchors.checks_table(found)
+    assert "| worst spin-back" in text and "| PGA PW on greens of stimp 8-14, calm | -5 to 5 | -1.0 to +3.0 |" in text

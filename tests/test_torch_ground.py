@@ -50,6 +50,10 @@ def test_the_device_ground_phase_gives_numpys_rests_hops_and_times(mixed):
     np.testing.assert_allclose(time_s.numpy(), want.time_s, rtol=0, atol=1e-9)
     assert (want.rest_position[:, 0] < position[:, 0]).any(), "no ball spun back: the case is not covered"
     assert (want.bounces > 1).any() and (slope > 0).any() == mixed
+    speed = np.linalg.norm(velocity, axis=-1)
+    from_normal = np.degrees(np.arctan2(np.hypot(velocity[:, 0], velocity[:, 1]), -velocity[:, 2]))
+    penner = np.asarray(surface.critical_angle_deg) * speed / 18.6 * from_normal / 44.0
+    assert (penner > np.asarray(surface.max_tilt_deg)).any() == mixed, "the green's tilt cap is not covered"
 
 
 def test_the_vectors_functions_answer_in_the_library_of_their_arguments():

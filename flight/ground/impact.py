@@ -1,5 +1,5 @@
 """The impact of a spinning ball on turf, one ball or many: Penner's tilted contact plane (Can. J. Phys. 80, 931
-(2002)), a turf that soaks up spin, and Coulomb friction that grips or lets the ball slip.
+(2002)), a turf that damps spin, and Coulomb friction that grips or lets the ball slip.
 
 1. Tilt. The turf gives under the ball, so it bounces off a contact plane tilted back towards it by Penner's critical
    angle theta_c: the normal n' = cos(tilt) n - sin(tilt) t, t the direction of the incoming tangential velocity.
@@ -9,27 +9,35 @@
    0), a steep wedge meets a gentler wall than a fast, shallow drive, and the later touches of a ball running on
    (theta_1 near 90 degrees) tilt most: the fit, applied as published, takes speed out of a ball skipping across the
    turf, which is what holds a drive that lands on a green to a few tens of yards. (It starts from a landing: a ball
-   already rolling, v_n = 0, would still see a tilt.) The tilt is capped at theta_1, so the tangential
+   already rolling, v_n = 0, would still see a tilt.) The tilt is the pitch mark's front wall, and its push runs
+   through the ball's centre: it is the one force of the impact that takes forward speed without taking spin. It is
+   capped at the surface's `max_tilt_deg`, the rim of the deepest pitch mark the turf takes (a mark d deep has its rim
+   at arccos(1 - d / R) from the ball's lowest point), because the linear fit stretched to twice Penner's landing
+   speed (a downwind drive) asks for walls that would stop a skimming ball dead; and at theta_1, so the tangential
    speed against the tilted plane, v sin(theta_1 - tilt), never turns negative: taking theta_1 as the landing angle
    from the horizontal instead makes that sine negative on shallow landings and "kills all rollout" of drivers (an
    open simulator's bug).
 2. Restitution. Against the tilted plane the normal speed comes back times Penner's e(v_n), scaled per surface.
-3. Spin friction. A ball pressed into turf touches it over a patch, not a point, and the turf's torque takes spin out
-   of it beyond what the friction force at the contact point does: an angular impulse against the spin's component
-   along the plane, of at most spin_friction x R x the normal impulse, that stops the spin but never reverses it.
+3. Spin damping. A ball pressed into turf touches it over a patch, not a point, and the grass the ball's surface rubs
+   through resists the spin beyond what the friction force at the contact point does: it takes the share
+   spin_damping x the normal impulse (per unit mass, m/s) of the spin's component along the plane, all of it at most,
+   never reversing it. A damper's torque grows with the rate it resists, like the grass drag on a rolling ball (and
+   the dampers of Haake's two-layer turf model), so a fast-spinning wedge loses the most and a slow spin still counts.
    Angular momentum about the contact point is what a ball rolls off with (5/7 v_t - 2/7 R omega); friction at the
-   contact point cannot change it, so without this torque a steep wedge would keep every bit of its back spin's
-   pull and roll back tens of metres.
+   contact point cannot change it, so without this torque a steep wedge would keep every bit of its back spin's pull
+   and roll back tens of metres.
 4. Grip or slip (Cross, "Grip-slip behavior of a bouncing ball", Am. J. Phys. 70, 1093 (2002); Biber et al.,
    "Measurements and linearized models for golf ball bounce on a green", Sports Engineering (2023)). Coulomb
    friction drives the contact point's slip towards zero: the ball leaves rolling (it grips: Penner's v_t' =
    5/7 v_t - 2/7 R omega) only if friction mu (1 + e) v_n suffices, and otherwise still slipping, as most of Biber et
    al.'s 1,000 measured bounces do. Slipping, a ball keeps its back spin only above a threshold set by the friction
-   and the spin friction: Haake's 721 filmed impacts on 18 greens (Aston PhD 1989; Science and Golf II, 1994) found
+   and the spin damping: Haake's 721 filmed impacts on 18 greens (Aston PhD 1989; Science and Golf II, 1994) found
    firm, freely drained greens let it keep back spin above about 350 rad/s, and softer greens turn it into top spin.
+   Friction takes 5/2 of a metre per second's worth of R omega with every metre per second of speed it takes, so with
+   that threshold it cannot stop an approach iron on its own: the wall of step 1 does.
 
-Energy never grows: |normal| shrinks by e <= 1, the spin friction shrinks |omega| and the friction impulse opposes
-the slip and never overshoots it.
+Energy never grows: |normal| shrinks by e <= 1, the spin damping shrinks |omega| and the friction impulse opposes the
+slip and never overshoots it.
 """
 
 from __future__ import annotations
@@ -62,20 +70,21 @@ def penner_restitution(normal_speed_mps):
     return 0.510 - 0.0375 * v + 0.000903 * v * v
 
 
-def penner_tilt(critical_angle_deg, speed_mps, incoming_rad):
-    """Penner's tilt of the contact plane (rad): theta_c (v / 18.6 m/s)(theta_1 / 44 deg), capped at theta_1 (the
-    incoming angle from the normal, `incoming_rad`) so the ball never meets a wall steeper than its own path."""
+def penner_tilt(critical_angle_deg, speed_mps, incoming_rad, max_tilt_deg=90.0):
+    """Penner's tilt of the contact plane (rad): theta_c (v / 18.6 m/s)(theta_1 / 44 deg), capped at `max_tilt_deg`
+    (the rim of the deepest pitch mark the turf takes) and at theta_1 (the incoming angle from the normal,
+    `incoming_rad`), so the ball never meets a wall steeper than the turf's or than its own path."""
     per_unit = math.radians(1.0) / (PENNER_REFERENCE_SPEED_MPS * math.radians(PENNER_REFERENCE_ANGLE_DEG))
-    return minimum(critical_angle_deg * per_unit * speed_mps * incoming_rad, incoming_rad)
+    penner = minimum(critical_angle_deg * per_unit * speed_mps * incoming_rad, max_tilt_deg * math.radians(1.0))
+    return minimum(penner, incoming_rad)
 
 
 def _soak_spin(spin: tuple, contact_normal: tuple, normal_impulse, surface: Surface) -> tuple:
-    """The spin after the turf's torque: its component along the contact plane shrunk by at most spin_friction x R x
-    the normal impulse (per unit mass, m/s) x m / I, down to zero and no further."""
+    """The spin after the turf's torque: its component along the contact plane shrunk by the share spin_damping x the
+    normal impulse (per unit mass, m/s), all of it at most."""
     along_plane = add(spin, contact_normal, -dot(spin, contact_normal))
-    size = norm(along_plane)
-    soaked = minimum(surface.spin_friction * normal_impulse * SPIN_PER_IMPULSE, size)
-    return add(spin, along_plane, -soaked / maximum(size, TINY))
+    share = minimum(surface.spin_damping_s_per_m * normal_impulse, 1.0)
+    return add(spin, along_plane, -share)
 
 
 def impact_components(velocity: tuple, spin: tuple, normal: tuple, surface: Surface) -> tuple[tuple, tuple]:
@@ -86,7 +95,8 @@ def impact_components(velocity: tuple, spin: tuple, normal: tuple, surface: Surf
     tangential = add(velocity, normal, normal_speed)
     tangential_speed = norm(tangential)
     along = times(1.0 / maximum(tangential_speed, TINY), tangential)
-    tilt = penner_tilt(surface.critical_angle_deg, norm(velocity), atan2(tangential_speed, normal_speed))
+    tilt = penner_tilt(surface.critical_angle_deg, norm(velocity), atan2(tangential_speed, normal_speed),
+                       surface.max_tilt_deg)
     contact_normal = add(times(cos(tilt), normal), along, -sin(tilt))
     incoming = -dot(velocity, contact_normal)
     restitution = minimum(maximum(surface.restitution_scale * penner_restitution(incoming), 0.0), 1.0)

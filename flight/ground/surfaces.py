@@ -3,23 +3,31 @@
 Parameters per surface: `restitution_scale` multiplies Penner's normal restitution e(v_n) (1 = his fairway);
 `critical_angle_deg` is Penner's theta_c, the angle the turf tilts the contact plane towards the incoming ball at his
 typical approach landing, 18.6 m/s at 44 degrees from the normal (in proportion to the speed and to that angle
-otherwise); `friction` is the kinetic (Coulomb) friction coefficient that caps the tangential impulse of an impact,
-and `spin_friction` the same for the turf's torque on the spin; `rolling_resistance` is the rolling deceleration on
-level ground in units of g, and `grass_drag_per_s` a further deceleration in proportion to the rolling speed (grass
-the ball brushes through: a fast roll slows sooner).
+otherwise), and `max_tilt_deg` the most it tilts at any landing: the rim of the deepest pitch mark the turf takes (a
+mark d deep has its rim at arccos(1 - d / R) from the ball's lowest point); `friction` is the kinetic (Coulomb)
+friction coefficient that caps the tangential impulse of an impact, and `spin_damping_s_per_m` the share of the spin
+(along the contact plane) the turf's torque takes per metre per second of normal impulse; `rolling_resistance` is the
+rolling deceleration on level ground in units of g, and `grass_drag_per_s` a further deceleration in proportion to
+the rolling speed (grass the ball brushes through: a fast roll slows sooner).
 
 Where the rows come from (docs/ground.md says more):
 - fairway: fitted on THE PLAYERS 2020 rest positions (`golfflight ground-fit`), friction held at 0.5 (openfairway's
-  fairway) and spin friction at 0 (with the green's 0.07 the fit's error grows);
+  fairway) and spin damping at 0; its tilt is a hair and never nears a cap;
 - firm_fairway: the fitted fairway with Penner's restitution, the fit's least rolling resistance and grass drag
   0.8 /s, set by that rule and not tuned;
 - rough: the fitted fairway times the anchors' rough-to-fairway ratios (ROUGH_OVER_FAIRWAY): every parameter soaks up
   at least as much as the fairway's, so a landing runs less far in the rough;
-- green: a firm, freely drained tour green. Penner's theta_c of about 15 degrees; libgolf's green-to-fairway
-  restitution (0.3-0.4 against 0.4-0.5: about three quarters); friction plus spin friction 0.165, so that at Penner's
-  typical landing a ball keeps its back spin through the bounce only above 347 rad/s (Haake: about 350 rad/s on such
-  greens), of it spin friction 0.07 so that no tour club spins back more than a few yards (docs/ground.md); rolling
-  resistance from the stimpmeter reading, no grass drag, so the reading maps exactly;
+- green: a firm, freely drained tour green that takes a pitch mark from every approach. Friction 0.115 and spin
+  damping 0.015 s/m put Haake's threshold at Penner's typical landing: the ball keeps its back spin through the bounce
+  only above 350 rad/s. Friction at the contact point takes spin with every bit of speed it takes, so with that
+  threshold it cannot stop an approach iron; the pitch mark's front wall, pushing through the ball's centre, takes
+  the forward speed and leaves the spin. Its theta_c is 20 degrees (Penner's fit to Haake's greens: 15.4), so that
+  calm tour 7-irons and wedges check on a green at least as well as TrackMan's table has them run on a fairway; capped
+  at 38 degrees, the rim of a pitch mark 4.5 mm deep, so that a drive skimming in downwind (Penner's fit would give it
+  52) is not stopped by a wall; friction against spin damping split so that the steepest headwind wedges spin back a
+  few yards. These four are set to the anchors, not measured (docs/ground.md). The restitution is libgolf's
+  green-to-fairway ratio (0.3-0.4 against 0.4-0.5: about three quarters); the rolling resistance comes from the
+  stimpmeter reading, with no grass drag, so the reading maps exactly;
 - bunker: anchors (Penner's soft-turf tilt and more, libgolf's and openfairway's figures), not measurements.
 """
 
@@ -54,9 +62,11 @@ class Surface:
     restitution_scale: float | np.ndarray
     critical_angle_deg: float | np.ndarray
     friction: float | np.ndarray
-    spin_friction: float | np.ndarray
+    spin_damping_s_per_m: float | np.ndarray
     rolling_resistance: float | np.ndarray
     grass_drag_per_s: float | np.ndarray
+    max_tilt_deg: float | np.ndarray = 90.0
+    """The steepest the contact plane tilts (90: no cap but the ball's own incoming angle, `impact.penner_tilt`)."""
 
     def take(self, index: np.ndarray) -> Surface:
         """The parameters of some balls of a batch."""
@@ -91,7 +101,7 @@ SURFACES: dict[str, Surface] = {
     "fairway": FAIRWAY,
     "firm_fairway": Surface(1.0, 0.0, 0.4, 0.0, 0.08, 0.8),
     "rough": scaled(FAIRWAY, ROUGH_OVER_FAIRWAY),
-    "green": Surface(0.75, 15.0, 0.095, 0.07, float(green_rolling_resistance(DEFAULT_STIMP_FT)), 0.0),
+    "green": Surface(0.75, 20.0, 0.115, 0.015, float(green_rolling_resistance(DEFAULT_STIMP_FT)), 0.0, 38.0),
     "bunker": Surface(0.2, 30.0, 0.8, 0.0, 1.0, 3.0),
 }
 """Surface presets by name; `surface(name, ...)` overrides any parameter."""
