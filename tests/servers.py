@@ -22,11 +22,13 @@ def free_port() -> int:
 
 
 @contextmanager
-def running(app, ready_path: str = "/healthz", timeout_s: float = 120.0) -> Iterator[httpx.Client]:
+def running(app, ready_path: str = "/healthz", timeout_s: float = 120.0, http=None) -> Iterator[httpx.Client]:
     """Serve `app` on a free loopback port until the block ends; yields a keep-alive client, once `ready_path`
-    answers 200 (or any answer, for apps whose model is meant to fail)."""
+    answers 200 (or any answer, for apps whose model is meant to fail). `http`: another HTTP protocol class than
+    `serve`'s (e.g. one with shorter request deadlines)."""
     port = free_port()
-    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning", **fast_io()))
+    io = {**fast_io(), **({"http": http} if http is not None else {})}
+    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning", **io))
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
     try:

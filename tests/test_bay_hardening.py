@@ -12,7 +12,6 @@ import os
 import socket
 import subprocess
 import sys
-import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -21,8 +20,6 @@ from pathlib import Path
 
 import httpx
 import pytest
-import uvicorn
-from golfflight.commands.serve import fast_io
 from golfflight.contract.flying import flown_shot
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.api.http_protocol import DeadlineHttpProtocol
@@ -32,7 +29,7 @@ from golfflight.service.runtime.feed import ShotFeed
 from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.viewer.session_csv import session_csv_slices
 from golfflight.service.viewer.stream import events
-from servers import free_port, keyed_service, running
+from servers import keyed_service, running
 from test_viewer import KEY, KEYED, next_event, reply_over_tcp
 
 
@@ -176,21 +173,8 @@ class _QuickDeadlines(DeadlineHttpProtocol):
 @contextmanager
 def _served_with_quick_deadlines() -> Iterator[int]:
     """The service on a free loopback port, its request deadlines half a second: the port."""
-    port = free_port()
-    app = create_app(api_key="", cors_origins=[])
-    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning",
-                                           **{**fast_io(), "http": _QuickDeadlines}))
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
-    try:
-        deadline = time.monotonic() + 60
-        while not server.started:
-            assert time.monotonic() < deadline and thread.is_alive(), "the service did not start"
-            time.sleep(0.05)
-        yield port
-    finally:
-        server.should_exit = True
-        thread.join(timeout=10)
+    with running(create_app(api_key="", cors_origins=[]), http=_QuickDeadlines) as http:
+        yield http.base_url.port
 
 
 def _closed_after(sock: socket.socket) -> tuple[bytes, float]:
