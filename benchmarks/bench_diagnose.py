@@ -35,6 +35,7 @@ from golfflight.discovery.fit import covariance, fit, linear_starts, residuals_a
 from golfflight.discovery.model import load_model
 from golfflight.discovery.prove import draw_effect
 from golfflight.discovery.recordings import read_recordings
+from golfflight.errors import InputError
 from golfflight.shots.records import write_shots
 from golfflight.shots.synth import SynthConfig, generate
 
@@ -55,7 +56,7 @@ def synthetic_set(n: int, seed: int, folder: Path) -> Path:
     if not path.is_file():
         records = generate(SynthConfig(n_shots=int(n * DRAW_MARGIN) + 10, seed=seed), progress=False).records
         if len(records) < n:
-            raise ValueError(f"the generator recorded {len(records)} shots for {n} wanted")
+            raise InputError(f"the generator recorded {len(records)} shots for {n} wanted")
         write_shots(path, records[:n])
     return path
 
@@ -69,7 +70,7 @@ def concealed_set(n: int, seed: int, hidden: str, model: str | None, folder: Pat
         effects = {name: draw_effect(name, rng) for name in hidden.split("+")}
         records = conceal(effects, int(n * DRAW_MARGIN) + 10, seed, model=load_model(model)).shots.records
         if len(records) < n:
-            raise ValueError(f"{len(records)} shots concealed for {n} wanted")
+            raise InputError(f"{len(records)} shots concealed for {n} wanted")
         write_shots(path, records[:n])
     return path
 

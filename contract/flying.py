@@ -19,8 +19,9 @@ from golfflight.contract.results import (
     TrajectoryPoint,
 )
 from golfflight.contract.trajectory import resample
+from golfflight.errors import FlightError, InputError
 from golfflight.flight.conditions import Conditions
-from golfflight.flight.engine import FlightEngine, FlightError, Launch, ShotFlight
+from golfflight.flight.engine import FlightEngine, Launch, ShotFlight
 from golfflight.flight.flyer import LAUNCH_WIDTH
 from golfflight.flight.ground import GroundSpec
 from golfflight.flight.wind import CALM
@@ -150,7 +151,7 @@ def fly_columns(engine: FlightEngine, shots: list[ShotRequest]) -> ShotColumns:
     """`fly_shots` without a result object a shot (the same batch, numbers and errors, straight into columns):
     for many shots at once (`golfflight sweep`). No trajectories: a shot asking for one is refused."""
     if any(shot.trajectory is not None for shot in shots):
-        raise ValueError("fly_columns flies no trajectories (fly_shots does)")
+        raise InputError("fly_columns flies no trajectories (fly_shots does)")
     n = len(shots)
     launches, conditions, grounds, replays, flats = _batch_of(shots)
     flights = engine.fly_columns(np.array(launches, dtype=float).reshape(-1, LAUNCH_WIDTH), conditions, grounds)

@@ -16,12 +16,13 @@ from typing import Annotated
 from golfflight.contract.bay import BayConditions, in_bay
 from golfflight.contract.flying import flown_shot
 from golfflight.contract.inputs import spin_from_components
-from golfflight.contract.refusals import describe_errors, encodable
+from golfflight.contract.refusals import answer_to, describe_errors, encodable
 from golfflight.contract.requests import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotRequest
 from golfflight.contract.results import ShotResult
+from golfflight.errors import FlightError, InputError
 from golfflight.flight import limits
 from golfflight.flight.constants import MPH_TO_MPS
-from golfflight.flight.engine import FlightEngine, FlightError, Launch
+from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.limits import Range
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
@@ -36,7 +37,7 @@ def _spelled_as_fields(data, fields) -> dict:
     for key, value in data.items():
         name = names.get(key.casefold(), key) if isinstance(key, str) else key
         if name in renamed and renamed[name] != value:
-            raise ValueError(f"{name} is given twice, in two spellings, with different values")
+            raise InputError(f"{name} is given twice, in two spellings, with different values")
         renamed[name] = value
     return renamed
 
@@ -148,7 +149,7 @@ class GSProMessage(_Lenient):
         degrees either way, as in GSPro) nor answered (the flight comes in yards and metres both); anything else is
         refused rather than ignored, as a connector sending it expects something that will not happen."""
         if value is not None and value.casefold() not in UNITS:
-            raise ValueError(f"Units must be {' or '.join(UNITS.values())} (GSPro Open Connect's two), got {value!r}")
+            raise InputError(f"Units must be {' or '.join(UNITS.values())} (GSPro Open Connect's two), got {value!r}")
         return value
 
     @field_validator("ShotNumber", mode="before")
@@ -157,7 +158,7 @@ class GSProMessage(_Lenient):
         """Refuse a ShotNumber out of range with the range written out: a bound quoted the usual way
         (`flight.limits.limit_text`, four significant digits) would read "less than or equal to 2147000000"."""
         if isinstance(value, int) and not isinstance(value, bool) and not 0 <= value <= SHOT_NUMBER_MAX:
-            raise ValueError(f"Input should be a whole number from 0 to {SHOT_NUMBER_MAX}")
+            raise InputError(f"Input should be a whole number from 0 to {SHOT_NUMBER_MAX}")
         return value
 
     @model_validator(mode="before")
@@ -198,11 +199,11 @@ def launch_from_ball_data(ball: GSProBallData) -> Launch:
     if ball.TotalSpin is None and ball.BackSpin is None:
         missing.append("TotalSpin (or BackSpin)")
     if missing:
-        raise ValueError(f"BallData is missing {', '.join(missing)}")
+        raise InputError(f"BallData is missing {', '.join(missing)}")
     if uses_components:
         spin, axis = spin_from_components(ball.BackSpin or 0.0, ball.SideSpin or 0.0)
         if spin > limits.SPIN_RPM.high:
-            raise ValueError(f"BallData: BackSpin and SideSpin make {spin:.0f} rpm, over {limits.SPIN_RPM.describe()}")
+            raise InputError(f"BallData: BackSpin and SideSpin make {spin:.0f} rpm, over {limits.SPIN_RPM.describe()}")
     else:
         spin, axis = ball.TotalSpin or 0.0, ball.SpinAxis or 0.0
     return Launch(ball.Speed * MPH_TO_MPS, ball.VLA, ball.HLA or 0.0, spin, axis)
@@ -245,8 +246,9 @@ def shot_reply(message: GSProMessage, result: ShotResult) -> GSProReply:
 
 
 def failed_reply(message: GSProMessage, error: Exception) -> GSProReply:
-    """Code 500 saying why the shot could not fly."""
-    return GSProReply(Code=500, Message=str(error), ShotNumber=message.ShotNumber)
+    """The reply saying why the shot could not fly, its code from `contract.refusals.FAILURES` (500; 503 while the
+    service cannot answer)."""
+    return GSProReply(Code=answer_to(error).open_connect_code, Message=str(error), ShotNumber=message.ShotNumber)
 
 
 def fly_message(

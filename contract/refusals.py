@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import json
 import math
+from typing import NamedTuple
 
 from golfflight.contract.requests import RANGES
+from golfflight.errors import FlightError, GolfflightError, InputError, ServiceError
 from golfflight.flight.limits import Range, limit_text
 
 QUOTED_CHARS = 40
@@ -85,6 +87,36 @@ def describe_error(error: dict, ranges: dict[str, Range] = RANGES) -> dict:
         parts.append(f"; allowed {entry['allowed']}")
     entry["message"] = " ".join(parts).replace(" ;", ";")
     return entry
+
+
+class Answer(NamedTuple):
+    """How the service answers one kind of failure: the HTTP status, the Open Connect reply code and the detail's
+    `type`."""
+
+    http_status: int
+    open_connect_code: int
+    kind: str
+
+
+FAILURES: dict[type[GolfflightError], Answer] = {
+    InputError: Answer(422, 500, "input_error"),
+    FlightError: Answer(422, 500, "flight_error"),
+    ServiceError: Answer(503, 503, "service_unavailable"),
+}
+"""The one table from a failure to its answer, for HTTP and Open Connect alike: the caller's input and a shot that
+cannot land are refused (HTTP 422, Open Connect's error Code 500); the service not able to answer now is 503 in both
+(try again). Any other exception is a bug: HTTP 500, Open Connect Code 500."""
+
+UNEXPECTED = Answer(500, 500, "internal_error")
+"""The answer to an exception outside the family: a bug, said as such."""
+
+
+def answer_to(error: BaseException) -> Answer:
+    """`error`'s row of FAILURES (its nearest kind), or UNEXPECTED outside the family."""
+    for kind in type(error).__mro__:
+        if kind in FAILURES:
+            return FAILURES[kind]
+    return UNEXPECTED
 
 
 def body_detail(message: str, kind: str) -> dict:

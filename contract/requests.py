@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
+from golfflight.errors import InputError
 from golfflight.flight import limits
 from golfflight.flight.conditions import NORMALIZED_HUMIDITY_PCT, NORMALIZED_TEMPERATURE_C
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS
@@ -99,14 +100,14 @@ def _exactly_one(model: BaseModel, quantity: str, *names: str) -> None:
     given = [name for name in names if getattr(model, name) is not None]
     if len(given) != 1:
         found = ", ".join(given) if given else "none"
-        raise ValueError(f"{quantity}: give exactly one of {' or '.join(names)} (got {found})")
+        raise InputError(f"{quantity}: give exactly one of {' or '.join(names)} (got {found})")
 
 
 def _at_most_one(model: BaseModel, quantity: str, *names: str) -> str | None:
     """The one of `names` that `model` gives, or None when it gives none; ValueError naming both when it gives two."""
     given = [name for name in names if getattr(model, name) is not None]
     if len(given) > 1:
-        raise ValueError(f"{quantity}: give {' or '.join(given)}, not both")
+        raise InputError(f"{quantity}: give {' or '.join(given)}, not both")
     return given[0] if given else None
 
 
@@ -143,10 +144,10 @@ class AirRequest(Strict):
         _at_most_one(self, "air temperature", *TEMPERATURE_FIELDS)
         altitude = _at_most_one(self, "altitude", *ALTITUDE_FIELDS)
         if altitude is not None and self.pressure_hpa is not None:
-            raise ValueError(f"air: give {altitude} or pressure_hpa, not both")
+            raise InputError(f"air: give {altitude} or pressure_hpa, not both")
         weather = [n for n in WEATHER_FIELDS if getattr(self, n) is not None]
         if self.density_kg_m3 is not None and weather:
-            raise ValueError(f"air: density_kg_m3 replaces the weather values; drop {', '.join(weather)}")
+            raise InputError(f"air: density_kg_m3 replaces the weather values; drop {', '.join(weather)}")
         return self
 
 
@@ -165,7 +166,7 @@ class ReferenceAir(Strict):
     @model_validator(mode="after")
     def _one_source(self) -> ReferenceAir:
         if self.altitude_m is not None and self.pressure_hpa is not None:
-            raise ValueError("normalized: give altitude_m or pressure_hpa, not both")
+            raise InputError("normalized: give altitude_m or pressure_hpa, not both")
         return self
 
 
@@ -232,12 +233,12 @@ class GroundRequest(Strict):
     @model_validator(mode="after")
     def _holds_a_ball(self) -> GroundRequest:
         if self.elevation_m is not None and self.elevation_ft is not None:
-            raise ValueError("ground elevation: give elevation_m or elevation_ft, not both")
+            raise InputError("ground elevation: give elevation_m or elevation_ft, not both")
         if self.stimp_ft is not None and self.surface != "green":
-            raise ValueError(f"stimp_ft: a green's reading; surface {self.surface!r} takes none")
+            raise InputError(f"stimp_ft: a green's reading; surface {self.surface!r} takes none")
         limit = float(holding_slope_deg(surface(self.surface, self.stimp_ft).rolling_resistance))
         if self.slope_deg >= limit:
-            raise ValueError(
+            raise InputError(
                 f"slope_deg: {self.slope_deg:g} is steeper than {self.surface} holds a ball still on; allowed 0 to "
                 f"{limit - 0.005:.2f} deg on this surface"
             )
@@ -281,13 +282,13 @@ class ShotRequest(Strict):
         _exactly_one(self, "ball speed", "ball_speed_mps", "ball_speed_mph")
         _exactly_one(self, "spin", "spin_rpm", "back_spin_rpm")
         if self.spin_rpm is not None and self.side_spin_rpm is not None:
-            raise ValueError("spin: side_spin_rpm goes with back_spin_rpm; with spin_rpm give spin_axis_deg")
+            raise InputError("spin: side_spin_rpm goes with back_spin_rpm; with spin_rpm give spin_axis_deg")
         if self.back_spin_rpm is not None and self.spin_axis_deg is not None:
-            raise ValueError("spin: spin_axis_deg goes with spin_rpm; with back_spin_rpm give side_spin_rpm")
+            raise InputError("spin: spin_axis_deg goes with spin_rpm; with back_spin_rpm give side_spin_rpm")
         if self.back_spin_rpm is not None:
             total = (self.back_spin_rpm**2 + (self.side_spin_rpm or 0.0) ** 2) ** 0.5
             if total > limits.SPIN_RPM.high:
-                raise ValueError(f"spin: back and side spin make {total:.0f} rpm, over {limits.SPIN_RPM.describe()}")
+                raise InputError(f"spin: back and side spin make {total:.0f} rpm, over {limits.SPIN_RPM.describe()}")
         return self
 
 
@@ -304,7 +305,7 @@ class BatchRequest(Strict):
     def _few_trajectories(self) -> BatchRequest:
         asked = sum(shot.trajectory is not None for shot in self.shots)
         if asked > MAX_BATCH_TRAJECTORIES:
-            raise ValueError(
+            raise InputError(
                 f"shots: {asked} shots ask for a trajectory, at most {MAX_BATCH_TRAJECTORIES} may in one batch"
             )
         return self

@@ -13,6 +13,7 @@ import unicodedata
 from typing import Annotated
 
 from golfflight.contract.requests import Strict
+from golfflight.errors import InputError
 from pydantic import AfterValidator, BaseModel, Field
 
 PLAYER_CHARS = 40
@@ -28,11 +29,11 @@ def _plain_name(name: str) -> str:
     no lone surrogates that no UTF-8 text can carry), not opening like a spreadsheet formula, not blank."""
     stripped = name.strip()
     if not stripped:
-        raise ValueError("a player's name needs a letter or a digit (leave `player` out for none)")
+        raise InputError("a player's name needs a letter or a digit (leave `player` out for none)")
     if stripped.startswith(FORMULA_STARTS):
-        raise ValueError(f"a player's name may not start with {' '.join(FORMULA_STARTS)} (a spreadsheet formula)")
+        raise InputError(f"a player's name may not start with {' '.join(FORMULA_STARTS)} (a spreadsheet formula)")
     if any(not char.isprintable() or unicodedata.category(char) == "Cs" for char in stripped):
-        raise ValueError("a player's name takes printable characters only")
+        raise InputError("a player's name takes printable characters only")
     return stripped
 
 

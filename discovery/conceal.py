@@ -18,6 +18,7 @@ from golfflight.discovery.model import FlightModel
 from golfflight.discovery.noise import RADAR_NOISE
 from golfflight.discovery.outside import OUTSIDE, air_motion, term_and_weights
 from golfflight.discovery.simulator import Setup
+from golfflight.errors import InputError
 from golfflight.flight.air import Air
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import initial_state
@@ -156,7 +157,7 @@ def _fly_model(
         set(hidden) - set(KNOBS) - set(LAUNCH_BIASES) - set(OUTSIDE) - {*AIR_VARIANTS, "wind", "landing_elevation"}
     )
     if unknown or wind_profile != "uniform":
-        raise ValueError(f"a model's own flights take library effects, uniform wind and discovery.outside: {unknown}")
+        raise InputError(f"a model's own flights take library effects, uniform wind and discovery.outside: {unknown}")
     n = len(true.club)
     scale = np.ones((n, 3))
     for column, name in enumerate(("lift_scale", "drag_scale", "spin_decay")):

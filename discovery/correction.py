@@ -23,6 +23,7 @@ from golfflight.discovery.fit import Fit, Problem, fit, residuals_and_jacobian
 from golfflight.discovery.recordings import OBSERVABLES
 from golfflight.discovery.schema import Unlisted
 from golfflight.discovery.simulator import Setup
+from golfflight.errors import InputError
 
 NAME = "unlisted"
 MIN_T = 4.0
@@ -267,4 +268,4 @@ def summary(result: Fit, error: float, library_error: float) -> Unlisted:
                 library_heldout_error=library_error,
             )
         start += effect.size
-    raise ValueError(f"{result.name} holds no learned correction")
+    raise InputError(f"{result.name} holds no learned correction")

@@ -14,6 +14,7 @@ from functools import cached_property
 
 import numpy as np
 from golfflight.discovery.simulator import Correction
+from golfflight.errors import InputError
 from golfflight.flight.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M
 from golfflight.flight.wind import Wind, wind_vector
 
@@ -111,7 +112,7 @@ def term_and_weights(
     has none (none hidden, or the gust, which is air motion: `air_motion`)."""
     present = [name for name in OUTSIDE if name in hidden]
     if len(present) > 1:
-        raise ValueError(f"one outside effect at a time, not {present}")
+        raise InputError(f"one outside effect at a time, not {present}")
     if not present or present[0] not in TERMS:
         return None, None
     term, keys = TERMS[present[0]]

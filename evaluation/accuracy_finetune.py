@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.evaluation.accuracy_sets import ClubComparison, compare_clubs, outcome_errors
 from golfflight.shots.progress import progress_bar
@@ -89,7 +90,7 @@ def finetune_study(
     a bar over the learning rates goes to standard error (the runs' own lines would go to standard output)."""
     train, measured = by_rounds(shots, train_rounds), by_rounds(shots, measured_rounds)
     if not len(train) or not len(measured):
-        raise ValueError(f"needs shots in rounds {list(train_rounds)} and {list(measured_rounds)}; "
+        raise InputError(f"needs shots in rounds {list(train_rounds)} and {list(measured_rounds)}; "
                          f"found {len(train)} and {len(measured)}")
     launch = measured.launch()
     before = outcome_errors(flyer.simulate(launch), measured)

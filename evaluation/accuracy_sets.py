@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.evaluation.accuracy_flyers import Flyer
 from golfflight.flight.air import Air
 from golfflight.flight.constants import FOOT_M, YARD_M
@@ -193,7 +194,7 @@ def shot_hole(shot_id: str) -> int:
     """The hole of a tour shot id ('060-R3-H15-P29725-S1' -> 15)."""
     match = HOLE.search(shot_id)
     if match is None:
-        raise ValueError(f"{shot_id!r} names no hole")
+        raise InputError(f"{shot_id!r} names no hole")
     return int(match["hole"])
 
 
@@ -219,7 +220,7 @@ def path_errors(flight: Flight, trajectories: Sequence[np.ndarray]) -> PathError
     """Compare the model's states (every step, relative to its start point) with each measured trajectory [T, 4] of
     t, x, y, z (relative to the start), interpolated to the step times; a shot counts while both are in the air."""
     if flight.states is None or flight.times_s is None:
-        raise ValueError("the flight was simulated without keep_states")
+        raise InputError("the flight was simulated without keep_states")
     positions = np.stack([s.position for s in flight.states]) - flight.states[0].position[None]
     model_end = np.where(flight.landed, flight.flight_time_s, np.inf)
     errors = []

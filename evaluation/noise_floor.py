@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.evaluation.validation import Errors, Prediction, ValidationShots, errors_of
 from golfflight.flight.air import Air
 from golfflight.flight.physics import initial_state
@@ -44,7 +45,7 @@ def read_session_truth(path: str | os.PathLike) -> dict[str, SessionTruth]:
 def _truth_columns(sessions: np.ndarray, truth: dict[str, SessionTruth]) -> dict[str, np.ndarray]:
     unknown = sorted({s for s in sessions if s not in truth})
     if unknown:
-        raise ValueError(f"shots of sessions {unknown[:5]} have no hidden truth in the sessions file")
+        raise InputError(f"shots of sessions {unknown[:5]} have no hidden truth in the sessions file")
     return {field: np.array([getattr(truth[s], field) for s in sessions]) for field in SessionTruth._fields}
 
 

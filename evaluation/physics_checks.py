@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.evaluation.accuracy_flyers import Flyer, ModelFlyer
 from golfflight.flight.air import Air
 from golfflight.flight.constants import BALL_RADIUS_M
@@ -140,7 +141,7 @@ def _rows(path: str | os.PathLike, columns: tuple[str, ...]) -> list[dict[str, s
         reader = csv.DictReader(handle)
         missing = [c for c in columns if c not in (reader.fieldnames or [])]
         if missing:
-            raise ValueError(f"{path}: columns {missing} missing")
+            raise InputError(f"{path}: columns {missing} missing")
         return list(reader)
 
 
@@ -396,7 +397,7 @@ def club_launch(name: str, spin_rpm: float | None = None) -> ClubLaunch:
     """The launch of CLUBS's club of this name (case-insensitive), with its spin replaced where one is given."""
     match = next((c for c in CLUBS if c.name.lower() == name.lower()), None)
     if match is None:
-        raise ValueError(f"no club {name!r} in shots.clubs.CLUBS")
+        raise InputError(f"no club {name!r} in shots.clubs.CLUBS")
     return match if spin_rpm is None else match._replace(spin_rpm=spin_rpm)
 
 
@@ -434,10 +435,10 @@ def run_physics_checks(model_dir: str | os.PathLike | None, data_dir: str | os.P
     literature = read_aero_literature(aero)
     measured = {name: measured_set(literature, name) for name in COEFFICIENTS}
     if not all(len(m.value) for m in measured.values()):
-        raise ValueError(f"{aero}: no measured point with Re and S for {', '.join(COEFFICIENTS)}")
+        raise InputError(f"{aero}: no measured point with Re and S for {', '.join(COEFFICIENTS)}")
     decay = read_spin_decay(spin)
     if not decay or any(SPIN_CHECK_TIME_S not in m.times_s for m in decay):
-        raise ValueError(f"{spin}: no spin-loss rows, or one without a value at {SPIN_CHECK_TIME_S:g} s")
+        raise InputError(f"{spin}: no spin-loss rows, or one without a value at {SPIN_CHECK_TIME_S:g} s")
     clubs = [check_flight(points, measured) for points in flight_points(flyer, list(CLUBS), air)]
     return PhysicsReport(flyer, air, literature, measured, clubs, check_spin(flyer, decay, air))
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.shots.records import ShotSet, read_shots
 from golfflight.shots.synth import MIN_APEX_M
 
@@ -52,7 +53,7 @@ def load_validation_shots(path: str | os.PathLike, min_apex_m: float = MIN_APEX_
     shots = read_shots(path)
     val = shots.subset(validation_mask(shots, min_apex_m))
     if not len(val):
-        raise ValueError(f"{path}: no validation shots (rows marked 'val' that pass the training filters)")
+        raise InputError(f"{path}: no validation shots (rows marked 'val' that pass the training filters)")
     return ValidationShots(path, val, shots)
 
 

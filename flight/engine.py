@@ -16,13 +16,13 @@ import time
 from collections.abc import Sequence
 
 import numpy as np
+from golfflight.errors import FlightError
 from golfflight.flight.bundle_check import open_session, session_options
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import (
     BATCH_THREADS,
     MAX_FLIGHT_TIME_S,
     NON_FINITE,
-    FlightError,
     Flyer,
     Launch,
     air_inputs,
@@ -40,7 +40,6 @@ __all__ = [
     "BatchFlights",
     "EulerStates",
     "FlightEngine",
-    "FlightError",
     "Launch",
     "Rest",
     "ShotFlight",

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import NamedTuple, Protocol
 
 import numpy as np
+from golfflight.errors import FlightError
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.constants import BALL_MASS_KG, BALL_RADIUS_M
@@ -69,10 +70,6 @@ class Launch(NamedTuple):
 LAUNCH_WIDTH = len(Launch._fields)
 """The width of a launches array [N, LAUNCH_WIDTH], its columns in Launch's order (`shots.records.LAUNCH_COLUMNS`
 and `contract.columns.LAUNCH_COLUMNS` name the columns of files)."""
-
-
-class FlightError(Exception):
-    """A shot the engine could not fly to the ground (the message says why); a batch reports it for that shot."""
 
 
 class ModelInAir(Protocol):

@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 from typing import Any, Generic, TypeVar
 
 import numpy as np
+from golfflight.errors import InputError
 
 T = TypeVar("T")
 
@@ -38,7 +39,7 @@ class PerShot(Sequence, Generic[T]):
         else:
             return cls([given], np.zeros(n, dtype=np.intp))
         if len(shared) != n:
-            raise ValueError(f"{len(shared)} {name} for {n} launches")
+            raise InputError(f"{len(shared)} {name} for {n} launches")
         return shared
 
     def __len__(self) -> int:

@@ -18,10 +18,7 @@ if getattr(golfflight, "__file__", None) is None:  # a namespace package: a fold
 
 from golfflight import __version__
 from golfflight.commands import COMMANDS
-
-
-class UserError(Exception):
-    """An error the user can fix (a bad file, a bad option): printed as one line, no traceback."""
+from golfflight.errors import GolfflightError, InputError
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -33,9 +30,11 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-USER_ERRORS = (UserError, ValueError, OSError, csv.Error)
-"""What a bad input can raise: ValueError covers RecordError, BundleError, pydantic's and JSON's errors; OSError a
-missing, unreadable or directory path; csv.Error a file that is not CSV (NUL bytes, runaway fields)."""
+USER_ERRORS = (InputError, FileNotFoundError, IsADirectoryError, NotADirectoryError, PermissionError, csv.Error)
+"""What the user can fix, printed as one line with exit status 2: our input errors (a bad option, file, record or
+bundle), a path that is missing, unreadable or a folder, and a file that is not CSV (NUL bytes, runaway fields).
+Our other failures (an output that cannot be written, a shot that cannot land) are one line with exit status 1;
+anything else is a bug and keeps its traceback."""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -45,6 +44,9 @@ def main(argv: list[str] | None = None) -> int:
     except USER_ERRORS as error:
         print(f"golfflight {args.command}: error: {error}", file=sys.stderr)
         return 2
+    except GolfflightError as error:
+        print(f"golfflight {args.command}: error: {error}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

@@ -13,6 +13,7 @@ import os
 
 import onnx
 import torch
+from golfflight.errors import InputError
 from golfflight.flight.bundle_check import OUTPUT_COLUMNS
 from golfflight.model_export.export import (
     PARITY_TOLERANCE,
@@ -58,13 +59,13 @@ def model_from_bundle(bundle_dir: str | os.PathLike) -> tuple[nn.Module, ModelCa
             state = {"params": torch.tensor(card.architecture.quadratic_params)}
         model.load_state_dict(state)
     except (KeyError, RuntimeError, TypeError) as error:
-        raise ValueError(
+        raise InputError(
             f"{onnx_path}: its weights do not fit a {card.variant} model {card.architecture.hidden_units} ({error})"
         ) from None
     model.eval()
     difference = onnx_torch_difference(model, onnx_path, *probe_inputs())
     if not difference <= PARITY_TOLERANCE:
-        raise ValueError(f"{onnx_path}: torch weights rebuilt from the graph differ from it by {difference:.3g}")
+        raise InputError(f"{onnx_path}: torch weights rebuilt from the graph differ from it by {difference:.3g}")
     return model, card
 
 

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
+from golfflight.errors import InputError
 from golfflight.flight.air import Air
 from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.shots.records import ShotSet, read_shots
@@ -138,7 +139,7 @@ def load_training_data(
         is_train, is_val = _first(is_train, limit - n_val), _first(is_val, n_val)
         filters["limit"] = before - int(is_train.sum() + is_val.sum())
     if not is_train.any() or not is_val.any():
-        raise ValueError(
+        raise InputError(
             f"{path}: need shots marked 'train' and 'val' in the split column after filtering "
             f"(have {int(is_train.sum())} train, {int(is_val.sum())} val; left out: {filters})"
         )

@@ -4,12 +4,13 @@ line where this machine lacks it (a GPU asked for where torch sees none)."""
 from __future__ import annotations
 
 import torch
+from golfflight.errors import InputError
 
 DEFAULT_DEVICE = "cpu"
 """Every command's device unless told otherwise: the CPU results are the ones the repository's numbers come from."""
 
 
-class DeviceError(ValueError):
+class DeviceError(InputError):
     """A device this machine cannot run torch on (no GPU for cuda, an unknown name)."""
 
 

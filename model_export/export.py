@@ -22,6 +22,7 @@ import numpy as np
 import onnx
 import onnxruntime as ort
 import torch
+from golfflight.errors import InputError
 from golfflight.flight.air import Air
 from golfflight.flight.bundle_check import OUTPUT_COLUMNS
 from golfflight.flight.coefficients import BASE_DYNAMIC_PRESSURE
@@ -372,7 +373,7 @@ def export_bundle(model: nn.Module, payload: dict[str, Any], out_dir: str | os.P
     checking ONNX Runtime reproduces the torch coefficients within PARITY_TOLERANCE."""
     config = TrainConfig(**payload["config"])
     if config.variant not in PHYSICS_VARIANTS:
-        raise ValueError(
+        raise InputError(
             f"variant {config.variant!r} has no coefficient graph to export "
             "(the NN baseline is trained and evaluated in torch only)"
         )

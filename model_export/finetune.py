@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 import torch
+from golfflight.errors import InputError
 from golfflight.model_export.data import load_training_data
 from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.export import export_checkpoint
@@ -66,7 +67,7 @@ def assign_split(shots: ShotSet, val_fraction: float) -> ShotSet:
     """Mark the most recent `val_fraction` of the shots 'val', the rest 'train' (by timestamp where every shot has
     one, else by file order). With several sessions, whole sessions go to validation; with one, the last shots."""
     if not 0 < val_fraction < 1:
-        raise ValueError(f"the validation fraction must be between 0 and 1, got {val_fraction}")
+        raise InputError(f"the validation fraction must be between 0 and 1, got {val_fraction}")
     stamps = shots.column("timestamp")
     order = np.argsort(stamps, kind="stable") if all(t is not None for t in stamps) else np.arange(len(shots))
     sessions = shots.column("session")[order]
@@ -134,7 +135,7 @@ def finetune(
     steps and epochs go to standard error and a line per epoch to standard output; `device` and `compile_step` as
     `training.train` takes them."""
     if epochs < 1:
-        raise ValueError(f"epochs must be at least 1, got {epochs}")
+        raise InputError(f"epochs must be at least 1, got {epochs}")
     where = resolve_device(device)
     out = Path(out)
     run_dir = out / RUN_DIR

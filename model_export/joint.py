@@ -27,6 +27,7 @@ from typing import Any
 
 import torch
 from golfflight.discovery.effects import EFFECTS
+from golfflight.errors import InputError
 from golfflight.flight.wind import Wind
 from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.observations import (
@@ -398,10 +399,10 @@ def train_joint_runs(data_path: str | os.PathLike, out_dirs: list[str | os.PathL
     """Several joint runs from `init` that differ only in their seed, trained side by side in one rollout
     (`model_export.stacked_runs`): each run as `train_joint` trains it alone, written to its own folder."""
     if len(out_dirs) != len(configs) or not configs:
-        raise ValueError(f"one folder a run: {len(out_dirs)} folders for {len(configs)} configurations")
+        raise InputError(f"one folder a run: {len(out_dirs)} folders for {len(configs)} configurations")
     differ = [c.seed for c in configs if replace(c, seed=0) != replace(configs[0], seed=0)]
     if differ:
-        raise ValueError(f"runs trained side by side may differ only in their seed; seeds {differ} differ from "
+        raise InputError(f"runs trained side by side may differ only in their seed; seeds {differ} differ from "
                          f"seed {configs[0].seed}'s configuration in more")
     where = resolve_device(device)
     torch.set_flush_denormal(True)

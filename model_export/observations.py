@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
+from golfflight.errors import InputError
 from golfflight.flight.air import Air
 from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.shots.records import ShotSet, read_shots, read_trajectories, trajectories_path
@@ -160,11 +161,11 @@ def load_observed(path: str | os.PathLike, weights: dict[str, float]) -> Observe
     paths = read_trajectories(companion) if companion.is_file() else {}
     unknown = sorted({s for s in shots.column("source") if s not in weights})
     if unknown:
-        raise ValueError(f"{path}: sources {unknown} have no weight (weights given for {sorted(weights)})")
+        raise InputError(f"{path}: sources {unknown} have no weight (weights given for {sorted(weights)})")
     split = shots.column("split")
     train, val = shots.subset(split == "train"), shots.subset(split == "val")
     if not len(train) or not len(val):
-        raise ValueError(f"{path}: need rows marked 'train' and 'val' (have {len(train)} and {len(val)})")
+        raise InputError(f"{path}: need rows marked 'train' and 'val' (have {len(train)} and {len(val)})")
     sources = list(dict.fromkeys(shots.column("source")))
     wind = [g for g, s in dict.fromkeys(zip(train.column("group"), train.column("source")))
             if g and s not in CALM_SOURCES]

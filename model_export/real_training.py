@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.flight.constants import YARD_M
 from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.export import export_bundle
@@ -193,7 +194,7 @@ class SeedPlan:
     def check(self) -> None:
         """ValueError, in the command line's words, for a plan that cannot run here."""
         if resolve_device(self.device).type != "cpu" and self.jobs > 1:
-            raise ValueError(f"--jobs {self.jobs} goes with --device cpu: on {self.device} the seeds run one after "
+            raise InputError(f"--jobs {self.jobs} goes with --device cpu: on {self.device} the seeds run one after "
                              "another, or side by side with --stack-seeds")
 
 

@@ -16,6 +16,7 @@ from contextlib import contextmanager
 import torch
 from torch import nn
 from torch.func import functional_call, stack_module_state, vmap
+from golfflight.errors import InputError
 
 
 class StackedNetworks:
@@ -25,7 +26,7 @@ class StackedNetworks:
 
     def __init__(self, module: nn.Module, runs: int) -> None:
         if runs < 1:
-            raise ValueError(f"runs must be at least 1, got {runs}")
+            raise InputError(f"runs must be at least 1, got {runs}")
         self.runs = runs
         self.base = copy.deepcopy(module)
         self.params, self.buffers = stack_module_state([module] * runs) if runs > 1 else ({}, {})

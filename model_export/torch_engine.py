@@ -36,6 +36,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import torch
+from golfflight.errors import InputError
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import LAUNCH_WIDTH, NON_FINITE, Launch, air_inputs, load_flyer
 from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, batch_surface, elevations, ground_phase
@@ -175,9 +176,9 @@ class TorchEngine:
         are set aside (1: never, every shot flies to the part's last step). `devices.DeviceError` for a device this
         machine lacks, ValueError for a dtype it does not know or a share outside (0, 1]."""
         if dtype not in DTYPES:
-            raise ValueError(f"dtype {dtype!r}: choose from {', '.join(DTYPES)}")
+            raise InputError(f"dtype {dtype!r}: choose from {', '.join(DTYPES)}")
         if not 0 < set_aside_share <= 1:
-            raise ValueError(f"set_aside_share {set_aside_share}: must be more than 0 and at most 1")
+            raise InputError(f"set_aside_share {set_aside_share}: must be more than 0 and at most 1")
         self.device, self.dtype = resolve_device(device), DTYPES[dtype]
         self.flyer = load_flyer(bundle_dir)
         self.card, self.sha256 = self.flyer.card, self.flyer.card.onnx.sha256
@@ -222,7 +223,7 @@ class TorchEngine:
         Conditions or GroundSpec for every shot is spread without a Python step a shot (a benchmark's millions)."""
         n = len(launches)
         if n == 0:
-            raise ValueError("no shots to fly")
+            raise InputError("no shots to fly")
         per_shot, shot_grounds = PerShot.of(conditions, n, "conditions"), PerShot.of(grounds, n, "grounds")
         started = time.perf_counter()
         inputs = self._inputs(np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH), per_shot, shot_grounds)

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import torch
+from golfflight.errors import InputError
 from golfflight.flight.constants import YARD_M
 from golfflight.model_export import DEFAULT_HIDDEN, VARIANTS
 from golfflight.model_export.data import MIN_APEX_M, DataSummary, ShotTensors, load_training_data
@@ -66,11 +67,11 @@ class TrainConfig:
     def __post_init__(self) -> None:
         self.hidden = tuple(int(h) for h in self.hidden)
         if self.variant not in VARIANTS:
-            raise ValueError(f"unknown variant {self.variant!r}; choose from {', '.join(VARIANTS)}")
+            raise InputError(f"unknown variant {self.variant!r}; choose from {', '.join(VARIANTS)}")
         if self.loss not in ("lp", "lp+lh", "observables"):
-            raise ValueError(f"loss must be 'lp', 'lp+lh' or 'observables', not {self.loss!r}")
+            raise InputError(f"loss must be 'lp', 'lp+lh' or 'observables', not {self.loss!r}")
         if self.variant == "nn" and self.loss != "lp":
-            raise ValueError("the NN baseline predicts the landing point only: train it with --loss lp")
+            raise InputError("the NN baseline predicts the landing point only: train it with --loss lp")
 
     def as_dict(self) -> dict[str, Any]:
         return {**asdict(self), "hidden": list(self.hidden)}
@@ -162,10 +163,10 @@ def load_checkpoint(path: str | os.PathLike) -> dict[str, Any]:
     try:
         payload = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as error:  # noqa: BLE001 - torch's weights-only reader raises many types on a corrupt file
-        raise ValueError(f"{path}: not a readable checkpoint ({type(error).__name__}: {error})") from None
+        raise InputError(f"{path}: not a readable checkpoint ({type(error).__name__}: {error})") from None
     if not isinstance(payload, dict) or payload.get("format") != CHECKPOINT_FORMAT:
         found = payload.get("format") if isinstance(payload, dict) else type(payload).__name__
-        raise ValueError(f"{path}: not a golfflight training checkpoint (format {found!r})")
+        raise InputError(f"{path}: not a golfflight training checkpoint (format {found!r})")
     return payload
 
 
@@ -183,14 +184,14 @@ def _write_json(path: Path, data: Any) -> None:
 
 def _check_resume(payload: dict[str, Any], config: TrainConfig, data: DataSummary) -> None:
     if payload["data"]["sha256"] != data.sha256:
-        raise ValueError(
+        raise InputError(
             f"--resume: the checkpoint was trained on another data file ({payload['data']['file']}, different SHA-256)"
         )
     saved = {k: v for k, v in payload["config"].items() if k != "epochs"}
     given = {k: v for k, v in config.as_dict().items() if k != "epochs"}
     changed = [f"{k}: {saved.get(k)!r} in the checkpoint, {v!r} now" for k, v in given.items() if saved.get(k) != v]
     if changed:
-        raise ValueError("--resume with different settings: " + "; ".join(changed))
+        raise InputError("--resume with different settings: " + "; ".join(changed))
 
 
 def _train_epoch(
@@ -267,7 +268,7 @@ def train(
     Denormal floats are flushed to zero while training (without it the first backward passes through the rollout
     hit denormals and a CPU batch runs 20-100x slower), and the CPU's normal mode is restored afterwards."""
     if config.loss == "observables":
-        raise ValueError("the 'observables' loss is trained by model_export.joint (golfflight train-real)")
+        raise InputError("the 'observables' loss is trained by model_export.joint (golfflight train-real)")
     where = resolve_device(device)
     torch.set_flush_denormal(True)
     try:

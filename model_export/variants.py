@@ -10,6 +10,7 @@ import math
 from collections.abc import Sequence
 
 import torch
+from golfflight.errors import InputError
 from golfflight.flight.coefficients import BASE_DYNAMIC_PRESSURE, FERGUSON_2022
 from golfflight.model_export import DEFAULT_HIDDEN, PHYS_NN_VARIANTS, VARIANTS
 from golfflight.model_export.torch_physics import spin_ratio, spin_ratio_of
@@ -71,7 +72,7 @@ class PhysNN(CoefficientModule):
     def __init__(self, variant: str, hidden: Sequence[int] = DEFAULT_HIDDEN):
         super().__init__()
         if variant not in PHYS_NN_VARIANTS:
-            raise ValueError(f"unknown Phys-NN variant {variant!r}; choose from {PHYS_NN_VARIANTS}")
+            raise InputError(f"unknown Phys-NN variant {variant!r}; choose from {PHYS_NN_VARIANTS}")
         self.variant = variant
         self.hidden = tuple(int(h) for h in hidden)
         self.learned_moment = variant != "phys-nn"
@@ -141,4 +142,4 @@ def build_model(variant: str, hidden: Sequence[int] = DEFAULT_HIDDEN) -> nn.Modu
         return PhysQ()
     if variant == "nn":
         return LandingNN(hidden)
-    raise ValueError(f"unknown variant {variant!r}; choose from {VARIANTS}")
+    raise InputError(f"unknown variant {variant!r}; choose from {VARIANTS}")

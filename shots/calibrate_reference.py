@@ -14,6 +14,7 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.flight.air import Air
 from golfflight.flight.coefficients import QuadraticSpinRatio
 from golfflight.flight.constants import YARD_M
@@ -216,7 +217,7 @@ def spin_loss_pct(flight: Flight, rows: list[int], times_s: tuple[float, ...] = 
     spin = np.stack([np.linalg.norm(s.spin[rows], axis=-1) for s in flight.states])
     index = [int(round(t / (flight.times_s[1] - flight.times_s[0]))) for t in times_s]
     if index[-1] >= len(spin):
-        raise ValueError(f"the flights end before {times_s[-1]} s: no spin loss to compare")
+        raise InputError(f"the flights end before {times_s[-1]} s: no spin loss to compare")
     return 100.0 * (1.0 - spin[index].T / spin[0][:, None])
 
 

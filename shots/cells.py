@@ -6,10 +6,12 @@ from __future__ import annotations
 import math
 from datetime import datetime
 
+from golfflight.errors import InputError
+
 DATE_FORMATS = ("%m/%d/%Y %I:%M:%S %p", "%Y-%m-%d %H:%M:%S", "%Y-%m-%dT%H:%M:%S")
 
 
-class BadRow(Exception):
+class BadRow(InputError):
     """A row that cannot become a canonical record; the message is the drop reason."""
 
 

@@ -10,6 +10,7 @@ from collections.abc import Sequence
 from typing import NamedTuple, Protocol
 
 import numpy as np
+from golfflight.errors import InputError
 
 
 class HasLaunch(Protocol):
@@ -119,7 +120,7 @@ def canonical_club_name(text: str) -> str:
     `3w`, `pw`, ...); ValueError listing the accepted names if it is none of them."""
     name = CLUB_ALIASES.get(club_key(text)) if isinstance(text, str) else None
     if name is None:
-        raise ValueError(
+        raise InputError(
             f"unknown club {text!r}: give one of {', '.join(CLUB_NAMES)} (any case; also short forms such as dr, 3w, "
             "7i, 7 iron, hy, pw, gw, sw, lw)"
         )

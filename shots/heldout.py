@@ -15,6 +15,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
+from golfflight.errors import InputError
+
 ROUND_COLUMN = "roundNumber"
 """The pbp column that names a row's round."""
 TOUR_SHOT_ID = re.compile(r"^(?:.*:)?[^:-]+-R(?P<round>\d+)-H\d+-P[^-]+-S\d+(?:-f\d+)?$")
@@ -70,7 +72,7 @@ HELD_OUT: tuple[HeldOutSet, ...] = (
 )
 
 
-class HeldOutError(ValueError):
+class HeldOutError(InputError):
     """Held-out rows reached a training set."""
 
 
@@ -101,7 +103,7 @@ def shot_round(shot_id: str) -> int:
     ValueError where the id is not one."""
     match = TOUR_SHOT_ID.match(shot_id.strip())
     if match is None:
-        raise ValueError(f"{shot_id!r} is not a tour shot id such as '060-R3-H15-P29725-S1'")
+        raise InputError(f"{shot_id!r} is not a tour shot id such as '060-R3-H15-P29725-S1'")
     return int(match["round"])
 
 

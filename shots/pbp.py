@@ -20,6 +20,7 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
+from golfflight.errors import InputError
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.shots.cells import BadRow, MalformedCell, finite_number
 from golfflight.shots.heldout import held_out_rounds, held_out_set
@@ -244,7 +245,7 @@ def distance_m(text: str) -> float | None:
         return None
     match = DISTANCE.fullmatch(text)
     if not match or not any(match.groupdict().values()):
-        raise ValueError(f"{text!r} is not a distance such as '306 yds' or '23 ft 3 in.'")
+        raise InputError(f"{text!r} is not a distance such as '306 yds' or '23 ft 3 in.'")
     parts = {unit: float(amount) for unit, amount in match.groupdict().items() if amount}
     return parts.get("yds", 0.0) * YARD_M + parts.get("ft", 0.0) * FOOT_M + parts.get("inch", 0.0) * FOOT_M / 12
 

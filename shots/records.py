@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Annotated, Iterable, Iterator, Literal
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.flight import limits
 from golfflight.flight.air import Air, pressure_at_altitude
 from golfflight.flight.limits import Range
@@ -102,7 +103,7 @@ AIR_COLUMNS = ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct")
 TRAJECTORY_COLUMNS = ("shot_id", "t_s", "x_m", "y_m", "z_m")
 
 
-class RecordError(ValueError):
+class RecordError(InputError):
     """A file that does not follow the canonical format; the message names file, line and column of each problem."""
 
 

@@ -12,6 +12,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.flight.air import Air
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
 from golfflight.flight.flyer import Flyer
@@ -109,11 +110,11 @@ def read_tour_averages(path: str | os.PathLike) -> list[ClubAverage]:
     with path.open(newline="") as handle:
         rows = list(csv.DictReader(handle))
     if not rows:
-        raise ValueError(f"{path}: no rows")
+        raise InputError(f"{path}: no rows")
     clubs = []
     for line, row in enumerate(rows, start=2):
         try:
             clubs.append(ClubAverage(**row))
         except ValueError as error:
-            raise ValueError(f"{path} line {line}: {error}") from None
+            raise InputError(f"{path} line {line}: {error}") from None
     return clubs

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.flight.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
 from golfflight.shots.records import RANGES, RecordError, ShotRecord, reading
 from golfflight.shots.trackman import Conversion, ConversionReport
@@ -68,7 +69,7 @@ class TrackedFlight:
         return len(self.coefficients) >= FULL_COEFFICIENTS
 
 
-class _BadFlight(Exception):
+class _BadFlight(InputError):
     """A flight that cannot become a canonical record; the message is the drop reason."""
 
 
@@ -102,7 +103,7 @@ def estimate_spin_rpm(coefficients: np.ndarray, air_density: float = ESTIMATE_AI
     c0, c1, c2 = FERGUSON_CL
     top = c0 - c1 * c1 / (4.0 * c2)
     if not c0 <= lift <= top:
-        raise ValueError(f"lift coefficient outside Ferguson's C_L(S) range {c0:g} to {top:.4f}")
+        raise InputError(f"lift coefficient outside Ferguson's C_L(S) range {c0:g} to {top:.4f}")
     ratio = (-c1 + math.sqrt(c1 * c1 - 4.0 * c2 * (c0 - lift))) / (2.0 * c2)
     return ratio * speed / BALL_RADIUS_M / RPM_TO_RADPS
 
@@ -117,7 +118,7 @@ def landing_time_s(coefficients: np.ndarray, time_end_s: float, tolerance_s: flo
     rising = height.deriv()
     crossings = [r.real for r in height.roots() if abs(r.imag) < 1e-9 and r.real > 0 and rising(r.real) < 0]
     if not crossings or min(abs(t - time_end_s) for t in crossings) > tolerance_s:
-        raise ValueError(f"no descending crossing of the start height within {tolerance_s:g} s of timeInterval end")
+        raise InputError(f"no descending crossing of the start height within {tolerance_s:g} s of timeInterval end")
     return min(crossings, key=lambda t: abs(t - time_end_s))
 
 

@@ -20,6 +20,7 @@ from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from contextlib import contextmanager
 from multiprocessing import forkserver
 
+from golfflight.errors import InputError
 from golfflight.sweep.flyer import Flyer
 from golfflight.sweep.stopping import exit_with_driver, group_signals_held
 
@@ -214,7 +215,7 @@ def gpu_actors(resources: dict, workers: int | None, gpus_per_actor: float) -> i
     or CPUs than the actors need (an actor Ray cannot place, or a read with no CPU left, would wait for ever)."""
     gpus, cpus = int(resources.get("GPU", 0)), int(resources.get("CPU", 0))
     if gpus < gpus_per_actor:
-        raise ValueError(
+        raise InputError(
             "--engine ray --device cuda: the Ray cluster lists no GPU (ray.cluster_resources() has none); start its "
             "nodes with their GPUs (ray start --num-gpus N, or a KubeRay worker group with nvidia.com/gpu), or sweep "
             "on CPUs without --device"
@@ -222,13 +223,13 @@ def gpu_actors(resources: dict, workers: int | None, gpus_per_actor: float) -> i
     by_gpus = math.floor(gpus / gpus_per_actor + 1e-9)
     most = min(by_gpus, cpus - 1)
     if most < 1:
-        raise ValueError(f"--engine ray --device cuda: the Ray cluster lists {cpus} CPUs; each GPU actor takes one "
+        raise InputError(f"--engine ray --device cuda: the Ray cluster lists {cpus} CPUs; each GPU actor takes one "
                          "and reading the launches one more")
     if workers is not None and workers > by_gpus:
-        raise ValueError(f"--workers {workers}: the Ray cluster lists {gpus} GPUs, and each actor takes "
+        raise InputError(f"--workers {workers}: the Ray cluster lists {gpus} GPUs, and each actor takes "
                          f"{gpus_per_actor:g} (leave --workers out for {most} actors)")
     if workers is not None and workers > most:
-        raise ValueError(f"--workers {workers}: the Ray cluster lists {cpus} CPUs, and each actor takes one beside "
+        raise InputError(f"--workers {workers}: the Ray cluster lists {cpus} CPUs, and each actor takes one beside "
                          f"the one that reads (leave --workers out for {most} actors)")
     return most if workers is None else workers
 
@@ -251,7 +252,7 @@ def check_actor_engine(ray, make_engine: Callable, bundle_dir: str, gpus: float)
     except Exception as error:  # noqa: BLE001 - Ray's own types: the task could not run (a module it lacks)
         problem = str(error).strip().splitlines()[-1]
     if problem:
-        raise ValueError(f"--engine ray: a worker of the Ray cluster cannot build the torch engine ({problem}); "
+        raise InputError(f"--engine ray: a worker of the Ray cluster cannot build the torch engine ({problem}); "
                          f"every node needs the train extra (torch), and a GPU node its CUDA driver")
 
 

@@ -26,6 +26,7 @@ from golfflight.contract.columns import (
     request_of_cells,
     result_columns,
 )
+from golfflight.errors import InputError
 
 if TYPE_CHECKING:
     from golfflight.flight.outcomes import BatchFlights
@@ -131,7 +132,7 @@ class Flyer:
             engine = FlightEngine(bundle_dir, batch_threads=1) if make_engine is None else make_engine(bundle_dir)
         self.engine = engine
         if self.engine.sha256 != sha256:
-            raise ValueError(f"{bundle_dir}: this worker's model ({self.engine.sha256[:12]}) is not the driver's "
+            raise InputError(f"{bundle_dir}: this worker's model ({self.engine.sha256[:12]}) is not the driver's "
                              f"({sha256[:12]}); every node needs the same bundle at the same path")
         self.source = source
         self.layout = Layout(tuple(source.columns))

@@ -15,9 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from golfflight.contract.columns import REQUEST_COLUMNS, TEXT_COLUMNS, cell_value, check, request_of_cells
+from golfflight.errors import InputError
 
 
-class GridError(ValueError):
+class GridError(InputError):
     """A grid axis that cannot be read or holds a value the request model refuses."""
 
 

@@ -17,6 +17,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from golfflight.errors import GolfflightError
+
 OWNED = re.compile(r"(?P<host>.+)\.(?P<pid>\d+)\.[^.]+\.tmp")
 """What follows `.OUT.` in a temporary file's name: the host and process id of the sweep writing it."""
 
@@ -24,7 +26,7 @@ MODE = 0o644
 """The output's permissions (a temporary file is made readable by its owner alone)."""
 
 
-class OutputError(OSError):
+class OutputError(GolfflightError, OSError):
     """The output could not be written: the file and the system's reason, in one line (`[Errno 28] Error writing
     bytes to file` named neither the file nor, in so many words, a full disk)."""
 

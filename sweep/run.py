@@ -17,6 +17,7 @@ from contextlib import closing, contextmanager, suppress
 from dataclasses import dataclass
 from typing import Literal
 
+from golfflight.errors import InputError
 from golfflight.flight.bundle_location import model_dir
 from golfflight.sweep.engines import PIECES_IN_FLIGHT
 from golfflight.sweep.flyer import PROBLEM, ROW, ColumnsEngine, Flyer, Layout
@@ -74,7 +75,7 @@ def _tables(source: Source, engine: Engine, workers: int | None, model: str | No
         if in_process is not None:
             return in_process_tables(source, Flyer(str(bundle), sha256, source, engine=in_process), in_flight)
         if worker_engine.make is None or workers is None:
-            raise ValueError("the torch engine flies in this process (in_process) or in a pool of `workers` "
+            raise InputError("the torch engine flies in this process (in_process) or in a pool of `workers` "
                              "processes, each with the engine worker_engine.make builds")
         return local_tables(source, str(bundle), sha256, workers, worker_engine.make)
     if engine == "ray":
@@ -163,7 +164,7 @@ def run_sweep(
                     shown = "\n  ".join(problems[:SHOWN_PROBLEMS])
                     more = f"\n  ... and {len(problems) - SHOWN_PROBLEMS} more" if len(problems) > SHOWN_PROBLEMS else ""
                     whole = f"none of the {count} rows is valid; " if none_valid else ""
-                    raise ValueError(
+                    raise InputError(
                         f"{len(problems)} invalid values in rows {start} to {start + count - 1} ({whole}nothing "
                         f"written; --skip-bad-rows flies the rest):\n  {shown}{more}"
                     )

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from golfflight.contract.columns import columns_message
+from golfflight.errors import InputError
 from golfflight.shots.records import reading
 from golfflight.sweep.grid import Grid
 
@@ -107,7 +108,7 @@ class CsvSource:
             header = next(csv.reader(handle), [])
         refused = columns_message(str(path), header)
         if refused:
-            raise ValueError(refused)
+            raise InputError(refused)
         return cls(str(path), tuple(header), chunk_rows)
 
     def place(self, row: int) -> str:
@@ -131,7 +132,7 @@ class CsvSource:
             reader = pyarrow.csv.open_csv(self.path, convert_options=self._convert_options())
             yield from packed(rebatch(reader, self.chunk_rows))
         except pa.ArrowInvalid as error:
-            raise ValueError(f"{self.path}: {error}") from None
+            raise InputError(f"{self.path}: {error}") from None
 
     def expand(self, piece):
         return unpacked(piece)
@@ -154,11 +155,11 @@ class ParquetSource:
         try:
             metadata = pq.read_metadata(path)
         except pa.ArrowInvalid as error:
-            raise ValueError(f"{path}: not a Parquet file ({error})") from None
+            raise InputError(f"{path}: not a Parquet file ({error})") from None
         columns = metadata.schema.to_arrow_schema().names
         refused = columns_message(str(path), columns)
         if refused:
-            raise ValueError(refused.replace(" line 1: no header row", ": no columns"))
+            raise InputError(refused.replace(" line 1: no header row", ": no columns"))
         return cls(str(path), tuple(columns), metadata.num_rows, chunk_rows)
 
     def place(self, row: int) -> str:
@@ -183,7 +184,7 @@ Source = GridSource | CsvSource | ParquetSource
 def open_source(path: str | None, grid: list[str] | None, chunk_rows: int) -> Source:
     """The source a command line names: a launches file (.csv or .parquet) or a grid (`sweep.grid`), not both."""
     if (path is None) == (not grid):
-        raise ValueError("give a launches file (CSV or Parquet) or --grid axes, one of the two")
+        raise InputError("give a launches file (CSV or Parquet) or --grid axes, one of the two")
     if grid:
         return GridSource(Grid.parse(grid), chunk_rows)
     file = Path(path)
@@ -193,4 +194,4 @@ def open_source(path: str | None, grid: list[str] | None, chunk_rows: int) -> So
         return CsvSource.open(file, chunk_rows)
     if file.suffix.lower() in (".parquet", ".pq"):
         return ParquetSource.open(file, chunk_rows)
-    raise ValueError(f"{file}: a launches file is .csv or .parquet")
+    raise InputError(f"{file}: a launches file is .csv or .parquet")

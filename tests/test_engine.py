@@ -10,9 +10,10 @@ import onnxruntime as ort
 import pytest
 from conftest import random_launches
 from golfflight.contract.trajectory import resample
+from golfflight.errors import FlightError
 from golfflight.flight.air import Air
 from golfflight.flight.conditions import STANDARD, Conditions
-from golfflight.flight.engine import FlightError, Launch, ShotFlight
+from golfflight.flight.engine import Launch, ShotFlight
 from golfflight.flight.integrator import simulate
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state, reynolds_scale

@@ -57,15 +57,16 @@ shot contract on it, the service, sweep, discovery and evaluation above, trainin
 on top. A package imports only from floors below its own, never sideways."""
 
 
-NAMESPACE_ROOT = {"golfflight", "golfflight.__version__"}
-"""The namespace's own `__init__` (imported before any golfflight module anyway) and its version: every floor may
-read them; the command line's modules (`golfflight.cli`, `golfflight.commands`) stay on the top floor."""
+NAMESPACE_ROOT = {"golfflight", "golfflight.__version__", "golfflight.errors"}
+"""The namespace's own `__init__` (imported before any golfflight module anyway), its version and its failures (the
+exception family every floor raises, `golfflight/errors.py`, which imports nothing of ours): every floor may read
+them; the command line's modules (`golfflight.cli`, `golfflight.commands`) stay on the top floor."""
 
 
 def _package(name: str) -> str | None:
     """The package folder a golfflight module belongs to (golfflight/ itself for the command line)."""
     parts = name.split(".")
-    if parts[0] != "golfflight" or name in NAMESPACE_ROOT:
+    if parts[0] != "golfflight" or name in NAMESPACE_ROOT or ".".join(parts[:2]) == "golfflight.errors":
         return None
     return parts[1] if len(parts) > 1 and parts[1] in FLOORS else "golfflight"
 
@@ -78,6 +79,10 @@ def test_imported_reads_plain_and_from_imports(tmp_path):
     source = tmp_path / "example.py"
     source.write_text("import golfflight.service.api.app\nfrom golfflight.service import api\n")
     assert {"golfflight.service.api.app", "golfflight.service.api"} <= imported(source)
+
+
+def test_the_failures_module_imports_nothing_of_ours():
+    assert [name for name in imported(ROOT / "golfflight" / "errors.py") if name.startswith("golfflight")] == []
 
 
 def test_every_package_folder_has_a_floor():

@@ -7,13 +7,14 @@ import json
 import os
 from pathlib import Path
 
+from golfflight.errors import InputError
 from golfflight.weights_schema.model_card import SUPPORTED_SCHEMA_VERSIONS, ModelCard
 from pydantic import ValidationError
 
 CARD_FILE = "model_card.json"
 
 
-class BundleError(ValueError):
+class BundleError(InputError):
     """A bundle that must not be used; the message says which file and why."""
 
 

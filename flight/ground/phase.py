@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
 from golfflight.flight.ground.impact import impact, impact_components
 from golfflight.flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, holding_slope_deg
@@ -98,7 +99,7 @@ def _check_slopes(slope: np.ndarray, resistance: np.ndarray) -> None:
     steep = slope >= holding_slope_deg(resistance)
     if np.any(steep):
         i = int(np.flatnonzero(np.atleast_1d(steep))[0])
-        raise ValueError(
+        raise InputError(
             f"slope_deg {np.atleast_1d(slope)[i]:g} is steeper than the surface holds a ball on "
             f"({float(np.atleast_1d(holding_slope_deg(resistance))[i]):.2f} deg): it would never come to rest"
         )

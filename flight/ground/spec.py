@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.flight.ground.surfaces import SURFACES, Surface, holding_slope_deg
 from golfflight.flight.limits import SLOPE_DEG
 from golfflight.flight.per_shot import PerShot
@@ -24,7 +25,7 @@ class GroundSpec:
     def __post_init__(self) -> None:
         holding = float(holding_slope_deg(self.surface.rolling_resistance))
         if not (0.0 <= self.slope_deg <= SLOPE_DEG.high and self.slope_deg < holding):
-            raise ValueError(f"slope_deg {self.slope_deg:g} is outside {SLOPE_DEG.describe()} or not below "
+            raise InputError(f"slope_deg {self.slope_deg:g} is outside {SLOPE_DEG.describe()} or not below "
                              f"{holding:.2f} deg, the steepest slope this surface holds a ball still on")
 
 

@@ -36,6 +36,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
+from golfflight.errors import InputError
 from golfflight.flight.constants import FOOT_M, GRAVITY_MPS2
 
 STIMPMETER_EXIT_SPEED_MPS = 6.00 * FOOT_M
@@ -110,11 +111,11 @@ SURFACES: dict[str, Surface] = {
 def surface(name: str, stimp_ft: float | None = None, **overrides: float) -> Surface:
     """A preset with parameters overridden; `stimp_ft` (greens only) sets the green's rolling resistance."""
     if name not in SURFACES:
-        raise ValueError(f"surface {name!r} is not one of {', '.join(SURFACES)}")
+        raise InputError(f"surface {name!r} is not one of {', '.join(SURFACES)}")
     preset = SURFACES[name]
     if stimp_ft is not None:
         if name != "green":
-            raise ValueError(f"stimp_ft is a green's reading; surface {name!r} takes none")
+            raise InputError(f"stimp_ft is a green's reading; surface {name!r} takes none")
         preset = replace(preset, rolling_resistance=float(green_rolling_resistance(stimp_ft)))
     return replace(preset, **overrides)
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from golfflight.errors import InputError
 from golfflight.flight.bundle_location import CHECKOUT_MODEL
 
 DEFAULT_SYNTHETIC = CHECKOUT_MODEL.parent / "synthetic"
@@ -39,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     from golfflight.evaluation.accuracy import run_accuracy
 
     if args.finetune_epochs < 0:
-        raise ValueError(f"--finetune-epochs must be 0 or more, got {args.finetune_epochs}")
+        raise InputError(f"--finetune-epochs must be 0 or more, got {args.finetune_epochs}")
     finetune = None
     if args.finetune_epochs:
         import torch

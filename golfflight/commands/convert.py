@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from golfflight.errors import InputError
 from golfflight.shots.garmin import load_garmin
 from golfflight.shots.pbp import load_pbp
 from golfflight.shots.records import trajectories_path, write_shots, write_trajectories
@@ -78,7 +79,7 @@ def _write(conversion: Conversion, out: str) -> int:
 def run_trackman(args: argparse.Namespace) -> int:
     fraction = None if args.all_flights else args.min_tracked_fraction
     if fraction is not None and not 0 < fraction <= 1:
-        raise ValueError(f"--min-tracked-fraction must be in (0, 1], got {fraction}")
+        raise InputError(f"--min-tracked-fraction must be in (0, 1], got {fraction}")
     conversion = load_trackman(args.source, min_tracked_fraction=fraction, balls=args.ball, session=args.session,
                                skip_bad_rows=args.skip_bad_rows)
     return _write(conversion, args.out)
@@ -86,7 +87,7 @@ def run_trackman(args: argparse.Namespace) -> int:
 
 def run_tourcast(args: argparse.Namespace) -> int:
     if args.sample_interval <= 0:
-        raise ValueError(f"--sample-interval must be positive, got {args.sample_interval}")
+        raise InputError(f"--sample-interval must be positive, got {args.sample_interval}")
     conversion = load_tourcast(args.source, args.pbp, estimate_spin=args.estimate_spin,
                                sample_interval_s=args.sample_interval, skip_bad_rows=args.skip_bad_rows)
     return _write(conversion, args.out)

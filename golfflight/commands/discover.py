@@ -13,6 +13,7 @@ from golfflight.discovery.outputs import write_diagnosis
 from golfflight.discovery.own_error import measure_own_error, write_own_error
 from golfflight.discovery.prove import CAMPAIGNS, CLEAN_SETS, TRUTHS, cases, command, prove, read_runs, write_tables
 from golfflight.discovery.recordings import read_recordings
+from golfflight.errors import InputError
 from golfflight.shots.progress import print_line, progress_step
 
 QUIET_HELP = "no progress on standard error"
@@ -87,7 +88,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run_diagnose(args: argparse.Namespace) -> int:
     recordings = read_recordings(args.recordings)
     if len(recordings) < 3:
-        raise ValueError(f"{args.recordings}: {len(recordings)} shots with an observed outcome; at least 3 are needed")
+        raise InputError(f"{args.recordings}: {len(recordings)} shots with an observed outcome; at least 3 are needed")
     model = load_model(args.model, control=args.reference_control)
     diagnosis = diagnose(
         recordings, model, seed=args.seed, estimate_scatter=not args.assumed_noise, progress=not args.quiet
@@ -106,7 +107,7 @@ def run_prove(args: argparse.Namespace) -> int:
         try:
             re.compile(args.cases)
         except re.error as error:
-            raise ValueError(f"--cases {args.cases!r} is not a regular expression: {error}") from None
+            raise InputError(f"--cases {args.cases!r} is not a regular expression: {error}") from None
     model = load_model(args.model)
     if args.tables_from:
         results = read_runs(Path(args.tables_from))
@@ -124,7 +125,7 @@ def run_prove(args: argparse.Namespace) -> int:
         )
     if not results:
         names = ", ".join(name for name, _ in cases(args.truth, args.campaign))
-        raise ValueError(f"--cases {args.cases!r} matches none of: {names}")
+        raise InputError(f"--cases {args.cases!r} matches none of: {names}")
     spec = args.model or "models/default"
     section = command(spec, args.truth, args.cases, args.seeds, args.campaign)
     json_path = Path(args.json) if args.json else None

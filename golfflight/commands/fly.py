@@ -16,6 +16,7 @@ import re
 from pydantic import ValidationError
 
 from golfflight.contract.figures import FIGURES, Figure
+from golfflight.errors import InputError
 from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.limits import WIND_SPEED_MPS, Range
 from golfflight.shots.clubs import CLUB_NAMES, club_named
@@ -89,7 +90,7 @@ def _one_of(args: argparse.Namespace, quantity: str, *names: str) -> None:
     given = [name for name in names if getattr(args, name) is not None]
     if len(given) > 1:
         flags = [f"--{name.replace('_', '-')}" for name in names]
-        raise ValueError(f"{quantity}: give {' or '.join(flags)}, not both")
+        raise InputError(f"{quantity}: give {' or '.join(flags)}, not both")
 
 
 def _with_flags(text: str) -> str:
@@ -130,7 +131,7 @@ def wind_speed_mps(args: argparse.Namespace) -> float | None:
         in_mph.model_validate({"wind_speed_mph": args.wind_speed_mph})
     except ValidationError as error:
         details = describe_errors(error.errors(), {"wind_speed_mph": bounds})
-        raise ValueError(_refusal([{**d, "field": "wind_speed_mph"} for d in details])) from None
+        raise InputError(_refusal([{**d, "field": "wind_speed_mph"} for d in details])) from None
     return args.wind_speed_mph * MPH_TO_MPS
 
 
@@ -179,7 +180,7 @@ def checked(shot: dict):
     try:
         return ShotRequest.model_validate(shot)
     except ValidationError as error:
-        raise ValueError(_refusal(describe_errors(error.errors()))) from None
+        raise InputError(_refusal(describe_errors(error.errors()))) from None
 
 
 def fly_reference_shot(shot) -> dict:
@@ -187,13 +188,13 @@ def fly_reference_shot(shot) -> dict:
     and wind and rolled to rest on the level fairway, as the engine flies a shot: the POST /v1/shots result fields."""
     from golfflight.contract.flying import flight_fields
     from golfflight.contract.inputs import conditions_of, launch_of
-    from golfflight.flight.flyer import FlightError
+    from golfflight.errors import FlightError
     from golfflight.flight.ground import LEVEL_FAIRWAY
     from golfflight.shots.reference_world import reference_flyer
 
     flown = reference_flyer().fly_batch([launch_of(shot)], conditions_of(shot), grounds=LEVEL_FAIRWAY)[0]
     if isinstance(flown, FlightError):
-        raise ValueError(f"the reference world could not fly the shot: {flown}")
+        raise InputError(f"the reference world could not fly the shot: {flown}")
     fields = flight_fields(flown, None)
     fields["landing"], fields["rest"] = (point.model_dump() for point in (fields["landing"], fields["rest"]))
     return {key: value for key, value in fields.items() if value is not None}
@@ -203,13 +204,14 @@ def fly_model_shot(shot, model: str | None) -> tuple[dict, dict]:
     """A checked request flown by the served model as POST /v1/shots flies it: (the result, the model's identity)."""
     from golfflight.contract.flying import fly_shot
     from golfflight.flight.bundle_location import model_dir
-    from golfflight.flight.engine import FlightEngine, FlightError
+    from golfflight.errors import FlightError
+    from golfflight.flight.engine import FlightEngine
 
     engine = FlightEngine(model_dir(model))
     try:
         result = fly_shot(engine, shot)
     except FlightError as error:
-        raise ValueError(str(error)) from None
+        raise InputError(str(error)) from None
     identity = {"bundle": str(engine.bundle_dir), "variant": engine.variant, "sha256": engine.sha256}
     return result.model_dump(exclude_none=True), identity
 

@@ -22,6 +22,8 @@ import os
 import socket
 import sys
 
+from golfflight.errors import InputError
+
 GRACEFUL_SHUTDOWN_S = 30
 """Longest a shutdown waits for in-flight requests (a full 10,000-shot batch takes about a second)."""
 
@@ -84,17 +86,17 @@ def _listenable(host: str, port: int, option: str) -> None:
     a traceback at startup (or, for the HTTP port, after the line saying the service is up). The probe binds as uvicorn
     does (IPv6 when the host has a colon, SO_REUSEADDR), so a port it refuses is one uvicorn could not take either."""
     if not 0 < port < 65536:
-        raise ValueError(f"{option} must be 1 to 65535, got {port}")
+        raise InputError(f"{option} must be 1 to 65535, got {port}")
     family = socket.AF_INET6 if ":" in host else socket.AF_INET
     try:
         socket.create_server((host, port), family=family).close()
     except OSError as error:
         if error.errno == errno.EADDRINUSE:
-            raise ValueError(
+            raise InputError(
                 f"{option}: {host}:{port} is in use (another program, perhaps another golfflight serve, listens "
                 f"there): stop it or choose another port with {option}"
             ) from None
-        raise ValueError(f"{option}: cannot listen on {host}:{port}: {error.strerror or error}") from None
+        raise InputError(f"{option}: cannot listen on {host}:{port}: {error.strerror or error}") from None
 
 
 def fast_io() -> dict[str, object]:
@@ -153,9 +155,9 @@ def run(args: argparse.Namespace) -> int:
     from golfflight.service.runtime.metrics import shared_across_workers
 
     if args.workers < 1:
-        raise ValueError(f"--workers must be at least 1, got {args.workers}")
+        raise InputError(f"--workers must be at least 1, got {args.workers}")
     if args.connect_port is not None and args.workers != 1:
-        raise ValueError("--connect-port needs --workers 1 (one process holds the connectors' port)")
+        raise InputError("--connect-port needs --workers 1 (one process holds the connectors' port)")
     bundle = model_dir(args.model).resolve()
     card = verify_bundle(bundle)  # refuse a bad bundle here, before any worker starts
     os.environ[MODEL_ENV] = str(bundle)  # the factory in every worker process reads these

@@ -52,6 +52,7 @@ from golfflight.contract.columns import (
 )
 from golfflight.contract.inputs import conditions_of
 from golfflight.contract.requests import ShotRequest
+from golfflight.errors import InputError
 from golfflight.shots.records import reading
 
 ECHOED_CONDITIONS = (*WIND_COLUMNS, *GROUND_COLUMNS)
@@ -94,7 +95,7 @@ def shots_from_csv(path: Path) -> Input:
         reader = csv.DictReader(handle)
         refused = columns_message(str(path), list(reader.fieldnames or []), also=frozenset({PUTT}))
         if refused:
-            raise ValueError(refused)
+            raise InputError(refused)
         seen: dict[str, int] = {}
         for row, cells in enumerate(reader):
             line, read.rows_read = row + 2, row + 1
@@ -139,7 +140,7 @@ def shots_from_json(text: str, source: str) -> Input:
     try:
         data = json.loads(text)
     except json.JSONDecodeError as error:
-        raise ValueError(f"{source}: not valid JSON ({error})") from None
+        raise InputError(f"{source}: not valid JSON ({error})") from None
     if isinstance(data, dict) and "shots" in data:
         data = data["shots"]
     shots = data if isinstance(data, list) else [data]
@@ -171,7 +172,7 @@ def refuse_or_skip(name: str, problems: list[str], flyable: int, rows_read: int,
         return
     why = "--skip-bad-rows flies the rest" if flyable else f"none of its {rows_read} shots is valid; nothing written"
     shown = "\n  ".join(problems[:20]) + (f"\n  ... and {len(problems) - 20} more" if len(problems) > 20 else "")
-    raise ValueError(f"{name}: {len(problems)} invalid values ({why}):\n  {shown}")
+    raise InputError(f"{name}: {len(problems)} invalid values ({why}):\n  {shown}")
 
 
 def flown_air(shot: ShotRequest) -> dict:
@@ -221,7 +222,7 @@ def fly_all(engine, shots: list[ShotRequest], putts: list[bool]) -> list[dict]:
     (`flown_shot(..., putt=True)`), the rest in engine batches (`fly_shots`)."""
     from golfflight.contract.flying import flown_shot, fly_shots
     from golfflight.contract.results import ShotFailure
-    from golfflight.flight.engine import FlightError
+    from golfflight.errors import FlightError
 
     results: list = [None] * len(shots)
     full = [i for i, putt in enumerate(putts) if not putt]
@@ -241,7 +242,7 @@ def run(args: argparse.Namespace) -> int:
 
     read, from_csv = read_input(args.input)
     if not read.shots and not read.problems:
-        raise ValueError(f"{args.input}: no shots in it")
+        raise InputError(f"{args.input}: no shots in it")
     shots, kept, invalid = validate(read.shots, read.places, from_csv)
     refuse_or_skip(args.input, read.problems + invalid, len(shots), read.rows_read, args.skip_bad_rows)
     engine = FlightEngine(model_dir(args.model))

@@ -22,6 +22,8 @@ import importlib
 import os
 import sys
 
+from golfflight.errors import InputError
+
 EXTRAS = {"sweep": ("pyarrow", "tqdm"), "ray": ("ray.data",), "train": ("torch",)}
 """The modules each extra brings: the serving install (`pip install .`, the Docker image) has none of them."""
 
@@ -91,7 +93,7 @@ def require_extras(*extras: str, who: str | None = None) -> None:
                 importlib.import_module(module)
             except ImportError as missing:
                 needs = who or {"ray": "--engine ray needs", "train": "--engine torch needs"}.get(extra, "needs")
-                raise ValueError(
+                raise InputError(
                     f"{needs} the {extra} extra, which is not installed (no {missing.name or module}): "
                     f"pip install 'golfflight[{extra}]'"
                 ) from None
@@ -105,23 +107,23 @@ def _torch_on_ray(args: argparse.Namespace) -> bool:
 def _check_options(args: argparse.Namespace) -> None:
     """Refuse options that do not go with the chosen engine, or numbers below 1."""
     if (args.workers is not None and args.workers < 1) or (args.chunk_rows is not None and args.chunk_rows < 1):
-        raise ValueError("--workers and --chunk-rows take a whole number of at least 1")
+        raise InputError("--workers and --chunk-rows take a whole number of at least 1")
     if args.ray_address and args.engine != "ray":
-        raise ValueError("--ray-address goes with --engine ray")
+        raise InputError("--ray-address goes with --engine ray")
     if args.threads is not None and args.threads < 1:
-        raise ValueError("--threads takes a whole number of at least 1")
+        raise InputError("--threads takes a whole number of at least 1")
     if args.actors_per_gpu is not None and (args.engine != "ray" or args.device != "cuda"):
-        raise ValueError("--actors-per-gpu goes with --engine ray --device cuda")
+        raise InputError("--actors-per-gpu goes with --engine ray --device cuda")
     if args.actors_per_gpu is not None and args.actors_per_gpu < 1:
-        raise ValueError("--actors-per-gpu takes a whole number of at least 1")
+        raise InputError("--actors-per-gpu takes a whole number of at least 1")
     torch_only = [name for name in ("device", "dtype", "threads", "compile") if getattr(args, name) is not None]
     if torch_only and args.engine == "local":
         also = "--engine ray" if torch_only[0] == "device" else "--engine ray with --device"
-        raise ValueError(f"--{torch_only[0]} goes with --engine torch, or {also}")
+        raise InputError(f"--{torch_only[0]} goes with --engine torch, or {also}")
     if torch_only and args.engine == "ray" and args.device is None:
-        raise ValueError(f"--{torch_only[0]} goes with --engine ray only beside --device (cuda or cpu): the torch engine")
+        raise InputError(f"--{torch_only[0]} goes with --engine ray only beside --device (cuda or cpu): the torch engine")
     if _torch_on_ray(args) and args.device not in ("cuda", "cpu"):
-        raise ValueError(f"--device {args.device}: with --engine ray, Ray gives each actor its own GPU; give --device "
+        raise InputError(f"--device {args.device}: with --engine ray, Ray gives each actor its own GPU; give --device "
                          "cuda (or cpu)")
 
 
@@ -162,7 +164,7 @@ def run(args: argparse.Namespace) -> int:
         from golfflight.sweep.sources import open_source
         from golfflight.sweep.stopping import Interrupted, stopped_by_signals
     except ImportError as missing:  # an install without the sweep package
-        raise ValueError(f"needs the sweep extra: pip install 'golfflight[sweep]' ({missing})") from None
+        raise InputError(f"needs the sweep extra: pip install 'golfflight[sweep]' ({missing})") from None
     require_extras("sweep", *({"ray": ["ray"], "torch": ["train"]}.get(args.engine, [])))
     _check_options(args)
     if _torch_on_ray(args):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from golfflight.errors import InputError
 from golfflight.shots.progress import progress_step
 from golfflight.shots.synth import SynthConfig, generate, sessions_path, write_synthetic
 
@@ -22,7 +23,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     if args.shots < 1:
-        raise ValueError(f"--shots must be at least 1, got {args.shots}")
+        raise InputError(f"--shots must be at least 1, got {args.shots}")
     config = SynthConfig(n_shots=args.shots, seed=args.seed, robot_share=args.robot_share,
                          val_fraction=args.val_fraction, calm=args.calm)
     synthetic = generate(config, progress=not args.quiet)

@@ -1,8 +1,9 @@
 """The direct path for the simulation routes' usual request: a body sent as `application/json` that validates, with a
 query of true/false flags at most, goes from the app's own middleware (metrics, body limit, API key, CORS) straight
-to the endpoint. Any other request (a body that is refused, another content type, another query, the model not yet
-loaded) goes on through FastAPI's exception handling, router and request handling as before, so every refusal and
-the OpenAPI document stay FastAPI's.
+to the endpoint. Any other request (a body that is refused, another content type, another query) goes on through
+FastAPI's exception handling, router and request handling as before, so every refusal and the OpenAPI document stay
+FastAPI's; a failure of ours on the direct path (the model not yet loaded, a shot that cannot land) is answered as
+FastAPI's handler answers it (`errors.failure_response`).
 
 Per single shot, FastAPI's request handling (body reading, a `json.loads`, the dependency solver) and the layers
 around a route (exception middleware, exit stacks, the router) cost about as much as all of the service's other
@@ -16,8 +17,9 @@ from collections.abc import Iterable
 from typing import Any
 
 from fastapi.routing import APIRoute
+from golfflight.errors import GolfflightError
+from golfflight.service.api.errors import failure_response
 from golfflight.service.api.request_body import read_body, replay
-from golfflight.service.runtime import NotReady
 from pydantic import BaseModel, ValidationError
 from starlette.requests import Request
 from starlette.responses import Response
@@ -90,8 +92,8 @@ class DirectLanes:
         scope["route"] = route  # as the router would set it: the metrics label the request by its template
         try:
             response = await route.direct(Request(scope, replay(messages, receive)), body)
-        except NotReady:
-            response = None  # FastAPI's path answers it (503) as it answers every route
+        except GolfflightError as error:
+            response = failure_response(scope["path"], error)
         if response is not None:
             await response(scope, receive, send)
             return

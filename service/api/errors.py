@@ -11,10 +11,10 @@ from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
 from golfflight.contract.gspro import GSProReply, invalid_message, shot_number_of
-from golfflight.contract.refusals import body_detail, describe_errors, not_json
+from golfflight.contract.refusals import answer_to, body_detail, describe_errors, not_json
 from golfflight.contract.requests import RANGES
+from golfflight.errors import GolfflightError
 from golfflight.service.api.paths import GSPRO_PATH
-from golfflight.service.runtime import NotReady
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 NOT_JSON = "the body is not JSON text in UTF-8 (or UTF-16 or UTF-32, which are read too)"
@@ -26,8 +26,8 @@ JSON_CONTENT_TYPE = "the body must be JSON: send content-type: application/json"
 """The refusal (415) of a body sent without a JSON content type, followed by what was sent."""
 
 
-def _gspro_error(message: str, status: int = 422, shot_number: int | None = None) -> JSONResponse:
-    reply = GSProReply(Code=500, Message=message, ShotNumber=shot_number)
+def _gspro_error(message: str, status: int = 422, shot_number: int | None = None, code: int = 500) -> JSONResponse:
+    reply = GSProReply(Code=code, Message=message, ShotNumber=shot_number)
     return JSONResponse(reply.model_dump(exclude_none=True), status)
 
 
@@ -73,12 +73,23 @@ async def http_error(request: Request, error: StarletteHTTPException) -> Respons
     return JSONResponse({"detail": [body_detail(message, "json_invalid")]}, 422)
 
 
-async def not_ready(request: Request, error: NotReady) -> JSONResponse:
-    return JSONResponse({"detail": str(error)}, 503)
+def failure_response(path: str, error: GolfflightError) -> JSONResponse:
+    """The answer to one of our failures (`contract.refusals.FAILURES`): on POST /v1/gspro Open Connect's reply with
+    its code; elsewhere a refusal's detail (4xx), or the reason alone when the service cannot answer now (503)."""
+    answer = answer_to(error)
+    if path == GSPRO_PATH:
+        return _gspro_error(str(error), answer.http_status, code=answer.open_connect_code)
+    if answer.http_status >= 500:
+        return JSONResponse({"detail": str(error)}, answer.http_status)
+    return JSONResponse({"detail": [body_detail(str(error), answer.kind)]}, answer.http_status)
+
+
+async def failed(request: Request, error: GolfflightError) -> JSONResponse:
+    return failure_response(request.url.path, error)
 
 
 def install(app: FastAPI) -> None:
     """Register the handlers on an app."""
     app.add_exception_handler(RequestValidationError, invalid_request)
     app.add_exception_handler(StarletteHTTPException, http_error)
-    app.add_exception_handler(NotReady, not_ready)
+    app.add_exception_handler(GolfflightError, failed)

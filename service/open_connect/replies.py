@@ -15,6 +15,7 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 from golfflight.contract.gspro import GSProMessage, GSProReply, invalid_message, shot_number_of
+from golfflight.errors import InputError
 from golfflight.service.open_connect.framing import Refused
 from pydantic import ValidationError
 
@@ -36,9 +37,9 @@ def player_information(club: str, handed: str) -> bytes:
     """The Code 201 object GSPro pushes when the player or the club changes, as it goes on the wire; ValueError for a
     hand other than RH or LH or a club that is not a GSPro club code."""
     if handed not in HANDED:
-        raise ValueError(f"handed must be one of {', '.join(HANDED)}, got {handed!r}")
+        raise InputError(f"handed must be one of {', '.join(HANDED)}, got {handed!r}")
     if not isinstance(club, str) or not CLUB.fullmatch(club):
-        raise ValueError(f"club must be a GSPro club code (DR, I7, PW, PT, ...), got {club!r}")
+        raise InputError(f"club must be a GSPro club code (DR, I7, PW, PT, ...), got {club!r}")
     player = {"Code": 201, "Message": "GSPro Player Information", "Player": {"Handed": handed, "Club": club}}
     return json.dumps(player, separators=(",", ":")).encode()
 

@@ -25,6 +25,7 @@ from multiprocessing.connection import wait
 from multiprocessing.process import BaseProcess
 from pathlib import Path
 
+from golfflight.errors import ServiceError
 from golfflight.service.runtime import batch_child
 
 RETRY_S = 5.0
@@ -33,6 +34,13 @@ RETRY_S = 5.0
 EXIT_CODE_WAIT_S = 0.5
 """Longest a watcher waits for a dead child's exit code once its pipe has closed (the pool's own thread may be
 collecting it at that moment)."""
+
+
+BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has been restarted): send the batch again"
+
+
+class BatchProcessDied(ServiceError):
+    """The batch process died while flying a batch; the next one goes to its replacement (HTTP 503)."""
 
 
 class BatchProcess:
@@ -72,7 +80,7 @@ class BatchProcess:
         """The encoded BatchResult of a validated BatchRequest body, the simulation seconds, and the last `shown`
         shots with their states (`batch_child.fly_and_encode`). A child found dead before the watcher has
         replaced it is replaced before the batch is sent; one that dies under this batch is replaced for the next
-        and this one raises BrokenProcessPool."""
+        and this one raises BatchProcessDied."""
         pool = self._pool
         try:
             future = pool.submit(batch_child.fly_and_encode, body, shown)
@@ -83,7 +91,7 @@ class BatchProcess:
             return await asyncio.wrap_future(future)
         except BrokenProcessPool:
             self._replace(pool)
-            raise
+            raise BatchProcessDied(BATCH_PROCESS_DIED) from None
 
     def _keep_alive(self, pool: ProcessPoolExecutor, process: BaseProcess | None) -> None:
         """Thread: each time the child dies while the server runs, start another at once and load the model in

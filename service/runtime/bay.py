@@ -25,6 +25,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from golfflight.contract.bay import BayConditions, Player
+from golfflight.errors import InputError
 from golfflight.shots.files import write_text_atomic
 from pydantic import ValidationError
 
@@ -48,7 +49,7 @@ PlayerListener = Callable[[Player], None]
 """Told of the new player whenever the bay's player changes (Open Connect sends connectors Code 201)."""
 
 
-class BayFileError(ValueError):
+class BayFileError(InputError):
     """A bay file that cannot be read as bay conditions: the message names the file and the field."""
 
 

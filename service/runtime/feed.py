@@ -24,6 +24,7 @@ from typing import Literal
 from golfflight.contract.bay import Player
 from golfflight.contract.requests import ShotRequest
 from golfflight.contract.results import ShotResult
+from golfflight.errors import ServiceError
 from golfflight.flight.engine import EulerStates
 from golfflight.service.runtime.sessions import MAX_SESSIONS, MAX_SHOTS, Session, Sessions, SessionShot
 
@@ -40,7 +41,7 @@ Source = Literal["http", "batch", "gspro-http", "open-connect"]
 """Where a shot came in: POST /v1/shots, POST /v1/shots/batch, POST /v1/gspro, GSPro Open Connect over TCP."""
 
 
-class TooManyViewers(Exception):
+class TooManyViewers(ServiceError):
     """MAX_VIEWERS streams are open already."""
 
 
@@ -159,7 +160,7 @@ class ShotFeed:
         """A new viewer's queue, announcing the current session, then holding its kept shots after `after_id` (all
         of them without one, or when the id is from before a restart); TooManyViewers when MAX_VIEWERS are open."""
         if len(self._viewers) >= self._max_viewers:
-            raise TooManyViewers(f"{self._max_viewers} viewers are open already")
+            raise TooManyViewers(f"{self._max_viewers} viewers are open already: close one and try again")
         viewer = Viewer(self._history.maxlen, self.sessions.current)
         resume = after_id is not None and after_id < self._next_id
         for entry in self._history:

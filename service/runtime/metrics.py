@@ -24,6 +24,7 @@ from prometheus_client import CollectorRegistry, Counter, Histogram
 from prometheus_client.exposition import CONTENT_TYPE_LATEST, generate_latest
 from prometheus_client.metrics_core import InfoMetricFamily
 from prometheus_client.multiprocess import MultiProcessCollector
+from golfflight.errors import InputError
 
 MULTIPROC_ENV = "PROMETHEUS_MULTIPROC_DIR"
 """prometheus-client's switch to multiprocess mode: the directory the worker processes write their samples to."""
@@ -110,7 +111,7 @@ def shared_across_workers(workers: int) -> Iterator[Path | None]:
     if given:
         directory = Path(given)
         if not directory.is_dir():
-            raise ValueError(f"${MULTIPROC_ENV} is {given!r}: no such directory")
+            raise InputError(f"${MULTIPROC_ENV} is {given!r}: no such directory")
         for stale in directory.glob("*.db"):
             stale.unlink()
         yield directory

@@ -22,7 +22,8 @@ from golfflight.contract.flying import flown_shot
 from golfflight.contract.gspro import GSProMessage, GSProReply, failed_reply, shot_reply, shot_request
 from golfflight.contract.requests import BatchRequest, ShotRequest
 from golfflight.contract.results import ShotResult
-from golfflight.flight.engine import FlightEngine, FlightError, ShotFlight
+from golfflight.errors import GolfflightError, ServiceError
+from golfflight.flight.engine import FlightEngine, ShotFlight
 from golfflight.service.runtime.batch_process import BatchProcess
 from golfflight.service.runtime.bay import Bay
 from golfflight.service.runtime.feed import Entry, ShotFeed, Source
@@ -37,7 +38,7 @@ PLAYER_SOURCES = frozenset({"http", "gspro-http", "open-connect"})
 GSPRO_SOURCES = frozenset({"gspro-http", "open-connect"})
 """Shots from a launch monitor's connector: with the putter selected they are putts, as in GSPro."""
 
-class NotReady(Exception):
+class NotReady(ServiceError):
     """A simulation was asked for before the model was loaded (HTTP: 503; Open Connect: Code 503)."""
 
 
@@ -144,21 +145,19 @@ class BayRuntime:
 
     def fly_gspro(self, message: GSProMessage, source: Source = "gspro-http") -> GSProReply:
         """A connector's shot (a message with BallData), over HTTP or TCP alike: Code 200 with its flight in the
-        bay, shown on its screens; Code 500 saying why it cannot fly; Code 503 until the model is ready."""
-        if self.engine is None:
-            return GSProReply(Code=503, Message=self.error or "the model is still loading",
-                              ShotNumber=message.ShotNumber)
+        bay, shown on its screens; Code 500 saying why it cannot fly; Code 503 until the model is ready (the codes of
+        `contract.refusals.FAILURES`)."""
         try:
             flown = self.fly(shot_request(message), source, shot_number=message.ShotNumber,
                              club_data=message.ClubData)
-        except (ValueError, FlightError) as error:
+        except (ValueError, GolfflightError) as error:  # ValueError: pydantic's, for a message's values
             return failed_reply(message, error)
         return shot_reply(message, flown.result)
 
     async def fly_batch(self, request: BatchRequest, body: bytes, show: bool) -> bytes:
         """A validated batch's encoded BatchResult, flown in the batch process (the bay's conditions filled in
         where a shot gives none); with `show`, its last shots go to the screens with the states they came from.
-        BrokenProcessPool when the batch process died under it."""
+        BatchProcessDied when the batch process died under it."""
         self.ready_engine()
         bay = self.bay.conditions
         if any(getattr(bay, name) is not None for name in CONDITION_FIELDS):

@@ -12,7 +12,6 @@ from __future__ import annotations
 from fastapi import APIRouter, Header, Request
 from fastapi.responses import JSONResponse, Response, StreamingResponse
 from golfflight.service.runtime import BayRuntime
-from golfflight.service.runtime.feed import TooManyViewers
 from golfflight.service.viewer import sessions
 from golfflight.service.viewer.page import ASSETS, PAGE_PATH, SECURITY_HEADERS
 from golfflight.service.viewer.stream import events, last_event_id
@@ -54,9 +53,6 @@ async def shot_events(request: Request, last_event: str | None = Header(None, al
     server-sent events; a new session is announced as it starts."""
     runtime = _runtime(request)
     runtime.ready_engine()
-    try:
-        viewer = runtime.feed.subscribe(last_event_id(last_event))
-    except TooManyViewers as error:
-        return JSONResponse({"detail": f"{error}: close one and try again"}, 503)
+    viewer = runtime.feed.subscribe(last_event_id(last_event))  # TooManyViewers: 503 (contract.refusals.FAILURES)
     headers = {"cache-control": "no-store", "x-accel-buffering": "no"}
     return StreamingResponse(events(runtime.feed, viewer), media_type="text/event-stream", headers=headers)

@@ -4,19 +4,13 @@ air, wind or ground of its own flies in the bay's (`service.runtime.bay`)."""
 
 from __future__ import annotations
 
-from concurrent.futures.process import BrokenProcessPool
-
 from fastapi import APIRouter, Query, Request
-from fastapi.responses import JSONResponse, Response
-from golfflight.contract.refusals import body_detail
+from fastapi.responses import Response
 from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, BatchRequest, ShotRequest
 from golfflight.contract.results import BatchResult, ShotResult
-from golfflight.flight.engine import FlightError
 from golfflight.service.api.dependencies import runtime_of
 from golfflight.service.api.direct import DirectRoute
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
-
-BATCH_PROCESS_DIED = "the batch process stopped while flying this batch (it has been restarted): send the batch again"
 
 router = APIRouter(prefix="/v1/shots", route_class=DirectRoute)
 
@@ -37,11 +31,7 @@ async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer)
     """Fly one shot: launch in SI or launch-monitor units, optional wind, air, ground, normalized and trajectory;
     the bay's conditions (GET /v1/bay) where the shot gives none."""
     # `request` was validated once (`service.api.direct`); the runtime comes from the app, not dependencies
-    try:
-        flown = runtime_of(http).fly(request, "http", show=viewer)
-    except FlightError as error:
-        return JSONResponse({"detail": [body_detail(str(error), "flight_error")]}, 422)
-    return json_response(flown.result)
+    return json_response(runtime_of(http).fly(request, "http", show=viewer).result)
 
 
 @router.post(
@@ -56,8 +46,5 @@ async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer)
 async def batch(request: BatchRequest, http: Request, viewer: bool = ShowOnViewer) -> Response:
     """`request` is valid (a 422 otherwise); the batch process flies its raw body, or the shots with the bay's
     conditions filled in when the bay has any."""
-    try:
-        body = await runtime_of(http).fly_batch(request, await http.body(), show=viewer)
-    except BrokenProcessPool:
-        return JSONResponse({"detail": BATCH_PROCESS_DIED}, 503)
+    body = await runtime_of(http).fly_batch(request, await http.body(), show=viewer)
     return Response(body, media_type="application/json")
