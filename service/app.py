@@ -10,50 +10,30 @@ player reaches every connector as Code 201 player information.
 from __future__ import annotations
 
 import asyncio
-import os
 from contextlib import asynccontextmanager
 
 from fastapi import FastAPI
 from golfflight.contract.bay import Player
 from golfflight.flight.bundle_location import model_dir
 from golfflight.service.api.app import http_app
-from golfflight.service.api.guards import ALLOWED_HOSTS_ENV, API_KEY_ENV, CORS_ORIGINS_ENV
 from golfflight.service.open_connect.server import ConnectAddress, OpenConnectServer
 from golfflight.service.runtime import BayRuntime
-from golfflight.service.runtime.bay import BAY_FILE_ENV, Bay
+from golfflight.service.runtime.bay import Bay
 from golfflight.service.runtime.parent_watch import exit_with_parent
+from golfflight.service.settings import ServiceSettings
 from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.viewer.page import PUBLIC_PATHS
 
 
-def _listed(text: str | None) -> list[str]:
-    """The items of a comma-separated setting (origins, host names)."""
-    return [origin.strip() for origin in (text or "").split(",") if origin.strip()]
-
-
-def create_app(
-    model: str | os.PathLike | None = None,
-    *,
-    api_key: str | None = None,
-    cors_origins: list[str] | None = None,
-    connect: ConnectAddress | None = None,
-    bay: str | os.PathLike | None = None,
-    allowed_hosts: list[str] | None = None,
-) -> FastAPI:
-    """The service for a model bundle (default: `flight.bundle_location.model_dir()`).
-
-    `api_key` (default $GOLFFLIGHT_API_KEY) makes every route but /healthz and the viewer's page require it;
-    `cors_origins` (default the comma-separated $GOLFFLIGHT_CORS_ORIGINS) are the browser origins allowed; none means
-    CORS stays off. `connect` (default from $GOLFFLIGHT_CONNECT_PORT and _HOST) also listens for GSPro Open Connect
-    over TCP there. `bay` (default $GOLFFLIGHT_BAY_FILE) is the file the bay's conditions are kept in
-    (`service.runtime.bay`); none keeps them in memory only. Without an API key, only requests to this machine's names
-    and `allowed_hosts` (default the comma-separated $GOLFFLIGHT_ALLOWED_HOSTS) are answered."""
-    bay = bay if bay is not None else os.environ.get(BAY_FILE_ENV) or None
-    runtime = BayRuntime(model_dir(model), Bay(bay))
-    api_key = api_key if api_key is not None else os.environ.get(API_KEY_ENV, "")
-    cors_origins = cors_origins if cors_origins is not None else _listed(os.environ.get(CORS_ORIGINS_ENV))
-    connect = connect if connect is not None else ConnectAddress.from_env()
-    allowed_hosts = allowed_hosts if allowed_hosts is not None else _listed(os.environ.get(ALLOWED_HOSTS_ENV))
+def create_app(settings: ServiceSettings | None = None) -> FastAPI:
+    """The service for `settings` (default: `ServiceSettings.from_env()`, the settings `serve` handed its workers or
+    the GOLFFLIGHT_* variables): the bundle (`flight.bundle_location.model_dir` where none is named), the API key
+    every route but /healthz and the viewer's page then requires, the browser origins allowed (none: CORS off), the
+    Host names answered without a key, the bay file (`service.runtime.bay`; none: in memory only) and, given a
+    connect port, GSPro Open Connect over TCP there."""
+    settings = settings if settings is not None else ServiceSettings.from_env()
+    runtime = BayRuntime(model_dir(settings.model), Bay(settings.bay_file))
+    connect = ConnectAddress(settings.connect_port, settings.connect_host) if settings.connect_port else None
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
@@ -79,8 +59,9 @@ def create_app(
             await loading
             runtime.stop()
 
-    return http_app(runtime, lifespan=lifespan, api_key=api_key, cors_origins=cors_origins,
-                    more_routers=viewer_routes.ROUTERS, open_paths=PUBLIC_PATHS, allowed_hosts=allowed_hosts)
+    return http_app(runtime, lifespan=lifespan, api_key=settings.api_key, cors_origins=list(settings.cors_origins),
+                    more_routers=viewer_routes.ROUTERS, open_paths=PUBLIC_PATHS,
+                    allowed_hosts=list(settings.allowed_hosts))
 
 
 def _tell(tcp: OpenConnectServer, player: Player) -> None:

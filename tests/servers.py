@@ -53,10 +53,10 @@ def running(app, ready_path: str = "/healthz", timeout_s: float = 120.0, http=No
 def keyed_service(key: str) -> Iterator[tuple[httpx.Client, int, object]]:
     """(client, Open Connect port, app) of one service with an API key, listening on HTTP and on Open Connect TCP."""
     from golfflight.service.app import create_app
-    from golfflight.service.open_connect.server import ConnectAddress
+    from golfflight.service.settings import ServiceSettings
 
     port = free_port()
-    app = create_app(api_key=key, cors_origins=[], connect=ConnectAddress(port))
+    app = create_app(ServiceSettings(api_key=key, connect_port=port))
     with running(app) as http:
         yield http, port, app
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import httpx
 import psutil
 import pytest
-from golfflight.service.api.guards import API_KEY_ENV
+from golfflight.service.settings import API_KEY_ENV
 from servers import free_port
 
 SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}

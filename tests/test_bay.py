@@ -11,7 +11,7 @@ import pytest
 from golfflight.contract.bay import BayConditions, in_bay
 from golfflight.contract.requests import AirRequest, GroundRequest, ShotRequest, WindRequest
 from golfflight.service.app import create_app
-from golfflight.service.open_connect.server import ConnectAddress
+from golfflight.service.settings import ServiceSettings
 from golfflight.service.runtime.bay import Bay, BayFileError
 
 from tests.servers import free_port, running, shot
@@ -70,7 +70,7 @@ def _open_connect_carry(port: int) -> float:
 
 def test_http_batch_and_open_connect_shots_fly_in_the_bay_and_it_survives_a_restart(tmp_path):
     path, port = tmp_path / "bay.json", free_port()
-    with running(create_app(connect=ConnectAddress(port), bay=path)) as http:
+    with running(create_app(ServiceSettings(connect_port=port, bay_file=path))) as http:
         calm = shot(http, **SEVEN_IRON)
         tcp_calm = _open_connect_carry(port)
         answer = http.put("/v1/bay", json=DENVER_HEAT)
@@ -93,13 +93,13 @@ def test_http_batch_and_open_connect_shots_fly_in_the_bay_and_it_survives_a_rest
         assert tcp != tcp_calm
         assert tcp == pytest.approx(shot(http, ball_speed_mph=123.0, launch_angle_deg=16.0, spin_rpm=7100.0,
                                          **DENVER_HEAT)["carry_m"], abs=1e-6)
-    with running(create_app(bay=path)) as http:
+    with running(create_app(ServiceSettings(bay_file=path))) as http:
         assert shot(http, **SEVEN_IRON) == explicit, "the bay came back from its file"
 
 
 def test_a_bad_bay_is_refused_like_a_bad_shot_and_changes_nothing(tmp_path):
     path = tmp_path / "bay.json"
-    with running(create_app(bay=path)) as http:
+    with running(create_app(ServiceSettings(bay_file=path))) as http:
         http.put("/v1/bay", json={"wind": {"speed_mps": 3.0}})
         answer = http.put("/v1/bay", json={"air": {"altitude_m": 99999.0}})
         assert answer.status_code == 422
@@ -110,7 +110,7 @@ def test_a_bad_bay_is_refused_like_a_bad_shot_and_changes_nothing(tmp_path):
 
 
 def test_the_bay_needs_the_api_key_when_one_is_set(tmp_path):
-    with running(create_app(api_key="k", bay=tmp_path / "bay.json")) as http:
+    with running(create_app(ServiceSettings(api_key="k", bay_file=tmp_path / "bay.json"))) as http:
         assert http.get("/v1/bay").status_code == 401
         assert http.put("/v1/bay", json={}).status_code == 401
         assert http.get("/v1/bay", headers={"x-api-key": "k"}).status_code == 200
@@ -135,7 +135,7 @@ def test_a_scripted_connector_session_flies_every_shot_in_the_bay():
 
     clubs = [(167.0, 11.0, 2650.0), (150.0, 12.5, 4200.0), (123.0, 16.1, 7124.0), (104.0, 23.7, 9316.0)]
     port = free_port()
-    with running(create_app(connect=ConnectAddress(port))) as http:
+    with running(create_app(ServiceSettings(connect_port=port))) as http:
         with socket.create_connection(("127.0.0.1", port), timeout=10) as connector:
             heartbeat = {**OPEN_CONNECT_SHOT, "ShotNumber": 0,
                          "ShotDataOptions": {"ContainsBallData": False, "IsHeartBeat": True}}
@@ -185,7 +185,7 @@ def test_a_shots_own_air_replaces_the_bays_quantity_by_quantity():
 
 def test_a_connectors_shot_carries_its_flat_figures_and_unknown_units_are_refused():
     """Issue 43: Open Connect replies left out `flat`, and `Units` "furlongs" was taken without a word."""
-    with running(create_app(api_key="", cors_origins=[])) as http:
+    with running(create_app(ServiceSettings())) as http:
         assert http.put("/v1/bay", json={"ground": {"surface": "fairway", "elevation_m": -5.0}}).status_code == 200
         reply = http.post("/v1/gspro", json=OPEN_CONNECT_SHOT).json()
         assert reply["Code"] == 200 and reply["Flight"]["flat"]["carry_m"] < reply["Flight"]["carry_m"]

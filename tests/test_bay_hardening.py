@@ -24,6 +24,7 @@ from golfflight.contract.flying import flown_shot
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.api.http_protocol import DeadlineHttpProtocol
 from golfflight.service.app import create_app
+from golfflight.service.settings import ServiceSettings
 from golfflight.service.runtime.bay import Bay, BayFileError
 from golfflight.service.runtime.feed import ShotFeed
 from golfflight.service.viewer import routes as viewer_routes
@@ -124,7 +125,7 @@ def _sparse_gigabyte(path: Path) -> None:
 def test_a_bay_file_that_is_not_a_small_regular_file_is_a_broken_bay_file(tmp_path, replacement, named):
     path = tmp_path / "bay.json"
     shot = {"ball_speed_mps": 60.0, "launch_angle_deg": 14.0, "spin_rpm": 5000.0}
-    with running(create_app(bay=path)) as http:
+    with running(create_app(ServiceSettings(bay_file=path))) as http:
         assert http.put("/v1/bay", json={"air": {"altitude_m": 1600.0}}).status_code == 200
         good = http.post("/v1/shots", json=shot).json()
         staged = tmp_path / "staged"
@@ -148,7 +149,7 @@ def test_a_bay_file_that_is_a_fifo_stops_the_start_with_its_name(tmp_path):
 
 def test_without_a_key_a_page_reached_by_dns_rebinding_can_neither_change_the_bay_nor_read_the_session():
     rebound = {"host": "evil.example.com"}
-    with running(create_app(api_key="", cors_origins=[], allowed_hosts=["bay-pc.local"])) as http:
+    with running(create_app(ServiceSettings(allowed_hosts=["bay-pc.local"]))) as http:
         assert http.patch("/v1/bay", json={"player": {"club": "PT"}}, headers=rebound).status_code == 403
         refused = http.get("/v1/session.csv", headers=rebound)
         assert refused.status_code == 403 and "evil.example.com" in refused.json()["detail"]
@@ -161,7 +162,7 @@ def test_without_a_key_a_page_reached_by_dns_rebinding_can_neither_change_the_ba
 
 
 def test_with_a_key_the_key_is_the_guard_and_any_host_is_answered():
-    with running(create_app(api_key="k", cors_origins=[])) as http:
+    with running(create_app(ServiceSettings(api_key="k"))) as http:
         assert http.get("/v1/bay", headers={"host": "golf.example.com", "x-api-key": "k"}).status_code == 200
 
 
@@ -173,7 +174,7 @@ class _QuickDeadlines(DeadlineHttpProtocol):
 @contextmanager
 def _served_with_quick_deadlines() -> Iterator[int]:
     """The service on a free loopback port, its request deadlines half a second: the port."""
-    with running(create_app(api_key="", cors_origins=[]), http=_QuickDeadlines) as http:
+    with running(create_app(ServiceSettings()), http=_QuickDeadlines) as http:
         yield http.base_url.port
 
 
@@ -229,7 +230,7 @@ def test_serve_raises_its_open_files_limit_to_the_hard_one():
 def test_a_body_nested_too_deeply_is_refused_as_that_on_every_route():
     body = b'{"a": ' + b"[" * 5000 + b"]" * 5000 + b"}"
     json_body = {"content-type": "application/json"}
-    with running(create_app(api_key="", cors_origins=[])) as http:
+    with running(create_app(ServiceSettings())) as http:
         for method, path in (("POST", "/v1/shots"), ("POST", "/v1/shots/batch"), ("PATCH", "/v1/bay")):
             refused = http.request(method, path, content=body, headers=json_body)
             assert refused.status_code == 422 and "nested too deeply" in refused.json()["detail"][0]["msg"], path

@@ -21,7 +21,7 @@ import httpx
 import numpy as np
 import pytest
 from golfflight.service.app import create_app
-from golfflight.service.open_connect.server import ConnectAddress
+from golfflight.service.settings import ServiceSettings
 from golfflight.service.viewer.event import ShotEvent
 from golfflight.shots.files import write_text_atomic
 
@@ -108,7 +108,7 @@ def drawn(event: ShotEvent) -> np.ndarray:
 @pytest.fixture()
 def bay_service():
     port = free_port()
-    with running(create_app(connect=ConnectAddress(port))) as http:
+    with running(create_app(ServiceSettings(connect_port=port))) as http:
         yield http, port
 
 
@@ -179,7 +179,7 @@ def test_patch_changes_only_the_parts_it_names(bay_service):
 
 def test_a_bay_file_broken_while_serving_keeps_the_last_good_bay_until_a_put_repairs_it(tmp_path):
     path, port = tmp_path / "bay.json", free_port()
-    with running(create_app(connect=ConnectAddress(port), bay=path)) as http:
+    with running(create_app(ServiceSettings(connect_port=port, bay_file=path))) as http:
         assert http.put("/v1/bay", json=BAY).status_code == 200
         good = http.post("/v1/shots", json={"ball_speed_mps": 60.0, "launch_angle_deg": 14.0, "spin_rpm": 5000.0})
         for broken in (b"{not json", b"\xff\xfe binary", None):
@@ -254,7 +254,7 @@ def test_a_club_changed_in_the_bay_file_reaches_a_connector_at_once_apart_from_a
     """Issue 43: the 201 used to go out at the next shot, 3.5 ms ahead of its 200, and a connector that reads once
     per shot took it for its reply; now the file is watched and the 201 comes within 2 s, on its own."""
     path, port = tmp_path / "bay.json", free_port()
-    with running(create_app(connect=ConnectAddress(port), bay=path)) as http:
+    with running(create_app(ServiceSettings(connect_port=port, bay_file=path))) as http:
         assert json.loads(path.read_text()) == {"player": {"club": "DR", "handed": "RH"}, "units": "imperial"}
         connector = Connector(port)
         assert connector.reply(message(1, BALLS[0]))["Code"] == 200

@@ -15,6 +15,7 @@ from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.service.app import create_app
+from golfflight.service.settings import ServiceSettings
 from golfflight.weights_schema.bundle import BundleError, sha256_of
 from onnx import numpy_helper
 from servers import running
@@ -164,7 +165,7 @@ def test_commands_refuse_a_broken_bundle_in_one_line(broken, tmp_path, capsys):
 def test_the_service_reports_a_broken_bundle_on_healthz_and_flies_nothing(tmp_path):
     bundle = _copy(tmp_path)
     weights_give_nan(bundle)
-    with running(create_app(bundle, api_key="", cors_origins=[])) as http:
+    with running(create_app(ServiceSettings(model=bundle))) as http:
         health = http.get("/healthz")
         assert health.status_code == 503 and health.json()["status"] == "failed"
         assert "non-finite" in health.json()["error"]

@@ -18,6 +18,7 @@ from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.flyer import Flyer
 from golfflight.flight.physics import initial_state
 from golfflight.service.app import create_app
+from golfflight.service.settings import ServiceSettings
 from golfflight.service.viewer.page import ASSETS
 from golfflight.shots import reference_world
 from golfflight.shots.clubs import CLUB_ALIASES, CLUB_NAMES, CLUBS, canonical_club_name, club_key, club_named
@@ -36,7 +37,7 @@ def fly_json(capsys, *argv: str) -> dict:
 
 @pytest.fixture(scope="module")
 def api():
-    with running(create_app(api_key="", cors_origins=[])) as http:
+    with running(create_app(ServiceSettings())) as http:
         yield http
 
 

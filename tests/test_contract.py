@@ -15,6 +15,7 @@ from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES
 from golfflight.flight import limits
 from golfflight.service.api.guards import MAX_BODY_BYTES
 from golfflight.service.app import create_app
+from golfflight.service.settings import ServiceSettings
 from servers import running
 
 SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}
@@ -57,7 +58,7 @@ slopes up to 10 degrees are held by the rough, not by the fairway, and a wind sp
 
 @pytest.fixture(scope="module")
 def app():
-    return create_app(api_key="", cors_origins=[])
+    return create_app(ServiceSettings())
 
 
 @pytest.fixture(scope="module")

@@ -12,6 +12,7 @@ import browser
 import pytest
 from golfflight.service.api.routes.docs import ASSETS_DIR
 from golfflight.service.app import create_app
+from golfflight.service.settings import ServiceSettings
 from servers import running
 
 KEY = "docs-test-key"
@@ -22,7 +23,7 @@ LOCAL_HOSTS = {"127.0.0.1"}
 @pytest.fixture(scope="module")
 def open_service():
     """A service without an API key (a simulator bay's usual setup)."""
-    with running(create_app(api_key="", cors_origins=[])) as http:
+    with running(create_app(ServiceSettings())) as http:
         yield http
 
 
@@ -65,7 +66,7 @@ def test_swagger_ui_loads_its_own_script_and_style(open_service):
 def test_the_docs_keep_the_api_key_and_openapi_json_works():
     """With a key, /docs, its files and /openapi.json need it like every route but /healthz; the files are
     counted under their mount in /metrics, not as unmatched paths."""
-    with running(create_app(api_key=KEY, cors_origins=[])) as http:
+    with running(create_app(ServiceSettings(api_key=KEY))) as http:
         for path in ("/docs", "/openapi.json", "/docs/assets/swagger-ui-bundle.js", "/docs/assets/swagger-ui.css"):
             refused = http.get(path)
             assert refused.status_code == 401 and "API key" in refused.json()["detail"], path

@@ -12,7 +12,7 @@ import time
 
 import httpx
 import pytest
-from golfflight.service.api.guards import API_KEY_ENV
+from golfflight.service.settings import ServiceSettings, API_KEY_ENV
 from golfflight.service.app import create_app
 from servers import free_port, running
 
@@ -31,7 +31,7 @@ def test_serve_binds_loopback_unless_told_otherwise():
 
 
 def test_the_api_key_is_required_everywhere_but_healthz():
-    with running(create_app(api_key=KEY, cors_origins=[])) as http:
+    with running(create_app(ServiceSettings(api_key=KEY))) as http:
         assert http.get("/healthz").status_code == 200
         for path in GET_ROUTES:
             refused = http.get(path)
@@ -47,17 +47,17 @@ def test_the_api_key_is_required_everywhere_but_healthz():
 
 
 def test_without_a_key_nothing_is_asked():
-    with running(create_app(api_key="", cors_origins=[])) as http:
+    with running(create_app(ServiceSettings())) as http:
         assert http.post("/v1/shots", json=SHOT).status_code == 200
 
 
 def test_cors_is_off_unless_origins_are_configured():
     preflight = {"origin": "https://sim.example", "access-control-request-method": "POST"}
-    with running(create_app(api_key="", cors_origins=[])) as http:
+    with running(create_app(ServiceSettings())) as http:
         answer = http.post("/v1/shots", json=SHOT, headers={"origin": "https://sim.example"})
         assert answer.status_code == 200 and "access-control-allow-origin" not in answer.headers
         assert "access-control-allow-origin" not in http.options("/v1/shots", headers=preflight).headers
-    with running(create_app(api_key=KEY, cors_origins=["https://sim.example"])) as http:
+    with running(create_app(ServiceSettings(api_key=KEY, cors_origins=["https://sim.example"]))) as http:
         allowed = http.options("/v1/shots", headers={**preflight, "access-control-request-headers": "x-api-key"})
         assert allowed.status_code == 200 and allowed.headers["access-control-allow-origin"] == "https://sim.example"
         other = http.options("/v1/shots", headers={**preflight, "origin": "https://evil.example"})
@@ -67,7 +67,7 @@ def test_cors_is_off_unless_origins_are_configured():
 
 
 def test_no_route_takes_a_path_from_the_client():
-    schema = create_app(api_key="", cors_origins=[]).openapi()
+    schema = create_app(ServiceSettings()).openapi()
     assert not any("{" in path for path in schema["paths"]), "path parameters"
     for path, operations in schema["paths"].items():
         for operation in operations.values():

@@ -9,6 +9,7 @@ import sys
 import pytest
 import schemathesis
 from golfflight.service.app import create_app
+from golfflight.service.settings import ServiceSettings
 from hypothesis import HealthCheck, given, settings
 from schemathesis import GenerationMode
 from schemathesis.checks import negative_data_rejection, positive_data_acceptance
@@ -44,7 +45,7 @@ def ieee_floats():
 
 @pytest.fixture(scope="module")
 def base_url():
-    with running(create_app(api_key="", cors_origins=[])) as http:
+    with running(create_app(ServiceSettings())) as http:
         yield str(http.base_url).rstrip("/")
 
 

@@ -12,7 +12,8 @@ from pathlib import Path
 import kubernetes_validate
 import pytest
 import yaml
-from golfflight.service.api.guards import API_KEY_ENV, OPEN_PATHS
+from golfflight.service.api.guards import OPEN_PATHS
+from golfflight.service.settings import API_KEY_ENV
 from golfflight.service.api.routes.metrics import METRICS_PATH
 
 from golfflight.commands import serve

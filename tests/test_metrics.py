@@ -16,7 +16,7 @@ from pathlib import Path
 import httpx
 import pytest
 from golfflight.flight.bundle_location import model_dir
-from golfflight.service.api.guards import API_KEY_ENV
+from golfflight.service.settings import ServiceSettings, API_KEY_ENV
 from golfflight.service.app import create_app
 from golfflight.service.runtime.metrics import MULTIPROC_ENV, shared_across_workers
 from golfflight.weights_schema.bundle import load_bundle
@@ -58,7 +58,7 @@ def requests(found: Samples, route: str, status: int, method: str = "POST") -> f
 
 @pytest.fixture(scope="module")
 def keyed():
-    with running(create_app(api_key=KEY, cors_origins=[]), ready_path="/healthz") as http:
+    with running(create_app(ServiceSettings(api_key=KEY)), ready_path="/healthz") as http:
         http.headers.update(KEYED)
         yield http
 

@@ -13,6 +13,7 @@ import time
 import pytest
 from golfflight.contract.gspro import GSProReply
 from golfflight.service.app import create_app
+from golfflight.service.settings import ServiceSettings
 from golfflight.service.open_connect.framing import MAX_MESSAGE_BYTES, ObjectFramer, Refused
 from golfflight.service.open_connect.limits import ConnectorLimits
 from golfflight.service.open_connect.replies import _read_by_python, reply_to
@@ -212,7 +213,7 @@ def test_a_message_read_once_by_pydantic_gets_the_reply_pythons_json_reading_giv
 def service():
     """(HTTP client, TCP port) of one app serving both."""
     port = free_port()
-    with running(create_app(connect=ConnectAddress(port))) as http:
+    with running(create_app(ServiceSettings(connect_port=port))) as http:
         yield http, port
 
 
@@ -448,7 +449,7 @@ def test_several_connectors_at_once_each_answered_in_milliseconds(service):
 
 def test_shutdown_closes_every_connection_and_the_port(tmp_path):
     port = free_port()
-    with running(create_app(connect=ConnectAddress(port))):
+    with running(create_app(ServiceSettings(connect_port=port))):
         client = Connector(port)
         reply, _, _ = client.fly(shot(91))
         assert reply["Code"] == 200
@@ -490,7 +491,7 @@ def test_serve_refuses_tcp_with_several_workers_and_a_busy_port(capsys):
     assert main(["serve", "--connect-port", str(free_port()), "--workers", "2"]) == 2
     assert "--connect-port" in capsys.readouterr().err
     assert main(["serve", "--connect-port", "70000"]) == 2
-    assert "--connect-port must be 1 to 65535" in capsys.readouterr().err
+    assert "--connect-port: Input should be less than or equal to 65535, got 70000" in capsys.readouterr().err
     with socket.create_server(("127.0.0.1", 0)) as busy:
         taken = busy.getsockname()[1]
         assert main(["serve", "--port", str(free_port()), "--connect-port", str(taken)]) == 2

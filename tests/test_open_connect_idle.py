@@ -11,8 +11,8 @@ import time
 
 import pytest
 from golfflight.service.app import create_app
+from golfflight.service.settings import ServiceSettings
 from golfflight.service.open_connect.limits import MAX_CONNECTIONS, ConnectorLimits
-from golfflight.service.open_connect.server import ConnectAddress
 
 from tests.servers import free_port, running
 from tests.test_open_connect import HEARTBEAT, encoded, shot
@@ -148,7 +148,7 @@ def test_when_every_connection_played_the_quietest_past_the_protection_gives_way
 
 def test_healthz_reports_open_connect_connections_refusals_and_evictions():
     port = free_port()
-    with running(create_app(connect=ConnectAddress(port))) as http:
+    with running(create_app(ServiceSettings(connect_port=port))) as http:
         assert http.get("/healthz").json()["open_connect"] == {
             "connected": 0, "max_connections": MAX_CONNECTIONS, "refused": 0, "evicted": 0}
         idle = [connect(port) for _ in range(MAX_CONNECTIONS)]

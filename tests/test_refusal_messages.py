@@ -10,6 +10,7 @@ from golfflight.contract.gspro import GSPRO_RANGES
 from golfflight.contract.requests import RANGES
 from golfflight.flight import limits
 from golfflight.service.app import create_app
+from golfflight.service.settings import ServiceSettings
 
 from golfflight.cli import main
 from tests.servers import running
@@ -22,7 +23,7 @@ SPEED_REFUSAL = "Input should be less than or equal to 223.6 (got 600.0); allowe
 @pytest.fixture(scope="module")
 def http():
     """A client of the real service on a loopback port."""
-    with running(create_app(api_key="", cors_origins=[])) as client:
+    with running(create_app(ServiceSettings())) as client:
         yield client
 
 

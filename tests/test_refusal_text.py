@@ -10,6 +10,7 @@ import pytest
 from golfflight.contract.refusals import QUOTED_CHARS, describe_errors
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.app import create_app
+from golfflight.service.settings import ServiceSettings
 from pydantic import ValidationError
 
 from tests.servers import running
@@ -62,7 +63,7 @@ def test_long_values_and_field_names_are_cut():
 @pytest.fixture(scope="module")
 def http():
     """A client of the real service on a loopback port."""
-    with running(create_app(api_key="", cors_origins=[])) as client:
+    with running(create_app(ServiceSettings())) as client:
         yield client
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import httpx
 import uvicorn
 from golfflight.service.app import create_app
-from golfflight.service.open_connect.server import ConnectAddress
+from golfflight.service.settings import ServiceSettings
 from servers import free_port
 
 SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}
@@ -40,7 +40,7 @@ def _connect_once_accepting(port: int, deadline: float) -> socket.socket:
 
 def test_the_first_request_once_the_ports_accept_is_served():
     http_port, tcp_port = free_port(), free_port()
-    app = create_app(connect=ConnectAddress(tcp_port))
+    app = create_app(ServiceSettings(connect_port=tcp_port))
     server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=http_port, log_level="warning"))
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()

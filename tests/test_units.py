@@ -15,7 +15,7 @@ from golfflight.contract.columns import result_columns
 from golfflight.contract.results import FlatFlight, FlightResult, Landing, RestPoint
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.service.app import create_app
-from golfflight.service.open_connect.server import ConnectAddress
+from golfflight.service.settings import ServiceSettings
 
 from golfflight.cli import main
 from tests.servers import free_port, running, shot
@@ -27,7 +27,7 @@ NEW_FIELDS = ("lateral_yd", "roll_yd", "landing_speed_mph")
 
 @pytest.fixture(scope="module")
 def http():
-    with running(create_app(api_key="", cors_origins=[])) as client:
+    with running(create_app(ServiceSettings())) as client:
         yield client
 
 
@@ -154,7 +154,7 @@ def test_the_bay_takes_and_echoes_mph_and_feet_and_its_shots_fly_in_them(tmp_pat
     port = free_port()
     bay = {"wind": {"speed_mph": 10.0, "from_deg": 0.0}, "ground": {"surface": "green", "stimp_ft": 12.0,
                                                                    "elevation_ft": -6.0}}
-    with running(create_app(connect=ConnectAddress(port), bay=tmp_path / "bay.json")) as http:
+    with running(create_app(ServiceSettings(connect_port=port, bay_file=tmp_path / "bay.json"))) as http:
         assert http.put("/v1/bay", json=bay).status_code == 200
         echoed = http.get("/v1/bay").json()
         assert echoed["wind"]["speed_mph"] == 10.0 and "speed_mps" not in echoed["wind"]

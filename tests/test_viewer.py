@@ -18,7 +18,7 @@ import pytest
 from golfflight.contract.flying import flown_shot
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.app import create_app
-from golfflight.service.open_connect.server import ConnectAddress
+from golfflight.service.settings import ServiceSettings
 from golfflight.service.runtime.feed import HISTORY, ShotFeed, TooManyViewers
 from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.viewer.event import SCHEMA_PATH, ShotEvent, schema_text
@@ -271,7 +271,7 @@ def test_too_many_viewers_get_503_saying_so(service):
 @pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
 def test_the_page_in_chromium_draws_shots_from_http_and_open_connect(tmp_path):
     port = free_port()
-    with running(create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))) as http:
+    with running(create_app(ServiceSettings(api_key=KEY, connect_port=port))) as http:
         base = str(http.base_url).rstrip("/")
         with browser.headless_page() as page:
             errors: list[str] = []

@@ -21,7 +21,7 @@ from golfflight.contract.bay import GSPRO_CLUBS
 from golfflight.contract.flying import flown_shot
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.app import create_app
-from golfflight.service.open_connect.server import ConnectAddress
+from golfflight.service.settings import ServiceSettings
 from golfflight.service.runtime.feed import ShotFeed
 from golfflight.service.viewer import routes as viewer_routes
 from golfflight.service.viewer.stream import KEEPALIVE_FRAME, KEEPALIVE_S, events, serving_server
@@ -257,7 +257,7 @@ def live_viewer(width: int, height: int):
     """(page, HTTP client, Open Connect port, the page's script errors) of a keyed service's viewer, open and live
     in headless Chromium at width x height."""
     port = free_port()
-    with running(create_app(api_key=KEY, cors_origins=[], connect=ConnectAddress(port))) as http:
+    with running(create_app(ServiceSettings(api_key=KEY, connect_port=port))) as http:
         base = str(http.base_url).rstrip("/")
         with browser.headless_page(width, height) as page:
             errors: list[str] = []

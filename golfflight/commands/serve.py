@@ -18,11 +18,15 @@ import copy
 import errno
 import importlib
 import ipaddress
-import os
 import socket
 import sys
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from golfflight.errors import InputError
+
+if TYPE_CHECKING:
+    from golfflight.service.settings import ServiceSettings
 
 GRACEFUL_SHUTDOWN_S = 30
 """Longest a shutdown waits for in-flight requests (a full 10,000-shot batch takes about a second)."""
@@ -59,8 +63,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--connect-host",
-        default="127.0.0.1",
-        help="interface for --connect-port (Open Connect has no authentication: keep loopback where you can)",
+        help="interface for --connect-port (default 127.0.0.1; Open Connect has no authentication: keep loopback where "
+        "you can)",
     )
     parser.add_argument(
         "--bay",
@@ -144,42 +148,59 @@ def open_files_raised() -> int | None:
     return wanted
 
 
+FLAGS = {"model": "--model", "cors_origins": "--cors-origin", "allowed_hosts": "--allowed-host", "bay_file": "--bay",
+         "connect_port": "--connect-port", "connect_host": "--connect-host"}
+"""Each setting's flag: a flag given takes the place of the environment's value."""
+
+
+def served_settings(args: argparse.Namespace, environment: ServiceSettings) -> ServiceSettings:
+    """The service's settings: the flags given over the environment's, with the bundle found and made absolute and
+    the bay file made absolute, so every worker reads the same ones. InputError naming the flag for a bad value."""
+    from golfflight.flight.bundle_location import model_dir
+    from golfflight.service.settings import ServiceSettings
+    from pydantic import ValidationError
+
+    given = {field: getattr(args, flag[2:].replace("-", "_")) for field, flag in FLAGS.items()}
+    given = {field: tuple(value) if isinstance(value, list) else value for field, value in given.items()
+             if value is not None}
+    values = {**environment.model_dump(), **given}
+    values["model"] = model_dir(values["model"]).resolve()
+    if values["bay_file"] is not None:
+        values["bay_file"] = Path(values["bay_file"]).absolute()
+    try:
+        return ServiceSettings.model_validate(values)
+    except ValidationError as error:
+        problem = error.errors()[0]
+        field = problem["loc"][0]
+        raise InputError(f"{FLAGS.get(field, field)}: {problem['msg']}, got {values[field]!r}") from None
+
+
 def run(args: argparse.Namespace) -> int:
     import uvicorn
 
     from golfflight.flight.bundle_check import verify_bundle
-    from golfflight.flight.bundle_location import MODEL_ENV, model_dir
-    from golfflight.service.api.guards import ALLOWED_HOSTS_ENV, API_KEY_ENV, CORS_ORIGINS_ENV
-    from golfflight.service.open_connect.server import CONNECT_HOST_ENV, CONNECT_PORT_ENV
-    from golfflight.service.runtime.bay import BAY_FILE_ENV, Bay
+    from golfflight.service.runtime.bay import Bay
     from golfflight.service.runtime.metrics import shared_across_workers
+    from golfflight.service.settings import API_KEY_ENV, ServiceSettings
 
     if args.workers < 1:
         raise InputError(f"--workers must be at least 1, got {args.workers}")
     if args.connect_port is not None and args.workers != 1:
         raise InputError("--connect-port needs --workers 1 (one process holds the connectors' port)")
-    bundle = model_dir(args.model).resolve()
-    card = verify_bundle(bundle)  # refuse a bad bundle here, before any worker starts
-    os.environ[MODEL_ENV] = str(bundle)  # the factory in every worker process reads these
-    if args.bay:
-        bay = Bay(args.bay).conditions  # refuse a bad bay file here, before any worker starts
-        os.environ[BAY_FILE_ENV] = os.path.abspath(args.bay)
-    if args.cors_origin:
-        os.environ[CORS_ORIGINS_ENV] = ",".join(args.cors_origin)
-    if args.allowed_host:
-        os.environ[ALLOWED_HOSTS_ENV] = ",".join(args.allowed_host)
+    settings = served_settings(args, ServiceSettings.from_env())  # the one reading of the environment
+    card = verify_bundle(settings.model)  # refuse a bad bundle here, before any worker starts
+    bay = Bay(settings.bay_file).conditions if settings.bay_file else None  # and a bad bay file
     _listenable(args.host, args.port, "--port")  # before the line saying it serves there
     connect = "off"
-    if args.connect_port is not None:
-        _listenable(args.connect_host, args.connect_port, "--connect-port")
-        os.environ[CONNECT_PORT_ENV], os.environ[CONNECT_HOST_ENV] = str(args.connect_port), args.connect_host
-        connect = f"on tcp://{args.connect_host}:{args.connect_port}"
-    keyed = bool(os.environ.get(API_KEY_ENV))
+    if settings.connect_port is not None:
+        _listenable(settings.connect_host, settings.connect_port, "--connect-port")
+        connect = f"on tcp://{settings.connect_host}:{settings.connect_port}"
+    keyed = bool(settings.api_key)
     print(
-        f"golfflight serve: {card.variant} model from {bundle} on http://{args.host}:{args.port} (docs at /docs), "
-        f"{args.workers} worker(s), API key {'required' if keyed else 'off'}, "
-        f"CORS {os.environ.get(CORS_ORIGINS_ENV) or 'off'}, GSPro Open Connect {connect}"
-        + (f", bay {args.bay} ({bay.model_dump_json(exclude_none=True)})" if args.bay else "")
+        f"golfflight serve: {card.variant} model from {settings.model} on http://{args.host}:{args.port} (docs at "
+        f"/docs), {args.workers} worker(s), API key {'required' if keyed else 'off'}, "
+        f"CORS {','.join(settings.cors_origins) or 'off'}, GSPro Open Connect {connect}"
+        + (f", bay {settings.bay_file} ({bay.model_dump_json(exclude_none=True)})" if bay else "")
     )
     if not keyed and not _loopback(args.host):
         print(
@@ -187,13 +208,14 @@ def run(args: argparse.Namespace) -> int:
             f"can use the service (set {API_KEY_ENV})",
             file=sys.stderr,
         )
-    if args.connect_port is not None and not _loopback(args.connect_host):
+    if settings.connect_port is not None and not _loopback(settings.connect_host):
         print(
-            f"golfflight serve: warning: GSPro Open Connect on {args.connect_host}: anyone who can reach port "
-            f"{args.connect_port} can send shots (the protocol has no key)",
+            f"golfflight serve: warning: GSPro Open Connect on {settings.connect_host}: anyone who can reach port "
+            f"{settings.connect_port} can send shots (the protocol has no key)",
             file=sys.stderr,
         )
     open_files_raised()
+    settings.hand_down()  # the factory in every worker process reads them
     with shared_across_workers(args.workers):  # GET /metrics sums every worker's counts
         uvicorn.run(
             "golfflight.service.app:create_app",

@@ -12,19 +12,10 @@ import json
 
 from golfflight.contract.refusals import body_detail
 from golfflight.service.api.request_body import read_body, replay
-
-API_KEY_ENV = "GOLFFLIGHT_API_KEY"
-"""Environment variable holding the API key; when set (non-empty) every route but /healthz requires it."""
-
-CORS_ORIGINS_ENV = "GOLFFLIGHT_CORS_ORIGINS"
-"""Environment variable with the comma-separated origins allowed to call the service from a browser (CORS)."""
+from golfflight.service.settings import ALLOWED_HOSTS_ENV, API_KEY_ENV
 
 MAX_BODY_BYTES = 8 * 1024 * 1024
 """Largest request body accepted (a full 10,000-shot batch with every option is about 4.5 MB)."""
-
-ALLOWED_HOSTS_ENV = "GOLFFLIGHT_ALLOWED_HOSTS"
-"""Environment variable with the comma-separated host names, beyond LOOPBACK_HOSTS and the listening address, that
-the service answers to without an API key (e.g. the bay PC's name on the venue's network)."""
 
 LOOPBACK_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
 """Host names always answered: the machine itself."""

@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import asyncio
 import logging
-import os
 import socket
 import time
 from collections import deque
@@ -53,8 +52,6 @@ from golfflight.service.open_connect.framing import ObjectFramer, Refused
 from golfflight.service.open_connect.limits import ConnectorLimits, TokenBucket
 from golfflight.service.open_connect.replies import Answer, Replied, encoded, player_information, reply_to
 
-CONNECT_HOST_ENV = "GOLFFLIGHT_CONNECT_HOST"
-CONNECT_PORT_ENV = "GOLFFLIGHT_CONNECT_PORT"
 PAUSE_S = 2.0
 """Silence after which a half-received object counts as paused (`ObjectFramer.stall`): a connector writes a message
 in one go, so its pieces arrive within milliseconds. Nothing is refused at the pause: what comes next is either the
@@ -108,14 +105,6 @@ class ConnectAddress:
 
     port: int
     host: str = "127.0.0.1"
-
-    @classmethod
-    def from_env(cls) -> ConnectAddress | None:
-        """The address `golfflight serve --connect-port` passes its workers, or None when TCP is off."""
-        port = os.environ.get(CONNECT_PORT_ENV)
-        if not port:
-            return None
-        return cls(int(port), os.environ.get(CONNECT_HOST_ENV) or cls.host)
 
 
 class OpenConnectServer:

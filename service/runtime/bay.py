@@ -29,9 +29,6 @@ from golfflight.errors import InputError
 from golfflight.shots.files import write_text_atomic
 from pydantic import ValidationError
 
-BAY_FILE_ENV = "GOLFFLIGHT_BAY_FILE"
-"""Where `golfflight serve --bay FILE` tells its worker processes the bay file is."""
-
 log = logging.getLogger(__name__)
 
 WATCH_S = 0.25

@@ -1,0 +1,92 @@
+"""The service's one settings object: read once from the GOLFFLIGHT_* variables (or whole, as `serve` hands it to its
+workers), flags over the environment, a bad value refused naming its variable or flag, and no other module of the
+service reading the environment for a setting."""
+
+from __future__ import annotations
+
+import argparse
+import ast
+from pathlib import Path
+
+import pytest
+from golfflight.commands.serve import register, served_settings
+from golfflight.errors import InputError
+from golfflight.flight.bundle_location import CHECKOUT_MODEL, MODEL_ENV
+from golfflight.service.settings import HANDED_DOWN_ENV, ServiceSettings
+
+from tests.test_imports import ROOT
+
+ENVIRONMENT = {
+    "GOLFFLIGHT_API_KEY": "secret",
+    "GOLFFLIGHT_CORS_ORIGINS": "https://sim.example, https://bay.example,",
+    "GOLFFLIGHT_ALLOWED_HOSTS": "bay-pc.local",
+    "GOLFFLIGHT_BAY_FILE": "/srv/bay.json",
+    "GOLFFLIGHT_CONNECT_PORT": "921",
+    "GOLFFLIGHT_CONNECT_HOST": "0.0.0.0",
+}
+
+
+def test_each_variable_gives_its_setting():
+    settings = ServiceSettings.from_env(ENVIRONMENT)
+    assert settings == ServiceSettings(api_key="secret", cors_origins=("https://sim.example", "https://bay.example"),
+                                       allowed_hosts=("bay-pc.local",), bay_file=Path("/srv/bay.json"),
+                                       connect_port=921, connect_host="0.0.0.0")
+    assert "secret" not in repr(settings)
+
+
+def test_unset_or_empty_variables_leave_the_defaults():
+    assert ServiceSettings.from_env({}) == ServiceSettings.from_env({name: "" for name in ENVIRONMENT})
+    assert ServiceSettings.from_env({}) == ServiceSettings()
+    assert ServiceSettings().connect_port is None and ServiceSettings().connect_host == "127.0.0.1"
+
+
+@pytest.mark.parametrize("port", ["0", "70000", "nine"])
+def test_a_bad_value_is_refused_naming_its_variable(port):
+    with pytest.raises(InputError, match=rf"^\$GOLFFLIGHT_CONNECT_PORT: .*, got '{port}'$"):
+        ServiceSettings.from_env({"GOLFFLIGHT_CONNECT_PORT": port})
+
+
+def test_handed_down_settings_are_read_back_whole(monkeypatch):
+    settings = ServiceSettings(api_key="k", cors_origins=("https://a.example",), connect_port=9210, model=Path("/m"))
+    monkeypatch.delenv(HANDED_DOWN_ENV, raising=False)
+    settings.hand_down()
+    assert ServiceSettings.from_env() == settings
+    assert ServiceSettings.from_env({HANDED_DOWN_ENV: settings.model_dump_json(), "GOLFFLIGHT_API_KEY": "x"}) == settings
+
+
+def _serve_args(*flags: str) -> argparse.Namespace:
+    parser = argparse.ArgumentParser()
+    register(parser.add_subparsers())
+    return parser.parse_args(["serve", *flags])
+
+
+def test_serve_puts_its_flags_over_the_environment(monkeypatch, tmp_path):
+    monkeypatch.delenv(MODEL_ENV, raising=False)
+    monkeypatch.chdir(tmp_path)
+    environment = ServiceSettings.from_env(ENVIRONMENT)
+    settings = served_settings(_serve_args("--cors-origin", "https://c.example", "--bay", "bay.json",
+                                           "--connect-port", "9921"), environment)
+    assert settings.cors_origins == ("https://c.example",) and settings.connect_port == 9921
+    assert settings.bay_file == tmp_path / "bay.json" and settings.model == CHECKOUT_MODEL.resolve()
+    assert (settings.api_key, settings.allowed_hosts, settings.connect_host) == ("secret", ("bay-pc.local",), "0.0.0.0")
+    assert served_settings(_serve_args(), environment).bay_file == Path("/srv/bay.json")
+
+
+def test_serve_refuses_a_bad_flag_naming_it():
+    with pytest.raises(InputError, match="^--connect-port: .*65535, got 70000$"):
+        served_settings(_serve_args("--connect-port", "70000"), ServiceSettings())
+
+
+def _reads_the_environment(path: Path) -> bool:
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Attribute) and node.attr in ("environ", "getenv") and getattr(node.value, "id", "") == "os":
+            return True
+    return False
+
+
+def test_no_other_module_of_the_service_reads_the_environment():
+    readers = {str(path.relative_to(ROOT)) for path in sorted((ROOT / "service").rglob("*.py"))
+               if _reads_the_environment(path)}
+    # metrics: Prometheus's own $PROMETHEUS_MULTIPROC_DIR, which prometheus_client reads in every worker itself
+    assert readers == {"service/settings.py", "service/runtime/metrics.py"}
+    assert not _reads_the_environment(ROOT / "golfflight" / "commands" / "serve.py")
