@@ -133,7 +133,7 @@ def serve(port: int, loop: str, http: str) -> None:
     _wrap(flying, "result_of", "result")
     _wrap(pydantic.BaseModel, "model_dump_json", "serialise")
     _wrap(starlette.responses.Response, "__init__", "serialise")
-    _wrap(bay_runtime.BayRuntime, "record_simulation", "record")
+    _wrap(bay_runtime.BayRuntime, "_record_simulation", "record")
 
     inner = create_app()
 

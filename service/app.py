@@ -41,9 +41,9 @@ def create_app(settings: ServiceSettings | None = None) -> FastAPI:
         tcp = OpenConnectServer(lambda message: runtime.fly_gspro(message, "open-connect")) if connect else None
         if tcp:  # taken before the model loads: a port that cannot be had stops the startup at once
             await tcp.start(connect, listening=False)
-            runtime.bay.on_player_change(lambda changed: _tell(tcp, changed))
+            runtime.on_player_change(lambda changed: _tell(tcp, changed))
             runtime.add_reporter("open_connect", tcp.health)  # /healthz: connectors, refusals, evictions
-        watching = asyncio.create_task(runtime.bay.watch())  # an edit of the bay file, a club change in it above all
+        watching = asyncio.create_task(runtime.watch_bay())  # an edit of the bay file, a club change in it above all
         loading = asyncio.get_running_loop().run_in_executor(None, runtime.load)  # the event loop stays free
         try:
             # Loaded before either port accepts (uvicorn binds HTTP's once this startup returns): the first request

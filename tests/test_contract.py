@@ -209,7 +209,7 @@ def test_a_batch_process_that_dies_is_replaced(http):
 
 
 def test_a_shot_that_does_not_land_in_time_fails_alone(app, http):
-    engine = app.state.runtime.engine
+    engine = app.state.runtime._engine  # the served engine itself: its step limit lowered for this test
     saved = engine.flyer.max_steps
     engine.flyer.max_steps = 12  # 1.2 s: a putt-like shot lands, a 7-iron is still up
     try:

@@ -219,7 +219,7 @@ def test_shots_over_http_batch_and_tcp_reach_an_open_stream_in_milliseconds(serv
 
 def test_a_stalled_viewer_never_delays_a_shot(service, monkeypatch):
     http, _, app = service
-    feed = app.state.runtime.feed
+    feed = app.state.runtime._feed
     monkeypatch.setattr(viewer_routes, "events", partial(events, lifetime_s=120))  # stalled, not just slow to close
 
     def timed(shot: dict, n: int) -> list[float]:
@@ -260,12 +260,12 @@ def test_a_stalled_viewer_never_delays_a_shot(service, monkeypatch):
 def test_too_many_viewers_get_503_saying_so(service):
     http, _, app = service
     state = app.state.runtime
-    kept, state.feed = state.feed, ShotFeed(max_viewers=0)
+    kept, state._feed = state._feed, ShotFeed(max_viewers=0)
     try:
         answer = http.get("/v1/events", headers=KEYED)
     finally:
-        state.feed = kept
-    assert answer.status_code == 503 and "viewers are open already" in answer.json()["detail"]
+        state._feed = kept
+    assert answer.status_code == 503 and "viewers are open already: close one and try again" in answer.json()["detail"]
 
 
 @pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))

@@ -66,9 +66,9 @@ def test_only_the_bays_own_shots_reach_the_viewer_unless_a_request_asks(service,
         batch = {"shots": [DRIVER, {**DRIVER, "ball_speed_mph": 120.0}]}
         assert http.post("/v1/shots/batch?viewer=true", json=batch, headers=KEYED).status_code == 200
         assert [next_event(lines).source, next_event(lines).source] == ["batch", "batch"]
-    kept = [entry.source for entry in app.state.runtime.feed.subscribe().pending]
-    for viewer in app.state.runtime.feed.viewers:
-        app.state.runtime.feed.unsubscribe(viewer)
+    kept = [entry.source for entry in app.state.runtime._feed.subscribe().pending]
+    for viewer in app.state.runtime._feed.viewers:
+        app.state.runtime._feed.unsubscribe(viewer)
     assert "batch" in kept and kept.count("http") <= 2  # earlier tests' tagged shots at most; none untagged
 
 

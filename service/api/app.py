@@ -1,6 +1,6 @@
 """The HTTP adapter of the bay runtime: `http_app` assembles FastAPI's "bigger applications" layout, the routers of
 `service.api.routes` over the plain functions of the shot contract (`contract`) and the runtime (`service.runtime`,
-on `app.state.runtime`, reached through `service.api.dependencies`).
+on `app.state.runtime`, reached through `service.runtime.runtime_of`).
 
 Single shots simulate inline in `async def` routes. Batches fly in the runtime's child process at a lower CPU
 priority, so a fitting studio's thousands of shots neither hold the GIL nor take a core from a simulator bay's single
@@ -79,7 +79,6 @@ def http_app(
     routes = [route for router in routers for route in router.routes] + [
         r for r in app.routes if isinstance(r, (Route, Mount))
     ]
-    app.add_middleware(
-        RequestMetrics, metrics=runtime.metrics, routes=routes, rolling=runtime.requests, timed_routes=SIMULATION_PATHS
-    )
+    counters, rolling = runtime.request_sinks()
+    app.add_middleware(RequestMetrics, metrics=counters, routes=routes, rolling=rolling, timed_routes=SIMULATION_PATHS)
     return app

@@ -2,6 +2,6 @@
 the shot feed, below its adapters (HTTP `service.api`, GSPro Open Connect `service.open_connect`, the viewer
 `service.viewer`), none of which imports another."""
 
-from golfflight.service.runtime.runtime import BayRuntime, Flown, NotReady
+from golfflight.service.runtime.runtime import BayRuntime, Flown, NotReady, runtime_of
 
-__all__ = ["BayRuntime", "Flown", "NotReady"]
+__all__ = ["BayRuntime", "Flown", "NotReady", "runtime_of"]

@@ -11,26 +11,31 @@ path drawn ends where the numbers say.
 from __future__ import annotations
 
 import gc
-import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Literal
 
-from golfflight.contract.bay import CONDITION_FIELDS, PUTTER, in_bay
-from golfflight.contract.flying import flown_shot
+from golfflight.contract.bay import CONDITION_FIELDS, PUTTER, BayConditions, Player, in_bay
+from golfflight.contract.flying import flown_shot, fly_shot
 from golfflight.contract.gspro import GSProMessage, GSProReply, failed_reply, shot_reply, shot_request
 from golfflight.contract.requests import BatchRequest, ShotRequest
 from golfflight.contract.results import ShotResult
+from golfflight.contract.session import SessionList, SessionSummary
 from golfflight.errors import GolfflightError, ServiceError
 from golfflight.flight.engine import FlightEngine, ShotFlight
 from golfflight.service.runtime.batch_process import BatchProcess
 from golfflight.service.runtime.bay import Bay
-from golfflight.service.runtime.feed import Entry, ShotFeed, Source
+from golfflight.service.runtime.feed import Entry, ShotFeed, Source, Viewer
 from golfflight.service.runtime.latency import Rolling
 from golfflight.service.runtime.metrics import ServiceMetrics
+from golfflight.service.runtime.sessions import Session
+from golfflight.weights_schema.model_card import ModelCard
 
 from golfflight import __version__
+
+PROBE_SHOT = ShotRequest(ball_speed_mps=55.0, launch_angle_deg=16.0, spin_rpm=7100.0)
+"""The shot /v1/latency times on demand: a tour-average 7-iron in standard air."""
 
 PLAYER_SOURCES = frozenset({"http", "gspro-http", "open-connect"})
 """Shots hit in this bay, tagged with the bay's player (batches are a studio's files, not the player's swings)."""
@@ -40,6 +45,13 @@ GSPRO_SOURCES = frozenset({"gspro-http", "open-connect"})
 
 class NotReady(ServiceError):
     """A simulation was asked for before the model was loaded (HTTP: 503; Open Connect: Code 503)."""
+
+
+def runtime_of(request) -> BayRuntime:
+    """The bay runtime an app was assembled with (`app.state.runtime`, set by `service.app`): how every adapter's
+    route reaches it, a plain attribute read (a FastAPI dependency would cost a dependency graph solved per request,
+    about a tenth of a single shot's time over HTTP)."""
+    return request.app.state.runtime
 
 
 @dataclass(frozen=True)
@@ -55,61 +67,59 @@ class Flown:
 
 class BayRuntime:
     """The engine once loaded (or why it failed), the batch process, the rolling latency figures, the Prometheus
-    metrics, the shots the screens show and the bay's conditions."""
+    metrics, the shots the screens show and the bay's conditions. A facade: its adapters and the assembly call its
+    public methods and touch nothing else (`tests/test_runtime_facade.py`)."""
 
     def __init__(self, bundle_dir: Path, bay: Bay | None = None):
-        self.bundle_dir = bundle_dir
-        self.bay = bay or Bay()
-        self.engine: FlightEngine | None = None
-        self.error: str | None = None
-        self.simulation = Rolling()
-        self.requests = Rolling()
-        self.loaded = threading.Event()
-        self.batches = BatchProcess(bundle_dir)
-        self.feed = ShotFeed()
-        self.metrics = ServiceMetrics(self.model_labels)
-        self._simulation_seconds = {kind: self.metrics.simulation_seconds.labels(kind) for kind in ("shot", "batch")}
-        self._reporters: dict[str, Callable[[], dict]] = {"batch_process": self.batches.health}
+        self._bundle_dir = bundle_dir
+        self._bay = bay or Bay()
+        self._engine: FlightEngine | None = None
+        self._error: str | None = None
+        self._simulation = Rolling()
+        self._requests = Rolling()
+        self._batches = BatchProcess(bundle_dir)
+        self._feed = ShotFeed()
+        self._metrics = ServiceMetrics(self._model_labels)
+        self._simulation_seconds = {kind: self._metrics.simulation_seconds.labels(kind) for kind in ("shot", "batch")}
+        self._reporters: dict[str, Callable[[], dict]] = {"batch_process": self._batches.health}
 
-    def model_labels(self) -> dict[str, str] | None:
+    def _model_labels(self) -> dict[str, str] | None:
         """The loaded model's variant and ONNX SHA-256 and the package version (/metrics' info labels)."""
-        if self.engine is None:
+        if self._engine is None:
             return None
-        return {"variant": self.engine.variant, "sha256": self.engine.sha256, "version": __version__}
+        return {"variant": self._engine.variant, "sha256": self._engine.sha256, "version": __version__}
 
-    def record_simulation(self, kind: Literal["shot", "batch"], seconds: float) -> None:
+    def _record_simulation(self, kind: Literal["shot", "batch"], seconds: float) -> None:
         """One simulation's engine time, into /v1/latency's window and /metrics' histogram (its two label sets
         bound once, at start-up, not looked up per shot)."""
-        self.simulation.add(seconds)
+        self._simulation.add(seconds)
         self._simulation_seconds[kind].observe(seconds)
 
-    def ready_engine(self) -> FlightEngine:
+    def _ready_engine(self) -> FlightEngine:
         """The loaded engine; NotReady while the model loads or after it failed to."""
-        if self.engine is None:
-            raise NotReady(self.error or "the model is still loading")
-        return self.engine
+        if self._engine is None:
+            raise NotReady(self._error or "the model is still loading")
+        return self._engine
 
     def load(self) -> None:
         """Load the model here and in the batch process; either failing leaves the service up to say why."""
         try:
-            engine = FlightEngine(self.bundle_dir)
-            if self.batches.start() != engine.sha256:
+            engine = FlightEngine(self._bundle_dir)
+            if self._batches.start() != engine.sha256:
                 raise RuntimeError("the batch process loaded a different model (the bundle changed during startup)")
-            self.engine = engine
+            self._engine = engine
             gc.freeze()  # the app and the model are here for good: keep them out of every later collection's scan
         except Exception as error:  # noqa: BLE001 - reported by /healthz, the service stays up to say so
-            self.error = f"{type(error).__name__}: {error}"
-        finally:
-            self.loaded.set()
+            self._error = f"{type(error).__name__}: {error}"
 
     def stop(self) -> None:
         """Let the batch in flight finish, then end the batch process."""
-        self.batches.stop()
+        self._batches.stop()
 
-    def problems(self) -> dict[str, str]:
+    def _problems(self) -> dict[str, str]:
         """What is degraded while shots still fly (GET /healthz): the bay file's problem, the batch process's (dead
         and restarting), if any."""
-        problems = {"bay": self.bay.problem, "batch": self.batches.problem}
+        problems = {"bay": self._bay.problem, "batch": self._batches.problem}
         return {name: problem for name, problem in problems.items() if problem}
 
     def add_reporter(self, name: str, report: Callable[[], dict]) -> None:
@@ -117,7 +127,7 @@ class BayRuntime:
         and refusals), without the runtime importing the adapter."""
         self._reporters[name] = report
 
-    def reports(self) -> dict[str, dict]:
+    def _reports(self) -> dict[str, dict]:
         """Each reporter's figures now, by name."""
         return {name: report() for name, report in self._reporters.items()}
 
@@ -126,8 +136,8 @@ class BayRuntime:
         """Fly `request` in the bay's conditions where it gives none of its own; with `show`, publish it to the
         screens with the states it was read from. A connector's shot with the putter selected is a putt. NotReady
         before the model is loaded; FlightError when it cannot land."""
-        engine = self.ready_engine()
-        bay = self.bay.conditions
+        engine = self._ready_engine()
+        bay = self._bay.conditions
         request = in_bay(request, bay)
         player = bay.player if source in PLAYER_SOURCES else None
         putt = source in GSPRO_SOURCES and bay.player.club == PUTTER
@@ -135,10 +145,10 @@ class BayRuntime:
         try:
             result, flight = flown_shot(engine, request, keep_states=show, putt=putt, flat=flat)
         finally:
-            self.record_simulation("shot", time.perf_counter() - started)
+            self._record_simulation("shot", time.perf_counter() - started)
         entry = None
         if show:
-            entry = self.feed.publish(source, request, result, flight.states, flight.flight_time_s,
+            entry = self._feed.publish(source, request, result, flight.states, flight.flight_time_s,
                                       shot_number=shot_number, player=player, putt=putt,
                                       club_data=club_data)
         return Flown(request, result, flight, entry)
@@ -158,16 +168,102 @@ class BayRuntime:
         """A validated batch's encoded BatchResult, flown in the batch process (the bay's conditions filled in
         where a shot gives none); with `show`, its last shots go to the screens with the states they came from.
         BatchProcessDied when the batch process died under it."""
-        self.ready_engine()
-        bay = self.bay.conditions
+        self._ready_engine()
+        bay = self._bay.conditions
         if any(getattr(bay, name) is not None for name in CONDITION_FIELDS):
             request = BatchRequest.model_construct(shots=[in_bay(shot, bay) for shot in request.shots])
             body = request.model_dump_json(exclude_none=True).encode()
-        shown = self.feed.history if show else 0
-        encoded, seconds, kept = await self.batches.submit(body, shown)
-        self.record_simulation("batch", seconds)
-        self.metrics.batch_shots.observe(len(request.shots))
+        shown = self._feed.history if show else 0
+        encoded, seconds, kept = await self._batches.submit(body, shown)
+        self._record_simulation("batch", seconds)
+        self._metrics.batch_shots.observe(len(request.shots))
         for index, (result, states, flight_time_s) in sorted(kept.items()):
-            self.feed.publish("batch", request.shots[index], result, states, flight_time_s)
+            self._feed.publish("batch", request.shots[index], result, states, flight_time_s)
         return encoded
 
+
+    def latency(self) -> dict:
+        """GET /v1/latency: the rolling p50/p95/p99 of simulation time and of whole requests, and PROBE_SHOT flown
+        now on the served single-shot path (in standard air, shown nowhere, left out of the windows)."""
+        engine = self._ready_engine()
+        started = time.perf_counter()
+        fly_shot(engine, PROBE_SHOT)
+        probe_ms = (time.perf_counter() - started) * 1e3
+        return {
+            "simulation": self._simulation.summary(),
+            "request": self._requests.summary(),
+            "probe": {"shot": PROBE_SHOT.model_dump(exclude_none=True), "simulation_ms": probe_ms},
+        }
+
+    def health(self) -> dict:
+        """GET /healthz: "loading" or "failed" (with the error) until the model is loaded; then "ready", or
+        "degraded" with `problems` saying what to repair while every shot still flies (a bay file broken while
+        serving, a batch process restarting); the model's variant and hash and each reporter's figures."""
+        if self._engine is None:
+            return {"status": "failed" if self._error else "loading", "error": self._error}
+        engine = self._engine
+        model = {"variant": engine.variant, "sha256": engine.sha256, "load_seconds": engine.load_seconds}
+        problems = self._problems()
+        answer = {"status": "degraded" if problems else "ready", "model": model, "version": __version__,
+                  **self._reports()}
+        return {**answer, "problems": problems} if problems else answer
+
+    def model(self) -> ModelCard:
+        """The loaded bundle's model card; NotReady before it is loaded."""
+        return self._ready_engine().card
+
+    def metrics(self) -> bytes:
+        """GET /metrics: every metric in Prometheus's text format (every worker's, several workers sharing)."""
+        return self._metrics.exposition()
+
+    def request_sinks(self) -> tuple[ServiceMetrics, Rolling]:
+        """Where the HTTP adapter counts and times each request: the Prometheus metrics and /v1/latency's request
+        window (`service.api.request_metrics`)."""
+        return self._metrics, self._requests
+
+    def bay(self) -> BayConditions:
+        """The bay's conditions and player now."""
+        return self._bay.conditions
+
+    def set_bay(self, conditions: BayConditions) -> BayConditions:
+        """Replace the bay's conditions (kept in its file, if it has one); BayFileError when the file cannot be
+        written."""
+        return self._bay.set(conditions)
+
+    def update_bay(self, change: Callable[[BayConditions], BayConditions]) -> BayConditions:
+        """Change the bay's conditions by `change` (a PATCH), as one step against concurrent changes."""
+        return self._bay.update(change)
+
+    def on_player_change(self, listener: Callable[[Player], None]) -> None:
+        """Call `listener` with the bay's player whenever it changes (Open Connect's Code 201)."""
+        self._bay.on_player_change(listener)
+
+    async def watch_bay(self) -> None:
+        """Follow the bay file's edits until cancelled."""
+        await self._bay.watch()
+
+    def subscribe(self, after_id: int | None = None) -> Viewer:
+        """A screen's queue of the bay's shots (`ShotFeed.subscribe`); NotReady before the model is loaded,
+        TooManyViewers when every place is taken."""
+        self._ready_engine()
+        return self._feed.subscribe(after_id)
+
+    def unsubscribe(self, viewer: Viewer) -> None:
+        """A screen has gone."""
+        self._feed.unsubscribe(viewer)
+
+    def start_session(self, player: str | None = None) -> Session:
+        """Start a new session (its player's name optional): the bay's screens empty, earlier sessions stay."""
+        return self._feed.start_session(player)
+
+    def session(self, session_id: int | None = None) -> Session | None:
+        """A kept session (the current one without an id), or None."""
+        return self._feed.sessions.get(session_id)
+
+    def sessions(self) -> SessionList:
+        """The sessions kept, oldest first, and the caps."""
+        return self._feed.sessions.listing()
+
+    def session_summary(self, session: Session) -> SessionSummary:
+        """A session's clubs: mean and spread of carry, total, apex and lateral, gaps, 95 % ellipses."""
+        return self._feed.sessions.summary(session)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Header, Request
 from fastapi.responses import JSONResponse, Response, StreamingResponse
-from golfflight.service.runtime import BayRuntime
+from golfflight.service.runtime import runtime_of
 from golfflight.service.viewer import sessions
 from golfflight.service.viewer.page import ASSETS, PAGE_PATH, SECURITY_HEADERS
 from golfflight.service.viewer.stream import events, last_event_id
@@ -22,10 +22,6 @@ router = APIRouter()
 
 ROUTERS = (router, sessions.router)
 """The viewer's routers, for the service's assembly to mount."""
-
-
-def _runtime(request: Request) -> BayRuntime:
-    return request.app.state.runtime
 
 
 def _asset(name: str) -> Response:
@@ -51,8 +47,7 @@ async def asset(name: str) -> Response:
 async def shot_events(request: Request, last_event: str | None = Header(None, alias="last-event-id")) -> Response:
     """The current session, then every shot flown from now on (and its kept ones, or those after Last-Event-ID) as
     server-sent events; a new session is announced as it starts."""
-    runtime = _runtime(request)
-    runtime.ready_engine()
-    viewer = runtime.feed.subscribe(last_event_id(last_event))  # TooManyViewers: 503 (contract.refusals.FAILURES)
+    runtime = runtime_of(request)
+    viewer = runtime.subscribe(last_event_id(last_event))  # NotReady, TooManyViewers: 503 (contract.refusals)
     headers = {"cache-control": "no-store", "x-accel-buffering": "no"}
-    return StreamingResponse(events(runtime.feed, viewer), media_type="text/event-stream", headers=headers)
+    return StreamingResponse(events(runtime, viewer), media_type="text/event-stream", headers=headers)

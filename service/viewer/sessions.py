@@ -9,7 +9,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Query, Request
 from fastapi.responses import JSONResponse, Response, StreamingResponse
 from golfflight.contract.session import NewSession, SessionInfo, SessionList, SessionSummary
-from golfflight.service.runtime import BayRuntime
+from golfflight.service.runtime import runtime_of
 from golfflight.service.runtime.sessions import Session
 from golfflight.service.viewer.session_csv import session_csv_slices
 
@@ -25,17 +25,13 @@ _ERRORS = {401: {"description": "the API key is required and was missing or wron
 SessionId = Query(None, ge=1, description="a session's id (GET /v1/sessions); the current session without one")
 
 
-def _runtime(request: Request) -> BayRuntime:
-    return request.app.state.runtime
-
-
 def _json(model, status_code: int = 200) -> Response:
     return Response(model.model_dump_json(exclude_none=True), status_code, media_type="application/json")
 
 
 def _session(request: Request, session_id: int | None) -> Session | JSONResponse:
     """The session asked for (the current one without an id), or the 404 that says it is not kept."""
-    found = _runtime(request).feed.sessions.get(session_id)
+    found = runtime_of(request).session(session_id)
     if found is None:
         return JSONResponse({"detail": f"session {session_id} is not kept: GET {SESSIONS_PATH} lists those that are"},
                             404)
@@ -47,14 +43,14 @@ def _session(request: Request, session_id: int | None) -> Session | JSONResponse
 async def new_session(request: Request, new: NewSession | None = None) -> Response:
     """Start a new session, the player's name optional: the bay's shots go to it from now on, and every screen of
     the bay empties (its shot list, paths, dispersion and summary); the sessions before it stay listed."""
-    session = _runtime(request).feed.start_session(None if new is None else new.player)
+    session = runtime_of(request).start_session(None if new is None else new.player)
     return _json(session.info(current=True), 201)
 
 
 @router.get(SESSIONS_PATH, response_model=SessionList, response_model_exclude_none=True, responses=_ERRORS)
 async def sessions(request: Request) -> Response:
     """The sessions kept, oldest first, each with its shots kept, and the caps."""
-    return _json(_runtime(request).feed.sessions.listing())
+    return _json(runtime_of(request).sessions())
 
 
 @router.get(SUMMARY_PATH, response_model=SessionSummary, response_model_exclude_none=True,
@@ -65,7 +61,7 @@ async def summary(request: Request, session: int | None = SessionId) -> Response
     found = _session(request, session)
     if isinstance(found, Response):
         return found
-    return _json(_runtime(request).feed.sessions.summary(found))
+    return _json(runtime_of(request).session_summary(found))
 
 
 @router.get(SESSION_PATH, response_class=Response,

@@ -19,8 +19,9 @@ import re
 import signal
 import time
 from collections.abc import AsyncIterator, Callable
+from typing import Protocol
 
-from golfflight.service.runtime.feed import ShotFeed, Viewer
+from golfflight.service.runtime.feed import Viewer
 from golfflight.service.viewer.frames import frame
 
 KEEPALIVE_S = 15.0
@@ -33,6 +34,12 @@ RETRY_MS = 500
 """The reconnection delay the stream asks for (EventSource's `retry:` field, also read by our page)."""
 
 KEEPALIVE_FRAME = ": keep-alive\n\n"
+
+
+class Subscriptions(Protocol):
+    """What hands out viewers and takes them back: the bay runtime (or, in tests, its shot feed)."""
+
+    def unsubscribe(self, viewer: Viewer) -> None: ...
 
 
 SHOT_ID = re.compile(r"[0-9]{1,18}")
@@ -60,7 +67,7 @@ def serving_server() -> Callable[[], bool]:
 
 
 async def events(
-    feed: ShotFeed,
+    feed: Subscriptions,
     viewer: Viewer,
     lifetime_s: float | None = None,
     keepalive_s: float = KEEPALIVE_S,

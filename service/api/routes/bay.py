@@ -5,13 +5,12 @@ when one is set, validated by the same limits as a shot's conditions."""
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Depends
+from fastapi import APIRouter, Request
 from fastapi.responses import JSONResponse, Response
 from golfflight.contract.bay import BayConditions, BayUpdate
 from golfflight.contract.refusals import body_detail
-from golfflight.service.api.dependencies import bay_runtime
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
-from golfflight.service.runtime import BayRuntime
+from golfflight.service.runtime import runtime_of
 
 BAY_PATH = "/v1/bay"
 
@@ -25,29 +24,29 @@ def _not_written(error: OSError) -> JSONResponse:
 
 
 @router.get(BAY_PATH, response_model=BayConditions, response_model_exclude_none=True, responses=_responses)
-async def get_bay(runtime: BayRuntime = Depends(bay_runtime)) -> Response:
+async def get_bay(http: Request) -> Response:
     """The bay's air, wind, ground, player and display units."""
-    return json_response(runtime.bay.conditions)
+    return json_response(runtime_of(http).bay())
 
 
 @router.put(BAY_PATH, response_model=BayConditions, response_model_exclude_none=True,
             responses={**_write_failed, **_responses})
-async def put_bay(conditions: BayConditions, runtime: BayRuntime = Depends(bay_runtime)) -> Response:
+async def put_bay(conditions: BayConditions, http: Request) -> Response:
     """Replace the bay's conditions (the whole object: an omitted field goes back to its default); written to the
     bay file first, so a failed write changes nothing. Repairs a bay file broken or removed while serving."""
     try:
-        return json_response(runtime.bay.set(conditions))
+        return json_response(runtime_of(http).set_bay(conditions))
     except OSError as error:
         return _not_written(error)
 
 
 @router.patch(BAY_PATH, response_model=BayConditions, response_model_exclude_none=True,
               responses={**_write_failed, **_responses})
-async def patch_bay(update: BayUpdate, runtime: BayRuntime = Depends(bay_runtime)) -> Response:
+async def patch_bay(update: BayUpdate, http: Request) -> Response:
     """Change the parts named and leave the rest: `{"units": "metric"}`, `{"player": {"club": "PT"}}`,
     `{"wind": null}` (calm); a part given replaces that part whole (air, wind, ground), the player's fields merge.
     Written to the bay file first, as PUT."""
     try:
-        return json_response(runtime.bay.update(update.applied_to))
+        return json_response(runtime_of(http).update_bay(update.applied_to))
     except OSError as error:
         return _not_written(error)

@@ -5,10 +5,10 @@ from __future__ import annotations
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 from golfflight.contract.gspro import GSProMessage, GSProReply
-from golfflight.service.api.dependencies import runtime_of
 from golfflight.service.api.direct import DirectRoute
 from golfflight.service.api.paths import GSPRO_PATH
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
+from golfflight.service.runtime import runtime_of
 
 GSPRO_STATUS = {200: 200, 500: 422, 503: 503}
 """HTTP status of each Open Connect reply code on POST /v1/gspro."""

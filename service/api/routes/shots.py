@@ -8,9 +8,9 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import Response
 from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, BatchRequest, ShotRequest
 from golfflight.contract.results import BatchResult, ShotResult
-from golfflight.service.api.dependencies import runtime_of
 from golfflight.service.api.direct import DirectRoute
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
+from golfflight.service.runtime import runtime_of
 
 router = APIRouter(prefix="/v1/shots", route_class=DirectRoute)
 
@@ -30,7 +30,7 @@ ShowOnViewer = Query(
 async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer) -> Response:
     """Fly one shot: launch in SI or launch-monitor units, optional wind, air, ground, normalized and trajectory;
     the bay's conditions (GET /v1/bay) where the shot gives none."""
-    # `request` was validated once (`service.api.direct`); the runtime comes from the app, not dependencies
+    # `request` was validated once (`service.api.direct`); the runtime comes from the app (`runtime_of`)
     return json_response(runtime_of(http).fly(request, "http", show=viewer).result)
 
 
