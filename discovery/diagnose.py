@@ -58,7 +58,7 @@ from golfflight.discovery.noise import (
 from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from golfflight.discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
 from golfflight.discovery.schema import AirRival, Candidate, Heldout, Located, ModelInfo, Report, ScatterStat, Unlisted
-from golfflight.discovery.simulator import Flown, Setup
+from golfflight.discovery.simulator import Outcomes, Setup
 from golfflight.discovery.physical import blocks, restatements
 from golfflight.discovery.venue_air import air_explanations, air_rival, air_sentence, with_air
 from golfflight.flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
@@ -113,7 +113,7 @@ class Baseline:
     wild readings left out of the fits, the error each shot is expected to miss by and the recordings' own scatter."""
 
     base: Setup
-    flown: Flown
+    flown: Outcomes
     predicted: np.ndarray
     offset: np.ndarray
     residual: np.ndarray

@@ -15,7 +15,7 @@ import numpy as np
 from golfflight.discovery.effects import Effect, apply_all
 from golfflight.discovery.model import FlightModel
 from golfflight.discovery.recordings import OBSERVABLES, Recordings
-from golfflight.discovery.simulator import Flown, Setup
+from golfflight.discovery.simulator import Outcomes, Setup
 from scipy.optimize import least_squares
 
 MISSED_LANDING_Z = 10.0
@@ -57,9 +57,9 @@ class Problem:
         rows: np.ndarray,
         keep_positions: bool = False,
         model: FlightModel | None = None,
-    ) -> Flown:
+    ) -> Outcomes:
         """Fly shots `rows` (may repeat) with per-row parameters theta_rows [M, k] through the diagnosed model (or
-        `model`, e.g. its control); returns the Flown batch."""
+        `model`, e.g. its control); returns the Outcomes batch."""
         conditions = apply_all(effects, theta_rows, self.base.take(rows))
         correction = next((e.correction for e in effects if e.correction is not None), None)
         return (model or self.model).simulate(conditions, correction, keep_positions)

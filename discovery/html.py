@@ -162,9 +162,9 @@ def _further(report: Report) -> list[str]:
                 else [[key.replace("_", " "), tables.flat_text(item), ""]]
             )
     columns = [
-        tables.Column("finding", "", False),
-        tables.Column("value", "in the unit beside it"),
-        tables.Column("unit", "", False),
+        tables.TableColumn("finding", "", False),
+        tables.TableColumn("value", "in the unit beside it"),
+        tables.TableColumn("unit", "", False),
     ]
     return ["<h2>Further findings</h2>" + tables.table(columns, rows)]
 

@@ -17,7 +17,7 @@ from typing import Literal
 
 import numpy as np
 from golfflight.discovery.recordings import OBSERVABLES
-from golfflight.discovery.simulator import Correction, Flown, Setup, fly_setup, simulate_setup
+from golfflight.discovery.simulator import Correction, Outcomes, Setup, fly_setup, simulate_setup
 from golfflight.flight.air import Air
 from golfflight.flight.flyer import Flyer, load_flyer
 from golfflight.flight.integrator import RUNGE_KUTTA_4
@@ -72,7 +72,7 @@ class FlightModel:
         recorded or the model's air, times the effects' ratio: `Setup.viscosity`)."""
         return self.flyer.in_air(setup.viscosity(self.flyer.kinematic_viscosity_m2_s))
 
-    def simulate(self, setup: Setup, correction: Correction | None = None, keep_positions: bool = False) -> Flown:
+    def simulate(self, setup: Setup, correction: Correction | None = None, keep_positions: bool = False) -> Outcomes:
         """Fly a setup's shots through this model (`discovery.simulator.simulate_setup`)."""
         settings = (self.dt_s, self.t_max_s, self.method, correction, keep_positions)
         return simulate_setup(setup, self.coefficients_for, *settings)

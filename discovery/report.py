@@ -15,7 +15,7 @@ from golfflight.discovery.schema import (
     EffectResult,
     Heldout,
     Located,
-    ServiceSettings,
+    CorrectionSettings,
     Unlisted,
     WindSetting,
 )
@@ -51,11 +51,11 @@ def effect_results(result: Fit, context: Context) -> list[EffectResult]:
 
 def service_settings(
     effects: list[EffectResult], context: Context, wind_factor: float | None = None
-) -> ServiceSettings:
+) -> CorrectionSettings:
     """The correction as the service's request options (wind, air) plus launch and model corrections.
     `wind_factor` (the log profile's uniform-equivalent factor along the corrected flights) adds the fitted wind as
     a 10 m station reading with the log profile."""
-    settings = ServiceSettings()
+    settings = CorrectionSettings()
     for effect in effects:
         p = effect.parameters
         if effect.name == "wind":

@@ -13,11 +13,11 @@ SCHEMA_VERSION = "1.1"
 SCHEMA_PATH = Path(__file__).with_name("report.schema.json")
 
 
-class _Strict(BaseModel):
+class _ReportModel(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
 
-class ObservableStat(_Strict):
+class ObservableStat(_ReportModel):
     """Mismatch of one observable before any correction: residual = recorded - model."""
 
     name: str
@@ -33,7 +33,7 @@ class ObservableStat(_Strict):
     significant: bool = Field(description="bias or excess significant at the family-wise level (Holm)")
 
 
-class CovariateStat(_Strict):
+class CovariateStat(_ReportModel):
     """How an observable's residual changes with a launch value or the shot order."""
 
     observable: str
@@ -44,7 +44,7 @@ class CovariateStat(_Strict):
     significant: bool
 
 
-class GroupStat(_Strict):
+class GroupStat(_ReportModel):
     """Whether residuals differ between clubs or between sessions (one-way ANOVA on standardized residuals)."""
 
     observable: str
@@ -56,7 +56,7 @@ class GroupStat(_Strict):
     extremes: dict[str, float] = Field(description="mean residual of the groups furthest from the overall mean")
 
 
-class TrajectoryStat(_Strict):
+class TrajectoryStat(_ReportModel):
     """Mean position residual (recorded - model) of trajectory samples in one flight phase and height band."""
 
     phase: Literal["ascent", "descent"]
@@ -69,7 +69,7 @@ class TrajectoryStat(_Strict):
     rms_m: float
 
 
-class Located(_Strict):
+class Located(_ReportModel):
     """Where the mismatch is: per observable, against covariates, between groups, along the flight."""
 
     observables: list[ObservableStat]
@@ -81,7 +81,7 @@ class Located(_Strict):
     summary: list[str]
 
 
-class EffectResult(_Strict):
+class EffectResult(_ReportModel):
     """A named effect with its fitted parameters and their 1-sigma uncertainties."""
 
     name: str
@@ -94,7 +94,7 @@ class EffectResult(_Strict):
     uncertainty: dict[str, float]
 
 
-class Candidate(_Strict):
+class Candidate(_ReportModel):
     """One effect (or combination) fitted through the simulator and scored on held-out sessions."""
 
     name: str
@@ -105,7 +105,7 @@ class Candidate(_Strict):
     score: float = Field(description="heldout_error + penalty: lower is better")
 
 
-class Heldout(_Strict):
+class Heldout(_ReportModel):
     """Held-out error before (model as is) and after (with the chosen correction), folds grouped by session."""
 
     grouping: str
@@ -134,7 +134,7 @@ class Heldout(_Strict):
     )
 
 
-class Ambiguity(_Strict):
+class Ambiguity(_ReportModel):
     """Two explanations the data cannot tell apart, and what would."""
 
     effects: tuple[str, str]
@@ -144,7 +144,7 @@ class Ambiguity(_Strict):
     note: str
 
 
-class AirRival(_Strict):
+class AirRival(_ReportModel):
     """Air density set against the chosen explanation of recordings that carry no air (`discovery.venue_air`)."""
 
     explanation: str = Field(
@@ -169,7 +169,7 @@ class AirRival(_Strict):
     note: str
 
 
-class Unlisted(_Strict):
+class Unlisted(_ReportModel):
     """A learned extra acceleration, summarised as a readable expression, when no library effect explains enough."""
 
     expression: str
@@ -180,23 +180,23 @@ class Unlisted(_Strict):
     library_heldout_error: float = Field(description="held-out error of the best library explanation alone")
 
 
-class WindSetting(_Strict):
+class WindSetting(_ReportModel):
     speed_mps: float
     from_deg: float
     profile: Literal["uniform", "log"] = "uniform"
     reference_height_m: float | None = Field(default=None, description="height the speed is stated at (log profile)")
 
 
-class AirDensity(_Strict):
+class AirDensity(_ReportModel):
     density_kg_m3: float
 
 
-class AirAltitude(_Strict):
+class AirAltitude(_ReportModel):
     altitude_m: float
     temperature_c: float
 
 
-class ServiceSettings(_Strict):
+class CorrectionSettings(_ReportModel):
     """The correction in the service's request options where it has one; launch-monitor corrections otherwise."""
 
     wind: WindSetting | None = None
@@ -216,7 +216,7 @@ class ServiceSettings(_Strict):
     )
 
 
-class ScatterStat(_Strict):
+class ScatterStat(_ReportModel):
     """The recordings' own shot-to-shot scatter of one observable, in units of the expected error."""
 
     ratio: float = Field(
@@ -227,7 +227,7 @@ class ScatterStat(_Strict):
     applied: bool = Field(description="the expected error of this observable was scaled by `ratio`")
 
 
-class ModelInfo(_Strict):
+class ModelInfo(_ReportModel):
     name: str
     dt_s: float
     integrator: str
@@ -249,7 +249,7 @@ class ModelInfo(_Strict):
     )
 
 
-class Report(_Strict):
+class Report(_ReportModel):
     """report.json of `golfflight diagnose`."""
 
     schema_version: Literal["1.1"] = SCHEMA_VERSION
@@ -279,7 +279,7 @@ class Report(_Strict):
     )
     heldout: Heldout
     statement: str
-    service_settings: ServiceSettings
+    service_settings: CorrectionSettings
     seconds: float
 
 

@@ -94,7 +94,7 @@ def concatenate(parts: list[Setup]) -> Setup:
 
 
 @dataclass
-class Flown:
+class Outcomes:
     """Outcome of a batch: landing point (x, y), apex, flight time, landing angle; NaN where a ball did not land."""
 
     landing_xy: np.ndarray
@@ -114,7 +114,7 @@ class Flown:
 
 
 FLOWN_OUTCOMES = ("landing_xy", "apex_m", "flight_time_s", "landing_angle_deg")
-"""The per-shot fields of a `Flown` batch, in order."""
+"""The per-shot fields of an `Outcomes` batch, in order."""
 
 
 def fly_setup(
@@ -150,7 +150,7 @@ def simulate_setup(
     method: Method = "euler",
     correction: Correction | None = None,
     keep_positions: bool = False,
-) -> Flown:
+) -> Outcomes:
     """Fly every shot through the flight core until it comes down through its landing ground (or t_max).
 
     A parameter set far outside reality may make a ball diverge; its outcome is then NaN (not landed), silently.
@@ -162,7 +162,7 @@ def simulate_setup(
             for start in range(0, len(setup), CHUNK_SHOTS)
         ]
         values = [np.concatenate([getattr(c, name) for c in chunks]) for name in FLOWN_OUTCOMES]
-        return Flown(*values, dt_s=dt_s)
+        return Outcomes(*values, dt_s=dt_s)
     flight = fly_setup(setup, coefficients_for, dt_s, t_max_s, method, correction, keep_positions)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         landing_angle = flight.landing_angle_deg
@@ -171,7 +171,7 @@ def simulate_setup(
     finite = np.isfinite(landing_xy).all(axis=1) & np.isfinite(landing_angle)
     for values in (landing_xy, apex, flight_time, landing_angle):
         values[~finite] = np.nan
-    return Flown(landing_xy, apex, flight_time, landing_angle, _positions(flight) if keep_positions else None, dt_s)
+    return Outcomes(landing_xy, apex, flight_time, landing_angle, _positions(flight) if keep_positions else None, dt_s)
 
 
 def _positions(flight: Flight) -> np.ndarray:

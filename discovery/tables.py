@@ -26,7 +26,7 @@ SCORE_NOTE = (
 
 
 @dataclass(frozen=True)
-class Column:
+class TableColumn:
     """A table column: its header, the unit line under it ("" for words) and whether it holds numbers."""
 
     header: str
@@ -52,7 +52,7 @@ def number(value: object, places: int | None = None) -> str:
     return f"{value:,.{places}f}".replace("-", "−")
 
 
-def table(columns: list[Column], rows: list[list[object]], caption: str = "", chosen: int | None = None) -> str:
+def table(columns: list[TableColumn], rows: list[list[object]], caption: str = "", chosen: int | None = None) -> str:
     """An HTML table; row `chosen` is highlighted."""
     head = "".join(
         f"<th{' class=num' if c.numeric else ''} scope=col>{escape(c.header)}"
@@ -82,14 +82,14 @@ def observables_table(report: Report) -> str:
         for o in report.located.observables
     ]
     columns = [
-        Column("observable", "with its unit", False),
-        Column("shots", "count"),
-        Column("mean difference, recorded − model", ROW_UNIT),
-        Column("standard error", ROW_UNIT),
-        Column("RMS difference", ROW_UNIT),
-        Column("expected RMS", ROW_UNIT),
-        Column("RMS / expected", "ratio"),
-        Column("significant", f"Holm, family-wise {100 * report.located.alpha:g} %", False),
+        TableColumn("observable", "with its unit", False),
+        TableColumn("shots", "count"),
+        TableColumn("mean difference, recorded − model", ROW_UNIT),
+        TableColumn("standard error", ROW_UNIT),
+        TableColumn("RMS difference", ROW_UNIT),
+        TableColumn("expected RMS", ROW_UNIT),
+        TableColumn("RMS / expected", "ratio"),
+        TableColumn("significant", f"Holm, family-wise {100 * report.located.alpha:g} %", False),
     ]
     return table(columns, rows, "Each outcome, before any correction")
 
@@ -110,12 +110,12 @@ def trends_table(report: Report, count: int = 8) -> str:
         for c in trends
     ]
     columns = [
-        Column("observable", "with its unit", False),
-        Column("launch value", "with its unit", False),
-        Column("change per standard deviation", ROW_UNIT),
-        Column("t", "ratio"),
-        Column("p", "before Holm correction"),
-        Column("significant", f"Holm, family-wise {100 * report.located.alpha:g} %", False),
+        TableColumn("observable", "with its unit", False),
+        TableColumn("launch value", "with its unit", False),
+        TableColumn("change per standard deviation", ROW_UNIT),
+        TableColumn("t", "ratio"),
+        TableColumn("p", "before Holm correction"),
+        TableColumn("significant", f"Holm, family-wise {100 * report.located.alpha:g} %", False),
     ]
     return table(columns, rows, f"The {len(rows)} strongest trends with the launch")
 
@@ -135,13 +135,13 @@ def groups_table(report: Report) -> str:
         for g in report.located.groups
     ]
     columns = [
-        Column("observable", "with its unit", False),
-        Column("between", "club or session", False),
-        Column("groups", "count"),
-        Column("F", "ratio"),
-        Column("p", "before Holm correction"),
-        Column("significant", f"Holm, family-wise {100 * report.located.alpha:g} %", False),
-        Column("most different groups: mean difference", ROW_UNIT, False),
+        TableColumn("observable", "with its unit", False),
+        TableColumn("between", "club or session", False),
+        TableColumn("groups", "count"),
+        TableColumn("F", "ratio"),
+        TableColumn("p", "before Holm correction"),
+        TableColumn("significant", f"Holm, family-wise {100 * report.located.alpha:g} %", False),
+        TableColumn("most different groups: mean difference", ROW_UNIT, False),
     ]
     return table(columns, rows)
 
@@ -155,14 +155,14 @@ def trajectory_table(report: Report) -> str:
     if not rows:
         return ""
     columns = [
-        Column("phase", "", False),
-        Column("height band", "m", False),
-        Column("samples", "count"),
-        Column("shots", "count"),
-        Column("across (+ right)", "m"),
-        Column("along", "m"),
-        Column("height", "m"),
-        Column("RMS", "m"),
+        TableColumn("phase", "", False),
+        TableColumn("height band", "m", False),
+        TableColumn("samples", "count"),
+        TableColumn("shots", "count"),
+        TableColumn("across (+ right)", "m"),
+        TableColumn("along", "m"),
+        TableColumn("height", "m"),
+        TableColumn("RMS", "m"),
     ]
     return table(columns, rows, "Mean position difference, recorded − model")
 
@@ -176,13 +176,13 @@ def heldout_table(report: Report) -> str:
             gain, low, high = held.improvement_by_observable.get(name, (np.nan, np.nan, np.nan))
             rows.append([_label(name), held.before[name], held.after[name], held.expected[name], gain, low, high])
     columns = [
-        Column("observable", "with its unit", False),
-        Column("RMS, model as is", ROW_UNIT),
-        Column("RMS, corrected", ROW_UNIT),
-        Column("expected RMS", ROW_UNIT),
-        Column("improvement", SCORE_UNIT),
-        Column("95 % interval from", SCORE_UNIT),
-        Column("to", SCORE_UNIT),
+        TableColumn("observable", "with its unit", False),
+        TableColumn("RMS, model as is", ROW_UNIT),
+        TableColumn("RMS, corrected", ROW_UNIT),
+        TableColumn("expected RMS", ROW_UNIT),
+        TableColumn("improvement", SCORE_UNIT),
+        TableColumn("95 % interval from", SCORE_UNIT),
+        TableColumn("to", SCORE_UNIT),
     ]
     return table(columns, rows, f"Shots held out of the fit (folds: {held.grouping})")
 
@@ -205,12 +205,12 @@ def candidates_table(report: Report, count: int = 15) -> str:
     ]
     chosen = next((i for i, c in enumerate(ranked) if report.systematic and c.name == named), None)
     columns = [
-        Column("explanation", "", False),
-        Column("fitted size", "± 1 standard deviation, with units", False, wide=True),
-        Column("parameters", "count"),
-        Column("held-out error", SCORE_UNIT),
-        Column("penalty", SCORE_UNIT),
-        Column("score", SCORE_UNIT),
+        TableColumn("explanation", "", False),
+        TableColumn("fitted size", "± 1 standard deviation, with units", False, wide=True),
+        TableColumn("parameters", "count"),
+        TableColumn("held-out error", SCORE_UNIT),
+        TableColumn("penalty", SCORE_UNIT),
+        TableColumn("score", SCORE_UNIT),
     ]
     return table(columns, rows, f"The {len(rows)} best of {len(report.candidates)} candidates", chosen)
 
@@ -239,13 +239,13 @@ def rivals_table(report: Report) -> str:
     if not rows:
         return ""
     columns = [
-        Column("rival", "", False),
-        Column("score − chosen's", SCORE_UNIT),
-        Column("95 % interval from", SCORE_UNIT),
-        Column("to", SCORE_UNIT),
-        Column("separating observable", "with its unit", False),
-        Column("recorded", "", False),
-        Column("why they cannot be told apart", "", False, wide=True),
+        TableColumn("rival", "", False),
+        TableColumn("score − chosen's", SCORE_UNIT),
+        TableColumn("95 % interval from", SCORE_UNIT),
+        TableColumn("to", SCORE_UNIT),
+        TableColumn("separating observable", "with its unit", False),
+        TableColumn("recorded", "", False),
+        TableColumn("why they cannot be told apart", "", False, wide=True),
     ]
     return table(columns, rows)
 
@@ -279,7 +279,7 @@ def settings_table(report: Report) -> str:
     if not rows:
         return "<p>None: the model as is needs no correction.</p>"
     return table(
-        [Column("setting", "", False), Column("value", "in the unit beside it"), Column("unit", "", False)], rows
+        [TableColumn("setting", "", False), TableColumn("value", "in the unit beside it"), TableColumn("unit", "", False)], rows
     )
 
 
@@ -300,13 +300,13 @@ def expected_table(report: Report) -> str:
         if n in model.model_error
     ]
     columns = [
-        Column("observable", "with its unit", False),
-        Column("model's own error", ROW_UNIT),
-        Column("source", "", False),
-        Column("outcome noise", ROW_UNIT),
-        Column("launch noise", ROW_UNIT),
-        Column("recordings' scatter", "times the expected"),
-        Column("scatter used", "", False),
+        TableColumn("observable", "with its unit", False),
+        TableColumn("model's own error", ROW_UNIT),
+        TableColumn("source", "", False),
+        TableColumn("outcome noise", ROW_UNIT),
+        TableColumn("launch noise", ROW_UNIT),
+        TableColumn("recordings' scatter", "times the expected"),
+        TableColumn("scatter used", "", False),
     ]
     return table(columns, rows)
 
@@ -324,5 +324,5 @@ def decision_table(report: Report) -> str:
     """The numbers the choice was made on (`systematic_test`), one a row, names in words."""
     test = report.systematic_test
     rows = [[key_words(k).replace("gain low", "gain, lower bound"), _decision_value(k, v)] for k, v in test.items()]
-    columns = [Column("quantity", "", False), Column("value", f"{SCORE_UNIT} where a number")]
+    columns = [TableColumn("quantity", "", False), TableColumn("value", f"{SCORE_UNIT} where a number")]
     return table(columns, rows)

@@ -30,7 +30,7 @@ from golfflight.evaluation.accuracy_finetune import (
     FinetuneStudy,
     finetune_study,
 )
-from golfflight.evaluation.accuracy_flyers import CoefficientFlyer, Flyer, ModelFlyer, ferguson_flyer
+from golfflight.evaluation.accuracy_flyers import CoefficientFlyer, EvaluatedModel, ModelFlyer, ferguson_flyer
 from golfflight.evaluation.accuracy_sets import (
     APEX_MAE_YD,
     APEX_METRICS,
@@ -87,7 +87,7 @@ from golfflight.shots.trackman import ConversionReport
 
 __all__ = [
     "COMMAND", "DRIVER_FILE", "OUTCOMES", "PATH_FIGURE", "PGA_TARGETS", "TOURCAST_PBP", "TOURCAST_TRAJECTORIES",
-    "AccuracyReport", "CoefficientFlyer", "Flyer", "ModelFlyer", "ball_types", "compare_clubs", "ferguson_flyer",
+    "AccuracyReport", "CoefficientFlyer", "EvaluatedModel", "ModelFlyer", "ball_types", "compare_clubs", "ferguson_flyer",
     "outcome_errors", "path_errors", "per_model", "run_accuracy",
 ]
 
@@ -123,7 +123,7 @@ class AccuracyReport:
     study: FinetuneStudy | None = None
 
 
-def _key(flyer: Flyer) -> tuple:
+def _key(flyer: EvaluatedModel) -> tuple:
     """What makes two flyers fly alike: the graph and the card's step and air, or the closed-form model."""
     if isinstance(flyer, ModelFlyer):
         physics = flyer.card.physics
@@ -131,7 +131,7 @@ def _key(flyer: Flyer) -> tuple:
     return ("model", repr(getattr(flyer, "model", flyer)), flyer.dt_s, flyer.t_sim_s, flyer.density_kg_m3)
 
 
-def per_model(flyers: Sequence[Flyer], work: Callable[[Flyer], T]) -> dict[str, T]:
+def per_model(flyers: Sequence[EvaluatedModel], work: Callable[[EvaluatedModel], T]) -> dict[str, T]:
     """`work` for each model, by label; a model that flies exactly like an earlier one reuses its result."""
     done: dict[tuple, T] = {}
     results = {}
@@ -173,7 +173,7 @@ def _verdict(name: str, value: float, limit: float, unit: str) -> str:
     return f"{name} {_cell(value)} {unit} (target <= {limit:g}): **{'met' if met else 'not met'}**"
 
 
-def _header(flyers: Sequence[Flyer], rho_note: str) -> list[str]:
+def _header(flyers: Sequence[EvaluatedModel], rho_note: str) -> list[str]:
     rows = []
     for flyer in flyers:
         if isinstance(flyer, ModelFlyer):
@@ -201,7 +201,7 @@ def _header(flyers: Sequence[Flyer], rho_note: str) -> list[str]:
     return lines
 
 
-def _drivers(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
+def _drivers(data_dir: Path, flyers: Sequence[EvaluatedModel], report: AccuracyReport) -> list[str]:
     lines = ["### TrackMan outdoor drivers (held out: lines 2943 on)", ""]
     path = data_dir / DRIVER_FILE
     if not path.is_file():
@@ -266,7 +266,7 @@ def _tee_group_rows(errors: dict[str, dict[str, np.ndarray]], labels: Sequence[s
     return rows
 
 
-def _tour_championship(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
+def _tour_championship(data_dir: Path, flyers: Sequence[EvaluatedModel], report: AccuracyReport) -> list[str]:
     held = TOUR_CHAMPIONSHIP_HELD_OUT
     lines = [f"### TOUR Championship 2020, East Lake (held out: {held.rows()})", ""]
     path = data_dir / TOUR_CHAMPIONSHIP_PBP
@@ -316,7 +316,7 @@ def _pga_outcome(index: int, comparisons: dict[str, ClubComparison], labels: Seq
             *table(("club", "TrackMan", *labels, "target"), rows), ""]
 
 
-def _pga(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport):
+def _pga(data_dir: Path, flyers: Sequence[EvaluatedModel], report: AccuracyReport):
     lines = ["### PGA TOUR 2023 TrackMan averages per club (a TRAINING set: a fit, not a check)", ""]
     path = data_dir / TOUR_AVERAGES_FILE
     if not path.is_file():
@@ -359,7 +359,7 @@ def _paper() -> list[str]:
     ]
 
 
-def _slow(flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
+def _slow(flyers: Sequence[EvaluatedModel], report: AccuracyReport) -> list[str]:
     labels = [f.label for f in flyers]
     report.slow = per_model(flyers, fly_slow)
     rows = []
@@ -384,7 +384,7 @@ def _slow(flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
     return lines
 
 
-def _sentry(data_dir: Path, flyers: Sequence[Flyer], out: Path, figures_dir: Path, report: AccuracyReport) -> list[str]:
+def _sentry(data_dir: Path, flyers: Sequence[EvaluatedModel], out: Path, figures_dir: Path, report: AccuracyReport) -> list[str]:
     from golfflight.evaluation import figures
 
     lines = ["### PGA TOUR trajectories, 2022 Sentry at Kapalua (a TRAINING set of the real-data model)", ""]
@@ -396,7 +396,7 @@ def _sentry(data_dir: Path, flyers: Sequence[Flyer], out: Path, figures_dir: Pat
     trajectories = [conversion.trajectories[s] for s in shots.column("shot_id")]
     labels = [f.label for f in flyers]
 
-    def evaluate(flyer: Flyer):
+    def evaluate(flyer: EvaluatedModel):
         flight = flyer.simulate(shots.launch(), keep_states=True)
         return outcome_errors(flight, shots), path_errors(flight, trajectories)
 
@@ -439,14 +439,14 @@ def _anova_cells(result: Anova) -> tuple[str, ...]:
             "–" if not math.isfinite(result.f) else f"{result.f:.1f} ({p})", _cell(result.between_fraction))
 
 
-def _winds(trajectory_file: Path, conversion, shots: ShotSet, flyers: Sequence[Flyer],
+def _winds(trajectory_file: Path, conversion, shots: ShotSet, flyers: Sequence[EvaluatedModel],
            report: AccuracyReport) -> list[str]:
     flights = read_flights(trajectory_file, ConversionReport(str(trajectory_file)))
     tracked = {f.shot_id: f.measured_time_s for f in flights}
     ids = list(shots.column("shot_id"))
     labels = [f.label for f in flyers]
 
-    def fit(flyer: Flyer) -> WindFit:
+    def fit(flyer: EvaluatedModel) -> WindFit:
         return fit_winds(flyer, measured_paths(ids, shots.launch(), conversion.trajectories, tracked, flyer.dt_s))
 
     report.winds = per_model(flyers, fit)
@@ -526,7 +526,7 @@ def _wind_answer(results: dict[str, Consistency], labels: Sequence[str]) -> str:
     return "In numbers: " + "; ".join(parts) + "."
 
 
-def _training_wind_lines(flyer: Flyer, fitted: dict[str, GroupWind], report: AccuracyReport) -> list[str]:
+def _training_wind_lines(flyer: EvaluatedModel, fitted: dict[str, GroupWind], report: AccuracyReport) -> list[str]:
     if not isinstance(flyer, ModelFlyer):
         return []
     entries = training_winds(flyer.bundle)
@@ -626,7 +626,7 @@ def run_accuracy(
     missing sets are announced. With `progress`, each set's step goes to standard error as it starts."""
     data_dir = Path(data_dir) if data_dir is not None else shared_data_dir()
     real = ModelFlyer(bundle, "real-data model")
-    flyers: list[Flyer] = [
+    flyers: list[EvaluatedModel] = [
         real,
         ModelFlyer(synthetic if synthetic is not None else bundle, "synthetic model"),
         ferguson_flyer(real.dt_s, real.t_sim_s),

@@ -20,7 +20,7 @@ STANDARD_DENSITY_KG_M3 = 1.225
 """ICAO standard air: the air a closed-form model is flown in (it has no Reynolds-number input)."""
 
 
-class Flyer:
+class EvaluatedModel:
     """A labelled `flight.flyer.Flyer`: its model and the air, step and maximum time it is flown at; `simulate` is
     the one flight-core call every model shares.
 
@@ -63,7 +63,7 @@ class Flyer:
                                  t_max_s)
 
 
-class ModelFlyer(Flyer):
+class ModelFlyer(EvaluatedModel):
     """A bundle's Flyer (`flight.flyer.load_flyer`): its ONNX coefficient graph at its card's step for the engine's
     maximum flight time, in the card's air by default (its density and, through the graph's Reynolds scale, its
     viscosity)."""
@@ -74,7 +74,7 @@ class ModelFlyer(Flyer):
         self.bundle, self.coefficients, self.card = flyer.bundle_dir, flyer.model, flyer.card
 
 
-class CoefficientFlyer(Flyer):
+class CoefficientFlyer(EvaluatedModel):
     """A closed-form coefficient model (C_L, C_D, C_M, C_Q of the spin ratio alone) flown like a bundle."""
 
     def __init__(self, model: CoefficientModel, label: str, dt_s: float = 0.1, t_sim_s: float = 10.0,

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 from golfflight.errors import InputError
-from golfflight.evaluation.accuracy_flyers import Flyer
+from golfflight.evaluation.accuracy_flyers import EvaluatedModel
 from golfflight.flight.air import Air
 from golfflight.flight.constants import FOOT_M, YARD_M
 from golfflight.flight.outcomes import Flight
@@ -70,7 +70,7 @@ class ClubComparison:
         return np.mean(self.model - self.targets, axis=0)
 
 
-def compare_clubs(flyer: Flyer, clubs: Sequence[ClubAverage], air: Air | None = None) -> ClubComparison:
+def compare_clubs(flyer: EvaluatedModel, clubs: Sequence[ClubAverage], air: Air | None = None) -> ClubComparison:
     """Fly each club's average launch (launch direction and spin axis 0) and compare with TrackMan's averages."""
     launch = straight_launches(clubs)
     density = flyer.density_kg_m3 if air is None else float(air.density_kg_m3)

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from golfflight.evaluation.accuracy_flyers import Flyer
+from golfflight.evaluation.accuracy_flyers import EvaluatedModel
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
 
 
@@ -95,7 +95,7 @@ def launch_of(shots: Sequence[SlowShot]) -> dict[str, np.ndarray]:
     }
 
 
-def fly_slow(flyer: Flyer, shots: Sequence[SlowShot] = SLOW_SHOTS) -> dict[str, np.ndarray]:
+def fly_slow(flyer: EvaluatedModel, shots: Sequence[SlowShot] = SLOW_SHOTS) -> dict[str, np.ndarray]:
     """Carry (yd), max height (yd) and land angle (deg) of each slow shot, calm, in the flyer's own air."""
     flight = flyer.simulate(launch_of(shots))
     return {"carry": flight.carry_m / YARD_M, "apex": flight.apex_m / YARD_M, "land": flight.landing_angle_deg}

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 from golfflight.errors import InputError
-from golfflight.evaluation.accuracy_flyers import Flyer, ModelFlyer
+from golfflight.evaluation.accuracy_flyers import EvaluatedModel, ModelFlyer
 from golfflight.flight.air import Air
 from golfflight.flight.constants import BALL_RADIUS_M
 from golfflight.flight.physics import spin_ratio
@@ -297,7 +297,7 @@ class FlightPoints:
     coefficients: dict[str, np.ndarray]
 
 
-def flight_points(flyer: Flyer, clubs: list[ClubLaunch], air: Air) -> list[FlightPoints]:
+def flight_points(flyer: EvaluatedModel, clubs: list[ClubLaunch], air: Air) -> list[FlightPoints]:
     """Fly the clubs through `flyer` in `air` (calm) and read back what each flight meets at each step above the
     ground. The coefficients are the model's at those states, the very values the integrator stepped with."""
     flight = flyer.simulate(straight_launches(clubs), air, keep_states=True)
@@ -314,7 +314,7 @@ def flight_points(flyer: Flyer, clubs: list[ClubLaunch], air: Air) -> list[Fligh
     return result
 
 
-def spin_lost(flyer: Flyer, clubs: list[ClubLaunch], air: Air, times_s: tuple[float, ...]) -> np.ndarray:
+def spin_lost(flyer: EvaluatedModel, clubs: list[ClubLaunch], air: Air, times_s: tuple[float, ...]) -> np.ndarray:
     """Share (0-1) of its launch spin each club's ball has lost at each time [clubs, times], flown through `flyer`
     in `air` (the spin magnitude interpolated linearly between steps). A ball is followed past its landing (the
     measurement is of the decay law, not of a flight's length), so the flight is run for the longest time asked."""
@@ -401,7 +401,7 @@ def club_launch(name: str, spin_rpm: float | None = None) -> ClubLaunch:
     return match if spin_rpm is None else match._replace(spin_rpm=spin_rpm)
 
 
-def check_spin(flyer: Flyer, measurements: list[SpinDecayMeasurement], air: Air) -> list[SpinCheck]:
+def check_spin(flyer: EvaluatedModel, measurements: list[SpinDecayMeasurement], air: Air) -> list[SpinCheck]:
     """Each TrackMan club flown with its tour-average speed and launch angle and TrackMan's launch spin: for a
     C_M = p_M S model the share lost depends on the speed history alone, and the launch spin changes that history
     only through the flight's lift."""

@@ -46,7 +46,7 @@ CHUNK = 500
 
 
 @dataclass
-class Predicted:
+class ApexPrediction:
     """Per shot: apex height, horizontal distance at the apex and carry (m)."""
 
     apex_m: np.ndarray
@@ -68,7 +68,7 @@ def reference(state) -> Flight:
 FLYERS = {"Ferguson 2022": ferguson, "reference world": reference}
 
 
-def predict(fly, launch: dict[str, np.ndarray]) -> Predicted:
+def predict(fly, launch: dict[str, np.ndarray]) -> ApexPrediction:
     """Fly the launches calm in chunks; the apex range is the horizontal distance at the step of the apex."""
     parts = []
     for start in range(0, len(launch["spin_rpm"]), CHUNK):
@@ -76,7 +76,7 @@ def predict(fly, launch: dict[str, np.ndarray]) -> Predicted:
         step = np.rint(flight.apex_time_s / (flight.times_s[1] - flight.times_s[0])).astype(int)
         at_apex = np.stack([s.position for s in flight.states])[step, np.arange(len(step))]
         parts.append((flight.apex_m, np.hypot(at_apex[:, 0], at_apex[:, 1]), flight.carry_m))
-    return Predicted(*(np.concatenate(column) for column in zip(*parts)))
+    return ApexPrediction(*(np.concatenate(column) for column in zip(*parts)))
 
 
 def ratio_stats(recorded: np.ndarray, predicted: np.ndarray) -> tuple[str, str, str]:

@@ -72,23 +72,23 @@ def grounds() -> dict[str, Surface]:
             "rough": SURFACES["rough"]}
 
 
-class Run(NamedTuple):
+class AnchorRun(NamedTuple):
     """One shot of the grid: its carry and its run after landing (total - carry; negative: it spun back), yards."""
 
     carry_yd: float
     run_yd: float
 
 
-Grid = dict[tuple[str, str, str, str], Run]
+Grid = dict[tuple[str, str, str, str], AnchorRun]
 """Runs by (tour, club, wind, ground)."""
 
 
-def fly(engine: FlightEngine, clubs: Sequence[ClubLaunch], wind: Wind, ground: Surface) -> list[Run]:
+def fly(engine: FlightEngine, clubs: Sequence[ClubLaunch], wind: Wind, ground: Surface) -> list[AnchorRun]:
     """`clubs` flown straight (launch direction and spin axis 0) through `engine` in ICAO air and `wind`, rolled to
     rest on a level `ground` at the tee's height."""
     launches = [Launch(c.ball_speed_mps, c.launch_angle_deg, 0.0, c.spin_rpm, 0.0) for c in clubs]
     flights = engine.fly_batch(launches, Conditions(wind=wind), grounds=GroundSpec(ground))
-    return [Run(f.carry_m / YARD_M, f.rest.roll_m / YARD_M) for f in flights]
+    return [AnchorRun(f.carry_m / YARD_M, f.rest.roll_m / YARD_M) for f in flights]
 
 
 def fly_grid(engine: FlightEngine, tours: dict[str, Sequence[ClubLaunch]] = TOURS,

@@ -17,7 +17,7 @@ from scipy.optimize import least_squares
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from golfflight.evaluation.accuracy_flyers import Flyer, ModelFlyer, ferguson_flyer
+from golfflight.evaluation.accuracy_flyers import EvaluatedModel, ModelFlyer, ferguson_flyer
 from golfflight.evaluation.accuracy_sets import outcome_errors
 from golfflight.flight.field import ScaledCoefficients
 from golfflight.flight.integrator import simulate
@@ -52,7 +52,7 @@ def axis_slope(errors: np.ndarray, launch: dict[str, np.ndarray],
     return float(coef[0]), float(np.sqrt(covariance[0, 0]))
 
 
-def side_per_degree(flyer: Flyer, launch: dict[str, np.ndarray]) -> float:
+def side_per_degree(flyer: EvaluatedModel, launch: dict[str, np.ndarray]) -> float:
     """The model's own mean change of the landing side (m) per degree of spin axis."""
     sides = []
     for step in (-AXIS_STEP_DEG, AXIS_STEP_DEG):
@@ -61,7 +61,7 @@ def side_per_degree(flyer: Flyer, launch: dict[str, np.ndarray]) -> float:
     return float(np.mean((sides[1] - sides[0]) / (2 * AXIS_STEP_DEG)))
 
 
-def model_rows(flyers: list[Flyer], shots: ShotSet, groups: np.ndarray) -> list[list[str]]:
+def model_rows(flyers: list[EvaluatedModel], shots: ShotSet, groups: np.ndarray) -> list[list[str]]:
     """Per model: side MAE and bias, the side error's slope on the axis (over all shots, and within groups), the
     model's own slope, their ratio."""
     rows = []
@@ -95,7 +95,7 @@ def scale_rows(flyer: ModelFlyer, shots: ShotSet, lift_scales: tuple[float, ...]
     return rows
 
 
-def axis_scale_rows(flyers: list[Flyer], sets: dict[str, ShotSet], scales: tuple[float, ...]) -> list[list[str]]:
+def axis_scale_rows(flyers: list[EvaluatedModel], sets: dict[str, ShotSet], scales: tuple[float, ...]) -> list[list[str]]:
     """Landing error and side MAE with the recorded spin axis multiplied by each scale (a launch-monitor reading
     error, if that is what the missing curvature is)."""
     rows = []
@@ -127,7 +127,7 @@ def monitor_profile(launch: dict[str, np.ndarray], profile: np.ndarray) -> dict[
                 launch_direction_deg=launch["launch_direction_deg"] + profile[3])
 
 
-def fit_monitor_profile(flyer: Flyer, shots: ShotSet, free: list[int]) -> np.ndarray:
+def fit_monitor_profile(flyer: EvaluatedModel, shots: ShotSet, free: list[int]) -> np.ndarray:
     """The profile whose `free` entries (the others as recorded) bring the flyer's carry, side and apex closest to
     the recordings (bounded least squares)."""
 
@@ -150,7 +150,7 @@ PROFILES = ([0, 1, 2], [0, 1, 2, 3])
 first three, then all four)."""
 
 
-def profile_rows(flyers: list[Flyer], fit_on: ShotSet, check_on: ShotSet) -> list[list[str]]:
+def profile_rows(flyers: list[EvaluatedModel], fit_on: ShotSet, check_on: ShotSet) -> list[list[str]]:
     """Per flyer and profile: the profile fitted on `fit_on`, and the landing error / side MAE without and with it
     on both sets."""
     rows = []
@@ -160,7 +160,7 @@ def profile_rows(flyers: list[Flyer], fit_on: ShotSet, check_on: ShotSet) -> lis
     return rows
 
 
-def _profile_row(flyer: Flyer, profile: np.ndarray, fit_on: ShotSet, check_on: ShotSet) -> list[str]:
+def _profile_row(flyer: EvaluatedModel, profile: np.ndarray, fit_on: ShotSet, check_on: ShotSet) -> list[str]:
     """One flyer and profile: the profile, and the landing error / side MAE without and with it on both sets."""
     cells = []
     for shots in (fit_on, check_on):

@@ -297,7 +297,7 @@ def fit_reference(
 
 
 @dataclass(frozen=True)
-class ClubCheck:
+class CalibrationClub:
     """A model's outcomes for the tour-averages table's clubs, beside TrackMan's."""
 
     clubs: list[ClubAverage]
@@ -323,18 +323,18 @@ def club_launch_state(clubs: list[ClubAverage]) -> State:
     return initial_state(**straight_launches(clubs))
 
 
-def _club_check(flight: Flight, clubs: list[ClubAverage]) -> ClubCheck:
-    return ClubCheck(clubs, flight.carry_m / YARD_M, flight.apex_m / YARD_M, flight.landing_angle_deg)
+def _club_check(flight: Flight, clubs: list[ClubAverage]) -> CalibrationClub:
+    return CalibrationClub(clubs, flight.carry_m / YARD_M, flight.apex_m / YARD_M, flight.landing_angle_deg)
 
 
 def evaluate_clubs(
     clubs: list[ClubAverage], params: ReferenceParameters = CALIBRATED, air: Air = CALIBRATION_AIR
-) -> ClubCheck:
+) -> CalibrationClub:
     """Fly every club's average launch through the reference world."""
     return _club_check(fly_reference(club_launch_state(clubs), air, params=params), clubs)
 
 
-def evaluate_clubs_ferguson(clubs: list[ClubAverage], air: Air = CALIBRATION_AIR) -> ClubCheck:
+def evaluate_clubs_ferguson(clubs: list[ClubAverage], air: Air = CALIBRATION_AIR) -> CalibrationClub:
     """The same shots with Ferguson 2022's quadratics (the open-model baseline), same integrator and air."""
     flight = simulate(
         club_launch_state(clubs), QuadraticSpinRatio(), air.density_kg_m3, dt=REFERENCE_DT_S,
@@ -354,8 +354,8 @@ def _round(value: float) -> float:
     return float(f"{value:.5g}")
 
 
-def render_markdown(evaluation: CellEvaluation, params: ReferenceParameters, check: ClubCheck | None = None,
-                    ferguson: ClubCheck | None = None, air_factors: dict[str, float] | None = None) -> str:
+def render_markdown(evaluation: CellEvaluation, params: ReferenceParameters, check: CalibrationClub | None = None,
+                    ferguson: CalibrationClub | None = None, air_factors: dict[str, float] | None = None) -> str:
     """Markdown: the parameters (and fitted air factors), the per-cell fit table, the spin-decay table and the
     tour-averages table per club."""
     out = ["### Parameters", "", "| parameter | value |", "|---|---|"]
@@ -385,7 +385,7 @@ def render_markdown(evaluation: CellEvaluation, params: ReferenceParameters, che
     return "\n".join(out) + "\n"
 
 
-def _club_check_markdown(check: ClubCheck, ferguson: ClubCheck | None) -> list[str]:
+def _club_check_markdown(check: CalibrationClub, ferguson: CalibrationClub | None) -> list[str]:
     out = [
         "",
         "### PGA TOUR 2023 averages per club, model vs TrackMan (the training clubs are cells of the fit)",

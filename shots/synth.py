@@ -58,7 +58,7 @@ class MeasurementNoise:
 
 
 @dataclass(frozen=True)
-class Session:
+class SyntheticSession:
     """One session's hidden truth: who hit, with which clubs, in which air and wind."""
 
     session: str
@@ -112,12 +112,12 @@ class SyntheticSet:
     """Generated records plus the hidden truth and what was dropped (and why)."""
 
     records: list[ShotRecord]
-    sessions: list[Session]
+    sessions: list[SyntheticSession]
     dropped: dict[str, int]
     seconds: float
 
 
-def draw_sessions(rng: np.random.Generator, n_shots: int, config: SynthConfig) -> list[Session]:
+def draw_sessions(rng: np.random.Generator, n_shots: int, config: SynthConfig) -> list[SyntheticSession]:
     """Sessions in time order until they hold `n_shots` shots, each with its own (hidden) air and wind."""
     sessions, total = [], 0
     weights = club_weights()
@@ -130,7 +130,7 @@ def draw_sessions(rng: np.random.Generator, n_shots: int, config: SynthConfig) -
         clubs = tuple(rng.choice(names, size=min(n_clubs, len(names)), replace=False, p=weights))
         altitude_band = rng.choice(3, p=list(ALTITUDE_BAND_SHARES))
         wind = 0.0 if config.calm else float(min(rng.weibull(2.0) * 3.5, 12.0))
-        sessions.append(Session(
+        sessions.append(SyntheticSession(
             session=f"S{len(sessions):05d}",
             kind="robot" if robot else "player",
             n_shots=n,
@@ -150,7 +150,7 @@ def draw_sessions(rng: np.random.Generator, n_shots: int, config: SynthConfig) -
     return sessions
 
 
-def draw_launches(rng: np.random.Generator, sessions: list[Session]) -> LaunchTable:
+def draw_launches(rng: np.random.Generator, sessions: list[SyntheticSession]) -> LaunchTable:
     """True launches: the club mean scaled by the session's player, plus shot-to-shot scatter."""
     by_name = {c.name: c for c in CLUBS}
     rows = []
@@ -177,11 +177,11 @@ def draw_launches(rng: np.random.Generator, sessions: list[Session]) -> LaunchTa
 
 
 def fly_sessions(
-    table: LaunchTable, sessions: list[Session], config: SynthConfig, rng: np.random.Generator, progress: bool = False
+    table: LaunchTable, sessions: list[SyntheticSession], config: SynthConfig, rng: np.random.Generator, progress: bool = False
 ) -> Flight:
     """Fly the true launches in each session's air and (gusting, log-profile) wind through the reference world, BATCH
     shots at a time (with a bar over the shots when `progress`: the reference world's RK4 takes most of a run)."""
-    per_shot = {f.name: np.array([getattr(sessions[i], f.name) for i in table.session_index]) for f in fields(Session)
+    per_shot = {f.name: np.array([getattr(sessions[i], f.name) for i in table.session_index]) for f in fields(SyntheticSession)
                 if f.name in ("temperature_c", "altitude_m", "humidity_pct", "wind_speed_mps", "wind_from_deg")}
     gust = np.exp(rng.normal(0, 0.15, size=len(table.session_index)))
     launch = table.launch()
@@ -220,7 +220,7 @@ def measure(rng: np.random.Generator, table: LaunchTable, flight: Flight, noise:
     }
 
 
-def validation_sessions(sessions: list[Session], fraction: float) -> set[str]:
+def validation_sessions(sessions: list[SyntheticSession], fraction: float) -> set[str]:
     """The most recent sessions holding at least `fraction` of all shots (the paper's time-ordered split)."""
     total = sum(s.n_shots for s in sessions)
     chosen, count = set(), 0
@@ -279,6 +279,6 @@ def sessions_path(path: str | Path) -> Path:
 def write_synthetic(path: str | Path, synthetic: SyntheticSet) -> None:
     """Write the canonical records and, beside them, the hidden per-session truth."""
     write_shots(path, synthetic.records)
-    header = [f.name for f in fields(Session)]
+    header = [f.name for f in fields(SyntheticSession)]
     rows = ([*(("|".join(v) if isinstance(v, tuple) else v) for v in asdict(s).values())] for s in synthetic.sessions)
     write_csv_atomic(sessions_path(path), header, rows)

@@ -2,7 +2,7 @@
 processes on this machine, each with ONNX Runtime or its own torch engine), `ray_tables` (Ray Data on a local Ray
 instance or an existing cluster) and `in_process_tables` (one engine in this process, whose parallelism is its
 device's: the torch engine, a few pieces at once in threads so that the CPU's work overlaps the device's). Each worker
-holds one `sweep.flyer.Flyer`, and at most a few pieces per worker are in flight, so memory stays bounded however long
+holds one `sweep.flyer.SweepWorker`, and at most a few pieces per worker are in flight, so memory stays bounded however long
 the input is.
 """
 
@@ -21,7 +21,7 @@ from contextlib import contextmanager
 from multiprocessing import forkserver
 
 from golfflight.errors import InputError
-from golfflight.sweep.flyer import Flyer
+from golfflight.sweep.flyer import SweepWorker
 from golfflight.sweep.stopping import exit_with_driver, group_signals_held
 
 PIECES_PER_WORKER = 2
@@ -36,7 +36,7 @@ writes)."""
 WORKER_IMPORTS = ["golfflight.flight.engine", "golfflight.contract.flying", "golfflight.sweep.flyer"]
 """Modules the local pool's fork server imports before it forks the workers."""
 
-_flyer: Flyer | None = None
+_flyer: SweepWorker | None = None
 """The flyer of a local pool's worker process (made once by `_start_worker`)."""
 
 
@@ -44,7 +44,7 @@ def _start_worker(bundle_dir: str, sha256: str, source, make: Callable | None) -
     """A local pool's worker: bound to the driver's life first (`sweep.stopping.exit_with_driver`), then its flyer."""
     global _flyer
     exit_with_driver()
-    _flyer = Flyer(bundle_dir, sha256, source, make_engine=make)
+    _flyer = SweepWorker(bundle_dir, sha256, source, make_engine=make)
 
 
 def _fly(piece):
@@ -92,7 +92,7 @@ def _stop_workers(pool: ProcessPoolExecutor) -> None:
     pool._result_queue._writer.close()
 
 
-def in_process_tables(source, flyer: Flyer, in_flight: int = PIECES_IN_FLIGHT) -> Iterator:
+def in_process_tables(source, flyer: SweepWorker, in_flight: int = PIECES_IN_FLIGHT) -> Iterator:
     """Result tables of `source`'s pieces flown by `flyer` in this process, `in_flight` pieces at once in threads, in
     input order (an engine that has the device to itself: a pool of processes would only share it; its engine
     takes pieces from several threads, `model_export.torch_engine.TorchEngine`)."""
@@ -188,7 +188,7 @@ def ray_noise_filtered(noise: tuple[bytes, ...] = RAY_NOISE):
 
 def ray_tables(source, bundle_dir: str, sha256: str, workers: int | None, address: str | None,
                make_engine: Callable | None = None, gpus_per_actor: float = 0) -> Iterator:
-    """Result tables of `source`'s pieces through Ray Data: `map_batches` with `Flyer` as a callable class on a pool
+    """Result tables of `source`'s pieces through Ray Data: `map_batches` with `SweepWorker` as a callable class on a pool
     of `workers` actors of one CPU each, order preserved. Each actor flies with ONNX Runtime, or with the engine
     `make_engine` builds on its node (the torch engine), asking Ray for `gpus_per_actor` GPUs instead of a CPU (a
     fraction: several actors share a GPU): then `workers` None is as many actors as the cluster's GPUs hold
@@ -280,7 +280,7 @@ def _ray_tables(ray, source, bundle_dir: str, sha256: str, workers: int | None, 
         # parameter of the Ray the `ray` extra pins (its ray_remote_args is deprecated there and goes away in 2.64).
         read = ray.data.read_datasource(PiecesDatasource(source), max_calls=1)
         dataset = read.map_batches(
-            Flyer,
+            SweepWorker,
             fn_constructor_args=(bundle_dir, sha256, source, None, make_engine),
             compute=ray.data.ActorPoolStrategy(size=workers),
             batch_size=1,  # one piece (one row) a call: one engine batch of --chunk-rows shots

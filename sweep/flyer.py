@@ -1,6 +1,6 @@
 """The worker side of a sweep: a table of input rows in, a table of the same rows with their flights out.
 
-One `Flyer` holds one FlightEngine (ONNX Runtime on one thread: the workers are the parallelism) and is what every
+One `SweepWorker` holds one FlightEngine (ONNX Runtime on one thread: the workers are the parallelism) and is what every
 engine runs: called in each process of the local pool, and as Ray Data's callable class (one per actor). A piece's
 rows are checked against the request model and flown a column at a time (`sweep.rows`: the verdicts, problem lines
 and numbers of each row through the request model and the batch `golfflight simulate` flies, `contract.flying`,
@@ -117,7 +117,7 @@ class ColumnsEngine(Protocol):
     def fly_columns(self, launches, conditions, grounds) -> BatchFlights: ...
 
 
-class Flyer:
+class SweepWorker:
     """A flight engine for one worker: `flyer(piece)` flies a piece of a source (module docstring)."""
 
     def __init__(self, bundle_dir: str, sha256: str, source, engine: ColumnsEngine | None = None,

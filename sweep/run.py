@@ -20,7 +20,7 @@ from typing import Literal
 from golfflight.errors import InputError
 from golfflight.flight.bundle_location import model_dir
 from golfflight.sweep.engines import PIECES_IN_FLIGHT
-from golfflight.sweep.flyer import PROBLEM, ROW, ColumnsEngine, Flyer, Layout
+from golfflight.sweep.flyer import PROBLEM, ROW, ColumnsEngine, Layout, SweepWorker
 from golfflight.sweep.output import clear_stale, write_whole, writing
 from golfflight.sweep.sources import Source
 
@@ -73,7 +73,7 @@ def _tables(source: Source, engine: Engine, workers: int | None, model: str | No
     sha256 = verify_bundle(bundle).onnx.sha256
     if engine == "torch":
         if in_process is not None:
-            return in_process_tables(source, Flyer(str(bundle), sha256, source, engine=in_process), in_flight)
+            return in_process_tables(source, SweepWorker(str(bundle), sha256, source, engine=in_process), in_flight)
         if worker_engine.make is None or workers is None:
             raise InputError("the torch engine flies in this process (in_process) or in a pool of `workers` "
                              "processes, each with the engine worker_engine.make builds")

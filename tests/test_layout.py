@@ -70,3 +70,18 @@ def test_the_wheel_installs_beside_a_package_called_service_and_flies_a_shot(tmp
     flown = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True)
     assert flown.returncode == 0, flown.stderr
     assert 140 < float(flown.stdout) < 180
+
+
+def test_no_two_classes_share_a_name():
+    """One name per concept: a class name means one thing across the project (tests aside)."""
+    import ast
+    from collections import defaultdict
+
+    from tests.test_imports import _modules
+
+    where = defaultdict(list)
+    for path in _modules():
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.ClassDef):
+                where[node.name].append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    assert {name: places for name, places in where.items() if len(places) > 1} == {}

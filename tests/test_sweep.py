@@ -224,7 +224,7 @@ def test_a_file_that_cannot_be_swept_gets_one_line(tmp_path, capsys, content, me
 
 def test_ray_sweep_with_two_actors_equals_simulate(launches, tmp_path, capfd, recwarn):
     """The command starts a local Ray instance (2 actors, a CPU for the read task) and stops it after. Both engines
-    read every source through the same `pieces()` and fly it with the same `Flyer`, so one CSV of 300 rows in 5
+    read every source through the same `pieces()` and fly it with the same `SweepWorker`, so one CSV of 300 rows in 5
     chunks over 2 actors stands for the sources here. No deprecated Ray argument (`ray_remote_args`, gone in Ray
     2.64) and no `E ... core_worker` line about Ray Data's own actors on standard error."""
     ray = pytest.importorskip("ray")

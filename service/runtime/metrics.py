@@ -43,7 +43,7 @@ ModelLabels = Callable[[], dict[str, str] | None]
 """The loaded model's info labels (variant, sha256, version), or None while it loads or after it failed to."""
 
 
-class ModelInfo:
+class ModelInfoCollector:
     """A collector of `golfflight_model_info{variant, sha256, version} 1` once the model is loaded. A collector read
     at scrape time, not an `Info` metric: prometheus-client's multiprocess mode has no `Info`, and every worker of a
     server loads the same verified bundle, so the scraped worker's labels are the pod's."""
@@ -88,12 +88,12 @@ class ServiceMetrics:
             buckets=BATCH_SHOTS_BUCKETS,
             registry=self.registry,
         )
-        self.registry.register(ModelInfo(model_labels))
+        self.registry.register(ModelInfoCollector(model_labels))
         self._scraped = self.registry
         if os.environ.get(MULTIPROC_ENV):
             self._scraped = CollectorRegistry()
             MultiProcessCollector(self._scraped)
-            self._scraped.register(ModelInfo(model_labels))
+            self._scraped.register(ModelInfoCollector(model_labels))
 
     def exposition(self) -> bytes:
         """Every metric in the Prometheus text format: this process's, or every worker's in multiprocess mode."""
