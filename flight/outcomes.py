@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass, fields
 
 import numpy as np
+from golfflight.flight import xp
 from golfflight.flight.constants import RPM_TO_RADPS
 from golfflight.flight.ground import GroundPath, GroundPhase
 from golfflight.flight.physics import State
@@ -21,21 +22,17 @@ def landing_angle_deg(vx, vy, vz):
     return math.degrees(math.atan2(-vz, math.hypot(vx, vy)))
 
 
-def parabola_apex(before, peak, after, peak_time_s, dt: float):
+def parabola_apex(before, peak, after, peak_time_s, dt: float, inside=True):
     """(apex height, apex time) of the parabola through three heights one step apart, the middle one the highest
     state: the integrator's apex between its steps rather than on them (about g dt^2 / 8 higher at most, up to dt / 2
-    earlier or later). Where a neighbour is missing (NaN: the launch state) or the three do not bend down, the peak
-    state itself."""
+    earlier or later). Where a neighbour is missing (NaN: the launch state; or `inside` False: a differentiable
+    caller's peak at the first or last state) or the three do not bend down, the peak state itself. Floats, NumPy
+    arrays or torch tensors (`flight.xp`)."""
     bend = before - 2.0 * peak + after
     rise = before - after
-    if isinstance(bend, np.ndarray):
-        down = bend < 0.0
-        shift = np.where(down, rise / (2.0 * np.where(down, bend, -1.0)), 0.0)
-        return np.where(down, peak - rise * shift / 4.0, peak), peak_time_s + shift * dt
-    if bend < 0.0:
-        shift = rise / (2.0 * bend)
-        return peak - rise * shift / 4.0, peak_time_s + shift * dt
-    return peak, peak_time_s
+    down = (bend < 0.0) & inside
+    shift = xp.where(down, rise / (2.0 * xp.where(down, bend, -1.0)), 0.0)
+    return xp.where(down, peak - rise * shift / 4.0, peak), peak_time_s + shift * dt
 
 
 @dataclass

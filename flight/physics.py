@@ -10,8 +10,9 @@ Aerodynamic coefficients come from a pluggable model (v_rel, omega) -> [N,4] = C
   dw/dt = -C_M q d A omega/|omega| / I               (erratum: spin only ever decays)
 
 The equations are written once, component by component (`accelerations`, `euler_step`), with nothing but
-+ - * / and ** 0.5, so the same code runs on plain Python floats (one shot, where NumPy's per-call cost would
-dominate) and on NumPy [N] arrays (a batch). The [N,3] functions below (`aerodynamics`, `derivatives`) wrap them.
++ - * / and ** 0.5 and `flight.xp`, so the same code runs on plain Python floats (one shot, where NumPy's per-call
+cost would dominate), on NumPy [N] arrays (a batch) and on torch [N] tensors (training's differentiable flight and
+the torch engine, `model_export.torch_physics`). `aerodynamics` wraps them for [N,3] arrays or tensors.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
+from golfflight.flight import xp
 from golfflight.flight.constants import (
     BALL_AREA_M2,
     BALL_INERTIA_KG_M2,
@@ -86,9 +88,20 @@ def initial_state(
     return State(position, velocity, omega)
 
 
-def spin_ratio(v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
+def magnitude(a):
+    """|a| of [..., 3] vectors (NumPy or torch), from their components as the equations take them."""
+    x, y, z = xp.columns(a)
+    return (x * x + y * y + z * z) ** 0.5
+
+
+def spin_ratio(v_rel, omega):
     """S = R |omega| / |v_rel| [N]: surface speed over air speed, the variable lift and drag depend on."""
-    return BALL_RADIUS_M * np.linalg.norm(omega, axis=-1) / np.maximum(np.linalg.norm(v_rel, axis=-1), TINY)
+    return spin_ratio_of(magnitude(v_rel), magnitude(omega))
+
+
+def spin_ratio_of(speed, spin_rate):
+    """S = R |omega| / |v_rel| from the two magnitudes, for callers that have them already."""
+    return BALL_RADIUS_M * spin_rate / at_least_tiny(speed)
 
 
 def reynolds_scale(kinematic_viscosity, nominal_kinematic_viscosity):
@@ -99,10 +112,8 @@ def reynolds_scale(kinematic_viscosity, nominal_kinematic_viscosity):
 
 
 def at_least_tiny(x):
-    """max(x, TINY) of a float or an array: the guard of every magnitude in a denominator."""
-    if isinstance(x, np.ndarray):
-        return np.maximum(x, TINY)
-    return max(x, TINY)
+    """max(x, TINY) of a float, an array or a tensor: the guard of every magnitude in a denominator."""
+    return xp.maximum(x, TINY)
 
 
 def accelerations(vx, vy, vz, wx, wy, wz, c_lift, c_drag, c_moment, c_q, density):
@@ -138,10 +149,12 @@ def euler_step(x, y, z, vx, vy, vz, wx, wy, wz, coefficients, density, air_vx, a
     )
 
 
-def aerodynamics(v_rel: np.ndarray, omega: np.ndarray, coefficients: np.ndarray, density: np.ndarray | float):
-    """Aerodynamic acceleration [N,3] (drag + Magnus lift) and spin acceleration [N,3] from the coefficients [N,4]."""
-    components = accelerations(*v_rel.T, *omega.T, *coefficients.T, density)
-    return np.stack(components[:3], -1), np.stack(components[3:], -1)
+def aerodynamics(v_rel, omega, coefficients, density):
+    """Aerodynamic acceleration [N,3] (drag + Magnus lift) and spin acceleration [N,3] from the coefficients [N,4]
+    (C_L, C_D, C_M, C_Q); NumPy arrays or torch tensors alike, density a float or [N]."""
+    v, w = xp.columns(v_rel), xp.columns(omega)
+    components = accelerations(*v, *w, *(coefficients[..., i] for i in range(4)), density)
+    return xp.stack(components[:3]), xp.stack(components[3:])
 
 
 def derivatives(

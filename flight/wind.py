@@ -6,12 +6,12 @@ Direction convention (degrees, clockwise seen from behind the golfer looking at 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Literal
 
 import numpy as np
+from golfflight.flight import xp
 from numpy.typing import ArrayLike
 
 STATION_HEIGHT_M = 10.0
@@ -28,18 +28,11 @@ def wind_vector(speed_mps: ArrayLike, from_deg: ArrayLike) -> np.ndarray:
     return np.stack([-speed * np.sin(theta), -speed * np.cos(theta), np.zeros_like(speed * theta)], axis=-1)
 
 
-def log_profile_factor(
-    height_m: ArrayLike, reference_height_m: ArrayLike, roughness_m: ArrayLike
-) -> np.ndarray | float:
-    """V(h)/V(h_ref) of the logarithmic wind profile; zero at and below the roughness length.
-
-    A float height gives a float through `math` (the one-shot engine calls this every step); anything else NumPy.
-    """
-    if isinstance(height_m, float):
-        h, log = max(height_m, roughness_m), math.log
-    else:
-        h, log = np.maximum(np.asarray(height_m, dtype=float), roughness_m), np.log
-    return log(h / roughness_m) / log(reference_height_m / roughness_m)
+def log_profile_factor(height_m, reference_height_m, roughness_m):
+    """V(h)/V(h_ref) of the logarithmic wind profile; zero at and below the roughness length. Floats (the one-shot
+    engine calls this every step), NumPy arrays or torch tensors (`flight.xp`)."""
+    height = xp.maximum(height_m, roughness_m)
+    return xp.log(height / roughness_m) / xp.log(reference_height_m / roughness_m)
 
 
 def uniform_equivalent_factor(heights_m: np.ndarray, reference_height_m: float, roughness_m: float) -> float:

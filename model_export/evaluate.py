@@ -22,9 +22,9 @@ from golfflight.evaluation.validation import Errors, Prediction, errors_of, gap
 from golfflight.flight.air import Air
 from golfflight.flight.flyer import load_flyer
 from golfflight.flight.outcomes import Flight
-from golfflight.flight.physics import initial_state
+from golfflight.flight.physics import initial_state, spin_ratio
 from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics
-from golfflight.model_export.torch_physics import euler_rollout, hard_landing, spin_ratio
+from golfflight.model_export.torch_physics import euler_rollout, hard_landing
 from golfflight.model_export.training import (
     VALIDATION_BATCH,
     TrainConfig,

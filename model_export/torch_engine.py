@@ -16,7 +16,7 @@ the part stopping once every shot has come down; a shot never down by the maximu
 not finite, fails with the engine's message (the batch is flown in parts that fit the device).
 
 The ground phase (bounce and roll) of the landing states in float64 is the engine's own: on a GPU its formulas run on
-the device (`torch_ground`, the batch's bookkeeping in torch), on a CPU its NumPy code (`flight.ground.ground_phase`).
+the device (`flight.ground.phase.roll_to_rest` on tensors), on a CPU on NumPy's arrays (`flight.ground.ground_phase`).
 `seconds` holds the time spent in each stage (`STAGES`: preparing a batch's launch states and air on the CPU, the
 device's flight, the figures and ground phase), summed over the threads that fly batches on one engine at once (a
 sweep's pieces in flight: `parts_at_once` share the device's memory). A part's size is `part_shots`. Nothing of the
@@ -40,11 +40,11 @@ from golfflight.errors import InputError
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import LAUNCH_WIDTH, NON_FINITE, Launch, air_inputs, load_flyer
 from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, batch_surface, elevations, ground_phase
-from golfflight.flight.ground.phase import plane_normals
+from golfflight.flight.ground.phase import plane_normals, roll_to_rest
 from golfflight.flight.outcomes import BatchFlights, Rest, landing_figures
 from golfflight.flight.per_shot import PerShot
 from golfflight.flight.physics import initial_state, reynolds_scale
-from golfflight.model_export import torch_ground
+from golfflight.flight.wind import log_profile_factor
 from golfflight.model_export.bundle_model import model_from_bundle
 from golfflight.model_export.devices import resolve_device
 from golfflight.model_export.torch_physics import LANDING_CHECK_STEPS, Trajectory, apex, euler_step, hard_landing
@@ -171,7 +171,7 @@ class TorchEngine:
         is the physics' precision; `part_shots` caps the shots flown at once (default: what the device's memory
         holds, shared by `parts_at_once` threads flying batches on this engine at once); `compile_step` fuses each
         Euler step's kernels with torch.compile (`step`: `flight_step`, compiled or eager, once for any part's size);
-        `ground_on_device` bounces and rolls the landings on the device (`torch_ground`; default: on a GPU) instead
+        `ground_on_device` bounces and rolls the landings on the device (`roll_to_rest`; default: on a GPU) instead
         of NumPy's on the CPU; `set_aside_share` is the share of a part's flying shots that must be down before they
         are set aside (1: never, every shot flies to the part's last step). `devices.DeviceError` for a device this
         machine lacks, ValueError for a dtype it does not know or a share outside (0, 1]."""
@@ -239,17 +239,22 @@ class TorchEngine:
 
     def _ground_on_device(self, position: np.ndarray, velocity: np.ndarray, spin: np.ndarray, surface: Surface,
                           slope_deg: np.ndarray, slope_dir_deg: np.ndarray) -> GroundPhase:
-        """`flight.ground.ground_phase`'s rests of these landings (NumPy [N,3]) computed on the device in float64
-        (`torch_ground.ground_phase`, the same formulas) and brought back; the planes' normals are NumPy's."""
+        """`flight.ground.ground_phase`'s rests of these landings (NumPy [N,3]) computed on the device in float64 by
+        the same driver (`flight.ground.phase.roll_to_rest` on tensors) and brought back; the planes' normals are
+        NumPy's."""
         def tensor(values: np.ndarray | float) -> torch.Tensor | float:
             if np.ndim(values) == 0:
                 return float(values)
             return torch.as_tensor(values, dtype=torch.float64, device=self.device)
 
-        normal = plane_normals(slope_deg, slope_dir_deg, len(position))
+        n = len(position)
+        normal = plane_normals(slope_deg, slope_dir_deg, n)
         on_device = Surface(*(tensor(getattr(surface, name)) for name in Surface.__dataclass_fields__))
-        rest, hops, time_s = torch_ground.ground_phase(tensor(position), tensor(velocity), tensor(spin), tensor(normal),
-                                                       on_device)
+        resistance, drag = (tensor(np.broadcast_to(np.asarray(value, dtype=float), (n,)))
+                            for value in (surface.rolling_resistance, surface.grass_drag_per_s))
+        level = tensor(normal)[:, 2] == 1.0
+        rest, hops, time_s = roll_to_rest(tensor(position), tensor(velocity), tensor(spin), tensor(normal), on_device,
+                                          resistance, drag, level)
         return GroundPhase(rest.cpu().numpy(), hops.cpu().numpy(), time_s.cpu().numpy())
 
     def _spent(self, stage: str, since: float) -> float:
@@ -375,23 +380,23 @@ class TorchEngineMaker:
 
 def _wind(at_reference: torch.Tensor, log_profile: torch.Tensor, reference_height_m: torch.Tensor,
           roughness_m: torch.Tensor) -> tuple[torch.Tensor | None, ...]:
-    """A part's wind as `wind_at` takes it: (at_reference, log_profile, reference_log, roughness), None for what the
-    part does not need (all four in calm air; the last three where no shot follows the log profile)."""
+    """A part's wind as `wind_at` takes it: (at_reference, log_profile, reference_height_m, roughness_m), None for
+    what the part does not need (all four in calm air; the last three where no shot follows the log profile)."""
     if not bool(at_reference.any()):
         return None, None, None, None
     if not bool(log_profile.any()):
         return at_reference, None, None, None
-    return at_reference, log_profile, torch.log(reference_height_m / roughness_m), roughness_m
+    return at_reference, log_profile, reference_height_m, roughness_m
 
 
 def wind_at(height_m: torch.Tensor, at_reference: torch.Tensor | None, log_profile: torch.Tensor | None,
-            reference_log: torch.Tensor | None, roughness_m: torch.Tensor | None) -> torch.Tensor | None:
+            reference_height_m: torch.Tensor | None, roughness_m: torch.Tensor | None) -> torch.Tensor | None:
     """The air's velocity [N,3] at the balls' heights [N], as `flight.wind.Wind.velocity` gives it: the wind at its
-    reference height, times V(h)/V(h_ref) of the log profile for the shots that follow it (zero at and below the
-    roughness length); None in calm air."""
+    reference height, times the log profile's factor (`flight.wind.log_profile_factor`) for the shots that follow
+    it; None in calm air."""
     if at_reference is None or log_profile is None:
         return at_reference
-    factor = torch.log(torch.maximum(height_m, roughness_m) / roughness_m) / reference_log
+    factor = log_profile_factor(height_m, reference_height_m, roughness_m)
     return at_reference * torch.where(log_profile, factor, torch.ones_like(factor))[:, None]
 
 

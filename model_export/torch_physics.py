@@ -1,7 +1,8 @@
-"""Differentiable PyTorch twin of `flight.physics` + forward Euler (paper sections 2.1, 2.3).
+"""The differentiable fixed-horizon rollout training needs (paper sections 2.1, 2.3), on the flight core's equations.
 
-The one place the equations of motion exist in torch. Same axes, signs, constants and guards as the NumPy
-core (errata applied: lift along omega x v, spin only decays, q = C_Q rho |v|^2), batched over shots and
+The equations of motion are `flight.physics`'s, written once over floats, NumPy and torch (`flight.xp`): this module
+adds what training alone needs, the whole-horizon rollout kept as one graph, the soft landing and the landing and
+apex read back differentiably (the apex's parabola is `flight.outcomes.parabola_apex`'s), batched over shots and
 dtype-agnostic (float64 for the parity tests, float32 for training). Wind is uniform (one air velocity per shot):
 real-data training fits it as a per-group nuisance, where a uniform wind is the simplest stand-in for the profile.
 The landing and the apex are measured as `flight.integrator` measures them (`hard_landing`, `apex`), so training
@@ -14,8 +15,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import torch
-from golfflight.flight.constants import BALL_AREA_M2, BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2
-from golfflight.flight.physics import TINY
+from golfflight.flight.constants import GRAVITY_MPS2
+from golfflight.flight.outcomes import parabola_apex
+from golfflight.flight.physics import TINY, aerodynamics
 
 DT_S = 0.1
 """Euler step of the paper (section 2.3.2): the step the models are trained and served with."""
@@ -71,36 +73,6 @@ class Landing:
     spin: torch.Tensor
     time_s: torch.Tensor
     landed: torch.Tensor
-
-
-def _norm(x: torch.Tensor) -> torch.Tensor:
-    return torch.linalg.vector_norm(x, dim=-1)
-
-
-def spin_ratio(v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
-    """S = R |omega| / |v_rel| [N], guarded like `flight.physics.spin_ratio`."""
-    return spin_ratio_of(_norm(v_rel), _norm(omega))
-
-
-def spin_ratio_of(speed: torch.Tensor, spin_rate: torch.Tensor) -> torch.Tensor:
-    """S = R |omega| / |v_rel| from the two magnitudes, for callers that have them already."""
-    return BALL_RADIUS_M * spin_rate / speed.clamp_min(TINY)
-
-
-def aerodynamics(
-    v_rel: torch.Tensor, omega: torch.Tensor, coefficients: torch.Tensor, density: torch.Tensor | float
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """Aerodynamic acceleration [N,3] (drag + Magnus lift) and spin acceleration [N,3], as in `flight.physics`."""
-    c_lift, c_drag, c_moment, c_q = coefficients.unbind(dim=-1)
-    speed = _norm(v_rel)
-    q_area = c_q * density * speed**2 * BALL_AREA_M2
-    magnus = torch.linalg.cross(omega, v_rel, dim=-1)
-    magnus_unit = magnus / _norm(magnus).clamp_min(TINY)[:, None]
-    drag_unit = v_rel / speed.clamp_min(TINY)[:, None]
-    force = q_area[:, None] * (c_lift[:, None] * magnus_unit - c_drag[:, None] * drag_unit)
-    spin_unit = omega / _norm(omega).clamp_min(TINY)[:, None]
-    torque = -(c_moment * q_area * 2.0 * BALL_RADIUS_M)[:, None] * spin_unit
-    return force / BALL_MASS_KG, torque / BALL_INERTIA_KG_M2
 
 
 def derivatives(
@@ -252,11 +224,8 @@ def apex(trajectory: Trajectory) -> Apex:
     shots = torch.arange(z.shape[1], device=z.device)
     peak = z[peak_step, shots]
     earlier, later = z[(peak_step - 1).clamp_min(0), shots], z[(peak_step + 1).clamp_max(last), shots]
-    bend, rise = earlier - 2.0 * peak + later, earlier - later
-    down = (bend < 0.0) & (peak_step > 0) & (peak_step < last)
-    shift = torch.where(down, rise / (2.0 * torch.where(down, bend, -torch.ones_like(bend))), 0.0)
-    height = torch.where(down, peak - rise * shift / 4.0, peak)
-    return Apex(height, (peak_step + shift) * trajectory.dt)
+    inside = (peak_step > 0) & (peak_step < last)
+    return Apex(*parabola_apex(earlier, peak, later, peak_step.to(z.dtype) * trajectory.dt, trajectory.dt, inside))
 
 
 def positions_at(trajectory: Trajectory, times_s: torch.Tensor) -> torch.Tensor:

@@ -12,8 +12,8 @@ from collections.abc import Sequence
 import torch
 from golfflight.errors import InputError
 from golfflight.flight.coefficients import BASE_DYNAMIC_PRESSURE, FERGUSON_2022
+from golfflight.flight.physics import spin_ratio, spin_ratio_of
 from golfflight.model_export import DEFAULT_HIDDEN, PHYS_NN_VARIANTS, VARIANTS
-from golfflight.model_export.torch_physics import spin_ratio, spin_ratio_of
 from torch import nn
 
 VELOCITY_SCALE_MPS = 89.4

@@ -48,7 +48,7 @@ def test_a_bad_value_is_refused_naming_its_variable(port):
 
 def test_handed_down_settings_are_read_back_whole(monkeypatch):
     settings = ServiceSettings(api_key="k", cors_origins=("https://a.example",), connect_port=9210, model=Path("/m"))
-    monkeypatch.delenv(HANDED_DOWN_ENV, raising=False)
+    monkeypatch.setenv(HANDED_DOWN_ENV, "")  # restored after the test, whatever hand_down writes
     settings.hand_down()
     assert ServiceSettings.from_env() == settings
     assert ServiceSettings.from_env({HANDED_DOWN_ENV: settings.model_dump_json(), "GOLFFLIGHT_API_KEY": "x"}) == settings

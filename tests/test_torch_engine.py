@@ -74,7 +74,7 @@ def onnx_flights(shots):
 @pytest.fixture(scope="module")
 def engines() -> dict[str, TorchEngine]:
     """Each precision eager, float32 with its Euler step compiled (torch.compile: seconds here), and float64 with its
-    ground phase in torch (`model_export.torch_ground`, a GPU's; here on the CPU)."""
+    ground phase in torch (`flight.ground.phase.roll_to_rest` on tensors, a GPU's; here on the CPU)."""
     bundle = load_flyer(None).bundle_dir
     return {"float32": TorchEngine(bundle, "cpu", "float32"), "float64": TorchEngine(bundle, "cpu", "float64"),
             "float32-compiled": TorchEngine(bundle, "cpu", "float32", compile_step=True),

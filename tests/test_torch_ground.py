@@ -1,15 +1,15 @@
-"""The ground phase on a torch device (`model_export.torch_ground`, the torch engine's on a GPU) against the engine's
-NumPy ground phase on the same landings: the same formulas, so the same rests, hops and times to rounding."""
+"""The ground phase's one driver on torch tensors (`flight.ground.phase.roll_to_rest`, the torch engine's on a GPU)
+against the engine's NumPy ground phase on the same landings: the same code, so the same rests, hops and times to
+rounding."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from golfflight.flight.ground import SURFACES, Surface, ground_phase
-from golfflight.flight.ground.phase import plane_normals
+from golfflight.flight.ground.phase import plane_normals, roll_to_rest
 
 torch = pytest.importorskip("torch")
-from golfflight.model_export.torch_ground import ground_phase as device_ground_phase
 
 SURFACE_NAMES = ("fairway", "green", "rough", "firm_fairway", "bunker")
 
@@ -43,8 +43,11 @@ def test_the_device_ground_phase_gives_numpys_rests_hops_and_times(mixed):
         surface, slope, direction = SURFACES["fairway"], np.zeros(n), np.zeros(n)
     want = ground_phase(position, velocity, spin, surface, slope, direction)
     on_device = Surface(*(tensor(getattr(surface, name)) for name in Surface.__dataclass_fields__))
-    rest, hops, time_s = device_ground_phase(tensor(position), tensor(velocity), tensor(spin),
-                                             tensor(plane_normals(slope, direction, n)), on_device)
+    normal = tensor(plane_normals(slope, direction, n))
+    resistance, drag = (tensor(np.broadcast_to(np.asarray(value, dtype=float), (n,)))
+                        for value in (surface.rolling_resistance, surface.grass_drag_per_s))
+    rest, hops, time_s = roll_to_rest(tensor(position), tensor(velocity), tensor(spin), normal, on_device, resistance,
+                                      drag, normal[:, 2] == 1.0)
     np.testing.assert_array_equal(hops.numpy(), want.bounces)
     np.testing.assert_allclose(rest.numpy(), want.rest_position, rtol=0, atol=1e-9)
     np.testing.assert_allclose(time_s.numpy(), want.time_s, rtol=0, atol=1e-9)
@@ -56,12 +59,12 @@ def test_the_device_ground_phase_gives_numpys_rests_hops_and_times(mixed):
     assert (penner > np.asarray(surface.max_tilt_deg)).any() == mixed, "the green's tilt cap is not covered"
 
 
-def test_the_vectors_functions_answer_in_the_library_of_their_arguments():
+def test_the_namespace_functions_answer_in_the_library_of_their_arguments():
     """Plain numbers (NumPy's scalars among them) stay plain, arrays NumPy's, tensors torch's (the device's)."""
-    from golfflight.flight.ground import vectors
+    from golfflight.flight import xp as vectors
 
     for name, args in (("minimum", (0.3, 0.5)), ("maximum", (0.3, 0.5)), ("atan2", (0.3, 0.5)), ("cos", (0.3,)),
-                       ("sin", (0.3,)), ("log1p", (0.3,)), ("expm1", (0.3,))):
+                       ("sin", (0.3,)), ("log", (0.3,)), ("log1p", (0.3,)), ("expm1", (0.3,))):
         function = getattr(vectors, name)
         plain = function(*args)
         assert isinstance(plain, float), name

@@ -9,7 +9,7 @@ import pytest
 import torch
 from golfflight.flight.coefficients import QuadraticSpinRatio
 from golfflight.model_export import PHYSICS_VARIANTS, VARIANTS
-from golfflight.model_export.torch_physics import spin_ratio
+from golfflight.flight.physics import spin_ratio
 from golfflight.model_export.variants import P_M_INIT, LandingNN, PhysNN, PhysQ, build_model
 from golfflight.weights_schema.model_card import ExportableVariant
 

@@ -47,7 +47,8 @@ import math
 import numpy as np
 from golfflight.flight.constants import BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M
 from golfflight.flight.ground.surfaces import Surface
-from golfflight.flight.ground.vectors import TINY, add, atan2, cos, cross, dot, maximum, minimum, norm, sin, times
+from golfflight.flight.ground.vectors import TINY, add, cross, dot, norm, times
+from golfflight.flight.xp import atan2, cos, maximum, minimum, sin
 
 PENNER_MAX_NORMAL_SPEED_MPS = 20.0
 """Penner's restitution fit holds up to 20 m/s normal speed; faster impacts keep its value there (about 0.12)."""

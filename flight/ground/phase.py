@@ -18,10 +18,10 @@ wind, whose drag is about 1e-5 g, under a thousandth of the fastest green's roll
 On a hop the wind changes the air's push on the ball by as much as the ball's own drag, which the hops leave out
 (above): a few per cent of a hop's length.
 
-The formulas are written once on (x, y, z) tuples of floats or arrays (`flight.ground.vectors`): `ground_phase` runs
-them on a batch, `ground_phase_one` on one ball's plain floats (the engine's one-shot latency path, where NumPy's
-per-call cost on arrays of one row would cost more than the physics), and the torch engine on a device's tensors
-(`model_export.torch_ground`).
+The formulas are written once on (x, y, z) tuples of floats, arrays or tensors (`flight.ground.vectors`, `flight.xp`),
+and so is the batch's driver (`roll_to_rest`, NumPy or torch: `ground_phase` runs it on a batch, the torch engine on a
+device's tensors); `ground_phase_one` runs the formulas on one ball's plain floats (the engine's one-shot latency
+path, where NumPy's per-call cost on arrays of one row would cost more than the physics).
 
 Every state of the phase can be kept (`keep_path`): after each impact, each touchdown, each roll step and the rest,
 with velocities, and a level roll's states every ROLL_STEP_S, so a renderer's cubic Hermite resampling follows the
@@ -37,9 +37,11 @@ from typing import NamedTuple
 import numpy as np
 from golfflight.errors import InputError
 from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
-from golfflight.flight.ground.impact import impact, impact_components
+from golfflight.flight.ground.impact import impact_components
 from golfflight.flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, holding_slope_deg
-from golfflight.flight.ground.vectors import TINY, add, cross, dot, expm1, log1p, maximum, norm, times, where
+from golfflight.flight.ground.vectors import TINY, add, cross, dot, norm, times
+from golfflight.flight import xp
+from golfflight.flight.xp import expm1, log1p, maximum, where
 
 MIN_HOP_SPEED_MPS = 0.5
 """Rebounds slower than this off the plane (a hop under 13 mm high: a skip the turf soaks up) end the bounces: the
@@ -193,34 +195,31 @@ class _Recorder:
         ]
 
 
-def _columns(a: np.ndarray) -> tuple:
-    return tuple(a.T)
-
-
 def _bounce(position, velocity, spin, normal, surface: Surface, record: _Recorder):
     """Impacts and hops until every ball rolls: (roll-start position, rolling velocity, time, hops)."""
     n = len(position)
-    time, hops = np.zeros(n), np.zeros(n, dtype=int)
-    position, velocity, spin = position.copy(), velocity.copy(), spin.copy()
-    bouncing = np.arange(n)
+    time, hops = xp.zeros(n, position), xp.zeros(n, position, integer=True)
+    position, velocity, spin = xp.copy(position), xp.copy(velocity), xp.copy(spin)
+    bouncing = xp.arange(n, position)
     record.add(bouncing, time, position, velocity)
-    while bouncing.size:
+    while xp.size(bouncing):
         ids = bouncing
-        v_out, w_out = impact(velocity[ids], spin[ids], normal[ids], surface.take(ids))
-        rebound = np.einsum("ij,ij->i", v_out, normal[ids])
+        v_out, w_out = impact_components(xp.columns(velocity[ids]), xp.columns(spin[ids]), xp.columns(normal[ids]),
+                                         surface.take(ids))
+        rebound = dot(v_out, xp.columns(normal[ids]))
         hopping = (rebound > MIN_HOP_SPEED_MPS) & (hops[ids] < MAX_BOUNCES)
-        velocity[ids], spin[ids] = v_out, w_out
+        velocity[ids], spin[ids] = xp.stack(v_out), xp.stack(w_out)
         flying = ids[hopping]
-        if flying.size:
+        if xp.size(flying):
             record.add(flying, time[flying], position[flying], velocity[flying])
             duration = 2.0 * rebound[hopping] / (GRAVITY_MPS2 * normal[flying, 2])
-            landed, incoming = hop(_columns(position[flying]), _columns(velocity[flying]), duration)
-            position[flying], velocity[flying] = np.stack(landed, -1), np.stack(incoming, -1)
+            landed, incoming = hop(xp.columns(position[flying]), xp.columns(velocity[flying]), duration)
+            position[flying], velocity[flying] = xp.stack(landed), xp.stack(incoming)
             time[flying] += duration
             hops[flying] += 1
             record.add(flying, time[flying], position[flying], velocity[flying])
         bouncing = flying
-    rolling = np.stack(rolling_velocity(_columns(velocity), _columns(spin), _columns(normal)), -1)
+    rolling = xp.stack(rolling_velocity(xp.columns(velocity), xp.columns(spin), xp.columns(normal)))
     return position, rolling, time, hops
 
 
@@ -246,34 +245,58 @@ def _record_level(record: _Recorder, ids, start_time, position, velocity, resist
 
 def _roll_level(position, velocity, resistance, drag):
     """Rest point and roll time on level ground (closed form, `stopping`)."""
-    speed = np.linalg.norm(velocity, axis=-1)
+    speed = norm(xp.columns(velocity))
     distance, time = stopping(speed, resistance * GRAVITY_MPS2, drag)
-    direction = velocity / np.maximum(speed, TINY)[:, None]
+    direction = velocity / maximum(speed, TINY)[:, None]
     return position + direction * distance[:, None], time
 
 
 def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder, ids, start):
     """Rest point and roll time on slopes, in `slope_step`s until every ball has stopped."""
-    downhill = np.stack(downhill_acceleration(_columns(normal)), -1)
+    downhill = xp.stack(downhill_acceleration(xp.columns(normal)))
     brake = resistance * GRAVITY_MPS2 * normal[:, 2]
-    position, velocity = position.copy(), velocity.copy()
-    rest, time = position.copy(), np.zeros(len(position))
-    moving = np.arange(len(position))
+    position, velocity = xp.copy(position), xp.copy(velocity)
+    rest, time = xp.copy(position), xp.zeros(len(position), position)
+    moving = xp.arange(len(position), position)
     for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
-        if not moving.size:
+        if not xp.size(moving):
             break
         stops, taken, stop_at, moved, after = slope_step(
-            _columns(position[moving]), _columns(velocity[moving]), _columns(downhill[moving]), brake[moving],
+            xp.columns(position[moving]), xp.columns(velocity[moving]), xp.columns(downhill[moving]), brake[moving],
             drag[moving],
         )
         stopped, going = moving[stops], moving[~stops]
-        rest[stopped] = np.stack(stop_at, -1)[stops]
+        rest[stopped] = xp.stack(stop_at)[stops]
         time[moving] += taken
-        position[going], velocity[going] = np.stack(moved, -1)[~stops], np.stack(after, -1)[~stops]
+        position[going], velocity[going] = xp.stack(moved)[~stops], xp.stack(after)[~stops]
         record.add(ids[going], start[going] + time[going], position[going], velocity[going])
         moving = going
     rest[moving] = position[moving]
     return rest, time
+
+
+def roll_to_rest(position, velocity, spin, normal, surface: Surface, resistance, drag, level,
+                 record: _Recorder | None = None):
+    """The batch's ground phase, NumPy arrays or torch tensors alike (the torch engine's on its device): bounce every
+    ball, then roll those on `level` ground in closed form and the rest in slope steps. Landing states and plane
+    normals [N,3], the surface's resistance and drag [N], `level` a mask [N]. (rest [N,3], hops [N], time on the
+    ground [N]); `record` (NumPy only) keeps every state."""
+    n = len(position)
+    record = record or _Recorder(n, keep=False)
+    everyone = xp.arange(n, position)
+    start, rolling, time, hops = _bounce(position, velocity, spin, normal, surface, record)
+    record.add(everyone[norm(xp.columns(rolling)) > 0.0], time, start, rolling)
+    rest, roll_time = xp.copy(start), xp.zeros(n, position)
+    rest[level], roll_time[level] = _roll_level(start[level], rolling[level], resistance[level], drag[level])
+    _record_level(record, everyone[level], time[level], start[level], rolling[level], resistance[level], drag[level],
+                  roll_time[level])
+    sloped = ~level
+    if bool(sloped.any()):
+        ids = everyone[sloped]
+        rest[sloped], roll_time[sloped] = _roll_slope(
+            start[sloped], rolling[sloped], normal[sloped], resistance[sloped], drag[sloped], record, ids, time[sloped]
+        )
+    return rest, hops, time + roll_time
 
 
 def ground_phase(
@@ -287,7 +310,7 @@ def ground_phase(
 ) -> GroundPhase:
     """Bounce and roll a batch of balls to rest from their landing states [N,3] (position on the ground, velocity,
     spin in rad/s) on planes through the landing points, sloped by `slope_deg` towards `slope_dir_deg`
-    (`plane_normals`); `surface` holds floats or [N] arrays. ValueError if a slope is steeper than its surface
+    (`plane_normals`); `surface` holds floats or [N] arrays. InputError if a slope is steeper than its surface
     holds a ball on."""
     n = len(position)
     resistance = np.broadcast_to(np.asarray(surface.rolling_resistance, dtype=float), (n,))
@@ -296,19 +319,7 @@ def ground_phase(
     _check_slopes(slope, resistance)
     normal = plane_normals(slope, slope_dir_deg, n)
     record = _Recorder(n, keep_path)
-    start, rolling, time, hops = _bounce(position, velocity, spin, normal, surface, record)
-    record.add(np.flatnonzero(np.linalg.norm(rolling, axis=-1) > 0.0), time, start, rolling)
-    level, sloped = np.flatnonzero(slope == 0.0), np.flatnonzero(slope != 0.0)
-    rest, roll_time = np.empty_like(start), np.empty(n)
-    rest[level], roll_time[level] = _roll_level(start[level], rolling[level], resistance[level], drag[level])
-    _record_level(record, level, time[level], start[level], rolling[level], resistance[level], drag[level],
-                  roll_time[level])
-    if sloped.size:
-        rest[sloped], roll_time[sloped] = _roll_slope(
-            start[sloped], rolling[sloped], normal[sloped], resistance[sloped], drag[sloped], record, sloped,
-            time[sloped],
-        )
-    total = time + roll_time
+    rest, hops, total = roll_to_rest(position, velocity, spin, normal, surface, resistance, drag, slope == 0.0, record)
     record.add(np.arange(n), total, rest, np.zeros_like(rest))
     return GroundPhase(rest, hops, total, record.paths())
 

@@ -1,0 +1,118 @@
+"""The array namespace the physics is written over: plain floats (one ball, on the single shot's latency path), NumPy
+arrays (a batch) and torch tensors (training and the torch engine, on a CPU or a GPU). The equations, the wind's
+profile, the apex and the ground phase use `+ - * /`, `** 0.5` and these functions only, so each is written once and
+runs on all three. The one place an array's kind is told apart: this module never imports torch (a caller holding
+tensors has), so the serving install stays torch-free.
+
+Array-API style, written out rather than taken from `array_api_compat`: that library has no namespace for plain
+floats, the latency path's, and these few functions are all the physics needs."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+import numpy as np
+
+NUMBERS = (float, int, np.generic)
+"""Plain numbers (NumPy's scalars among them): one ball's components, checked before anything slower."""
+
+
+def _tensor_call(name: str, *values):
+    """torch's `name` on `values`, some of them tensors; the plain numbers among them made tensors like the first."""
+    torch = sys.modules["torch"]
+    like = next(v for v in values if isinstance(v, torch.Tensor))
+    return getattr(torch, name)(*(v if isinstance(v, torch.Tensor) else torch.as_tensor(v, dtype=like.dtype,
+                                                                                       device=like.device)
+                                  for v in values))
+
+
+CLAMPS = {"maximum": "clamp_min", "minimum": "clamp_max"}
+"""A tensor's bound by a plain number without making the number a tensor (no copy to a device every call)."""
+
+
+def _binary(name: str, numbers, arrays):
+    def function(a, b):
+        if isinstance(a, NUMBERS) and isinstance(b, NUMBERS):
+            return numbers(a, b)
+        if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+            return arrays(a, b)
+        if name in CLAMPS and isinstance(b, NUMBERS):
+            return getattr(a, CLAMPS[name])(b)
+        if name in CLAMPS and isinstance(a, NUMBERS):
+            return getattr(b, CLAMPS[name])(a)
+        return _tensor_call(name, a, b)
+
+    function.__name__ = name
+    return function
+
+
+def _unary(name: str, numbers, arrays):
+    def function(a):
+        if isinstance(a, NUMBERS):
+            return numbers(a)
+        return arrays(a) if isinstance(a, np.ndarray) else getattr(a, name)()
+
+    function.__name__ = name
+    return function
+
+
+maximum = _binary("maximum", max, np.maximum)
+minimum = _binary("minimum", min, np.minimum)
+atan2 = _binary("atan2", math.atan2, np.arctan2)
+cos = _unary("cos", math.cos, np.cos)
+sin = _unary("sin", math.sin, np.sin)
+log = _unary("log", math.log, np.log)
+log1p = _unary("log1p", math.log1p, np.log1p)
+expm1 = _unary("expm1", math.expm1, np.expm1)
+
+
+def where(condition, a, b):
+    """a where `condition` holds, else b (both evaluated)."""
+    if isinstance(condition, (bool, np.bool_)):
+        return a if condition else b
+    if isinstance(condition, np.ndarray):
+        return np.where(condition, a, b)
+    torch = sys.modules["torch"]
+    dtype = next((v.dtype for v in (a, b) if isinstance(v, torch.Tensor)), torch.float64)
+    return torch.where(condition, *(v if isinstance(v, torch.Tensor) else torch.as_tensor(v, dtype=dtype,
+                                                                                        device=condition.device)
+                                    for v in (a, b)))
+
+
+def stack(components) -> object:
+    """[..., k] from k arrays of one kind (NumPy or torch), along a new last axis."""
+    first = components[0]
+    if isinstance(first, np.ndarray):
+        return np.stack(components, -1)
+    return sys.modules["torch"].stack(tuple(components), -1)
+
+
+def columns(a) -> tuple:
+    """The three components of [..., 3] vectors (NumPy or torch): views, not copies."""
+    return a[..., 0], a[..., 1], a[..., 2]
+
+
+def zeros(n: int, like, integer: bool = False):
+    """n zeros of `like`'s kind (its dtype and device for a tensor; int64 where `integer`)."""
+    if isinstance(like, np.ndarray):
+        return np.zeros(n, dtype=np.int64 if integer else float)
+    torch = sys.modules["torch"]
+    return torch.zeros(n, dtype=torch.int64 if integer else like.dtype, device=like.device)
+
+
+def arange(n: int, like):
+    """0 .. n-1 as indices of `like`'s kind."""
+    if isinstance(like, np.ndarray):
+        return np.arange(n)
+    return sys.modules["torch"].arange(n, device=like.device)
+
+
+def copy(a):
+    """A copy of an array or a tensor."""
+    return a.copy() if isinstance(a, np.ndarray) else a.clone()
+
+
+def size(a) -> int:
+    """How many elements."""
+    return int(a.size) if isinstance(a, np.ndarray) else int(a.numel())
