@@ -1,4 +1,4 @@
-"""The torch engine (`golfflight sweep --engine torch`, `model_export.torch_engine`) on one device: shots per second
+"""The torch engine (`golfflight sweep --engine torch`, `flight.torch_engine`) on one device: shots per second
 against batch size (the flight alone, eager and with its Euler step compiled, and with its launch states and ground
 phase, the ground phase where the engine puts it and on the other side: the device or NumPy on the CPU; and eager
 with every shot flown to its part's last step, the landed shots never set aside), peak memory,
@@ -44,8 +44,8 @@ from golfflight.flight.air import Air
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import load_flyer
 from golfflight.flight.ground import SURFACES, GroundSpec
+from golfflight.flight.torch_engine import STAGES, TorchEngine
 from golfflight.flight.wind import Wind
-from golfflight.model_export.torch_engine import STAGES, TorchEngine
 from golfflight.shots.clubs import CLUBS
 from golfflight.sweep.engines import PIECES_IN_FLIGHT
 from golfflight.sweep.grid import Grid

@@ -30,7 +30,7 @@ from pathlib import Path
 import torch
 from common import REPO, RESULTS, write_results
 from golfflight.flight.bundle_location import model_dir
-from golfflight.model_export.devices import resolve_device
+from golfflight.flight.devices import resolve_device
 from golfflight.model_export.joint import JointConfig, JointResult
 from golfflight.model_export.real_data import build
 from golfflight.model_export.real_training import DATA_FILE, SeedPlan, train_seeds

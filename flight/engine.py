@@ -16,7 +16,7 @@ import time
 from collections.abc import Sequence
 
 import numpy as np
-from golfflight.errors import FlightError
+from golfflight.errors import FlightError, InputError
 from golfflight.flight.bundle_check import open_session, session_options
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import (
@@ -89,6 +89,23 @@ class FlightEngine:
     @property
     def variant(self) -> str:
         return self.card.variant
+
+    @classmethod
+    def from_bundle(cls, bundle_dir: str | os.PathLike, backend: str = "onnx", device: str = "cpu", **options):
+        """The engine of a bundle on a backend: "onnx", ONNX Runtime on the CPU (this class: the served engine, its
+        single shot and its batches), or "torch" on `device` ("cpu", "cuda", "cuda:N": `flight.torch_engine`'s
+        TorchEngine, which flies batches as `fly_columns` does; torch is imported here only, so the serving install
+        stays torch-free). `options` go to the engine's constructor. InputError for another backend, or a device
+        with ONNX Runtime."""
+        if backend == "onnx":
+            if device != "cpu":
+                raise InputError(f"device {device!r}: the onnx backend runs on the cpu; a GPU takes backend='torch'")
+            return cls(bundle_dir, **options)
+        if backend == "torch":
+            from golfflight.flight.torch_engine import TorchEngine
+
+            return TorchEngine(bundle_dir, device=device, **options)
+        raise InputError(f"backend {backend!r}: choose onnx or torch")
 
     @property
     def sha256(self) -> str:

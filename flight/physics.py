@@ -12,7 +12,7 @@ Aerodynamic coefficients come from a pluggable model (v_rel, omega) -> [N,4] = C
 The equations are written once, component by component (`accelerations`, `euler_step`), with nothing but
 + - * / and ** 0.5 and `flight.xp`, so the same code runs on plain Python floats (one shot, where NumPy's per-call
 cost would dominate), on NumPy [N] arrays (a batch) and on torch [N] tensors (training's differentiable flight and
-the torch engine, `model_export.torch_physics`). `aerodynamics` wraps them for [N,3] arrays or tensors.
+the torch engine, `flight.rollout`). `aerodynamics` wraps them for [N,3] arrays or tensors.
 """
 
 from __future__ import annotations

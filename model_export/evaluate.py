@@ -24,7 +24,7 @@ from golfflight.flight.flyer import load_flyer
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import initial_state, spin_ratio
 from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics
-from golfflight.model_export.torch_physics import euler_rollout, hard_landing
+from golfflight.flight.rollout import euler_rollout, hard_landing
 from golfflight.model_export.training import (
     VALIDATION_BATCH,
     TrainConfig,

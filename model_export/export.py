@@ -34,8 +34,8 @@ from golfflight.flight.constants import (
     GRAVITY_MPS2,
     TEE_HEIGHT_M,
 )
+from golfflight.flight.rollout import LANDING_SEARCH_START_S, TINY
 from golfflight.model_export import PHYSICS_VARIANTS
-from golfflight.model_export.torch_physics import LANDING_SEARCH_START_S, TINY
 from golfflight.model_export.training import TrainConfig, load_checkpoint, model_from_checkpoint
 from golfflight.model_export.variants import SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, PhysNN, PhysQ
 from golfflight.shots.files import write_atomic
@@ -87,7 +87,7 @@ LANDING = (
     "parabola through the highest step k up to the landing and its two neighbours, z_k - (z_{k-1} - z_{k+1})^2 / (8 "
     "(z_{k-1} - 2 z_k + z_{k+1})) at t_k + dt (z_{k-1} - z_{k+1}) / (2 (z_{k-1} - 2 z_k + z_{k+1})) (the highest step "
     "itself where it is the first or last or the three do not bend down): about g dt^2 / 8 (1.2 cm at 0.1 s) above it "
-    "at most. Training (model_export.torch_physics) and the runtime (flight.integrator, flight.outcomes.parabola_apex) "
+    "at most. Training (flight.rollout) and the runtime (flight.integrator, flight.outcomes.parabola_apex) "
     "measure both the same way. The soft-argmax landing of the L_p loss searches from landing_search_start_s on."
 )
 

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 import torch
 from golfflight.errors import InputError
+from golfflight.flight.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.data import load_training_data
-from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.export import export_checkpoint
 from golfflight.model_export.training import (
     RunResult,

@@ -28,8 +28,8 @@ from typing import Any
 import torch
 from golfflight.discovery.effects import EFFECTS
 from golfflight.errors import InputError
+from golfflight.flight.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.flight.wind import Wind
-from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.observations import (
     OBSERVABLES,
     PATH_OBSERVATIONS,
@@ -39,7 +39,7 @@ from golfflight.model_export.observations import (
     load_observed,
 )
 from golfflight.model_export.stacked_runs import StackedNetworks, clip_per_run, run_of_rows, runs_held
-from golfflight.model_export.torch_physics import (
+from golfflight.flight.rollout import (
     DT_S,
     T_SIM_S,
     Coefficients,

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from golfflight.errors import InputError
 from golfflight.flight.constants import YARD_M
-from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
+from golfflight.flight.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export.export import export_bundle
 from golfflight.model_export.joint import JointConfig, JointResult, soup_runs, train_joint, train_joint_runs
 from golfflight.model_export.observations import NOISE, OBSERVABLES, PATH_OBSERVATIONS, PATH_SIGMA_M

@@ -18,10 +18,10 @@ from typing import Any, Literal
 import torch
 from golfflight.errors import InputError
 from golfflight.flight.constants import YARD_M
+from golfflight.flight.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export import DEFAULT_HIDDEN, VARIANTS
 from golfflight.model_export.data import MIN_APEX_M, DataSummary, ShotTensors, load_training_data
-from golfflight.model_export.devices import DEFAULT_DEVICE, resolve_device
-from golfflight.model_export.torch_physics import (
+from golfflight.flight.rollout import (
     DT_S,
     SOFT_ARGMAX_TEMPERATURE_M,
     T_SIM_S,
@@ -132,7 +132,7 @@ def errors(landing: torch.Tensor, apex: torch.Tensor | None, shots: ShotTensors)
 @torch.no_grad()
 def validate(model: nn.Module, shots: ShotTensors, config: TrainConfig, step: EulerStep = euler_step
              ) -> dict[str, float]:
-    """Validation metrics with the runtime's landing and apex (`torch_physics.hard_landing`, `apex`), in m and yd
+    """Validation metrics with the runtime's landing and apex (`rollout.hard_landing`, `apex`), in m and yd
     (`step` as `predict` takes it)."""
     model.eval()
     sums = {"landing": 0.0, "apex": 0.0}

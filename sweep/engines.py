@@ -54,7 +54,7 @@ def _fly(piece):
 def local_tables(source, bundle_dir: str, sha256: str, workers: int, make: Callable | None = None) -> Iterator:
     """Result tables of `source`'s pieces, flown by `workers` processes forked from a fresh server process that has
     imported the engine once (not from this one: the driver's Arrow and progress threads stay behind), each with
-    ONNX Runtime or the engine `make` builds (`model_export.torch_engine.TorchEngineMaker`: torch is imported, and a
+    ONNX Runtime or the engine `make` builds (`flight.torch_engine.TorchEngineMaker`: torch is imported, and a
     GPU taken, in each worker, never in the server)."""
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(WORKER_IMPORTS)
@@ -95,7 +95,7 @@ def _stop_workers(pool: ProcessPoolExecutor) -> None:
 def in_process_tables(source, flyer: SweepWorker, in_flight: int = PIECES_IN_FLIGHT) -> Iterator:
     """Result tables of `source`'s pieces flown by `flyer` in this process, `in_flight` pieces at once in threads, in
     input order (an engine that has the device to itself: a pool of processes would only share it; its engine
-    takes pieces from several threads, `model_export.torch_engine.TorchEngine`)."""
+    takes pieces from several threads, `flight.torch_engine.TorchEngine`)."""
     pool = ThreadPoolExecutor(in_flight, thread_name_prefix="sweep-piece")
     try:
         pending = deque()

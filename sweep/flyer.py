@@ -110,7 +110,7 @@ def echo(column: str, value):
 
 class ColumnsEngine(Protocol):
     """What a worker flies its rows with: `FlightEngine`, or another engine with its batch path (`fly_columns`) and the
-    SHA-256 of the bundle's graph (`model_export.torch_engine.TorchEngine`, given by the command line)."""
+    SHA-256 of the bundle's graph (`flight.torch_engine.TorchEngine`, given by the command line)."""
 
     sha256: str
 
@@ -123,7 +123,7 @@ class SweepWorker:
     def __init__(self, bundle_dir: str, sha256: str, source, engine: ColumnsEngine | None = None,
                  make_engine: Callable[[str], ColumnsEngine] | None = None):
         """Load the bundle at `bundle_dir` (its own path on each node of a cluster) with ONNX Runtime, or with
-        `make_engine` (a Ray actor's torch engine, `model_export.torch_engine.TorchEngineMaker`), or take `engine`
+        `make_engine` (a Ray actor's torch engine, `flight.torch_engine.TorchEngineMaker`), or take `engine`
         already loaded, and refuse it unless its ONNX graph is the one the driver checked (`sha256`); `source`
         (`sweep.sources`) turns pieces into rows."""
         from golfflight.flight.engine import FlightEngine

@@ -36,7 +36,7 @@ Engine = Literal["local", "ray", "torch"]
 class WorkerEngine:
     """What each worker process (a Ray actor, or a process of the pool here under `engine="torch"`) flies with:
     ONNX Runtime on its CPU (`make` None), or the engine `make` builds from the bundle's path on the worker's node
-    (`model_export.torch_engine.TorchEngineMaker`), with, on Ray, `gpus` GPUs of its own (a fraction where actors
+    (`flight.torch_engine.TorchEngineMaker`), with, on Ray, `gpus` GPUs of its own (a fraction where actors
     share one)."""
 
     make: Callable[[str], ColumnsEngine] | None = None
@@ -138,7 +138,7 @@ def run_sweep(
 ) -> Summary:
     """Fly every row of `source` on `engine` and write `out` (Parquet): the input row's number, its columns, its
     flight (module docstring). `skipped` gets each problem of a row left out under `skip_bad_rows`; `in_process` is
-    the engine `engine="torch"` flies with (`model_export.torch_engine.TorchEngine`, loaded from `model`), `in_flight`
+    the engine `engine="torch"` flies with (`flight.torch_engine.TorchEngine`, loaded from `model`), `in_flight`
     pieces at once; `worker_engine` what each actor of `engine="ray"` flies with (`workers` None: as many as the
     cluster's GPUs hold),
     and, without `in_process`, each of the `workers` processes of `engine="torch"`. `notice` gets a line for each

@@ -36,7 +36,7 @@ SEVEN_IRON = Launch(55.0, 16.0, 0.0, 7100.0, 0.0)
 def test_flights_match_the_torch_simulator_within_a_centimetre(engine, air):
     """In the card's air and in hot, high air (density and Reynolds scale of the inputs both differ)."""
     torch = pytest.importorskip("torch")
-    from golfflight.model_export.torch_physics import euler_rollout, hard_landing
+    from golfflight.flight.rollout import euler_rollout, hard_landing
 
     shots = launches(64, seed=21)
     session = ort.InferenceSession(str(engine.bundle_dir / engine.card.onnx.file), providers=["CPUExecutionProvider"])

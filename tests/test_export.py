@@ -16,8 +16,8 @@ from golfflight.flight import constants
 from golfflight.flight.integrator import simulate
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state
+from golfflight.flight.rollout import euler_rollout, hard_landing
 from golfflight.model_export.export import OPSET, export_bundle, export_checkpoint, probe_inputs
-from golfflight.model_export.torch_physics import euler_rollout, hard_landing
 from golfflight.model_export.training import TrainConfig, load_checkpoint, model_from_checkpoint, train
 from golfflight.weights_schema import BundleError, load_bundle
 from golfflight.weights_schema.model_card import SCHEMA_PATH, schema_text

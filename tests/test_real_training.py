@@ -24,7 +24,7 @@ from golfflight.model_export.real_data import (
     players,
     trackman_outdoor,
 )
-from golfflight.model_export.torch_physics import euler_rollout, hard_landing, positions_at
+from golfflight.flight.rollout import euler_rollout, hard_landing, positions_at
 from golfflight.model_export.training import load_checkpoint
 from golfflight.model_export.variants import PhysNN, PhysQ
 from golfflight.shots.heldout import (

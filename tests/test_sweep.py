@@ -318,7 +318,7 @@ def test_ray_actors_fly_the_torch_engine_as_engine_torch_does(tmp_path, capsys):
     build (no CUDA, as on a GPU node without its driver), is refused in one line before any actor starts."""
     ray = pytest.importorskip("ray")
     pytest.importorskip("torch")
-    from golfflight.model_export.torch_engine import TorchEngineMaker
+    from golfflight.flight.torch_engine import TorchEngineMaker
     from golfflight.sweep.run import WorkerEngine, run_sweep
     from golfflight.sweep.sources import open_source
 

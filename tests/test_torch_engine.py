@@ -1,4 +1,4 @@
-"""The torch engine (`model_export.torch_engine`, `golfflight sweep --engine torch`) flies the shipped bundle as the
+"""The torch engine (`flight.torch_engine`, `golfflight sweep --engine torch`) flies the shipped bundle as the
 ONNX engine does: the same figures, errors and rests for mixed shots (air, uniform and log winds, grounds above and
 below the tee, sloped surfaces), the engine's landing and apex rules to float64 rounding, the same sweep columns;
 a device this machine lacks, a missing torch and options of other engines are refused in one line; training's
@@ -12,15 +12,15 @@ import numpy as np
 import pytest
 import torch
 from conftest import random_launches
+from golfflight.flight import torch_engine
 from golfflight.flight.air import Air
 from golfflight.flight.conditions import Conditions
+from golfflight.flight.devices import DeviceError, resolve_device
 from golfflight.flight.flyer import Flyer, load_flyer
 from golfflight.flight.ground import SURFACES, GroundSpec
 from golfflight.flight.physics import reynolds_scale
+from golfflight.flight.torch_engine import STAGES, TorchEngine
 from golfflight.flight.wind import Wind
-from golfflight.model_export import torch_engine
-from golfflight.model_export.devices import DeviceError, resolve_device
-from golfflight.model_export.torch_engine import STAGES, TorchEngine
 from golfflight.model_export.training import TrainConfig, load_checkpoint, train
 
 from golfflight.cli import main

@@ -44,7 +44,7 @@ def test_the_device_ground_phase_gives_numpys_rests_hops_and_times(mixed):
     want = ground_phase(position, velocity, spin, surface, slope, direction)
     on_device = Surface(*(tensor(getattr(surface, name)) for name in Surface.__dataclass_fields__))
     normal = tensor(plane_normals(slope, direction, n))
-    resistance, drag = (tensor(np.broadcast_to(np.asarray(value, dtype=float), (n,)))
+    resistance, drag = (tensor(np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy())
                         for value in (surface.rolling_resistance, surface.grass_drag_per_s))
     rest, hops, time_s = roll_to_rest(tensor(position), tensor(velocity), tensor(spin), normal, on_device, resistance,
                                       drag, normal[:, 2] == 1.0)

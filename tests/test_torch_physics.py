@@ -11,7 +11,7 @@ from golfflight.flight.coefficients import ConstantCoefficients, QuadraticSpinRa
 from golfflight.flight.integrator import simulate
 from golfflight.flight.physics import State, initial_state
 from golfflight.flight.physics import derivatives as np_derivatives
-from golfflight.model_export.torch_physics import (
+from golfflight.flight.rollout import (
     Trajectory,
     apex,
     derivatives,

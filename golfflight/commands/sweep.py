@@ -5,7 +5,7 @@ product: START:STOP:COUNT, V1,V2,... or V per column, `sweep.grid`). Output: one
 (`row`), its columns and its flight, the same numbers as `golfflight simulate`. `--engine local` flies on a pool of
 processes here, `--engine ray` through Ray Data (a local Ray instance, or a cluster's with `--ray-address`),
 `--engine torch` in this process on `--device cpu` or `cuda` (the bundle rebuilt in torch,
-`model_export.torch_engine`), or with `--workers K` in K processes here, each with its own torch engine on the
+`flight.torch_engine`), or with `--workers K` in K processes here, each with its own torch engine on the
 device (sharing one GPU, so that one process's host work overlaps another's flight, as Ray's actors do). `--engine
 ray --device cuda` flies the torch engine in each Ray actor on a GPU (one actor a GPU, or `--actors-per-gpu K`
 sharing each, so that one actor's host work, checking rows, rolling to rest and writing, overlaps another's flight;
@@ -128,8 +128,8 @@ def _check_options(args: argparse.Namespace) -> None:
 
 
 def _torch_maker(args: argparse.Namespace, threads: int | None, parts_at_once: int = 1):
-    """How the torch engine is built on the asked device (`model_export.torch_engine.TorchEngineMaker`)."""
-    from golfflight.model_export.torch_engine import TorchEngineMaker
+    """How the torch engine is built on the asked device (`flight.torch_engine.TorchEngineMaker`)."""
+    from golfflight.flight.torch_engine import TorchEngineMaker
 
     return TorchEngineMaker(args.device or "cpu", args.dtype or "float32", threads, parts_at_once, bool(args.compile))
 
@@ -143,7 +143,7 @@ def _engines(args: argparse.Namespace):
     from golfflight.sweep.run import WorkerEngine
 
     if args.engine == "torch" and args.workers is not None:
-        from golfflight.model_export.devices import resolve_device
+        from golfflight.flight.devices import resolve_device
 
         resolve_device(args.device or "cpu")  # refused here in one line, not in each worker's start
         return None, WorkerEngine(_torch_maker(args, args.threads or 1, args.workers))

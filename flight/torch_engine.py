@@ -1,10 +1,11 @@
-"""A bundle flown in torch, on a CPU or a GPU: `TorchEngine`, the served engine's batch path (`FlightEngine.fly_columns`)
-rebuilt on training's physics, for `golfflight sweep --engine torch`.
+"""A bundle flown in torch, on a CPU or a GPU: `TorchEngine`, the engine's torch backend (`FlightEngine.from_bundle(...,
+backend="torch")`): the served engine's batch path (`FlightEngine.fly_columns`) on torch tensors, for `golfflight
+sweep --engine torch`. No training code: the flight core alone.
 
-The coefficient network is the bundle's ONNX graph's weights in the training code's model class
-(`bundle_model.model_from_bundle`, checked against ONNX Runtime on probe inputs), run in float32 as the graph runs;
-the equations of motion are training's (`torch_physics.euler_step`, the forward-Euler step `euler_rollout`
-repeats), in float32 or float64. What the engine takes, this takes: every shot's air (density, and its kinematic
+The coefficient network is the bundle's ONNX graph run by torch (`flight.torch_network`, checked against ONNX Runtime
+on the bundle checker's probes), in float32 as the graph runs; the equations of motion are the flight core's
+(`flight.physics`, through `rollout.euler_step`, the forward-Euler step `euler_rollout` repeats), in float32 or
+float64. What the engine takes, this takes: every shot's air (density, and its kinematic
 viscosity as the Reynolds scale of the network's inputs), its wind (uniform, or the log profile evaluated at the
 ball's height each step) and its ground's elevation, down to the engine's maximum flight time. The landing and apex
 are training's `hard_landing` and `apex`, which hold the integrator's rules (the state interpolated linearly to the
@@ -38,16 +39,16 @@ import numpy as np
 import torch
 from golfflight.errors import InputError
 from golfflight.flight.conditions import STANDARD, Conditions
+from golfflight.flight.devices import resolve_device
 from golfflight.flight.flyer import LAUNCH_WIDTH, NON_FINITE, Launch, air_inputs, load_flyer
 from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, batch_surface, elevations, ground_phase
 from golfflight.flight.ground.phase import plane_normals, roll_to_rest
 from golfflight.flight.outcomes import BatchFlights, Rest, landing_figures
 from golfflight.flight.per_shot import PerShot
 from golfflight.flight.physics import initial_state, reynolds_scale
+from golfflight.flight.rollout import LANDING_CHECK_STEPS, Trajectory, apex, euler_step, hard_landing
+from golfflight.flight.torch_network import network_from_bundle
 from golfflight.flight.wind import log_profile_factor
-from golfflight.model_export.bundle_model import model_from_bundle
-from golfflight.model_export.devices import resolve_device
-from golfflight.model_export.torch_physics import LANDING_CHECK_STEPS, Trajectory, apex, euler_step, hard_landing
 
 DTYPES = {"float32": torch.float32, "float64": torch.float64}
 """The physics' precisions by name (the network always runs in float32, as the bundle's graph does)."""
@@ -182,8 +183,7 @@ class TorchEngine:
         self.device, self.dtype = resolve_device(device), DTYPES[dtype]
         self.flyer = load_flyer(bundle_dir)
         self.card, self.sha256 = self.flyer.card, self.flyer.card.onnx.sha256
-        model, _ = model_from_bundle(self.flyer.bundle_dir)
-        self.model = model.to(self.device)
+        self.network, _ = network_from_bundle(self.flyer.bundle_dir, self.device)
         self.part_limit, self.parts_at_once, self.set_aside_share = part_shots, parts_at_once, set_aside_share
         self.ground_on_device = self.device.type == "cuda" if ground_on_device is None else ground_on_device
         self.seconds = dict.fromkeys(STAGES, 0.0)
@@ -197,7 +197,7 @@ class TorchEngine:
 
     def coefficients(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
         """C_L, C_D, C_M, C_Q [N,4] in the physics' dtype from the network run in float32, as the graph runs."""
-        return self.model(v_rel.float(), omega.float()).to(v_rel.dtype)
+        return self.network(v_rel.float(), omega.float()).to(v_rel.dtype)
 
     def part_shots(self) -> int:
         """Shots flown at once: `part_shots` if given, else what the device's free memory holds (a GPU: free to the
@@ -250,7 +250,7 @@ class TorchEngine:
         n = len(position)
         normal = plane_normals(slope_deg, slope_dir_deg, n)
         on_device = Surface(*(tensor(getattr(surface, name)) for name in Surface.__dataclass_fields__))
-        resistance, drag = (tensor(np.broadcast_to(np.asarray(value, dtype=float), (n,)))
+        resistance, drag = (tensor(np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy())
                             for value in (surface.rolling_resistance, surface.grass_drag_per_s))
         level = tensor(normal)[:, 2] == 1.0
         rest, hops, time_s = roll_to_rest(tensor(position), tensor(velocity), tensor(spin), tensor(normal), on_device,
@@ -374,8 +374,10 @@ class TorchEngineMaker:
     def __call__(self, bundle_dir: str | os.PathLike) -> TorchEngine:
         if self.threads is not None:
             torch.set_num_threads(self.threads)
-        return TorchEngine(bundle_dir, self.device, self.dtype, parts_at_once=self.parts_at_once,
-                           compile_step=self.compile_step)
+        from golfflight.flight.engine import FlightEngine
+
+        return FlightEngine.from_bundle(bundle_dir, "torch", self.device, dtype=self.dtype,
+                                        parts_at_once=self.parts_at_once, compile_step=self.compile_step)
 
 
 def _wind(at_reference: torch.Tensor, log_profile: torch.Tensor, reference_height_m: torch.Tensor,
@@ -403,7 +405,7 @@ def wind_at(height_m: torch.Tensor, at_reference: torch.Tensor | None, log_profi
 def flight_step(coefficients, dt: float, position: torch.Tensor, velocity: torch.Tensor, spin: torch.Tensor,
                 down: torch.Tensor, density: torch.Tensor, scale: torch.Tensor, ground: torch.Tensor,
                 *wind: torch.Tensor | None) -> tuple[torch.Tensor, ...]:
-    """One forward-Euler step of training's equations (`torch_physics.euler_step`) in each shot's air and wind
+    """One forward-Euler step of training's equations (`rollout.euler_step`) in each shot's air and wind
     (`wind_at`'s four), and whether each shot has come down through its ground's plane by its end (`down`, kept)."""
     moved, velocity, spin = euler_step(position, velocity, spin, coefficients, density, dt, scale,
                                        wind_at(position[:, 2], *wind))
