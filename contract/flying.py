@@ -21,9 +21,10 @@ from golfflight.contract.results import (
 from golfflight.contract.trajectory import resample
 from golfflight.errors import FlightError, InputError
 from golfflight.flight.conditions import Conditions
-from golfflight.flight.engine import FlightEngine, Launch, ShotFlight
+from golfflight.flight.engine import BatchFlights, FlightEngine, Launch, ShotFlight
 from golfflight.flight.flyer import LAUNCH_WIDTH
 from golfflight.flight.ground import GroundSpec
+from golfflight.flight.per_shot import PerShot
 from golfflight.flight.wind import CALM
 
 
@@ -104,9 +105,23 @@ def flown_shot(
     return result_of(shot, flight, normalized, flat_flight), flight
 
 
-def _batch_of(shots: list[ShotRequest]) -> tuple[list[Launch], list[Conditions], list, list[int], list[int]]:
-    """One engine batch for `shots`: their launches, conditions and grounds, then their normalized replays' and flat
-    flights' appended, and which shots those are (in the order appended)."""
+@dataclass(frozen=True)
+class Batch:
+    """One engine batch for `n` shots: their launches, conditions and grounds, then those of their normalized
+    replays and of their flat flights appended; `replays` and `flats` say which shots those are, in the order
+    appended. Made from requests (`batch_of`) or from a sweep's columns (`sweep.rows`); its flights go back into
+    results (`fly_shots`) or columns (`columns_of`)."""
+
+    launches: list[Launch] | np.ndarray
+    conditions: list[Conditions] | PerShot
+    grounds: list[GroundSpec | None] | PerShot
+    n: int
+    replays: np.ndarray
+    flats: np.ndarray
+
+
+def batch_of(shots: list[ShotRequest]) -> Batch:
+    """The engine batch of `shots` (`Batch`)."""
     launches = [launch_of(shot) for shot in shots]
     conditions = [conditions_of(shot) for shot in shots]
     grounds: list[GroundSpec | None] = [ground_of(shot.ground) for shot in shots]
@@ -115,7 +130,8 @@ def _batch_of(shots: list[ShotRequest]) -> tuple[list[Launch], list[Conditions],
     launches += [launches[i] for i in replays + flats]
     conditions += [Conditions(air_of(reference_of(shots[i])), CALM) for i in replays] + [conditions[i] for i in flats]
     grounds += [grounds[i] for i in replays] + [None] * len(flats)
-    return launches, conditions, grounds, replays, flats
+    return Batch(launches, conditions, grounds, len(shots), np.array(replays, dtype=np.intp),
+                 np.array(flats, dtype=np.intp))
 
 
 def _fly_group(
@@ -123,8 +139,9 @@ def _fly_group(
 ) -> tuple[list[ShotResult | ShotFailure], list[ShotFlight | FlightError]]:
     """One engine batch for `shots`, their normalized replays and their flat flights; results in order, and each
     shot's own flight."""
-    launches, conditions, grounds, replays, flats = _batch_of(shots)
-    flights = engine.fly_batch(launches, conditions, keep, grounds)
+    batch = batch_of(shots)
+    flights = engine.fly_batch(batch.launches, batch.conditions, keep, batch.grounds)
+    replays, flats = batch.replays.tolist(), batch.flats.tolist()
     replayed = dict(zip(replays, flights[len(shots) : len(shots) + len(replays)], strict=True))
     flat = dict(zip(flats, flights[len(shots) + len(replays) :], strict=True))
     results: list[ShotResult | ShotFailure] = []
@@ -147,38 +164,48 @@ class ShotColumns:
     errors: list[str | None]
 
 
-def fly_columns(engine: FlightEngine, shots: list[ShotRequest]) -> ShotColumns:
-    """`fly_shots` without a result object a shot (the same batch, numbers and errors, straight into columns):
-    for many shots at once (`golfflight sweep`). No trajectories: a shot asking for one is refused."""
-    if any(shot.trajectory is not None for shot in shots):
-        raise InputError("fly_columns flies no trajectories (fly_shots does)")
-    n = len(shots)
-    launches, conditions, grounds, replays, flats = _batch_of(shots)
-    flights = engine.fly_columns(np.array(launches, dtype=float).reshape(-1, LAUNCH_WIDTH), conditions, grounds)
+def columns_of(flights: BatchFlights, batch: Batch) -> ShotColumns:
+    """The columns of a batch's flights (`ShotColumns`, without the air density): a shot fails with the first error
+    of its own flight, its replay, its flat flight."""
+    n, replays, flats = batch.n, batch.replays, batch.flats
     replay_rows = np.arange(n, n + len(replays))
     flat_rows = np.arange(n + len(replays), n + len(replays) + len(flats))
+    owner = np.concatenate([np.arange(n), replays, flats]).tolist()
     errors: list[str | None] = [None] * n
-    for shot, rows in ((range(n), range(n)), (replays, replay_rows.tolist()), (flats, flat_rows.tolist())):
-        for i, row in zip(shot, rows, strict=True):
-            if errors[i] is None and row in flights.errors:
-                errors[i] = flights.errors[row]
-    flew = np.array([e is None for e in errors], dtype=bool)
+    for row in sorted(flights.errors):  # a shot's own row comes before its replay's, which comes before its flat's
+        if errors[owner[row]] is None:
+            errors[owner[row]] = flights.errors[row]
+    flew = np.ones(n, dtype=bool)
+    flew[[owner[row] for row in flights.errors]] = False
     values, present = {}, {}
     for prefix, numbers, rows, own in (
         ("", flight_numbers, np.arange(n), np.arange(n)),
-        ("normalized_", flight_numbers, replay_rows, np.array(replays, dtype=np.intp)),
-        ("flat_", flat_numbers, flat_rows, np.array(flats, dtype=np.intp)),
+        ("normalized_", flight_numbers, replay_rows, replays),
+        ("flat_", flat_numbers, flat_rows, flats),
     ):
         mask = np.zeros(n, dtype=bool)
         mask[own] = True
         mask &= flew
-        for name, column in numbers(flights.take(rows)).items():
+        taken = flights if len(rows) == len(owner) else flights.take(rows)  # the whole batch: its own shots alone
+        for name, column in numbers(taken).items():
             full = np.zeros(n, dtype=column.dtype)
             full[own] = column
             values[prefix + name], present[prefix + name] = full, mask
-    values[AIR_DENSITY] = np.array([c.air.density_kg_m3 for c in conditions[:n]], dtype=float)
-    present[AIR_DENSITY] = np.ones(n, dtype=bool)
     return ShotColumns(values, present, errors)
+
+
+def fly_columns(engine: FlightEngine, shots: list[ShotRequest]) -> ShotColumns:
+    """`fly_shots` without a result object a shot (the same batch, numbers and errors, straight into columns):
+    for many shots at once (`golfflight simulate`). No trajectories: a shot asking for one is refused."""
+    if any(shot.trajectory is not None for shot in shots):
+        raise InputError("fly_columns flies no trajectories (fly_shots does)")
+    batch = batch_of(shots)
+    flights = engine.fly_columns(np.array(batch.launches, dtype=float).reshape(-1, LAUNCH_WIDTH), batch.conditions,
+                                 batch.grounds)
+    flown = columns_of(flights, batch)
+    flown.values[AIR_DENSITY] = np.array([c.air.density_kg_m3 for c in batch.conditions[: batch.n]], dtype=float)
+    flown.present[AIR_DENSITY] = np.ones(batch.n, dtype=bool)
+    return flown
 
 
 def fly_shots(engine: FlightEngine, shots: list[ShotRequest]) -> list[ShotResult | ShotFailure]:

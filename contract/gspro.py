@@ -24,7 +24,7 @@ from golfflight.flight import limits
 from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.limits import Range
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, WithJsonSchema, field_validator, model_validator
 
 
 def _spelled_as_fields(data, fields) -> dict:
@@ -134,7 +134,12 @@ class GSProMessage(_Lenient):
     ShotNumber: int | None = Field(None, ge=0, le=SHOT_NUMBER_MAX)
     APIversion: str | None = None
     BallData: GSProBallData | None = None
-    ClubData: dict[str, ClubValue] | None = None
+    ClubData: Annotated[
+        dict[str, ClubValue] | None,
+        WithJsonSchema({"anyOf": [{"type": "object"}, {"type": "null"}], "description": "the club's numbers, any "
+                        "values: plain ones are kept for the screens, nested ones left out (`club_values`)"},
+                       mode="validation"),
+    ] = None
     ShotDataOptions: GSProOptions = Field(default_factory=GSProOptions)
 
     @field_validator("ClubData", mode="before")

@@ -18,8 +18,9 @@ not restate them.
 Flying. The valid rows' launches are converted as `contract.inputs.launch_of` converts them, in arrays (back and side
 spin by `spin_from_components` itself); their conditions, grounds and normalized replays come from the contract's own
 functions (`air_of`, `wind_of`, `ground_of`, `reference_of`, `lands_off_the_flat`) on one validated request part for
-each distinct combination of those columns' cells. The batch (the rows, their normalized replays, then their flat flights)
-and its columns are `contract.flying.fly_columns`'s.
+each distinct combination of those columns' cells. The batch (the rows, their normalized replays, then their flat
+flights) is a `contract.flying.Batch`, as `batch_of` makes one from requests, and its flights go back into columns
+through the same `contract.flying.columns_of`.
 """
 
 from __future__ import annotations
@@ -41,8 +42,7 @@ from golfflight.contract.columns import (
     cell_value,
     request_of_cells,
 )
-from golfflight.contract.figures import flat_numbers, flight_numbers
-from golfflight.contract.flying import ShotColumns
+from golfflight.contract.flying import Batch, ShotColumns, columns_of
 from golfflight.contract.inputs import (
     air_of,
     ground_of,
@@ -389,41 +389,13 @@ def fly_checked(engine, checked: Checked) -> ShotColumns:
         [None if r is None else Conditions(air_of(r), CALM) for r in references.objects], references.index[replays]
     )
     launches = _launches(checked.columns, rows)
-    flights = engine.fly_columns(
+    batch = Batch(
         np.concatenate([launches, launches[replays], launches[flats]]),
         conditions.plus(replay_air, conditions.take(flats)),
         own_grounds.plus(own_grounds.take(replays), PerShot([None], np.zeros(len(flats), dtype=np.intp))),
+        n, replays, flats,
     )
-    flown = _columns(flights, n, replays, flats)
+    flown = columns_of(engine.fly_columns(batch.launches, batch.conditions, batch.grounds), batch)
     flown.values[AIR_DENSITY] = np.array([air.density_kg_m3 for air in air_of_group], dtype=float)[airs.index]
     flown.present[AIR_DENSITY] = np.ones(n, dtype=bool)
     return flown
-
-
-def _columns(flights, n: int, replays: np.ndarray, flats: np.ndarray) -> ShotColumns:
-    """`fly_columns`'s columns of a batch of n shots, then the replays of `replays`, then the flat flights of
-    `flats`: a shot fails with the first error of its own flight, its replay, its flat flight."""
-    replay_rows = np.arange(n, n + len(replays))
-    flat_rows = np.arange(n + len(replays), n + len(replays) + len(flats))
-    owner = np.concatenate([np.arange(n), replays, flats]).tolist()
-    errors: list[str | None] = [None] * n
-    for row in sorted(flights.errors):  # a shot's own row comes before its replay's, which comes before its flat's
-        if errors[owner[row]] is None:
-            errors[owner[row]] = flights.errors[row]
-    flew = np.ones(n, dtype=bool)
-    flew[[owner[row] for row in flights.errors]] = False
-    values, present = {}, {}
-    for prefix, numbers, rows, own in (
-        ("", flight_numbers, np.arange(n), np.arange(n)),
-        ("normalized_", flight_numbers, replay_rows, replays),
-        ("flat_", flat_numbers, flat_rows, flats),
-    ):
-        mask = np.zeros(n, dtype=bool)
-        mask[own] = True
-        mask &= flew
-        taken = flights if len(rows) == len(owner) else flights.take(rows)  # the whole batch: its own shots alone
-        for name, column in numbers(taken).items():
-            full = np.zeros(n, dtype=column.dtype)
-            full[own] = column
-            values[prefix + name], present[prefix + name] = full, mask
-    return ShotColumns(values, present, errors)
