@@ -72,7 +72,7 @@ def test_a_calm_green_holds_a_tour_approach_as_well_as_a_fairway(engine, club, l
 
 def test_the_checks_read_the_grid():
     """`checks` on a grid worked by hand: the worst spin-back, the longest driver on a green, the rough's excess."""
-    run = anchors.Run
+    run = anchors.AnchorRun
     grid = {
         ("PGA", "Driver", "calm", "green 8"): run(280.0, 30.0),
         ("PGA", "Driver", "tail", "green 14"): run(300.0, 35.0),
