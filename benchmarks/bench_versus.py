@@ -1,12 +1,16 @@
-"""This checkout against an earlier one, interleaved in one sitting (the machines drift within a session): the single
-shot in process (`FlightEngine.fly`, the tour 7-iron and driver rolled to rest on the fairway, median of 300 shots)
-and whole `golfflight sweep` runs of one grid, `--engine local --workers 1` and `--engine torch --device cpu
---threads 1` (rows/s, process start to file written). Each measurement runs in a fresh process started in its
-checkout, the order alternating round by round (ABBA). Prints a table with each round's figures and the median
-ratio after / before; writes the `versus` section of results.json. HTTP single shots and batches have their own A/B
-(`bench_wire.py --versus`).
+"""This checkout against an earlier one, interleaved in one sitting (the machines drift by tens of per cent from minute
+to minute): the single shot in process (`FlightEngine.fly`, the tour 7-iron and driver rolled to rest on the
+fairway), the torch engine's batch in process on the CPU (8,192 mixed launches, one thread) and whole `golfflight
+sweep` runs of one grid, `--engine local --workers 1` and `--engine torch --device cpu --threads 1` (rows/s, process
+start to file written).
 
-python benchmarks/bench_versus.py --before ../wt-before [--rounds 3] [--grid-rows 50000]
+The in-process figures come from one worker process per checkout, both alive throughout, timing short blocks in turn
+(A B, then B A, ...), so that each block of one checkout has a block of the other beside it in time; the ratio of
+each pair is taken and the median of the pairs reported. The sweeps are whole processes, one of each checkout per
+round, the order alternating (ABBA), ratios per round. Prints a table; writes the `versus` section of results.json.
+HTTP single shots and batches have their own A/B (`bench_wire.py --versus`).
+
+python benchmarks/bench_versus.py --before ../wt-before [--blocks 40] [--rounds 3] [--grid-rows 50000]
 """
 
 from __future__ import annotations
@@ -22,42 +26,89 @@ from pathlib import Path
 
 from common import REPO, write_results
 
-SINGLE_SHOT = """
-import json, statistics, time
+WORKER = r"""
+import json, sys, time
+import numpy as np
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.ground import GroundSpec
-engine = FlightEngine(model_dir())
-fairway = GroundSpec()
-out = {}
-for name, launch in (("7-iron", Launch(55.0, 16.0, 0.0, 7100.0, 0.0)), ("driver", Launch(76.5, 10.5, 0.0, 2550.0, 0.0))):
-    for _ in range(100):
-        engine.fly(launch, ground=fairway)
+
+engine, fairway = FlightEngine(model_dir()), GroundSpec()
+shots = {"7-iron": Launch(55.0, 16.0, 0.0, 7100.0, 0.0), "driver": Launch(76.5, 10.5, 0.0, 2550.0, 0.0)}
+torch_engine = launches = None
+
+
+def single(name, count):
     times = []
-    for _ in range(300):
+    for _ in range(count):
         started = time.perf_counter()
-        engine.fly(launch, ground=fairway)
+        engine.fly(shots[name], ground=fairway)
         times.append(time.perf_counter() - started)
-    out[name] = statistics.median(times) * 1e3
-print(json.dumps(out))
+    return sorted(times)[len(times) // 2] * 1e3
+
+
+def torch_batch(n):
+    global torch_engine, launches
+    if torch_engine is None:
+        import torch
+        try:
+            from golfflight.flight.torch_engine import TorchEngine
+        except ImportError:  # before issue 44 the torch engine was training's
+            from golfflight.model_export.torch_engine import TorchEngine
+        torch.set_num_threads(1)
+        rng = np.random.default_rng(0)
+        launches = np.stack([rng.uniform(30, 80, n), rng.uniform(6, 24, n), rng.normal(0, 2, n),
+                             rng.uniform(2000, 8000, n), rng.normal(0, 5, n)], -1)
+        torch_engine = TorchEngine(model_dir())
+        torch_engine.fly_columns(launches[:512])
+    started = time.perf_counter()
+    torch_engine.fly_columns(launches)
+    return n / (time.perf_counter() - started)
+
+
+for name in shots:
+    single(name, 100)
+print("ready", flush=True)
+for line in sys.stdin:
+    kind, *args = line.split()
+    value = single(args[0], int(args[1])) if kind == "single" else torch_batch(int(args[0]))
+    print(json.dumps(value), flush=True)
 """
 
+BLOCKS = {
+    "single shot, 7-iron (ms, median of 50)": "single 7-iron 50",
+    "single shot, driver (ms, median of 50)": "single driver 50",
+    "torch engine in process, 8,192 mixed shots (shots/s)": "torch 8192",
+}
 
-def single_shot(tree: Path) -> dict[str, float]:
-    """Median ms of one shot (7-iron, driver) in a fresh process of `tree`."""
-    done = subprocess.run([sys.executable, "-c", SINGLE_SHOT], cwd=tree, capture_output=True, text=True, check=True)
-    return json.loads(done.stdout.splitlines()[-1])
+
+class Worker:
+    """A process of one checkout that times blocks on request (WORKER)."""
+
+    def __init__(self, tree: Path) -> None:
+        self.process = subprocess.Popen([sys.executable, "-c", WORKER], cwd=tree, stdin=subprocess.PIPE,
+                                        stdout=subprocess.PIPE, text=True)
+        assert self.process.stdout.readline().strip() == "ready"
+
+    def time(self, command: str) -> float:
+        self.process.stdin.write(command + "\n")
+        self.process.stdin.flush()
+        return json.loads(self.process.stdout.readline())
+
+    def close(self) -> None:
+        self.process.stdin.close()
+        self.process.wait(timeout=60)
 
 
 def grid_axes(rows: int) -> list[str]:
-    """A grid of about `rows` launches: speeds x angles x 10 spins."""
-    speeds = max(rows // 500, 1)
-    return ["--grid", f"ball_speed_mps=30:80:{speeds}", "launch_angle_deg=6:24:50", "spin_rpm=2000:8000:10"]
+    """A grid of about `rows` launches: speeds x 50 angles x 10 spins."""
+    return ["--grid", f"ball_speed_mps=30:80:{max(rows // 500, 1)}", "launch_angle_deg=6:24:50",
+            "spin_rpm=2000:8000:10"]
 
 
 SWEEPS = {
-    "sweep local": ["--engine", "local", "--workers", "1"],
-    "sweep torch cpu": ["--engine", "torch", "--device", "cpu", "--threads", "1"],
+    "sweep --engine local --workers 1 (rows/s)": ["--engine", "local", "--workers", "1"],
+    "sweep --engine torch --device cpu --threads 1 (rows/s)": ["--engine", "torch", "--device", "cpu", "--threads", "1"],
 }
 
 
@@ -69,38 +120,52 @@ def sweep_rate(tree: Path, engine: list[str], rows: int, folder: Path) -> float:
     subprocess.run(command, cwd=tree, capture_output=True, text=True, check=True)
     seconds = time.perf_counter() - started
     out.unlink()
-    return (rows // 500 * 500) / seconds
+    return (max(rows // 500, 1) * 500) / seconds
+
+
+def interleaved(trees: dict[str, Path], blocks: int) -> dict[str, dict[str, list[float]]]:
+    """Each in-process measurement, block by block, the two checkouts' workers in turn (A B, B A, ...)."""
+    workers = {side: Worker(tree) for side, tree in trees.items()}
+    figures: dict[str, dict[str, list[float]]] = {name: {side: [] for side in trees} for name in BLOCKS}
+    try:
+        for block in range(blocks):
+            order = list(trees) if block % 2 == 0 else list(trees)[::-1]
+            for name, command in BLOCKS.items():
+                for side in order:
+                    figures[name][side].append(workers[side].time(command))
+    finally:
+        for worker in workers.values():
+            worker.close()
+    return figures
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--before", required=True, help="a checkout of the earlier commit (e.g. a git worktree)")
-    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--blocks", type=int, default=40, help="in-process blocks of each checkout")
+    parser.add_argument("--rounds", type=int, default=3, help="whole sweeps of each checkout")
     parser.add_argument("--grid-rows", type=int, default=50_000)
     args = parser.parse_args()
     trees = {"before": Path(args.before).resolve(), "after": REPO}
-    figures: dict[str, dict[str, list[float]]] = {side: {} for side in trees}
+    figures = interleaved(trees, args.blocks)
     with tempfile.TemporaryDirectory(prefix="bench_versus_") as folder:
+        for name in SWEEPS:
+            figures[name] = {side: [] for side in trees}
         for round_number in range(args.rounds):
-            order = ["before", "after"] if round_number % 2 == 0 else ["after", "before"]
-            for side in order:
-                tree, mine = trees[side], figures[side]
-                for name, ms in single_shot(tree).items():
-                    mine.setdefault(f"single shot, {name} (ms)", []).append(ms)
-                for name, engine in SWEEPS.items():
-                    rate = sweep_rate(tree, engine, args.grid_rows, Path(folder))
-                    mine.setdefault(f"{name} (rows/s)", []).append(rate)
-                print(f"round {round_number} {side}: " + ", ".join(f"{k} {v[-1]:,.3g}" for k, v in mine.items()),
-                      flush=True)
+            order = list(trees) if round_number % 2 == 0 else list(trees)[::-1]
+            for name, engine in SWEEPS.items():
+                for side in order:
+                    figures[name][side].append(sweep_rate(trees[side], engine, args.grid_rows, Path(folder)))
+            print(f"round {round_number} of the sweeps done", flush=True)
     rows = []
-    print(f"\n{args.rounds} rounds, ABBA; before {trees['before']}\n")
-    print("| measurement | before (rounds) | after (rounds) | median after / before |")
+    print(f"\nbefore: {trees['before']}; {args.blocks} in-process blocks each, {args.rounds} sweeps each\n")
+    print("| measurement | before, median (range) | after, median (range) | after / before, median of the pairs |")
     print("|---|---|---|---:|")
-    for name in figures["after"]:
-        before, after = figures["before"][name], figures["after"][name]
-        ratio = statistics.median(after) / statistics.median(before)
-        rows.append({"name": name, "before": before, "after": after, "ratio": ratio})
-        shown = [", ".join(f"{v:,.3g}" for v in side) for side in (before, after)]
+    for name, sides in figures.items():
+        before, after = sides["before"], sides["after"]
+        ratio = statistics.median(a / b for a, b in zip(after, before, strict=True))
+        rows.append({"name": name, "before": before, "after": after, "paired_ratio": ratio})
+        shown = [f"{statistics.median(v):,.4g} ({min(v):,.4g}-{max(v):,.4g})" for v in (before, after)]
         print(f"| {name} | {shown[0]} | {shown[1]} | {ratio:.3f} |")
     write_results("versus", rows)
 

@@ -107,7 +107,8 @@ class Service:
                 started = time.perf_counter()
                 self.post("/v1/shots?viewer=true", body)
                 for line in lines:
-                    if line.startswith("data: ") and json.loads(line[6:])["launch"]["ball_speed_mps"] == speed:
+                    event = json.loads(line[6:]) if line.startswith("data: ") else {}
+                    if event.get("launch", {}).get("ball_speed_mps") == speed:  # a session's event has no launch
                         break
                 if i >= 0:
                     seconds.append(time.perf_counter() - started)

