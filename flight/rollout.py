@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import torch
 from golfflight.flight.constants import GRAVITY_MPS2
 from golfflight.flight.outcomes import parabola_apex
-from golfflight.flight.physics import TINY, aerodynamics
+from golfflight.flight.physics import aerodynamics
 
 DT_S = 0.1
 """Euler step of the paper (section 2.3.2): the step the models are trained and served with."""

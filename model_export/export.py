@@ -34,7 +34,8 @@ from golfflight.flight.constants import (
     GRAVITY_MPS2,
     TEE_HEIGHT_M,
 )
-from golfflight.flight.rollout import LANDING_SEARCH_START_S, TINY
+from golfflight.flight.physics import TINY
+from golfflight.flight.rollout import LANDING_SEARCH_START_S
 from golfflight.model_export import PHYSICS_VARIANTS
 from golfflight.model_export.training import TrainConfig, load_checkpoint, model_from_checkpoint
 from golfflight.model_export.variants import SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, PhysNN, PhysQ
