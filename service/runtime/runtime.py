@@ -43,6 +43,7 @@ PLAYER_SOURCES = frozenset({"http", "gspro-http", "open-connect"})
 GSPRO_SOURCES = frozenset({"gspro-http", "open-connect"})
 """Shots from a launch monitor's connector: with the putter selected they are putts, as in GSPro."""
 
+
 class NotReady(ServiceError):
     """A simulation was asked for before the model was loaded (HTTP: 503; Open Connect: Code 503)."""
 
