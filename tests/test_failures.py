@@ -7,7 +7,6 @@ from __future__ import annotations
 import argparse
 import ast
 import builtins
-from pathlib import Path
 
 import pytest
 from golfflight import cli
@@ -99,7 +98,3 @@ def test_a_bug_keeps_its_traceback_and_is_not_called_the_users(monkeypatch):
         _main_raising(monkeypatch, ValueError("a bug"))
     with pytest.raises(ZeroDivisionError):
         _main_raising(monkeypatch, ZeroDivisionError())
-
-
-def test_the_modules_read_are_the_projects(tmp_path):
-    assert ROOT / "golfflight" / "errors.py" in _modules() and all(isinstance(p, Path) for p in _modules())
