@@ -247,14 +247,9 @@ class TorchEngine:
                 return float(values)
             return torch.as_tensor(values, dtype=torch.float64, device=self.device)
 
-        n = len(position)
-        normal = plane_normals(slope_deg, slope_dir_deg, n)
+        normal = plane_normals(slope_deg, slope_dir_deg, len(position))
         on_device = Surface(*(tensor(getattr(surface, name)) for name in Surface.__dataclass_fields__))
-        resistance, drag = (tensor(np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy())
-                            for value in (surface.rolling_resistance, surface.grass_drag_per_s))
-        level = tensor(normal)[:, 2] == 1.0
-        rest, hops, time_s = roll_to_rest(tensor(position), tensor(velocity), tensor(spin), tensor(normal), on_device,
-                                          resistance, drag, level)
+        rest, hops, time_s = roll_to_rest(tensor(position), tensor(velocity), tensor(spin), tensor(normal), on_device)
         return GroundPhase(rest.cpu().numpy(), hops.cpu().numpy(), time_s.cpu().numpy())
 
     def _spent(self, stage: str, since: float) -> float:

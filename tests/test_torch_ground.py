@@ -43,11 +43,8 @@ def test_the_device_ground_phase_gives_numpys_rests_hops_and_times(mixed):
         surface, slope, direction = SURFACES["fairway"], np.zeros(n), np.zeros(n)
     want = ground_phase(position, velocity, spin, surface, slope, direction)
     on_device = Surface(*(tensor(getattr(surface, name)) for name in Surface.__dataclass_fields__))
-    normal = tensor(plane_normals(slope, direction, n))
-    resistance, drag = (tensor(np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy())
-                        for value in (surface.rolling_resistance, surface.grass_drag_per_s))
-    rest, hops, time_s = roll_to_rest(tensor(position), tensor(velocity), tensor(spin), normal, on_device, resistance,
-                                      drag, normal[:, 2] == 1.0)
+    rest, hops, time_s = roll_to_rest(tensor(position), tensor(velocity), tensor(spin),
+                                      tensor(plane_normals(slope, direction, n)), on_device)
     np.testing.assert_array_equal(hops.numpy(), want.bounces)
     np.testing.assert_allclose(rest.numpy(), want.rest_position, rtol=0, atol=1e-9)
     np.testing.assert_allclose(time_s.numpy(), want.time_s, rtol=0, atol=1e-9)

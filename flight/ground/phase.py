@@ -275,14 +275,16 @@ def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder,
     return rest, time
 
 
-def roll_to_rest(position, velocity, spin, normal, surface: Surface, resistance, drag, level,
-                 record: _Recorder | None = None):
+def roll_to_rest(position, velocity, spin, normal, surface: Surface, record: _Recorder | None = None):
     """The batch's ground phase, NumPy arrays or torch tensors alike (the torch engine's on its device): bounce every
-    ball, then roll those on `level` ground in closed form and the rest in slope steps. Landing states and plane
-    normals [N,3], the surface's resistance and drag [N], `level` a mask [N]. (rest [N,3], hops [N], time on the
-    ground [N]); `record` (NumPy only) keeps every state."""
+    ball, then roll those on level ground (a normal straight up) in closed form and the rest in slope steps. Landing
+    states and plane normals [N,3]; `surface` holds floats or [N] values of the same kind. (rest [N,3], hops [N],
+    time on the ground [N]); `record` (NumPy only) keeps every state."""
     n = len(position)
     record = record or _Recorder(n, keep=False)
+    resistance = xp.zeros(n, position) + surface.rolling_resistance
+    drag = xp.zeros(n, position) + surface.grass_drag_per_s
+    level = normal[:, 2] == 1.0
     everyone = xp.arange(n, position)
     start, rolling, time, hops = _bounce(position, velocity, spin, normal, surface, record)
     record.add(everyone[norm(xp.columns(rolling)) > 0.0], time, start, rolling)
@@ -313,13 +315,11 @@ def ground_phase(
     (`plane_normals`); `surface` holds floats or [N] arrays. InputError if a slope is steeper than its surface
     holds a ball on."""
     n = len(position)
-    resistance = np.broadcast_to(np.asarray(surface.rolling_resistance, dtype=float), (n,))
-    drag = np.broadcast_to(np.asarray(surface.grass_drag_per_s, dtype=float), (n,))
     slope = np.broadcast_to(np.asarray(slope_deg, dtype=float), (n,))
-    _check_slopes(slope, resistance)
+    _check_slopes(slope, np.broadcast_to(np.asarray(surface.rolling_resistance, dtype=float), (n,)))
     normal = plane_normals(slope, slope_dir_deg, n)
     record = _Recorder(n, keep_path)
-    rest, hops, total = roll_to_rest(position, velocity, spin, normal, surface, resistance, drag, slope == 0.0, record)
+    rest, hops, total = roll_to_rest(position, velocity, spin, normal, surface, record)
     record.add(np.arange(n), total, rest, np.zeros_like(rest))
     return GroundPhase(rest, hops, total, record.paths())
 

@@ -5,13 +5,15 @@ from __future__ import annotations
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 from golfflight.contract.gspro import GSProMessage, GSProReply
+from golfflight.contract.refusals import FAILURES
 from golfflight.service.api.direct import DirectRoute
 from golfflight.service.api.paths import GSPRO_PATH
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
 from golfflight.service.runtime import runtime_of
 
-GSPRO_STATUS = {200: 200, 500: 422, 503: 503}
-"""HTTP status of each Open Connect reply code on POST /v1/gspro."""
+GSPRO_STATUS = {200: 200, **{answer.open_connect_code: answer.http_status for answer in FAILURES.values()}}
+"""HTTP status of each Open Connect reply code on POST /v1/gspro: 200 for a flight, else the failure's own
+(`contract.refusals.FAILURES`: Code 500 is 422, Code 503 is 503)."""
 
 router = APIRouter(route_class=DirectRoute)
 
