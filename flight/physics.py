@@ -31,6 +31,7 @@ from golfflight.flight.constants import (
     RPM_TO_RADPS,
     TEE_HEIGHT_M,
 )
+from golfflight.flight.ground.vectors import norm
 from golfflight.flight.wind import CALM, Wind
 
 TINY = 1e-12
@@ -88,15 +89,10 @@ def initial_state(
     return State(position, velocity, omega)
 
 
-def magnitude(a):
-    """|a| of [..., 3] vectors (NumPy or torch), from their components as the equations take them."""
-    x, y, z = xp.columns(a)
-    return (x * x + y * y + z * z) ** 0.5
-
-
 def spin_ratio(v_rel, omega):
-    """S = R |omega| / |v_rel| [N]: surface speed over air speed, the variable lift and drag depend on."""
-    return spin_ratio_of(magnitude(v_rel), magnitude(omega))
+    """S = R |omega| / |v_rel| [N]: surface speed over air speed, the variable lift and drag depend on (NumPy or
+    torch [N,3])."""
+    return spin_ratio_of(norm(xp.columns(v_rel)), norm(xp.columns(omega)))
 
 
 def spin_ratio_of(speed, spin_rate):
