@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
+from golfflight.flight import xp
 from numpy.typing import ArrayLike
 
 SEA_LEVEL_PRESSURE_PA = 101325.0
@@ -69,10 +70,6 @@ _one_air = lru_cache(maxsize=1024)(_density_and_viscosity)
 """The same for one air of plain numbers, cached because a stream of shots mostly shares a few airs."""
 
 
-_NUMBER = (int, float)
-"""What one air's weather values are (a NumPy float64 is a float); anything else is flown as arrays."""
-
-
 @dataclass(frozen=True)
 class Air:
     """The air a shot flies through: its density and its kinematic viscosity (for Reynolds numbers), floats for one
@@ -90,12 +87,8 @@ class Air:
         pressure_pa: ArrayLike | None = None,
     ) -> Air:
         """Air at a temperature, humidity and either a station pressure or (if none given) an altitude."""
-        one = (
-            isinstance(temperature_c, _NUMBER)
-            and isinstance(altitude_m, _NUMBER)
-            and isinstance(humidity_pct, _NUMBER)
-            and (pressure_pa is None or isinstance(pressure_pa, _NUMBER))
-        )
+        given = (temperature_c, altitude_m, humidity_pct) + (() if pressure_pa is None else (pressure_pa,))
+        one = all(xp.is_number(value) for value in given)
         formulas = _one_air if one else _density_and_viscosity
         return cls(*formulas(temperature_c, altitude_m, humidity_pct, pressure_pa))
 
@@ -103,7 +96,7 @@ class Air:
     def from_density(cls, density_kg_m3: ArrayLike, temperature_c: ArrayLike = STANDARD_TEMPERATURE_C) -> Air:
         """Air of a given density; its viscosity is still Sutherland's at the temperature (ICAO 15 degC unless
         given), so a density alone moves the dynamic pressure and the Reynolds number as thinner air would."""
-        density = density_kg_m3 if isinstance(density_kg_m3, _NUMBER) else np.asarray(density_kg_m3, dtype=float)
+        density = density_kg_m3 if xp.is_number(density_kg_m3) else np.asarray(density_kg_m3, dtype=float)
         return cls(density, _plain(dynamic_viscosity(temperature_c) / density))
 
     @classmethod

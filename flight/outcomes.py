@@ -15,11 +15,13 @@ from golfflight.flight.ground import GroundPath, GroundPhase
 from golfflight.flight.physics import State
 
 
+DEGREES_PER_RADIAN = 180.0 / math.pi
+
+
 def landing_angle_deg(vx, vy, vz):
-    """Descent angle below the horizontal (positive, degrees) of a velocity, component by component."""
-    if isinstance(vz, np.ndarray):
-        return np.degrees(np.arctan2(-vz, np.hypot(vx, vy)))
-    return math.degrees(math.atan2(-vz, math.hypot(vx, vy)))
+    """Descent angle below the horizontal (positive, degrees) of a velocity, component by component (floats, NumPy
+    arrays or torch tensors, `flight.xp`)."""
+    return xp.atan2(-vz, (vx * vx + vy * vy) ** 0.5) * DEGREES_PER_RADIAN
 
 
 def parabola_apex(before, peak, after, peak_time_s, dt: float, inside=True):

@@ -18,6 +18,11 @@ NUMBERS = (float, int, np.generic)
 """Plain numbers (NumPy's scalars among them): one ball's components, checked before anything slower."""
 
 
+def is_number(value) -> bool:
+    """Whether a value is one plain number rather than an array (one ball's, or one air's: hashable, cacheable)."""
+    return isinstance(value, NUMBERS)
+
+
 def _tensor_call(name: str, *values):
     """torch's `name` on `values`, some of them tensors; the plain numbers among them made tensors like the first."""
     torch = sys.modules["torch"]
