@@ -213,25 +213,29 @@ def expression_of(names: tuple[str, ...], theta: np.ndarray | None) -> str:
     )
 
 
-def select_terms(z: np.ndarray, jacobian: np.ndarray) -> tuple[int, ...]:
-    """Backward elimination on the linearised problem: drop the weakest term while |t| < MIN_T or too many."""
+def select_terms(z: np.ndarray, jacobian: np.ndarray, free: int = 0) -> tuple[int, ...]:
+    """Backward elimination on the linearised problem: drop the weakest term while |t| < MIN_T or too many. The first
+    `free` columns (the library explanation's parameters) are fitted beside the terms and never dropped, so a term
+    does not have to take up what the explanation's own parameters would; the kept terms' indices count from after
+    them."""
     used = np.isfinite(z)
     r = z[used]
     J_all = jacobian[used]
-    kept = list(range(J_all.shape[1]))
+    kept = list(range(free, J_all.shape[1]))
     while kept:
-        J = J_all[:, kept]
+        columns = list(range(free)) + kept
+        J = J_all[:, columns]
         scale = np.linalg.norm(J, axis=0)
         scale[scale == 0] = 1.0
-        ridge = 1e-6 * np.eye(len(kept))
+        ridge = 1e-6 * np.eye(len(columns))
         normal = (J / scale).T @ (J / scale) + ridge
         step = np.linalg.solve(normal, -(J / scale).T @ r)
         resid = r + (J / scale) @ step
-        s2 = resid @ resid / max(len(r) - len(kept), 1)
-        t = np.abs(step) / np.sqrt(s2 * np.diag(np.linalg.inv(normal)))
+        s2 = resid @ resid / max(len(r) - len(columns), 1)
+        t = (np.abs(step) / np.sqrt(s2 * np.diag(np.linalg.inv(normal))))[free:]
         weakest = int(np.argmin(t))
         if t[weakest] >= MIN_T and len(kept) <= MAX_TERMS:
-            return tuple(kept)
+            return tuple(k - free for k in kept)
         kept.pop(weakest)
     return ()
 
@@ -244,7 +248,7 @@ def fit_correction(problem: Problem, rows: np.ndarray, base: Fit) -> Fit | None:
     effects = base.effects + (everything,)
     theta = np.concatenate([base.theta, everything.null])
     z, jacobian = residuals_and_jacobian(problem, effects, theta, rows)
-    kept = select_terms(z, jacobian[..., base.k :])
+    kept = select_terms(z, jacobian, free=base.k)
     if not kept:
         return None
     term = correction_effect(kept, knots)

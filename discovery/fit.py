@@ -3,8 +3,9 @@
 Residuals are standardized (recorded - model) / expected sigma over every observed outcome, so carry, apex,
 time and angle weigh by how well each is known. The optimiser is scipy's bounded least squares with a Jacobian
 built from finite differences flown as ONE stacked batch. Held-out error: folds grouped by session; each fold's
-parameters are one Gauss-Newton step from the all-data fit using only the other folds' residuals and Jacobian
-(exact for a locally linear problem, and cheap), then the held-out shots are flown with them.
+parameters are one Gauss-Newton step from the all-data fit using only the other folds' residuals and Jacobian,
+within the parameters' bounds (exact for a locally linear problem, and cheap), then the held-out shots are flown
+with them.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from golfflight.discovery.effects import Effect, apply_all
 from golfflight.discovery.model import FlightModel
 from golfflight.discovery.recordings import OBSERVABLES, Recordings
 from golfflight.discovery.simulator import Outcomes, Setup
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, lsq_linear
 
 MISSED_LANDING_Z = 10.0
 """Standardized residual given to a shot the model does not land (it cannot be compared)."""
@@ -271,15 +272,21 @@ def folds(groups: np.ndarray, n_folds: int = 5) -> tuple[np.ndarray, str]:
 
 
 def fold_thetas(result: Fit, fold: np.ndarray) -> dict[int, np.ndarray]:
-    """Each fold's parameters: one Gauss-Newton step from the fit using only the other folds' residuals and Jacobian
-    (`fold` gives the fold of each shot the fit's residuals are on)."""
+    """Each fold's parameters: one Gauss-Newton step from the fit using only the other folds' residuals and Jacobian,
+    solved within the parameters' bounds (`fold` gives the fold of each shot the fit's residuals are on). An
+    unbounded step clipped afterwards can land far from the fold's own best where parameters are nearly collinear
+    and the fit sits at a bound."""
     low, high, _, _ = _bounds(result.effects)
     used = np.isfinite(result.z)
     thetas = {}
     for f in np.unique(fold):
         train = used & (fold != f)[:, None]
         J, r = result.jacobian[train], result.z[train]
-        step = np.linalg.lstsq(J, -r, rcond=None)[0] if len(r) > result.k else np.zeros(result.k)
+        if len(r) <= result.k:
+            thetas[int(f)] = result.theta
+            continue
+        room = (low - result.theta, high - result.theta)
+        step = lsq_linear(J, -r, bounds=(np.minimum(room[0], 0.0), np.maximum(room[1], 0.0))).x
         thetas[int(f)] = np.clip(result.theta + step, low, high)
     return thetas
 

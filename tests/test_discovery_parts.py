@@ -18,6 +18,7 @@ from golfflight.discovery.correction import (
     terms_for,
 )
 from golfflight.discovery.effects import EFFECTS, Context, equivalent_altitude_m
+from golfflight.discovery.fit import Fit, fold_thetas
 from golfflight.discovery.model import reference
 from golfflight.discovery.outside import HEIGHT_GUST, OUTSIDE, HeightGust, air_motion
 from golfflight.discovery.prove import (
@@ -48,6 +49,46 @@ def test_term_selection_keeps_the_terms_that_made_the_data():
     z = -(jacobian @ truth) + rng.normal(0, 0.3, (n, 5))
     assert select_terms(z, jacobian) == (1, 5)
     assert select_terms(rng.normal(size=(n, 5)), jacobian) == ()
+
+
+def test_term_selection_fits_the_explanation_beside_the_terms():
+    """Selected with the library explanation's parameters free, a term that only copies what the explanation does is
+    not kept; with them held at their start it takes the explanation's place (a correction fitted on a wind once
+    took up the wind's own error instead of the model's form)."""
+    rng = np.random.default_rng(1)
+    n, k = 400, len(TERMS)
+    explanation = rng.normal(size=(n, 5, 1))
+    terms = rng.normal(size=(n, 5, k))
+    terms[..., 2] = explanation[..., 0] + rng.normal(0, 0.1, (n, 5))
+    z = -0.8 * explanation[..., 0] + rng.normal(0, 0.3, (n, 5))
+    assert select_terms(z, terms) == (2,)
+    assert select_terms(z, np.concatenate([explanation, terms], axis=-1), free=1) == ()
+
+
+def test_fold_parameters_are_the_best_within_the_bounds():
+    """A fit at its bound with two nearly collinear parameters: each fold's parameters are the bounded linear least
+    squares step, never worse on the fold's own shots than an unbounded step clipped afterwards (which once sent a
+    held-out error to ten times the fit's own)."""
+    rng = np.random.default_rng(2)
+    n = 300
+    column = rng.normal(size=(n, 5))
+    jacobian = np.stack([column, column + rng.normal(0, 0.01, (n, 5))], axis=-1)
+    z = -(jacobian @ np.array([2.0, -1.5])) + rng.normal(0, 1.0, (n, 5))
+    effects = (EFFECTS["drag_scale"], EFFECTS["lift_scale"])
+    theta = np.array([1.4, 1.0])
+    result = Fit(effects, theta, z, jacobian, np.eye(2))
+    fold = np.arange(n) % 5
+    thetas = fold_thetas(result, fold)
+    low, high = np.array([0.7, 0.6]), np.array([1.4, 1.5])
+    better = []
+    for f, fold_theta in thetas.items():
+        assert np.all(fold_theta >= low) and np.all(fold_theta <= high)
+        J, r = jacobian[fold != f].reshape(-1, 2), z[fold != f].reshape(-1)
+        clipped = np.clip(theta + np.linalg.lstsq(J, -r, rcond=None)[0], low, high)
+        cost = [float(np.sum((r + J @ (t - theta)) ** 2)) for t in (fold_theta, clipped)]
+        assert cost[0] <= cost[1] + 1e-9
+        better.append(cost[0] < cost[1] - 1.0)
+    assert any(better)
 
 
 def test_correction_features_are_accelerations_per_unit_weight():
