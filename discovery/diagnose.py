@@ -12,7 +12,8 @@ the best singles is combined with the other effects that most reduce its lineari
 pair beats the best single, each of the best pairs with a third (triples). A candidate replaces a simpler one only if
 its held-out error is lower beyond doubt (the lower end of a session-bootstrap interval of the improvement is above
 zero) and by a material share, and, against a controlled model, by more than the model's own error of response to
-the simpler explanation (`Diagnoser.response_error`). The choice is then stated in physical terms: coefficient
+the simpler explanation (`Diagnoser.response_error`); a candidate with a library parameter pinned at its bound is
+never chosen (`inside`). The choice is then stated in physical terms: coefficient
 scales that agree as air density, and on recordings without air, air set against it on equal terms
 (`Diagnoser.in_physical_terms`); a venue condition or monitor bias that moves no recorded observable by more than
 the model's own error is left to the model's form (`Diagnoser.within_form`). Structure the library explanation
@@ -81,6 +82,9 @@ NOISE_SPREAD = 0.25
 """How far below the noise floor a held-out error may fall by chance: clean 300-shot sets flown by the served model
 scored 0.56-0.84 around a floor of about 0.70 (docs/discovery.md), so only a fit more than this share below it is
 said to absorb noise."""
+
+AT_BOUND = 1e-3
+"""A library parameter within this share of its range from a bound is at the bound (`inside`)."""
 
 PAIR_ANCHORS = 3
 """Pairs are built on the best three single effects (greedy selection on the best one alone can be misled)."""
@@ -153,6 +157,23 @@ def _mean_sq(z: np.ndarray) -> float:
 
 def _rms(values: np.ndarray) -> float:
     return float(np.sqrt(np.nanmean(values**2)))
+
+
+def inside(candidate: Scored) -> bool:
+    """Whether every library parameter of a candidate lies inside its bounds (the learned correction's weights
+    aside): a parameter pinned at its plausible bound says the effect stands in for something outside its range, so
+    such a candidate is not chosen (it stays among the candidates the report lists)."""
+    start = 0
+    for effect in candidate.fit.effects:
+        theta = candidate.fit.theta[start : start + effect.size]
+        start += effect.size
+        if learned.is_correction(effect):
+            continue
+        for value, parameter in zip(theta, effect.parameters, strict=True):
+            margin = AT_BOUND * (parameter.high - parameter.low)
+            if not parameter.low + margin < value < parameter.high - margin:
+                return False
+    return True
 
 
 def library_for(air_recorded: bool) -> tuple[Effect, ...]:
@@ -544,6 +565,9 @@ class Diagnoser:
         error), and the next step's candidates fitted only on a choice that passed. (choice, the pairs and triples
         fitted, the systematic test's entries)."""
         chosen, test = null, {}
+        singles = [s for s in singles if inside(s)]
+        if not singles:
+            return chosen, [], test
         flag, gain, low, _ = self.better(singles[0], null, SINGLE_LEVEL, against=max(null.error - 1.0, 0.0))
         test.update(best_single=singles[0].fit.name, best_single_gain=gain, best_single_gain_low=low)
         if not flag:
@@ -552,6 +576,9 @@ class Diagnoser:
         for step, simpler, anchors in (("pair", "single", PAIR_ANCHORS), ("triple", "pair", TRIPLE_ANCHORS)):
             extended = self.fit_extensions(bases, anchors, f"{step}s on the best {simpler}s")
             richer += extended
+            extended = [e for e in extended if inside(e)]
+            if not extended:
+                break
             tolerance = self.response_error(chosen)
             flag, gain, low, _ = self.better(extended[0], chosen, COMBINATION_LEVEL, tolerance)
             test.update(
@@ -580,7 +607,7 @@ class Diagnoser:
         tried += air_explanations(self.problem, chosen, scored, self.score, self.rows)
         seen = {id(s) for s in scored}
         fresh = list({id(s): s for s in tried if id(s) not in seen}.values())
-        simpler_ones = {id(s): s for s in tried if s.fit.k < chosen.fit.k}.values()
+        simpler_ones = {id(s): s for s in tried if s.fit.k < chosen.fit.k and inside(s)}.values()
         for simpler in sorted(simpler_ones, key=lambda s: s.error):
             if not self.better(chosen, simpler, COMBINATION_LEVEL)[0]:
                 test.update(in_physical_terms=simpler.fit.name, in_physical_terms_from=chosen.fit.name)
@@ -627,7 +654,8 @@ class Diagnoser:
             start = np.concatenate([chosen.fit.theta[block] for _, block in kept])
             refitted.append(self.score(fit(self.problem, tuple(e for e, _ in kept), start, self.rows)))
         against = max(null.error - 1.0, 0.0)
-        passing = [s for s in options + refitted if self.better(s, null, SINGLE_LEVEL, against=against)[0]]
+        eligible = [s for s in options + refitted if inside(s)]
+        passing = [s for s in eligible if self.better(s, null, SINGLE_LEVEL, against=against)[0]]
         return min(passing, key=lambda s: s.score, default=null), refitted
 
     def try_correction(self, null: Scored, chosen: Scored) -> tuple[Scored, list[Scored], dict]:
@@ -653,7 +681,7 @@ class Diagnoser:
             test[f"correction_on_{foundation.fit.name}_gain_low"] = low
             if foundation is null:
                 alone = candidate
-            if flag and candidate.error < chosen.error:
+            if flag and candidate.error < chosen.error and inside(candidate):
                 chosen = candidate
         if alone is not None and chosen is not alone and chosen is not library:
             flag, gain, low, _ = self.better(chosen, alone, COMBINATION_LEVEL, tolerance)

@@ -18,7 +18,8 @@ from golfflight.discovery.correction import (
     terms_for,
 )
 from golfflight.discovery.effects import EFFECTS, Context, equivalent_altitude_m
-from golfflight.discovery.fit import Fit, fold_thetas
+from golfflight.discovery.diagnose import inside
+from golfflight.discovery.fit import Fit, Scored, fold_thetas
 from golfflight.discovery.model import reference
 from golfflight.discovery.outside import HEIGHT_GUST, OUTSIDE, HeightGust, air_motion
 from golfflight.discovery.prove import (
@@ -89,6 +90,25 @@ def test_fold_parameters_are_the_best_within_the_bounds():
         assert cost[0] <= cost[1] + 1e-9
         better.append(cost[0] < cost[1] - 1.0)
     assert any(better)
+
+
+def test_a_candidate_pinned_at_a_bound_is_not_eligible():
+    """A library parameter at its plausible bound (drag x 1.40, the top of its range) says the effect stands in for
+    something outside its range, so `diagnose.inside` refuses the candidate; just inside it is eligible, and the
+    learned correction's own weights are not judged (East Lake's apex-only rounds once chose drag x 1.40 beside a
+    ball speed x 1.12)."""
+
+    def candidate(effects, theta):
+        theta = np.asarray(theta, dtype=float)
+        result = Fit(effects, theta, np.zeros((1, 5)), np.zeros((1, 5, len(theta))), np.eye(len(theta)))
+        return Scored(result, np.zeros((1, 5)), 1.0, 0.0)
+
+    drag, speed = EFFECTS["drag_scale"], EFFECTS["ball_speed_bias"]
+    assert not inside(candidate((drag, speed), [1.4, 1.12]))
+    assert not inside(candidate((speed,), [0.85]))
+    assert inside(candidate((drag, speed), [1.39, 1.12]))
+    term = correction_effect((0,))
+    assert inside(candidate((drag, term), [1.05, term.parameters[0].high]))
 
 
 def test_correction_features_are_accelerations_per_unit_weight():
