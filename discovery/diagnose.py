@@ -163,13 +163,10 @@ def inside(candidate: Scored) -> bool:
     """Whether every library parameter of a candidate lies inside its bounds (the learned correction's weights
     aside): a parameter pinned at its plausible bound says the effect stands in for something outside its range, so
     such a candidate is not chosen (it stays among the candidates the report lists)."""
-    start = 0
-    for effect in candidate.fit.effects:
-        theta = candidate.fit.theta[start : start + effect.size]
-        start += effect.size
+    for effect, block in blocks(candidate.fit):
         if learned.is_correction(effect):
             continue
-        for value, parameter in zip(theta, effect.parameters, strict=True):
+        for value, parameter in zip(candidate.fit.theta[block], effect.parameters, strict=True):
             margin = AT_BOUND * (parameter.high - parameter.low)
             if not parameter.low + margin < value < parameter.high - margin:
                 return False

@@ -285,8 +285,7 @@ def fold_thetas(result: Fit, fold: np.ndarray) -> dict[int, np.ndarray]:
         if len(r) <= result.k:
             thetas[int(f)] = result.theta
             continue
-        room = (low - result.theta, high - result.theta)
-        step = lsq_linear(J, -r, bounds=(np.minimum(room[0], 0.0), np.maximum(room[1], 0.0))).x
+        step = lsq_linear(J, -r, bounds=(low - result.theta, high - result.theta)).x
         thetas[int(f)] = np.clip(result.theta + step, low, high)
     return thetas
 
