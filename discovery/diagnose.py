@@ -173,13 +173,16 @@ def inside(candidate: Scored) -> bool:
     return True
 
 
-def library_for(air_recorded: bool) -> tuple[Effect, ...]:
+def library_for(air_recorded: bool, wind_recorded: bool = False) -> tuple[Effect, ...]:
     """The effects offered: the whole library for recordings without air; for recordings that carry their air, no
     air density (with the air recorded there is no air finding) but the Reynolds scale (`effects.REYNOLDS_SCALE`,
-    the model's form: how the recordings' physics reads that air)."""
+    the model's form: how the recordings' physics reads that air). Recordings that carry their wind get no wind
+    either, as with the air: a recorded wind of 0 says the carry was flown, or computed by the launch monitor, in
+    still air."""
+    library = tuple(e for e in LIBRARY if not (wind_recorded and e.name == "wind"))
     if not air_recorded:
-        return LIBRARY
-    return tuple(e for e in LIBRARY if e.name not in AIR_VARIANTS) + (REYNOLDS_SCALE,)
+        return library
+    return tuple(e for e in library if e.name not in AIR_VARIANTS) + (REYNOLDS_SCALE,)
 
 
 def outlier_mask(residual: np.ndarray) -> np.ndarray:
@@ -316,7 +319,7 @@ class Diagnoser:
         self.started = time.perf_counter()
         self.recordings, self.model = recordings, model
         self.air_recorded = recordings.density_kg_m3 is not None
-        self.library = library_for(self.air_recorded)
+        self.library = library_for(self.air_recorded, recordings.wind_xy_mps is not None)
         self.with_correction, self.estimate_scatter, self.progress = with_correction, estimate_scatter, progress
         self.rng = np.random.default_rng(seed)
         self.step(f"flying {len(recordings):,} recorded shots through the model and its expected error...")
