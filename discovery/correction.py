@@ -249,7 +249,7 @@ def fit_correction(problem: Problem, rows: np.ndarray, base: Fit) -> Fit | None:
     The terms are chosen with `base`'s parameters free (`select_terms`), then fitted with them held where `base`
     has them (`held`): the correction is the model's form, what the physical explanation leaves, and fitted jointly
     it trades against that explanation's parameters (1,900 m air, 0.776 x ICAO, concealed in the reference world:
-    air fitted 0.74 alone and 0.69 beside a constant drag term fitted with it; held, 0.74 beside it)."""
+    air fitted 0.74 alone and 0.70 beside a constant drag term fitted with it; held, 0.74 beside it)."""
     knots = knots_for(problem.predict(base.effects, base.theta, rows)[0, :, OBSERVABLES.index("apex_m")])
     everything = correction_effect(tuple(range(len(terms_for(knots)))), knots)
     effects = base.effects + (everything,)

@@ -7,8 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from golfflight.discovery.conceal import NOMINAL_CONTEXT, conceal
-from golfflight.discovery.diagnose import diagnose
+from golfflight.discovery.correction import fit_correction, is_correction
+from golfflight.discovery.diagnose import Diagnoser, diagnose, library_for
 from golfflight.discovery.effects import ALIASES, DENSITY_ONLY, EFFECTS, LIBRARY, apply_all, equivalent_altitude_m
+from golfflight.discovery.fit import fit, linear_starts
 from golfflight.discovery.model import load_model, reference
 from golfflight.discovery.prove import Run, _acted_on, _among, ferguson_world, fitted_as, run_case
 from golfflight.discovery.noise import base_conditions
@@ -162,3 +164,34 @@ def test_a_choice_dropped_as_the_model_s_form_after_the_correction_reports_witho
     run = run_case(load_model(None), "outside: critical_reynolds", ("critical_reynolds",), 0, 300, "reference")
     assert set(run.fitted) <= {"unlisted"}
     assert run.named == ("unlisted" if run.systematic else "none")
+
+
+def _thin_air_in_the_reference_world(wind: dict | None = None) -> ShotSet:
+    """1,900 m air as density alone concealed in the reference world's flights (whose form differs from the served
+    model's), the air left blank; `wind` recorded beside every shot where given."""
+    records = conceal({DENSITY_ONLY: {"ratio": 0.776}}, 200, 1).shots.records
+    return ShotSet([r.model_copy(update=wind or {}) for r in records])
+
+
+def test_the_correction_leaves_the_physical_explanation_where_it_was():
+    """The learned correction on top of air density alone keeps the air's ratio where air alone put it: the
+    correction is the model's form, and fitted jointly it traded against the air (a constant drag term beside air
+    thinner than the truth)."""
+    diagnoser = Diagnoser(from_shot_set(_thin_air_in_the_reference_world()), load_model(None), progress=False)
+    problem, rows = diagnoser.problem, diagnoser.rows
+    start, _ = linear_starts(problem, None, (EFFECTS[DENSITY_ONLY],), rows)[0]
+    base = fit(problem, (EFFECTS[DENSITY_ONLY],), start, rows)
+    corrected = fit_correction(problem, rows, base)
+    assert corrected is not None and corrected.effects[0] is EFFECTS[DENSITY_ONLY]
+    assert is_correction(corrected.effects[1]) and corrected.k > base.k
+    assert corrected.theta[0] == pytest.approx(base.theta[0], abs=1e-6)
+
+
+def test_with_the_wind_recorded_no_wind_is_offered():
+    """A recorded wind is the recordings' own, as a recorded air is: with it recorded (calm, as a launch monitor
+    computes carry), no wind is fitted; left blank, a wind is among the effects tried."""
+    assert "wind" not in {e.name for e in library_for(False, wind_recorded=True)}
+    assert "wind" in {e.name for e in library_for(False)} and "wind" in {e.name for e in library_for(True)}
+    calm = {"wind_speed_mps": 0.0, "wind_from_deg": 0.0}
+    diagnoser = Diagnoser(from_shot_set(_thin_air_in_the_reference_world(calm)), load_model(None), progress=False)
+    assert "wind" not in {e.name for e in diagnoser.library}
