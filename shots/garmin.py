@@ -18,6 +18,11 @@ The export has one header row whose names carry their units ("Ball Speed (mph)",
   kPa -> pressure_hpa) and flies in the density they make (dry: the export names no humidity). The recorded Air
   Density (g/L, the same number in kg/m³) is not kept: rows where it differs from that density by more than
   DENSITY_TOLERANCE are noted in the report. `air=False` (--no-air) leaves the air blank: ICAO standard air.
+- wind: every row records a calm wind (wind_speed_mps 0). The export's carry and apex are the monitor's own flight
+  model's, computed from the launch it measured in still air: a consumer radar tracks the ball for 8 to 30 feet and a
+  camera unit sees only the impact (https://halfwayhouse.golf/articles/how-a-launch-monitor-actually-works). So no
+  wind reaches them, and `golfflight diagnose` looks for none (a wind would otherwise stand in for the monitor's
+  model).
 - identity: shot_id is the row's line number; Date gives timestamp and session (its day); Club, else Club Type, the
   club, as written. Other columns (the club's delivery, smash factor, totals) are passed over.
 
@@ -68,6 +73,9 @@ AIR_NUMBERS = (*AIR, DENSITY)
 REQUIRED = (BALL_SPEED, LAUNCH_ANGLE, LAUNCH_DIRECTION, CARRY)
 SPIN_FORMS = ((SPIN_RATE, SPIN_AXIS), (BACKSPIN, SIDESPIN))
 """A file needs one of these pairs of columns (a row may mix them: the pair it lacks gives what the other lacks)."""
+
+STILL_AIR = {"wind_speed_mps": 0.0, "wind_from_deg": 0.0}
+"""The wind every row records: the carry is the monitor's computation, which no wind reaches (module docstring)."""
 
 GEOMETRY_TOLERANCE_YD = 1.0
 """Most a row's Carry Deviation Distance may differ from carry sin(deviation angle) before the report notes it (the
@@ -161,6 +169,7 @@ def _values(numbers: dict[str, float | None], air: bool) -> dict[str, float]:
     values |= _spin(numbers) | _carry(numbers)
     if numbers[APEX] is not None:
         values["apex_m"] = _checked(APEX, "apex_m", numbers[APEX], numbers[APEX] * FOOT_M)
+    values |= STILL_AIR
     return (values | _air(numbers)) if air else values
 
 

@@ -50,6 +50,7 @@ def test_units_become_si_as_worked_by_hand(tmp_path):
     assert shot.temperature_c == pytest.approx(20.0, abs=1e-12)  # (68 - 32) x 5/9
     assert shot.pressure_hpa == pytest.approx(1013.0, abs=1e-9)  # 101.3 kPa, station pressure
     assert (shot.altitude_m, shot.humidity_pct) == (None, None)
+    assert (shot.wind_speed_mps, shot.wind_from_deg) == (0.0, 0.0)  # the monitor's computed carry: still air
     assert (shot.shot_id, shot.session, shot.timestamp, shot.club) == ("2", "2024-05-12", "2024-05-12T10:31:22",
                                                                       "Driver")
 
