@@ -15,10 +15,10 @@ import argparse
 from pathlib import Path
 
 from golfflight.discovery.conceal import NOMINAL_CONTEXT, conceal
-from golfflight.discovery.prove import truth_world
 from golfflight.discovery.diagnose import diagnose
 from golfflight.discovery.effects import AIR_VARIANTS, DENSITY_ONLY, equivalent_altitude_m
 from golfflight.discovery.model import load_model
+from golfflight.discovery.prove import truth_world
 from golfflight.discovery.recordings import from_shot_set
 from golfflight.discovery.schema import Report
 from golfflight.shots.files import write_text_atomic
