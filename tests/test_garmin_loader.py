@@ -175,3 +175,50 @@ def test_convert_garmin_writes_a_file_that_simulate_flies_in_its_air(tmp_path, c
         flown = list(csv.DictReader(handle))
     assert [float(row["air_density_kg_m3"]) for row in flown] == [STANDARD.air.density_kg_m3] * 2
     assert "temperature_c" not in flown[0]
+
+
+def _as_garmin_row(record, day: str) -> dict:
+    """A canonical record written back in the export's columns and units, rounded as the app rounds them."""
+    carry_m = math.hypot(record.carry_x_m, record.carry_y_m)
+    return {
+        **SHOT,
+        "Date": f"{day} 10:00:00",
+        "Ball Speed (mph)": f"{record.ball_speed_mps / 0.44704:.1f}",
+        "Launch Angle (deg)": f"{record.launch_angle_deg:.1f}",
+        "Launch Direction (deg)": f"{record.launch_direction_deg:.1f}",
+        "Spin Rate (rpm)": f"{record.spin_rpm:.0f}",
+        "Spin Axis (deg)": f"{record.spin_axis_deg:.1f}",
+        "Apex Height (ft)": f"{record.apex_m / 0.3048:.1f}",
+        "Carry Distance (yards)": f"{carry_m / 0.9144:.1f}",
+        "Carry Deviation Angle (deg)": f"{math.degrees(math.atan2(record.carry_x_m, record.carry_y_m)):.1f}",
+        "Carry Deviation Distance (yards)": f"{record.carry_x_m / 0.9144:.1f}",
+        "Temperature (F)": "59", "Air Pressure (kPA)": "80.9", "Air Density (g/L)": "0.951",
+    }
+
+
+def test_a_thin_air_venue_exported_by_the_app_is_found_with_its_air_concealed(tmp_path):
+    """The user's path end to end: a venue at about 1,900 m whose monitor flies density alone (0.776 x ICAO), its shots
+    written in the Garmin export's columns (carry, deviation and apex only, rounded as the app rounds them),
+    converted with --no-air (the air concealed; the wind recorded calm) and diagnosed: air alone is named, within
+    0.03, and no wind is fitted."""
+    from golfflight.discovery.conceal import conceal
+    from golfflight.discovery.diagnose import diagnose
+    from golfflight.discovery.effects import DENSITY_ONLY
+    from golfflight.discovery.model import load_model
+    from golfflight.discovery.recordings import from_shot_set
+    from golfflight.shots.records import ShotSet
+
+    model = load_model(None)
+    records = conceal({DENSITY_ONLY: {"ratio": 0.776}}, 200, 5, model=model).shots.records
+    days = {session: f"2024-05-{10 + i:02d}" for i, session in enumerate(sorted({r.session for r in records}))}
+    source = tmp_path / "venue.csv"
+    with source.open("w", newline="") as handle:
+        writer = csv.DictWriter(handle, COLUMNS)
+        writer.writeheader()
+        writer.writerows(_as_garmin_row(r, days[r.session]) for r in records)
+    converted = load_garmin(source, air=False).records
+    assert len(converted) == len(records) and all(r.wind_speed_mps == 0.0 for r in converted)
+    report = diagnose(from_shot_set(ShotSet(converted)), model, progress=False).report
+    assert not any("wind" in c.name.split("+") for c in report.candidates)
+    assert [e.name for e in report.effects] == [DENSITY_ONLY]
+    assert report.effects[0].parameters["ratio"] == pytest.approx(0.776, abs=0.03)
