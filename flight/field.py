@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
+from golfflight.flight import xp
 from golfflight.flight.physics import CoefficientModel, ExtraAcceleration, State, derivatives
 from golfflight.flight.wind import CALM, Wind
 
@@ -26,8 +27,8 @@ class VectorField(Protocol):
 def take(part: Any, index: np.ndarray) -> Any:
     """Some balls' share of a per-ball value: an array's rows, a model's own `take`; a scalar, or a model without
     per-ball values, is everyone's."""
-    if isinstance(part, (np.ndarray, np.generic, float)):
-        return part[index] if np.ndim(part) > 0 else part
+    if xp.is_number(part) or xp.is_array(part):
+        return xp.rows(part, index)
     return part.take(index) if hasattr(part, "take") else part
 
 

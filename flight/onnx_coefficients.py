@@ -12,6 +12,7 @@ import copy
 import os
 
 import numpy as np
+from golfflight.flight import xp
 from golfflight.flight.bundle_check import open_verified
 from golfflight.flight.physics import reynolds_scale
 
@@ -37,7 +38,7 @@ class OnnxCoefficients:
 
     def take(self, index: np.ndarray) -> OnnxCoefficients:
         """This model for some of the balls (their own air's input scale)."""
-        if isinstance(self.input_scale, float):
+        if xp.is_number(self.input_scale):
             return self
         other = copy.copy(self)
         other.input_scale = self.input_scale[index]

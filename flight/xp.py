@@ -23,6 +23,18 @@ def is_number(value) -> bool:
     return isinstance(value, NUMBERS)
 
 
+def is_array(value) -> bool:
+    """Whether a value is an array of numbers, NumPy's or torch's (torch's told by its type's module: this module
+    never imports torch), rather than one number or an object such as a coefficient model."""
+    return isinstance(value, np.ndarray) or type(value).__module__.startswith("torch")
+
+
+def rows(value, index):
+    """Some balls' share of a per-ball value: an array's rows at `index`; one number, or a 0-d array, is every
+    ball's."""
+    return value[index] if is_array(value) and value.ndim > 0 else value
+
+
 def _tensor_call(name: str, *values):
     """torch's `name` on `values`, some of them tensors; the plain numbers among them made tensors like the first."""
     torch = sys.modules["torch"]
