@@ -25,8 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 LONG = ["--grid", "ball_speed_mps=30:80:400", "launch_angle_deg=6:24:400", "spin_rpm=2000:4000:10", "--chunk-rows",
         "500"]
 """1,600,000 shots in pieces of 500, signalled once the first pieces are written: over a minute of flying at 23,000
-shots/s on two workers. (160,000 took 7 s once the engine got faster, and a signal could arrive after a sweep that had
-already finished and exited 0.)"""
+shots/s on two workers."""
 SHORT = ["--grid", "ball_speed_mps=50", "launch_angle_deg=12", "spin_rpm=3000"]
 GONE_WITHIN_S = 5.0
 """How long after the signal nothing of the sweep may be left."""
@@ -87,12 +86,20 @@ def wait_mid_way(run: subprocess.Popen, folder: Path) -> None:
         time.sleep(0.05)
 
 
+def as_from_a_terminal() -> None:
+    """Run in the child before the sweep starts: SIGINT, SIGHUP and SIGTERM back to their defaults, as a terminal's
+    shell starts a command. A test run under nohup or as a background job inherits them ignored, and so would the
+    sweep: it then flew on to its end and exited 0 (as a sweep started with nohup should)."""
+    for signum in (signal.SIGINT, signal.SIGHUP, signal.SIGTERM):
+        signal.signal(signum, signal.SIG_DFL)
+
+
 def started(folder: Path) -> tuple[subprocess.Popen, dict[int, str]]:
     """A long sweep into `folder`, mid-way, in a session of its own (so that a signal to its process group reaches
     no test), and its processes below it then: the resource tracker, the fork server and the workers."""
     with open(folder / "err", "w") as err:
         run = subprocess.Popen(sweep_command(folder / "out.parquet", *LONG), cwd=ROOT, stdout=subprocess.DEVNULL,
-                               stderr=err, start_new_session=True)
+                               stderr=err, start_new_session=True, preexec_fn=as_from_a_terminal)
     try:
         wait_mid_way(run, folder)
         recorded = descendants(run.pid)
