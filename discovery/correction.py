@@ -19,7 +19,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from golfflight.discovery.effects import Context, Effect, Parameter, Reported
-from golfflight.discovery.fit import Fit, Problem, fit, residuals_and_jacobian
+from golfflight.discovery.fit import Fit, Problem, blocks, fit, residuals_and_jacobian
 from golfflight.discovery.recordings import OBSERVABLES
 from golfflight.discovery.schema import Unlisted
 from golfflight.discovery.simulator import Setup
@@ -266,10 +266,10 @@ def fit_correction(problem: Problem, rows: np.ndarray, base: Fit) -> Fit | None:
 def held(base: Fit) -> tuple[Effect, ...]:
     """`base`'s effects with each parameter's bounds closed to within HELD of its fitted value: the fitter then
     leaves them where they are (the effects themselves, unchanged, go back into the fit it returns)."""
-    effects, values = [], iter(base.theta)
-    for effect in base.effects:
+    effects = []
+    for effect, block in blocks(base):
         parameters = []
-        for parameter, value in zip(effect.parameters, values):
+        for parameter, value in zip(effect.parameters, base.theta[block], strict=True):
             margin = HELD * (parameter.high - parameter.low)
             parameters.append(replace(parameter, low=value - margin, high=value + margin))
         effects.append(replace(effect, parameters=tuple(parameters)))
@@ -278,11 +278,9 @@ def held(base: Fit) -> tuple[Effect, ...]:
 
 def summary(result: Fit, error: float, library_error: float) -> Unlisted:
     """The learned correction of a fit as the report's readable expression with its coefficients."""
-    start = 0
-    for effect in result.effects:
+    for effect, block in blocks(result):
         if is_correction(effect):
-            theta = result.theta[start : start + effect.size]
-            cov = result.covariance[start : start + effect.size, start : start + effect.size]
+            theta, cov = result.theta[block], result.covariance[block, block]
             names = tuple(p.name for p in effect.parameters)
             return Unlisted(
                 expression=expression_of(names, theta),
@@ -292,5 +290,4 @@ def summary(result: Fit, error: float, library_error: float) -> Unlisted:
                 heldout_error=error,
                 library_heldout_error=library_error,
             )
-        start += effect.size
     raise InputError(f"{result.name} holds no learned correction")

@@ -35,6 +35,7 @@ from golfflight.discovery.fit import (
     Fit,
     Problem,
     Scored,
+    blocks,
     cluster_bootstrap,
     fit,
     fit_rows,
@@ -60,7 +61,7 @@ from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from golfflight.discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
 from golfflight.discovery.schema import AirRival, Candidate, Heldout, Located, ModelInfo, Report, ScatterStat, Unlisted
 from golfflight.discovery.simulator import Outcomes, Setup
-from golfflight.discovery.physical import blocks, restatements
+from golfflight.discovery.physical import restatements
 from golfflight.discovery.venue_air import air_explanations, air_rival, air_sentence, with_air
 from golfflight.flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
 from golfflight.shots.progress import progress_bar, progress_step
@@ -179,10 +180,8 @@ def library_for(air_recorded: bool, wind_recorded: bool = False) -> tuple[Effect
     the model's form: how the recordings' physics reads that air). Recordings that carry their wind get no wind
     either, as with the air: a recorded wind of 0 says the carry was flown, or computed by the launch monitor, in
     still air."""
-    library = tuple(e for e in LIBRARY if not (wind_recorded and e.name == "wind"))
-    if not air_recorded:
-        return library
-    return tuple(e for e in library if e.name not in AIR_VARIANTS) + (REYNOLDS_SCALE,)
+    recorded = ({"wind"} if wind_recorded else set()) | (set(AIR_VARIANTS) if air_recorded else set())
+    return tuple(e for e in LIBRARY if e.name not in recorded) + ((REYNOLDS_SCALE,) if air_recorded else ())
 
 
 def outlier_mask(residual: np.ndarray) -> np.ndarray:

@@ -129,6 +129,15 @@ def per_shot(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.where(used, z**2, 0.0).sum(axis=1), used.sum(axis=1).astype(float)
 
 
+def blocks(result: Fit) -> list[tuple[Effect, slice]]:
+    """Each effect of a fit with its parameters' place in the fit's parameter vector."""
+    out, start = [], 0
+    for effect in result.effects:
+        out.append((effect, slice(start, start + effect.size)))
+        start += effect.size
+    return out
+
+
 def _bounds(effects: tuple[Effect, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     params = [p for e in effects for p in e.parameters]
     return (

@@ -12,18 +12,9 @@ from collections.abc import Callable
 
 import numpy as np
 from golfflight.discovery.effects import ALIASES, AIR_VARIANTS, EFFECTS, Effect
-from golfflight.discovery.fit import Fit, Problem, Scored, fit
+from golfflight.discovery.fit import Fit, Problem, Scored, blocks, fit
 
 Score = Callable[[Fit], Scored]
-
-
-def blocks(result: Fit) -> list[tuple[Effect, slice]]:
-    """Each effect of a fit with its parameters' place in the fit's parameter vector."""
-    out, start = [], 0
-    for effect in result.effects:
-        out.append((effect, slice(start, start + effect.size)))
-        start += effect.size
-    return out
 
 
 def aliased(result: Fit) -> list[tuple[Effect, slice]]:

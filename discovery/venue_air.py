@@ -19,9 +19,9 @@ from collections.abc import Callable
 
 import numpy as np
 from golfflight.discovery.effects import ALIASES, AIR_VARIANTS, DENSITY_ONLY, Context
-from golfflight.discovery.fit import Fit, Problem, Scored, cluster_bootstrap, per_shot
+from golfflight.discovery.fit import Fit, Problem, Scored, blocks, cluster_bootstrap, per_shot
 from golfflight.discovery.noise import ExpectedError
-from golfflight.discovery.physical import air_in_place, blocks
+from golfflight.discovery.physical import air_in_place
 from golfflight.discovery.recordings import LABELS, OBSERVABLES
 from golfflight.discovery.schema import AirRival, Ambiguity
 from golfflight.flight.air import STANDARD_TEMPERATURE_C
