@@ -23,7 +23,7 @@ from golfflight.discovery.prove import truth_world
 from golfflight.discovery.recordings import from_shot_set
 from golfflight.discovery.schema import Report
 from golfflight.shots.files import write_text_atomic
-from golfflight.shots.markdown import replace_section
+from golfflight.shots.markdown import replace_section, table
 from golfflight.shots.records import ShotSet
 
 RATIO = 0.776
@@ -90,11 +90,7 @@ def main() -> None:
     parser.add_argument("--shots", type=int, default=300)
     parser.add_argument("--out", default="docs/discovery.md")
     args = parser.parse_args()
-    lines = [
-        "| world | air | wind | observed | seed | air found | ratio | within 0.03 | within 0.72-0.86 |",
-        "|---|---|---|---|---:|---|---:|---|---|",
-    ]
-    summary = []
+    runs, summary = [], []
     for world, air, wind, observed in CASES:
         passed = in_range = 0
         for seed in range(args.seeds):
@@ -103,25 +99,24 @@ def main() -> None:
             inside = named and OUTSIDE_RANGE[0] <= ratio <= OUTSIDE_RANGE[1]
             passed, in_range = passed + good, in_range + inside
             shown = "-" if ratio is None else f"{ratio:.3f}"
-            ranged = inside if air == "blank" else "-"
-            lines.append(f"| {world} | {air} | {wind} | {observed} | {seed} | {found} | {shown} | {good} | {ranged} |")
-            print(lines[-1], flush=True)
-        if air == "recorded":
-            found_in = f"no air finding in {passed} of {args.seeds} | -"
-        else:
-            found_in = f"{passed} of {args.seeds} | {in_range} of {args.seeds}"
-        summary.append(f"| {world} | {air} | {wind} | {observed} | {found_in} |")
-    table = (
+            runs.append([world, air, wind, observed, seed, found, shown, good, inside if air == "blank" else "-"])
+            print(" | ".join(map(str, runs[-1])), flush=True)
+        found_in = [f"no air finding in {passed} of {args.seeds}", "-"] if air == "recorded" else [
+            f"{passed} of {args.seeds}", f"{in_range} of {args.seeds}"]
+        summary.append([world, air, wind, observed, *found_in])
+    columns = ["world", "air", "wind", "observed"]
+    text = "\n".join([
         f"Density-only air at {RATIO} x ICAO concealed, {args.shots} shots a set (model: the served model's own "
         "flights; reference, ferguson: the worlds whose form differs); with the air left blank, air named or listed "
-        "first as inseparable (observed: all five outcomes, or what a Garmin export records):\n\n"
-        "| world | air | wind | observed | within 0.03 | within 0.72-0.86 |\n|---|---|---|---|---:|---:|\n"
-        + "\n".join(summary)
-    )
-    print(table)
+        "first as inseparable (observed: all five outcomes, or what a Garmin export records):",
+        "",
+        *table([*columns, "within 0.03", "within 0.72-0.86"], summary, "llllrr"),
+        "",
+        *table([*columns, "seed", "air found", "ratio", "within 0.03", "within 0.72-0.86"], runs, "llllrlrll"),
+    ]) + "\n"
+    print(text)
     out = Path(args.out)
-    text = replace_section(out.read_text(), table + "\n\n" + "\n".join(lines) + "\n", MARKER)
-    write_text_atomic(out, text)
+    write_text_atomic(out, replace_section(out.read_text(), text, MARKER))
 
 
 if __name__ == "__main__":
