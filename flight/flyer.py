@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, fields
-from functools import lru_cache
+from functools import lru_cache, partial
 from pathlib import Path
 from typing import NamedTuple, Protocol
 
@@ -233,22 +233,11 @@ class Flyer:
         field = self._batch_field(per_shot)
         flight = integrate(start, field, self.dt_s, self.max_steps, self.rule, GroundPlane(heights),
                            record_for(keep_states))
-        x, y, _ = flight.landing_position.T
-        carry, angle, speed, spin = landing_figures(x, y, *flight.landing_velocity.T, *flight.landing_spin.T)
-        numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
-        finite = np.isfinite(np.stack(numbers)).all(axis=0)
-        errors = {}
-        for i in np.flatnonzero(~(flight.landed & finite)).tolist():
-            unlanded = not flight.landed[i]
-            errors[i] = self.unlanded_message(float(flight.apex_m[i]), float(heights[i])) if unlanded else NON_FINITE
-        rolled = flight.landed & finite & shot_grounds.column(lambda g: g is not None, bool)
-        shots = np.flatnonzero(rolled)
-        phase = _ground_phase(flight, shots, shot_grounds.take(shots), keep_states)
-        columns = BatchFlights(
-            landing_x_m=x, landing_y_m=y, carry_m=carry, lateral_m=x, apex_m=flight.apex_m,
-            apex_time_s=flight.apex_time_s, flight_time_s=flight.flight_time_s, landing_angle_deg=angle,
-            landing_speed_mps=speed, landing_spin_rpm=spin, rest=Rest.of_batch(phase, shots, n, carry),
-            rolled=rolled, errors=errors,
+        roll = partial(ground_phase, keep_path=keep_states)
+        columns, phase = landed_columns(
+            Landings(flight.landed, flight.landing_position, flight.landing_velocity, flight.landing_spin,
+                     flight.flight_time_s, flight.apex_m, flight.apex_time_s),
+            shot_grounds, self.unlanded_message, roll,
         )
         return _Flown(columns, flight, phase)
 
@@ -276,22 +265,56 @@ class Flyer:
         return EulerStates(times_s=times, positions=positions, velocities=velocities)
 
 
-def _ground_phase(
-    flight: Flight, shots: np.ndarray, grounds: PerShot[GroundSpec], keep_states: bool
-) -> GroundPhase | None:
-    """The ground phase of the landed `shots` of a batch flight, each on its ground (`grounds`, theirs), in one
-    batch."""
-    if not shots.size:
-        return None
-    return ground_phase(
-        flight.landing_position[shots],
-        flight.landing_velocity[shots],
-        flight.landing_spin[shots],
-        batch_surface(grounds),
-        grounds.column(lambda g: g.slope_deg),
-        grounds.column(lambda g: g.slope_dir_deg),
-        keep_states,
+@dataclass(frozen=True)
+class Landings:
+    """What a batch's flight hands its figures and ground phase, NumPy float64: whether each shot came down, its
+    landing state [N,3] (the last state where it did not), its flight time, apex height and apex time [N]."""
+
+    landed: np.ndarray
+    position: np.ndarray
+    velocity: np.ndarray
+    spin: np.ndarray
+    flight_time_s: np.ndarray
+    apex_m: np.ndarray
+    apex_time_s: np.ndarray
+
+
+Roll = Callable[..., GroundPhase]
+"""(position, velocity, spin [N,3], surface, slope_deg, slope_dir_deg) -> the ground phase of those landings
+(`flight.ground.ground_phase`, or the same driver on a device)."""
+
+
+def landed_columns(
+    flight: Landings, grounds: PerShot[GroundSpec | None], unlanded: Callable[[float, float], str], roll: Roll
+) -> tuple[BatchFlights, GroundPhase | None]:
+    """A batch's columns from its landings, for every backend: the figures (NaN where a shot never came down), an
+    error a shot that never came down (`unlanded(apex_m, ground_m)`) or whose figures are not finite, and the rests
+    of the landed shots with a ground, bounced and rolled by `roll` in one batch; and that ground phase."""
+    n, heights = len(flight.landed), elevations(grounds)
+    x, y = flight.position[:, 0], flight.position[:, 1]
+    carry, angle, speed, spin = landing_figures(x, y, *flight.velocity.T, *flight.spin.T)
+    numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
+    finite = np.isfinite(np.stack(numbers)).all(axis=0)
+    errors = {}
+    for i in np.flatnonzero(~(flight.landed & finite)).tolist():
+        errors[i] = unlanded(float(flight.apex_m[i]), float(heights[i])) if not flight.landed[i] else NON_FINITE
+    rolled = flight.landed & finite & grounds.column(lambda g: g is not None, bool)
+    shots = np.flatnonzero(rolled)
+    phase = None
+    if shots.size:
+        on = grounds.take(shots)
+        phase = roll(flight.position[shots], flight.velocity[shots], flight.spin[shots], batch_surface(on),
+                     on.column(lambda g: g.slope_deg), on.column(lambda g: g.slope_dir_deg))
+    x, y, carry, angle, speed, spin, flight_time = (
+        np.where(flight.landed, v, math.nan) for v in (x, y, carry, angle, speed, spin, flight.flight_time_s)
     )
+    columns = BatchFlights(
+        landing_x_m=x, landing_y_m=y, carry_m=carry, lateral_m=x, apex_m=flight.apex_m,
+        apex_time_s=flight.apex_time_s, flight_time_s=flight_time, landing_angle_deg=angle,
+        landing_speed_mps=speed, landing_spin_rpm=spin, rest=Rest.of_batch(phase, shots, n, carry),
+        rolled=rolled, errors=errors,
+    )
+    return columns, phase
 
 
 def check_ball(card: ModelCard, card_path: Path) -> None:

@@ -28,7 +28,6 @@ sent).
 
 from __future__ import annotations
 
-import math
 import os
 import threading
 import time
@@ -40,10 +39,10 @@ import torch
 from golfflight.errors import InputError
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.devices import resolve_device
-from golfflight.flight.flyer import LAUNCH_WIDTH, NON_FINITE, Launch, air_inputs, load_flyer
-from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, batch_surface, elevations, ground_phase
+from golfflight.flight.flyer import LAUNCH_WIDTH, Landings, Launch, air_inputs, landed_columns, load_flyer
+from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, elevations, ground_phase
 from golfflight.flight.ground.phase import plane_normals, roll_to_rest
-from golfflight.flight.outcomes import BatchFlights, Rest, landing_figures
+from golfflight.flight.outcomes import BatchFlights
 from golfflight.flight.per_shot import PerShot
 from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.flight.rollout import LANDING_CHECK_STEPS, Trajectory, apex, euler_step, hard_landing
@@ -98,20 +97,6 @@ class ShotInputs:
     def part(self, start: int, stop: int) -> ShotInputs:
         """The shots start..stop-1."""
         return ShotInputs(*(getattr(self, name)[start:stop] for name in self.__dataclass_fields__))
-
-
-@dataclass(frozen=True)
-class Landings:
-    """What the flight hands the ground phase and the figures, float64 NumPy: the landing states [N,3], the flight
-    and apex times and the apex height [N], and whether each shot came down."""
-
-    position: np.ndarray
-    velocity: np.ndarray
-    spin: np.ndarray
-    flight_time_s: np.ndarray
-    apex_m: np.ndarray
-    apex_time_s: np.ndarray
-    landed: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -316,41 +301,15 @@ class TorchEngine:
             return values.to(device="cpu", dtype=torch.float64).numpy()
 
         return Landings(
-            array(landing.position), array(landing.velocity), array(landing.spin), array(landing.time_s),
-            array(peak.height_m + ground), array(peak.time_s), landing.landed.cpu().numpy(),
+            landing.landed.cpu().numpy(), array(landing.position), array(landing.velocity), array(landing.spin),
+            array(landing.time_s), array(peak.height_m + ground), array(peak.time_s),
         )
 
     def _columns(self, flight: Landings, grounds: PerShot[GroundSpec | None]) -> BatchFlights:
-        """The batch's figures, errors and rests from its landings (as `flight.flyer.Flyer` makes them from the
-        integrator's), the landed shots with a ground bounced and rolled to rest on the CPU."""
-        n = len(flight.landed)
-        x, y = flight.position[:, 0], flight.position[:, 1]
-        carry, angle, speed, spin = landing_figures(x, y, *flight.velocity.T, *flight.spin.T)
-        numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
-        finite = np.isfinite(np.stack(numbers)).all(axis=0)
-        errors, heights = {}, elevations(grounds)
-        for i in np.flatnonzero(~(flight.landed & finite)).tolist():
-            unlanded = not flight.landed[i]
-            errors[i] = (self.flyer.unlanded_message(float(flight.apex_m[i]), float(heights[i]))
-                         if unlanded else NON_FINITE)
-        rolled = flight.landed & finite & grounds.column(lambda g: g is not None, bool)
-        shots = np.flatnonzero(rolled)
-        phase = None
-        if shots.size:
-            on = grounds.take(shots)
-            roll = self._ground_on_device if self.ground_on_device else ground_phase
-            phase = roll(flight.position[shots], flight.velocity[shots], flight.spin[shots], batch_surface(on),
-                         on.column(lambda g: g.slope_deg), on.column(lambda g: g.slope_dir_deg))
-        # a shot that never came down has no landing: NaN figures, as the integrator leaves them
-        x, y, carry, angle, speed, spin, flight_time = (
-            np.where(flight.landed, v, math.nan) for v in (x, y, carry, angle, speed, spin, flight.flight_time_s)
-        )
-        return BatchFlights(
-            landing_x_m=x, landing_y_m=y, carry_m=carry, lateral_m=x, apex_m=flight.apex_m,
-            apex_time_s=flight.apex_time_s, flight_time_s=flight_time, landing_angle_deg=angle,
-            landing_speed_mps=speed, landing_spin_rpm=spin, rest=Rest.of_batch(phase, shots, n, carry),
-            rolled=rolled, errors=errors,
-        )
+        """The batch's figures, errors and rests from its landings (`flight.flyer.landed_columns`, as the engine
+        makes them), the landed shots with a ground bounced and rolled on the device or on the CPU."""
+        roll = self._ground_on_device if self.ground_on_device else ground_phase
+        return landed_columns(flight, grounds, self.flyer.unlanded_message, roll)[0]
 
 
 @dataclass(frozen=True)
