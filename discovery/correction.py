@@ -215,7 +215,7 @@ def expression_of(names: tuple[str, ...], theta: np.ndarray | None) -> str:
     )
 
 
-def select_terms(z: np.ndarray, jacobian: np.ndarray, free: int = 0, most: int = MAX_TERMS) -> tuple[int, ...]:
+def select_terms(z: np.ndarray, jacobian: np.ndarray, free: int = 0) -> tuple[int, ...]:
     """Backward elimination on the linearised problem: drop the weakest term while |t| < MIN_T or too many. The first
     `free` columns (the library explanation's parameters) are fitted beside the terms and never dropped, so a term
     does not have to take up what the explanation's own parameters would; the kept terms' indices count from after
@@ -236,13 +236,13 @@ def select_terms(z: np.ndarray, jacobian: np.ndarray, free: int = 0, most: int =
         s2 = resid @ resid / max(len(r) - len(columns), 1)
         t = (np.abs(step) / np.sqrt(s2 * np.diag(np.linalg.inv(normal))))[free:]
         weakest = int(np.argmin(t))
-        if t[weakest] >= MIN_T and len(kept) <= most:
+        if t[weakest] >= MIN_T and len(kept) <= MAX_TERMS:
             return tuple(k - free for k in kept)
         kept.pop(weakest)
     return ()
 
 
-def fit_correction(problem: Problem, rows: np.ndarray, base: Fit, most: int = MAX_TERMS) -> Fit | None:
+def fit_correction(problem: Problem, rows: np.ndarray, base: Fit) -> Fit | None:
     """The sparse learned correction on top of `base` (the best library explanation), or None if no term holds. The
     height terms' hinges come from the apex of the flights `base` predicts for these shots.
 
@@ -255,7 +255,7 @@ def fit_correction(problem: Problem, rows: np.ndarray, base: Fit, most: int = MA
     effects = base.effects + (everything,)
     theta = np.concatenate([base.theta, everything.null])
     z, jacobian = residuals_and_jacobian(problem, effects, theta, rows)
-    kept = select_terms(z, jacobian, free=base.k, most=most)
+    kept = select_terms(z, jacobian, free=base.k)
     if not kept:
         return None
     term = correction_effect(kept, knots)

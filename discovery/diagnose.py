@@ -462,16 +462,7 @@ class Diagnoser:
         if within:
             chosen, refitted = self.form_instead(null, chosen, within, scored, test)
             scored += refitted
-        unlisted, left = None, []
-        if structure and self.with_correction and chosen.fit.k:
-            library_best = chosen
-            chosen, rival = self.against_form(null, chosen, test)
-            if rival is not None:
-                scored.append(rival)
-            if chosen is rival:
-                unlisted = learned.summary(chosen.fit, chosen.error, library_best.error)
-        if structure and self.with_correction and unlisted is None:
-            left = self.structure_left(chosen)
+        unlisted, left = None, self.structure_left(chosen) if structure and self.with_correction else []
         if left:
             library_best = chosen
             chosen, tried, entries = self.try_correction(null, chosen)
@@ -665,33 +656,6 @@ class Diagnoser:
         eligible = [s for s in options + refitted if inside(s)]
         passing = [s for s in eligible if self.better(s, null, SINGLE_LEVEL, against=against)[0]]
         return min(passing, key=lambda s: s.score, default=null), refitted
-
-    def against_form(self, null: Scored, chosen: Scored, test: dict) -> tuple[Scored, Scored | None]:
-        """The choice's venue conditions and monitor biases set against the model's form with as many parameters:
-        the learned correction with at most that many terms in their place (on the choice's form effects, if any).
-        They stand only if the choice beats that beyond doubt and materially; otherwise the form explanation is
-        chosen. (choice, the form rival fitted or None)."""
-        acted = [(e, b) for e, b in blocks(chosen.fit) if e.kind != "form"]
-        if not acted:
-            return chosen, None
-        form = [(e, b) for e, b in blocks(chosen.fit) if e.kind == "form"]
-        base = null.fit
-        if form:
-            start = np.concatenate([chosen.fit.theta[b] for _, b in form])
-            base = fit(self.problem, tuple(e for e, _ in form), start, self.rows)
-        most = sum(b.stop - b.start for _, b in acted)
-        term = learned.fit_correction(self.problem, self.rows, base, most=most)
-        if term is None:
-            return chosen, None
-        rival = self.score(term)
-        flag, gain, low, _ = self.better(chosen, rival, COMBINATION_LEVEL)
-        test["conditions_over_form_gain"], test["conditions_over_form_gain_low"] = gain, low
-        if flag or not inside(rival):
-            return chosen, rival
-        if not self.better(rival, null, SINGLE_LEVEL, against=max(null.error - 1.0, 0.0))[0]:
-            return chosen, rival
-        test["form_instead_of"] = chosen.fit.name
-        return rival, rival
 
     def try_correction(self, null: Scored, chosen: Scored) -> tuple[Scored, list[Scored], dict]:
         """The learned correction on top of the chosen explanation and alone; it replaces the choice if better. A

@@ -159,12 +159,11 @@ def test_the_smallest_hidden_venue_and_monitor_effects_move_more_than_the_model_
 def test_a_choice_dropped_as_the_model_s_form_after_the_correction_reports_without_one():
     """The moved drag crisis of the model-form campaign, seed 0: the learned correction's library company (drag,
     spin and air) holds an air density within the model's own error, so the company is dropped as the model's form
-    and the model's form alone is reported (coefficient scales and the learned correction) where it beats the model
-    as is, else nothing (this once stopped the campaign: the report asked the model as is for its learned
-    correction)."""
+    and the correction alone is reported where it beats the model as is, else nothing (this once stopped the
+    campaign: the report asked the model as is for its learned correction)."""
     run = run_case(load_model(None), "outside: critical_reynolds", ("critical_reynolds",), 0, 300, "reference")
-    assert set(run.named_kinds) <= {"form"}
-    assert ("unlisted" in run.named.split("+")) if run.systematic else run.named == "none"
+    assert set(run.fitted) <= {"unlisted"}
+    assert run.named == ("unlisted" if run.systematic else "none")
 
 
 def _thin_air_in_the_reference_world(wind: dict | None = None) -> ShotSet:
