@@ -287,6 +287,8 @@ def test_the_narrow_layout_keeps_the_lateral_column_and_whole_dots():
         for number, (hla, axis) in enumerate(((-6.0, -20.0), (0.0, 0.0), (6.0, 25.0)), start=1):
             gspro_over_tcp(port, number, {**WEDGE_BALL, "HLA": hla, "SpinAxis": axis})
         page.wait_for_selector("#shots tbody tr[data-shot='3']", timeout=10_000)
+        page.wait_for_function(  # the session's summary of the three read and drawn: no redraw while measured
+            "() => session.summary && session.summary.clubs.reduce((n, c) => n + c.shots, 0) === 3", timeout=10_000)
         assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")  # no sideways scroll
         scroll = page.locator(".shots .scroll")
         assert scroll.evaluate("e => e.scrollWidth <= e.clientWidth"), "the shot table is cut"
