@@ -43,7 +43,7 @@ def main() -> None:
     args = parser.parse_args()
     engine = FlightEngine(model_dir(args.model), BATCH_THREADS)
     launches = mixed_launches(1024)
-    landed = engine.fly_batch([DRIVER], keep_states=True)[0]
+    landed = engine.fly_batch([DRIVER], keep_states=True).shots()[0]
     states, spin = landed.states, landed.landing_spin_rpm * RPM_TO_RADPS
     landing = (tuple(states.positions[-1]), tuple(states.velocities[-1]), (spin, 0.0, 0.0))
     single = {(shot, name): [] for shot in ("7-iron", "driver") for name in GROUNDS}
@@ -60,7 +60,7 @@ def main() -> None:
             alone[name].append(percentiles_ms(cpu_timed(call, 500, warmup=50)))
         for name in batch:
             ground = GROUNDS[name]
-            batch[name].append(statistics.median(cpu_timed(lambda: engine.fly_batch(launches, grounds=ground), 5)))
+            batch[name].append(statistics.median(cpu_timed(lambda: engine.fly_batch(launches, grounds=ground).shots(), 5)))
     rows = []
     for shot in ("7-iron", "driver"):
         flight_only = median_of_rounds(single[shot, "flight alone"])

@@ -41,7 +41,7 @@ def time_single(engine: FlightEngine, launch, shots: int) -> dict:
 
 
 def time_batch(engine: FlightEngine, launches, repeats: int) -> list[float]:
-    return timed(lambda: engine.fly_batch(launches), repeats)
+    return timed(lambda: engine.fly_batch(launches).shots(), repeats)
 
 
 def main() -> None:

@@ -35,7 +35,7 @@ from golfflight.flight.ground import GroundSpec
 
 engine, fairway = FlightEngine(model_dir()), GroundSpec()
 shots = {"7-iron": Launch(55.0, 16.0, 0.0, 7100.0, 0.0), "driver": Launch(76.5, 10.5, 0.0, 2550.0, 0.0)}
-torch_engine = launches = None
+torch_fly = launches = None
 
 
 def single(name, count):
@@ -48,8 +48,8 @@ def single(name, count):
 
 
 def torch_batch(n):
-    global torch_engine, launches
-    if torch_engine is None:
+    global torch_fly, launches
+    if torch_fly is None:
         import torch
         try:
             from golfflight.flight.torch_engine import TorchEngine
@@ -59,10 +59,11 @@ def torch_batch(n):
         rng = np.random.default_rng(0)
         launches = np.stack([rng.uniform(30, 80, n), rng.uniform(6, 24, n), rng.normal(0, 2, n),
                              rng.uniform(2000, 8000, n), rng.normal(0, 5, n)], -1)
-        torch_engine = TorchEngine(model_dir())
-        torch_engine.fly_columns(launches[:512])
+        backend = TorchEngine(model_dir())
+        torch_fly = getattr(backend, "fly_columns", None) or backend.fly_batch  # its name before one batch method
+        torch_fly(launches[:512])
     started = time.perf_counter()
-    torch_engine.fly_columns(launches)
+    torch_fly(launches)
     return n / (time.perf_counter() - started)
 
 

@@ -140,7 +140,7 @@ def _fly_group(
     """One engine batch for `shots`, their normalized replays and their flat flights; results in order, and each
     shot's own flight."""
     batch = batch_of(shots)
-    flights = engine.fly_batch(batch.launches, batch.conditions, keep, batch.grounds)
+    flights = engine.fly_batch(batch.launches, batch.conditions, batch.grounds, keep).shots()
     replays, flats = batch.replays.tolist(), batch.flats.tolist()
     replayed = dict(zip(replays, flights[len(shots) : len(shots) + len(replays)], strict=True))
     flat = dict(zip(flats, flights[len(shots) + len(replays) :], strict=True))
@@ -200,7 +200,7 @@ def fly_columns(engine: FlightEngine, shots: list[ShotRequest]) -> ShotColumns:
     if any(shot.trajectory is not None for shot in shots):
         raise InputError("fly_columns flies no trajectories (fly_shots does)")
     batch = batch_of(shots)
-    flights = engine.fly_columns(np.array(batch.launches, dtype=float).reshape(-1, LAUNCH_WIDTH), batch.conditions,
+    flights = engine.fly_batch(np.array(batch.launches, dtype=float).reshape(-1, LAUNCH_WIDTH), batch.conditions,
                                  batch.grounds)
     flown = columns_of(flights, batch)
     flown.values[AIR_DENSITY] = np.array([c.air.density_kg_m3 for c in batch.conditions[: batch.n]], dtype=float)

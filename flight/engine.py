@@ -1,6 +1,6 @@
 """The served engine: a bundle's `flight.flyer.Flyer` and its single-shot latency twin.
 
-A batch is the Flyer's (`fly_batch`, `fly_columns`: NumPy [N] arrays through `flight.integrator`). One shot runs on
+A batch is the Flyer's (`fly_batch`: NumPy [N] arrays through `flight.integrator`). One shot runs on
 plain Python floats with the network's inputs and output bound once to preallocated float32 buffers (IOBinding, one
 thread): per-call overheads, not arithmetic, decide single-shot latency (docs/benchmarks.md). It is the same forward
 Euler at the Flyer's step, fed v_rel and omega times the air's Reynolds scale, stopping at the same interpolated
@@ -48,7 +48,7 @@ __all__ = [
 
 class FlightEngine:
     """A loaded model bundle (its `Flyer`) and the two ways to fly shots through it: `fly` (one, on floats) and
-    `fly_batch` / `fly_columns` (many, the Flyer's)."""
+    `fly_batch` (many, the Flyer's: columns, `.shots()` one ShotFlight a shot)."""
 
     def __init__(self, bundle_dir: str | os.PathLike, batch_threads: int = BATCH_THREADS):
         """Load and verify a bundle (`flight.flyer.load_flyer`: card, ball, hash, graph interface, finite
@@ -94,7 +94,7 @@ class FlightEngine:
     def from_bundle(cls, bundle_dir: str | os.PathLike, backend: str = "onnx", device: str = "cpu", **options):
         """The engine of a bundle on a backend: "onnx", ONNX Runtime on the CPU (this class: the served engine, its
         single shot and its batches), or "torch" on `device` ("cpu", "cuda", "cuda:N": `flight.torch_engine`'s
-        TorchEngine, which flies batches as `fly_columns` does; torch is imported here only, so the serving install
+        TorchEngine, which flies batches as `fly_batch` does; torch is imported here only, so the serving install
         stays torch-free). `options` go to the engine's constructor. InputError for another backend, or a device
         with ONNX Runtime."""
         if backend == "onnx":
@@ -208,19 +208,11 @@ class FlightEngine:
 
     def fly_batch(
         self,
-        launches: Sequence[Launch],
-        conditions: Sequence[Conditions] | Conditions = STANDARD,
-        keep_states: bool = False,
-        grounds: Sequence[GroundSpec] | GroundSpec | None = None,
-    ) -> list[ShotFlight | FlightError]:
-        """Many shots through the Flyer (`Flyer.fly_batch`): one ShotFlight or FlightError a shot, in order."""
-        return self.flyer.fly_batch(launches, conditions, keep_states, grounds)
-
-    def fly_columns(
-        self,
         launches: Sequence[Launch] | np.ndarray,
         conditions: Sequence[Conditions] | Conditions = STANDARD,
         grounds: Sequence[GroundSpec | None] | GroundSpec | None = None,
+        keep_states: bool = False,
     ) -> BatchFlights:
-        """`fly_batch`'s numbers as arrays over the shots (`Flyer.fly_columns`), for callers that want columns."""
-        return self.flyer.fly_columns(launches, conditions, grounds)
+        """Many shots through the Flyer (`Flyer.fly_batch`): their figures, rests and errors as columns (one
+        ShotFlight or FlightError a shot, in order, from `.shots()`)."""
+        return self.flyer.fly_batch(launches, conditions, grounds, keep_states)

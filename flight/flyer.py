@@ -15,13 +15,12 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, replace
 from functools import lru_cache, partial
 from pathlib import Path
 from typing import NamedTuple, Protocol
 
 import numpy as np
-from golfflight.errors import FlightError
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.constants import BALL_MASS_KG, BALL_RADIUS_M
@@ -31,12 +30,10 @@ from golfflight.flight.integrator import FORWARD_EULER, GroundPlane, StepRule, i
 from golfflight.flight.limits import FLIGHT_TIME_S
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.outcomes import (
-    SHOT_NUMBERS,
     BatchFlights,
     EulerStates,
     Flight,
     Rest,
-    ShotFlight,
     landing_figures,
 )
 from golfflight.flight.per_shot import PerShot
@@ -173,49 +170,36 @@ class Flyer:
             return f"the ball never rose to its landing ground: apex {apex_m:.1f} m, ground.elevation_m {height_m:g} m"
         return f"the ball was still in the air after {self.max_steps * self.dt_s:g} s (the simulation cap)"
 
-    def fly_columns(
+    def fly_batch(
         self,
         launches: Sequence[Launch] | np.ndarray,
         conditions: Sequence[Conditions] | Conditions = STANDARD,
         grounds: Sequence[GroundSpec | None] | GroundSpec | None = None,
+        keep_states: bool = False,
     ) -> BatchFlights:
         """Shots (launches an [N, LAUNCH_WIDTH] array or a sequence of Launch), each in its conditions, down to its
-        ground and rolled to rest there (grounds None: the flights alone, down to z = 0), as columns."""
-        return self._fly(launches, conditions, False, grounds).columns
-
-    def fly_batch(
-        self,
-        launches: Sequence[Launch],
-        conditions: Sequence[Conditions] | Conditions = STANDARD,
-        keep_states: bool = False,
-        grounds: Sequence[GroundSpec] | GroundSpec | None = None,
-    ) -> list[ShotFlight | FlightError]:
-        """`fly_columns`'s numbers as one ShotFlight a shot (with its states when kept, through the bounces and the
-        roll), in the order of `launches`; a FlightError for a shot that has not landed by the maximum flight time or
-        whose flight is not finite."""
-        if len(launches) == 0:
-            return []
+        ground and rolled to rest there (grounds None: the flights alone, down to z = 0), as columns; a shot that has
+        not landed by the maximum flight time, or whose flight is not finite, fails (`errors`). With `keep_states`,
+        each shot's states through its bounces and roll (`BatchFlights.states`). `.shots()` gives one ShotFlight a
+        shot."""
         columns, flight, phase = self._fly(launches, conditions, keep_states, grounds)
-        history = None
-        if flight.states is not None:
-            history = (np.stack([s.position for s in flight.states]), np.stack([s.velocity for s in flight.states]))
+        if flight.states is None:
+            return columns
+        history = (np.stack([s.position for s in flight.states]), np.stack([s.velocity for s in flight.states]))
         rolled_row = np.cumsum(columns.rolled) - 1
-        rest_names = [f.name for f in fields(Rest)]
-        rests = zip(*(getattr(columns.rest, name).tolist() for name in rest_names), strict=True)
-        numbers = zip(*(getattr(columns, name).tolist() for name in SHOT_NUMBERS), strict=True)
-        results: list[ShotFlight | FlightError] = []
-        for i, (shot, rest, rolled) in enumerate(zip(numbers, rests, columns.rolled.tolist(), strict=True)):
-            if i in columns.errors:
-                results.append(FlightError(columns.errors[i]))
+        states: list[EulerStates | None] = [None] * len(columns.rolled)
+        errors = dict(columns.errors)
+        for i in range(len(states)):
+            if i in errors:
                 continue
-            figures = dict(zip(SHOT_NUMBERS, shot, strict=True))
-            states = None if history is None else self._shot_states(history, flight, i)
-            if rolled and states is not None:
-                states = states.through_rest(phase, int(rolled_row[i]), figures["flight_time_s"])
-            shot_rest = Rest(**dict(zip(rest_names, rest, strict=True))) if rolled else None
-            flown = ShotFlight(**figures, states=states, rest=shot_rest)
-            results.append(flown if states is None or states.finite else FlightError(NON_FINITE))
-        return results
+            kept = self._shot_states(history, flight, i)
+            if columns.rolled[i]:
+                kept = kept.through_rest(phase, int(rolled_row[i]), float(columns.flight_time_s[i]))
+            if kept.finite:
+                states[i] = kept
+            else:
+                errors[i] = NON_FINITE
+        return replace(columns, states=states, errors=errors)
 
     def _fly(
         self,
@@ -224,7 +208,7 @@ class Flyer:
         keep_states: bool,
         grounds: Sequence[GroundSpec | None] | GroundSpec | None,
     ) -> _Flown:
-        """The batch flight behind `fly_batch` and `fly_columns`."""
+        """The batch flight behind `fly_batch`."""
         n = len(launches)
         per_shot = PerShot.of(conditions, n, "conditions")
         shot_grounds = PerShot.of(grounds, n, "grounds")

@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass, fields
 
 import numpy as np
+from golfflight.errors import FlightError
 from golfflight.flight import xp
 from golfflight.flight.constants import RPM_TO_RADPS
 from golfflight.flight.ground import GroundPath, GroundPhase
@@ -177,9 +178,10 @@ SHOT_NUMBERS = tuple(f.name for f in fields(ShotFlight) if f.name not in ("state
 
 @dataclass(frozen=True, kw_only=True)
 class BatchFlights:
-    """A batch's outcomes as [N] arrays, named as ShotFlight's fields: what `Flyer.fly_batch` turns into one
-    ShotFlight a shot, for callers that want columns. `rest` holds arrays too (NaN, bounces -1, where `rolled` is
-    False: a flight alone, or a shot that failed); `errors` maps a failed shot to why (its numbers are meaningless)."""
+    """A batch's outcomes as [N] arrays, named as ShotFlight's fields (`shots` makes one ShotFlight a shot). `rest`
+    holds arrays too (NaN, bounces -1, where `rolled` is False: a flight alone, or a shot that failed); `errors` maps
+    a failed shot to why (its numbers are meaningless); `states`, where they were kept, each shot's states through its
+    bounces and roll (None for a failed one)."""
 
     landing_x_m: np.ndarray
     landing_y_m: np.ndarray
@@ -194,11 +196,29 @@ class BatchFlights:
     rest: Rest
     rolled: np.ndarray
     errors: dict[int, str]
+    states: list[EulerStates | None] | None = None
 
     def take(self, shots) -> BatchFlights:
         """The flights of `shots` (indices), in that order."""
         shots = np.asarray(shots, dtype=np.intp)
         where = {int(s): k for k, s in enumerate(shots.tolist())}
-        arrays = {f.name: getattr(self, f.name)[shots] for f in fields(self) if f.name not in ("rest", "errors")}
+        arrays = {f.name: getattr(self, f.name)[shots] for f in fields(self) if f.name not in ("rest", "errors", "states")}
         errors = {where[i]: message for i, message in self.errors.items() if i in where}
-        return BatchFlights(**arrays, rest=self.rest.take(shots), errors=errors)
+        states = None if self.states is None else [self.states[i] for i in shots.tolist()]
+        return BatchFlights(**arrays, rest=self.rest.take(shots), errors=errors, states=states)
+
+    def shots(self) -> list[ShotFlight | FlightError]:
+        """One ShotFlight a shot (its states where they were kept, its rest where it was rolled), or a FlightError
+        for a shot that failed; in order."""
+        rest_names = [f.name for f in fields(Rest)]
+        rests = zip(*(getattr(self.rest, name).tolist() for name in rest_names), strict=True)
+        numbers = zip(*(getattr(self, name).tolist() for name in SHOT_NUMBERS), strict=True)
+        states = self.states or [None] * len(self.rolled)
+        flown: list[ShotFlight | FlightError] = []
+        for i, (shot, rest, rolled, kept) in enumerate(zip(numbers, rests, self.rolled.tolist(), states, strict=True)):
+            if i in self.errors:
+                flown.append(FlightError(self.errors[i]))
+                continue
+            shot_rest = Rest(**dict(zip(rest_names, rest, strict=True))) if rolled else None
+            flown.append(ShotFlight(**dict(zip(SHOT_NUMBERS, shot, strict=True)), states=kept, rest=shot_rest))
+        return flown

@@ -1,5 +1,5 @@
 """A bundle flown in torch, on a CPU or a GPU: `TorchEngine`, the engine's torch backend (`FlightEngine.from_bundle(...,
-backend="torch")`): the served engine's batch path (`FlightEngine.fly_columns`) on torch tensors, for `golfflight
+backend="torch")`): the served engine's batch path (`FlightEngine.fly_batch`) on torch tensors, for `golfflight
 sweep --engine torch`. No training code: the flight core alone.
 
 The coefficient network is the bundle's ONNX graph run by torch (`flight.torch_network`, checked against ONNX Runtime
@@ -146,7 +146,7 @@ class Aloft:
 
 
 class TorchEngine:
-    """A bundle's coefficient network on a torch device, flying batches as `FlightEngine.fly_columns` does
+    """A bundle's coefficient network on a torch device, flying batches as `FlightEngine.fly_batch` does
     (module docstring)."""
 
     def __init__(self, bundle_dir: str | os.PathLike, device: str = "cpu", dtype: str = "float32",
@@ -197,15 +197,19 @@ class TorchEngine:
         per_shot = (self.flyer.max_steps + 1) * 3 * STATE_COPIES * itemsize + WORKING_BYTES_PER_SHOT
         return max(1024, int(free * DEVICE_MEMORY_SHARE / self.parts_at_once / per_shot))
 
-    def fly_columns(
+    def fly_batch(
         self,
         launches: Sequence[Launch] | np.ndarray,
         conditions: Sequence[Conditions] | Conditions = STANDARD,
         grounds: Sequence[GroundSpec | None] | GroundSpec | None = None,
+        keep_states: bool = False,
     ) -> BatchFlights:
         """Shots (an [N, LAUNCH_WIDTH] array or Launches), each in its conditions, down to its ground and rolled to
-        rest there (grounds None: down to z = 0, the flight alone), as `FlightEngine.fly_columns` gives them. One
-        Conditions or GroundSpec for every shot is spread without a Python step a shot (a benchmark's millions)."""
+        rest there (grounds None: down to z = 0, the flight alone), as `FlightEngine.fly_batch` gives them, without
+        states (InputError for `keep_states`: the sweep's engine keeps none). One Conditions or GroundSpec for every
+        shot is spread without a Python step a shot (a benchmark's millions)."""
+        if keep_states:
+            raise InputError("keep_states: the torch engine keeps no states (FlightEngine.fly_batch does)")
         n = len(launches)
         if n == 0:
             raise InputError("no shots to fly")

@@ -87,7 +87,7 @@ def fly(engine: FlightEngine, clubs: Sequence[ClubLaunch], wind: Wind, ground: S
     """`clubs` flown straight (launch direction and spin axis 0) through `engine` in ICAO air and `wind`, rolled to
     rest on a level `ground` at the tee's height."""
     launches = [Launch(c.ball_speed_mps, c.launch_angle_deg, 0.0, c.spin_rpm, 0.0) for c in clubs]
-    flights = engine.fly_batch(launches, Conditions(wind=wind), grounds=GroundSpec(ground))
+    flights = engine.fly_batch(launches, Conditions(wind=wind), GroundSpec(ground)).shots()
     return [AnchorRun(f.carry_m / YARD_M, f.rest.roll_m / YARD_M) for f in flights]
 
 

@@ -109,12 +109,12 @@ def echo(column: str, value):
 
 
 class ColumnsEngine(Protocol):
-    """What a worker flies its rows with: `FlightEngine`, or another engine with its batch path (`fly_columns`) and the
+    """What a worker flies its rows with: `FlightEngine`, or another engine with its batch path (`fly_batch`) and the
     SHA-256 of the bundle's graph (`flight.torch_engine.TorchEngine`, given by the command line)."""
 
     sha256: str
 
-    def fly_columns(self, launches, conditions, grounds) -> BatchFlights: ...
+    def fly_batch(self, launches, conditions, grounds) -> BatchFlights: ...
 
 
 class SweepWorker:

@@ -395,7 +395,7 @@ def fly_checked(engine, checked: Checked) -> ShotColumns:
         own_grounds.plus(own_grounds.take(replays), PerShot([None], np.zeros(len(flats), dtype=np.intp))),
         n, replays, flats,
     )
-    flown = columns_of(engine.fly_columns(batch.launches, batch.conditions, batch.grounds), batch)
+    flown = columns_of(engine.fly_batch(batch.launches, batch.conditions, batch.grounds), batch)
     flown.values[AIR_DENSITY] = np.array([air.density_kg_m3 for air in air_of_group], dtype=float)[airs.index]
     flown.present[AIR_DENSITY] = np.ones(n, dtype=bool)
     return flown

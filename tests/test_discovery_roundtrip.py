@@ -29,7 +29,7 @@ def _service_rms(engine: FlightEngine, records, settings: dict | None) -> np.nda
         request = ShotRequest.model_validate({**launch, **({"wind": settings["wind"]} if settings else {})})
         launches.append(Launch(*launch.values()))
         conditions.append(conditions_of(request))
-    flights = engine.fly_batch(launches, conditions)
+    flights = engine.fly_batch(launches, conditions).shots()
     residual = np.array([[r.carry_y_m - f.landing_y_m, r.carry_x_m - f.landing_x_m] for r, f in zip(records, flights)])
     return np.sqrt(np.mean(residual**2, axis=0))
 

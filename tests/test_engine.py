@@ -60,7 +60,7 @@ def test_flights_match_the_torch_simulator_within_a_centimetre(engine, air):
             scale,
         )
         landing = hard_landing(trajectory)
-    flights = engine.fly_batch(shots, Conditions(air))
+    flights = engine.fly_batch(shots, Conditions(air)).shots()
     assert landing.landed.all()
     got = np.array([[f.landing_x_m, f.landing_y_m] for f in flights])
     assert np.hypot(*(got - landing.position[:, :2].numpy()).T).max() < 0.01
@@ -79,7 +79,7 @@ def test_single_shots_equal_the_batch(engine):
         )
         for i in range(len(shots))
     ]
-    batch = engine.fly_batch(shots, conditions)
+    batch = engine.fly_batch(shots, conditions).shots()
     for shot, condition, flown in zip(shots, conditions, batch, strict=True):
         single = engine.fly(shot, condition)
         assert single.carry_m == pytest.approx(flown.carry_m, abs=1e-6)
@@ -96,7 +96,7 @@ def test_the_single_shot_latency_path_is_the_flight_core(engine):
         Conditions(Air.from_conditions(temperature_c=30.0 - i), Wind(0.5 * i, 15.0 * i, "log" if i % 3 else "uniform"))
         for i in range(len(shots))
     ]
-    core = engine.fly_batch(shots, conditions, keep_states=True)
+    core = engine.fly_batch(shots, conditions, keep_states=True).shots()
     for shot, condition, flown in zip(shots, conditions, core, strict=True):
         single = engine.fly(shot, condition, keep_states=True)
         for name in ShotFlight.__dataclass_fields__:
@@ -115,7 +115,7 @@ def test_a_long_flight_goes_on_past_t_sim_and_the_cap_fails_only_that_shot(engin
     capped.flyer.max_steps = int(engine.t_sim / engine.dt)
     with pytest.raises(FlightError, match="still in the air"):
         capped.fly(sky_ball)
-    first, second = capped.fly_batch([sky_ball, SEVEN_IRON])
+    first, second = capped.fly_batch([sky_ball, SEVEN_IRON]).shots()
     assert isinstance(first, FlightError) and second.carry_m == pytest.approx(engine.fly(SEVEN_IRON).carry_m)
 
 

@@ -58,8 +58,8 @@ def test_every_caller_flies_the_shot_to_the_engines_carry_for_the_same_time(engi
     level = RestShots("one", np.array([SKY_BALL]), np.full(1, np.nan), np.zeros(1), np.full(1, np.nan))
     evaluate = pytest.importorskip("golfflight.model_export.evaluate")
     carries = {
-        "engine.fly_batch": engine.fly_batch([SKY_BALL])[0].carry_m,
-        "engine.fly_columns (sweep)": engine.fly_columns(np.array([SKY_BALL])).carry_m[0],
+        "engine.fly_batch": engine.fly_batch([SKY_BALL]).shots()[0].carry_m,
+        "engine.fly_batch, columns (sweep)": engine.fly_batch(np.array([SKY_BALL])).carry_m[0],
         "discovery from_bundle": discovery.fly(setup).carry_m[0],
         "accuracy ModelFlyer": accuracy.simulate(launch_columns(SKY_BALL)).carry_m[0],
         "evaluate runtime path": evaluate.runtime_flight(None, launch_columns(SKY_BALL), calm_air).carry_m[0],

@@ -158,7 +158,7 @@ def test_every_shot_comes_to_rest_finite_and_the_batch_agrees(engine, launch, na
     steepest = min(float(holding_slope_deg(where.rolling_resistance)), SLOPE_DEG.high)
     ground = GroundSpec(where, elevation, slope_share * steepest, slope_dir)
     one = engine.fly(Launch(*launch), ground=ground)
-    batch = engine.fly_batch([Launch(*launch)] * 2, grounds=ground)[1]
+    batch = engine.fly_batch([Launch(*launch)] * 2, grounds=ground).shots()[1]
     rest = one.rest
     assert all(math.isfinite(v) for v in (rest.x_m, rest.y_m, rest.total_m, rest.roll_m, rest.ground_time_s))
     assert rest.bounces >= 0 and rest.ground_time_s >= 0.0

@@ -61,8 +61,8 @@ def test_the_engine_flies_a_per_shot_batch_to_the_numbers_of_the_same_objects_gi
     grounds = [None, GroundSpec(SURFACES["green"], -3.0, 1.5, 40.0), GroundSpec(SURFACES["rough"], 2.0)]
     conditions = PerShot(airs, rng.integers(0, 3, n))
     shot_grounds = PerShot(grounds, rng.integers(0, 3, n))
-    shared = flyer.fly_columns(launches, conditions, shot_grounds)
-    listed = flyer.fly_columns(launches, list(conditions), list(shot_grounds))
+    shared = flyer.fly_batch(launches, conditions, shot_grounds)
+    listed = flyer.fly_batch(launches, list(conditions), list(shot_grounds))
     assert shared.errors == listed.errors
     np.testing.assert_array_equal(shared.rolled, listed.rolled)
     for name in ("carry_m", "apex_m", "landing_angle_deg", "flight_time_s"):

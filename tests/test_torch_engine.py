@@ -68,7 +68,7 @@ def shots():
 
 @pytest.fixture(scope="module")
 def onnx_flights(shots):
-    return load_flyer(None).fly_columns(*shots)
+    return load_flyer(None).fly_batch(*shots)
 
 
 @pytest.fixture(scope="module")
@@ -94,7 +94,7 @@ def test_the_torch_engine_flies_mixed_shots_as_the_onnx_engine(engines, shots, o
     what is left is the network's float32 arithmetic (torch's and ONNX Runtime's sums differ by an ulp: about 1e-7
     in a coefficient), some 10 um of carry (the rules themselves are held to 1e-6 m below), with the ground phase in
     NumPy or in torch. The other figures (degrees, rpm, s) and the rests after the ground phase follow."""
-    got = engines[dtype].fly_columns(*shots)
+    got = engines[dtype].fly_batch(*shots)
     assert got.errors == onnx_flights.errors and {1, 2} <= set(got.errors)
     assert "never rose to its landing ground" in got.errors[1]
     np.testing.assert_array_equal(got.rolled, onnx_flights.rolled)
@@ -136,7 +136,7 @@ def test_in_float64_the_landing_and_apex_rules_are_the_integrators(engines, shot
     onnx = engine.flyer
     numpy_flyer = Flyer(TorchNetwork(engine), onnx.dt_s, onnx.max_flight_time_s, onnx.density_kg_m3,
                         onnx.kinematic_viscosity_m2_s)
-    want, got = numpy_flyer.fly_columns(*shots), engine.fly_columns(*shots)
+    want, got = numpy_flyer.fly_batch(*shots), engine.fly_batch(*shots)
     assert got.errors == want.errors
     landed = np.array([i not in got.errors for i in range(SHOTS)])
     for name in FIGURES:
@@ -151,7 +151,7 @@ def test_a_batch_split_into_parts_flies_the_same_numbers(shots):
     small = TorchEngine(load_flyer(None).bundle_dir, "cpu", "float64", part_shots=64)
     whole = TorchEngine(load_flyer(None).bundle_dir, "cpu", "float64")
     launches, conditions, grounds = (part[:150] for part in shots)
-    split, joined = small.fly_columns(launches, conditions, grounds), whole.fly_columns(launches, conditions, grounds)
+    split, joined = small.fly_batch(launches, conditions, grounds), whole.fly_batch(launches, conditions, grounds)
     assert split.errors == joined.errors
     for name in FIGURES:
         np.testing.assert_allclose(getattr(split, name), getattr(joined, name), rtol=1e-8, atol=1e-6)
@@ -172,9 +172,9 @@ def test_shots_set_aside_as_they_land_fly_the_same_numbers(shots, monkeypatch):
         return step(coefficients, dt, position, *rest)
 
     monkeypatch.setattr(torch_engine, "flight_step", counted)
-    aside = TorchEngine(bundle, "cpu", "float64").fly_columns(*shots)
+    aside = TorchEngine(bundle, "cpu", "float64").fly_batch(*shots)
     aside_steps, flown[:] = sum(flown), []
-    together = TorchEngine(bundle, "cpu", "float64", set_aside_share=1.0).fly_columns(*shots)
+    together = TorchEngine(bundle, "cpu", "float64", set_aside_share=1.0).fly_batch(*shots)
     assert aside.errors == together.errors and {1, 2} <= set(aside.errors)
     for name in FIGURES:
         np.testing.assert_allclose(getattr(aside, name), getattr(together, name), rtol=1e-8, atol=1e-6, err_msg=name)

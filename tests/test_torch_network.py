@@ -57,7 +57,7 @@ def test_from_bundle_picks_the_backend():
     assert type(onnx_engine) is FlightEngine and isinstance(torch_engine, TorchEngine)
     assert onnx_engine.sha256 == torch_engine.sha256
     launches = np.array([Launch(55.0, 16.0, 0.0, 7100.0, 0.0), Launch(76.5, 10.5, 1.0, 2550.0, -3.0)])
-    want, got = onnx_engine.fly_columns(launches), torch_engine.fly_columns(launches)
+    want, got = onnx_engine.fly_batch(launches), torch_engine.fly_batch(launches)
     np.testing.assert_allclose(got.carry_m, want.carry_m, rtol=0, atol=1e-3)  # torch CPU parity: 1 mm
     with pytest.raises(InputError, match="backend 'jax': choose onnx or torch"):
         FlightEngine.from_bundle(bundle, backend="jax")

@@ -192,7 +192,7 @@ def fly_reference_shot(shot) -> dict:
     from golfflight.flight.ground import LEVEL_FAIRWAY
     from golfflight.shots.reference_world import reference_flyer
 
-    flown = reference_flyer().fly_batch([launch_of(shot)], conditions_of(shot), grounds=LEVEL_FAIRWAY)[0]
+    flown = reference_flyer().fly_batch([launch_of(shot)], conditions_of(shot), LEVEL_FAIRWAY).shots()[0]
     if isinstance(flown, FlightError):
         raise InputError(f"the reference world could not fly the shot: {flown}")
     fields = flight_fields(flown, None)
