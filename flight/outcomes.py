@@ -202,7 +202,8 @@ class BatchFlights:
         """The flights of `shots` (indices), in that order."""
         shots = np.asarray(shots, dtype=np.intp)
         where = {int(s): k for k, s in enumerate(shots.tolist())}
-        arrays = {f.name: getattr(self, f.name)[shots] for f in fields(self) if f.name not in ("rest", "errors", "states")}
+        columns = [f.name for f in fields(self) if f.name not in ("rest", "errors", "states")]
+        arrays = {name: getattr(self, name)[shots] for name in columns}
         errors = {where[i]: message for i, message in self.errors.items() if i in where}
         states = None if self.states is None else [self.states[i] for i in shots.tolist()]
         return BatchFlights(**arrays, rest=self.rest.take(shots), errors=errors, states=states)
