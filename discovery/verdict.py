@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from golfflight.discovery.effects import DENSITY_ONLY
 from golfflight.discovery.recordings import LABELS, OBSERVABLES
 from golfflight.discovery.report import effect_phrase, share_interval
 from golfflight.discovery.schema import Ambiguity, Candidate, Located, ObservableStat, Report
@@ -184,7 +185,21 @@ def _physics(report: Report) -> list[str]:
     if air and air.get("named") and isinstance(air.get("ratio"), float):
         density = air["ratio"] * report.model.density_kg_m3
         out.append(f"The recordings carry no air, so this is the venue's: {density:.3f} kg/m³.")
+        out.append(coefficients_alike(air))
     return out
+
+
+def coefficients_alike(air: dict) -> str:
+    """What else flies as a named air does: the ball's drag, lift and spin torque all scaled by its ratio in the
+    assumed air (exactly so for density alone; real air differs from that only through the Reynolds number), and
+    the recording that tells the two apart."""
+    alone = DENSITY_ONLY in str(air.get("explanation", "")).split("+")
+    same = "the same flights" if alone else "nearly the same flights (they differ only through the Reynolds number)"
+    return (
+        f"A ball whose drag, lift and spin torque were all {air['ratio']:.3f} times the model's would fly {same} in "
+        "the assumed air: the venue's air recorded with the shots (its temperature and pressure, or its altitude) "
+        "tells the two apart."
+    )
 
 
 def venue_air(report: Report) -> dict | None:

@@ -18,7 +18,9 @@ from golfflight.discovery.recordings import OBSERVABLES, from_shot_set
 from golfflight.discovery.report import form_sentence
 from golfflight.discovery.schema import EffectResult
 from golfflight.discovery.simulator import Setup
+from golfflight.discovery.verdict import coefficients_alike
 from golfflight.flight.constants import MPH_TO_MPS
+from golfflight.flight.physics import accelerations
 from golfflight.shots.records import ShotSet
 
 YD = 0.9144
@@ -195,3 +197,20 @@ def test_with_the_wind_recorded_no_wind_is_offered():
     calm = {"wind_speed_mps": 0.0, "wind_from_deg": 0.0}
     diagnoser = Diagnoser(from_shot_set(_thin_air_in_the_reference_world(calm)), load_model(None), progress=False)
     assert "wind" not in {e.name for e in diagnoser.library}
+
+
+def test_density_alone_is_every_coefficient_scaled_alike():
+    """What the report says of a named density-only air (`verdict.coefficients_alike`), worked on the equations of
+    motion: air 0.776 times as dense gives a 54 m/s ball spinning 7,000 rpm the very accelerations and spin decay that
+    drag, lift and spin torque all 0.776 times as large give in the assumed air (the Reynolds number unchanged)."""
+    state = (1.0, 53.0, 10.0, -730.0, 0.0, 20.0)
+    coefficients = (0.21, 0.27, 0.011, 1.0)
+    ratio, density = 0.776, 1.225
+    thin = accelerations(*state, *coefficients, density * ratio)
+    scaled = accelerations(*state, *(c * ratio for c in coefficients[:3]), coefficients[3], density)
+    assert thin == pytest.approx(scaled, rel=1e-12)
+    dense = accelerations(*state, *coefficients, density)
+    assert thin[1] == pytest.approx(ratio * dense[1], rel=1e-12)  # the drag along the line, by hand: q scales with rho
+    assert coefficients_alike({"explanation": DENSITY_ONLY, "ratio": ratio}).startswith(
+        "A ball whose drag, lift and spin torque were all 0.776 times the model's would fly the same flights")
+    assert "nearly the same flights" in coefficients_alike({"explanation": "air_density", "ratio": ratio})

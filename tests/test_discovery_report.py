@@ -274,7 +274,9 @@ def test_the_venue_air_is_said_where_the_report_compares_it(diagnosis, named):
     found = verdict(diagnosis.report.model_copy(update={"air_rival": rival}))
     air = "air 0.899 ± 0.015 times as dense as assumed (1.101 kg/m³, as at about 888 m in the standard atmosphere)"
     if named:
-        assert found.physics[-1] == "The recordings carry no air, so this is the venue's: 1.101 kg/m³."
+        assert found.physics[-2] == "The recordings carry no air, so this is the venue's: 1.101 kg/m³."
+        assert found.physics[-1].startswith("A ball whose drag, lift and spin torque were all 0.899 times the model's")
+        assert "tells the two apart" in found.physics[-1]
     else:
         assert f"Venue air ruled out: {air} fits held-out shots worse beyond doubt (held-out error 1.64 against" in (
             " ".join(found.rivals)
