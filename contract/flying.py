@@ -201,7 +201,7 @@ def fly_columns(engine: FlightEngine, shots: list[ShotRequest]) -> ShotColumns:
         raise InputError("fly_columns flies no trajectories (fly_shots does)")
     batch = batch_of(shots)
     flights = engine.fly_batch(np.array(batch.launches, dtype=float).reshape(-1, LAUNCH_WIDTH), batch.conditions,
-                                 batch.grounds)
+                               batch.grounds)
     flown = columns_of(flights, batch)
     flown.values[AIR_DENSITY] = np.array([c.air.density_kg_m3 for c in batch.conditions[: batch.n]], dtype=float)
     flown.present[AIR_DENSITY] = np.ones(batch.n, dtype=bool)

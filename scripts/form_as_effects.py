@@ -78,7 +78,7 @@ def section(sets: int) -> str:
         "as the length of its vector, a scale as its distance from 1). A hidden effect is fitted within 10 % of its "
         "size only where that size is at least ten times what the form alone fits in its direction, i.e. where a "
         "world's ÷ column is below 0.1 at the median hidden size; its last column is the share of the sizes the "
-        "campaign draws (2,000 draws) that are. Their mean over the twelve effects is the share of a world's "
+        "campaign draws (2,000 draws) that are that large. Their mean over the twelve effects is the share of a world's "
         "library sets within 10 % that this linear picture allows, with every effect named: "
         f"{ceilings}."
     )
