@@ -274,13 +274,15 @@ def landed_columns(
     """A batch's columns from its landings, for every backend: the figures (NaN where a shot never came down), an
     error a shot that never came down (`unlanded(apex_m, ground_m)`) or whose figures are not finite, and the rests
     of the landed shots with a ground, bounced and rolled by `roll` in one batch; and that ground phase."""
-    n, heights = len(flight.landed), elevations(grounds)
+    n = len(flight.landed)
     x, y = flight.position[:, 0], flight.position[:, 1]
     carry, angle, speed, spin = landing_figures(x, y, *flight.velocity.T, *flight.spin.T)
     numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
     finite = np.isfinite(np.stack(numbers)).all(axis=0)
+    failed = np.flatnonzero(~(flight.landed & finite))
+    heights = elevations(grounds) if failed.size else None  # the grounds' elevations only where a message needs one
     errors = {}
-    for i in np.flatnonzero(~(flight.landed & finite)).tolist():
+    for i in failed.tolist():
         errors[i] = unlanded(float(flight.apex_m[i]), float(heights[i])) if not flight.landed[i] else NON_FINITE
     rolled = flight.landed & finite & grounds.column(lambda g: g is not None, bool)
     shots = np.flatnonzero(rolled)

@@ -11,6 +11,7 @@ import pytest
 from golfflight.cli import main
 from golfflight.flight.air import air_density
 from golfflight.flight.conditions import STANDARD
+from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
 from golfflight.shots.garmin import load_garmin
 from golfflight.shots.records import RecordError, read_shots
 
@@ -183,15 +184,15 @@ def _as_garmin_row(record, day: str) -> dict:
     return {
         **SHOT,
         "Date": f"{day} 10:00:00",
-        "Ball Speed (mph)": f"{record.ball_speed_mps / 0.44704:.1f}",
+        "Ball Speed (mph)": f"{record.ball_speed_mps / MPH_TO_MPS:.1f}",
         "Launch Angle (deg)": f"{record.launch_angle_deg:.1f}",
         "Launch Direction (deg)": f"{record.launch_direction_deg:.1f}",
         "Spin Rate (rpm)": f"{record.spin_rpm:.0f}",
         "Spin Axis (deg)": f"{record.spin_axis_deg:.1f}",
-        "Apex Height (ft)": f"{record.apex_m / 0.3048:.1f}",
-        "Carry Distance (yards)": f"{carry_m / 0.9144:.1f}",
+        "Apex Height (ft)": f"{record.apex_m / FOOT_M:.1f}",
+        "Carry Distance (yards)": f"{carry_m / YARD_M:.1f}",
         "Carry Deviation Angle (deg)": f"{math.degrees(math.atan2(record.carry_x_m, record.carry_y_m)):.1f}",
-        "Carry Deviation Distance (yards)": f"{record.carry_x_m / 0.9144:.1f}",
+        "Carry Deviation Distance (yards)": f"{record.carry_x_m / YARD_M:.1f}",
         "Temperature (F)": "59", "Air Pressure (kPA)": "80.9", "Air Density (g/L)": "0.951",
     }
 
