@@ -8,8 +8,8 @@ python benchmarks/bench_wire.py --versus ../wt25-before --versus-without uvloop 
 
 Everything runs in one process tree on the same cores at the same time, so the machine's drift (which moves
 absolute figures by 10-30 % from minute to minute) cancels out of the differences. The in-process figure is
-`contract.flying.fly_shot` on a parsed request, the work `GET /v1/latency` times as the server's simulation (the
-flight rolled to rest and its result object); the batch's is `fly_shots` on the parsed shots. `--versus TREE` also
+`contract.flying.fly_request` on a parsed request, the work `GET /v1/latency` times as the server's simulation (the
+flight rolled to rest and its result object); the batch's is `fly_requests` on the parsed shots. `--versus TREE` also
 serves the service of another checkout (e.g. a `git worktree` of an older commit) and alternates the two servers
 shot by shot and run by run; `--versus-without MODULE...` hides modules from that server only (so that a baseline
 whose dependencies did not include them runs as it would have been installed), and the table gains the paired
@@ -30,7 +30,7 @@ from pathlib import Path
 import httpx
 import numpy as np
 from common import REPO, SEVEN_IRON, mixed_launches, write_results
-from golfflight.contract.flying import fly_shot, fly_shots
+from golfflight.contract.flying import fly_request, fly_requests
 from golfflight.contract.requests import BatchRequest, ShotRequest
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine
@@ -161,8 +161,8 @@ def warm_up(
             service.tcp.fly()
         service.post("/v1/shots/batch", batch_body)
     for _ in range(200):
-        fly_shot(engine, shot)
-    fly_shots(engine, batch_shots)
+        fly_request(engine, shot)
+    fly_requests(engine, batch_shots)
 
 
 def one_round(round_: int, args: argparse.Namespace, services: list[Service], engine: FlightEngine, shot,
@@ -173,7 +173,7 @@ def one_round(round_: int, args: argparse.Namespace, services: list[Service], en
     http, raw, tcp = ({s.name: [] for s in services} for _ in range(3))
     for i in range(args.shots):
         order = services if (i + round_) % 2 == 0 else services[::-1]
-        own.append(timed(lambda: fly_shot(engine, shot)))
+        own.append(timed(lambda: fly_request(engine, shot)))
         for service in order:
             http[service.name].append(timed(lambda s=service: s.post("/v1/shots", shot_body)))
         for service in order:
@@ -187,7 +187,7 @@ def one_round(round_: int, args: argparse.Namespace, services: list[Service], en
         service.flight_p50.append(service.http.get("/v1/latency").json()["simulation"]["p50_ms"])
     runs, batch = [], {s.name: [] for s in services}
     for j in range(args.batches):
-        runs.append(timed(lambda: fly_shots(engine, batch_shots)))
+        runs.append(timed(lambda: fly_requests(engine, batch_shots)))
         for service in services if (j + round_) % 2 == 0 else services[::-1]:
             batch[service.name].append(timed(lambda s=service: s.post("/v1/shots/batch", batch_body)))
     for service in services:
@@ -293,9 +293,9 @@ def main() -> None:
             service.close()
     flight = median_of_rounds(inprocess, 50)
     flight_batch = statistics.median(statistics.median(r) for r in inprocess_batch) * 1e3
-    rows = [{"name": "in process: one 7-iron (fly_shot)", "unit": "ms", "p50": flight,
+    rows = [{"name": "in process: one 7-iron (fly_request)", "unit": "ms", "p50": flight,
              "p99": median_of_rounds(inprocess, 99)},
-            {"name": "in process: batch of 1,024 (fly_shots)", "unit": "ms", "p50": flight_batch}]
+            {"name": "in process: batch of 1,024 (fly_requests)", "unit": "ms", "p50": flight_batch}]
     for service in services:
         rows += service_rows(service, "" if len(services) == 1 else f" [{service.name}]", flight, flight_batch)
     if len(services) == 2:

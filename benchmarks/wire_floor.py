@@ -101,19 +101,19 @@ def timed(call) -> float:
 
 
 def in_process_p50() -> float:
-    """The 7-iron's p50 in process (`contract.flying.fly_shot`), seconds."""
-    from golfflight.contract.flying import fly_shot
+    """The 7-iron's p50 in process (`contract.flying.fly_request`), seconds."""
+    from golfflight.contract.flying import fly_request
     from golfflight.contract.requests import ShotRequest
     from golfflight.flight.bundle_location import model_dir
     from golfflight.flight.engine import FlightEngine
 
     engine, shot = FlightEngine(model_dir()), ShotRequest.model_validate_json(BODY)
     for _ in range(200):
-        fly_shot(engine, shot)
+        fly_request(engine, shot)
     seconds = []
     for _ in range(1000):
         started = time.perf_counter()
-        fly_shot(engine, shot)
+        fly_request(engine, shot)
         seconds.append(time.perf_counter() - started)
     return statistics.median(seconds)
 

@@ -19,10 +19,9 @@ from golfflight.contract.results import (
     TrajectoryPoint,
 )
 from golfflight.contract.trajectory import resample
-from golfflight.errors import FlightError, InputError
+from golfflight.errors import FlightError
 from golfflight.flight.conditions import Conditions
 from golfflight.flight.engine import BatchFlights, FlightEngine, Launch, ShotFlight
-from golfflight.flight.flyer import LAUNCH_WIDTH
 from golfflight.flight.ground import GroundSpec
 from golfflight.flight.per_shot import PerShot
 from golfflight.flight.wind import CALM
@@ -79,15 +78,11 @@ def result_of(
     return ShotResult.model_construct(**flight_fields(flight, shot.trajectory), normalized=extra, flat=flat_result)
 
 
-def fly_shot(engine: FlightEngine, shot: ShotRequest) -> ShotResult:
-    """One shot (and its normalized replay) on the engine's single-shot path; FlightError if it cannot land."""
-    return flown_shot(engine, shot)[0]
-
-
-def flown_shot(
+def fly_request(
     engine: FlightEngine, shot: ShotRequest, *, keep_states: bool = False, putt: bool = False, flat: bool = True
 ) -> tuple[ShotResult, ShotFlight]:
-    """`fly_shot`'s result and the flight it was read from (its states through the ground phase to rest when
+    """One request on the engine's single-shot path (`FlightEngine.fly`: the shot, its normalized replay, its flat
+    flight): its result and the flight it was read from (its states through the ground phase to rest when
     `keep_states`, for a renderer: the numbers and the picture of one flight). A `putt` rolls on the shot's ground
     from the start (`FlightEngine.putt`: no flight, so no normalized or flat flight); `flat` False leaves the flat
     flight out (a GSPro reply has no field for it). FlightError if it cannot land."""
@@ -110,7 +105,7 @@ class Batch:
     """One engine batch for `n` shots: their launches, conditions and grounds, then those of their normalized
     replays and of their flat flights appended; `replays` and `flats` say which shots those are, in the order
     appended. Made from requests (`batch_of`) or from a sweep's columns (`sweep.rows`); its flights go back into
-    results (`fly_shots`) or columns (`columns_of`)."""
+    results (`fly_requests`) or columns (`columns_of`)."""
 
     launches: list[Launch] | np.ndarray
     conditions: list[Conditions] | PerShot
@@ -154,10 +149,10 @@ def _fly_group(
 
 @dataclass(frozen=True)
 class ShotColumns:
-    """`fly_shots`'s results as columns over the shots, named as `contract.columns.flat_row` names them: `values` holds
-    an array for each flight, normalized_* and flat_* column, valid where `present` is True (the shot flew and, for
-    normalized_* and flat_*, asked for that flight), and the air density each shot was flown in (`AIR_DENSITY`, valid
-    for every shot); `errors` the error column (None where the shot flew)."""
+    """A batch's results as columns over the shots (`columns_of`), named as `contract.columns.flat_row` names them:
+    `values` holds an array for each flight, normalized_* and flat_* column, valid where `present` is True (the shot
+    flew and, for normalized_* and flat_*, asked for that flight), and the air density each shot was flown in
+    (`AIR_DENSITY`, valid for every shot); `errors` the error column (None where the shot flew)."""
 
     values: dict[str, np.ndarray]
     present: dict[str, np.ndarray]
@@ -165,8 +160,8 @@ class ShotColumns:
 
 
 def columns_of(flights: BatchFlights, batch: Batch) -> ShotColumns:
-    """The columns of a batch's flights (`ShotColumns`, without the air density): a shot fails with the first error
-    of its own flight, its replay, its flat flight."""
+    """The columns of a batch's flights (`ShotColumns`): a shot fails with the first error of its own flight, its
+    replay, its flat flight."""
     n, replays, flats = batch.n, batch.replays, batch.flats
     replay_rows = np.arange(n, n + len(replays))
     flat_rows = np.arange(n + len(replays), n + len(replays) + len(flats))
@@ -191,34 +186,18 @@ def columns_of(flights: BatchFlights, batch: Batch) -> ShotColumns:
             full = np.zeros(n, dtype=column.dtype)
             full[own] = column
             values[prefix + name], present[prefix + name] = full, mask
+    conditions = PerShot.of(batch.conditions, len(owner), "conditions").take(np.arange(n))
+    values[AIR_DENSITY], present[AIR_DENSITY] = conditions.column(lambda c: c.air.density_kg_m3), np.ones(n, bool)
     return ShotColumns(values, present, errors)
 
 
-def fly_columns(engine: FlightEngine, shots: list[ShotRequest]) -> ShotColumns:
-    """`fly_shots` without a result object a shot (the same batch, numbers and errors, straight into columns):
-    for many shots at once (`golfflight simulate`). No trajectories: a shot asking for one is refused."""
-    if any(shot.trajectory is not None for shot in shots):
-        raise InputError("fly_columns flies no trajectories (fly_shots does)")
-    batch = batch_of(shots)
-    flights = engine.fly_batch(np.array(batch.launches, dtype=float).reshape(-1, LAUNCH_WIDTH), batch.conditions,
-                               batch.grounds)
-    flown = columns_of(flights, batch)
-    flown.values[AIR_DENSITY] = np.array([c.air.density_kg_m3 for c in batch.conditions[: batch.n]], dtype=float)
-    flown.present[AIR_DENSITY] = np.ones(batch.n, dtype=bool)
-    return flown
-
-
-def fly_shots(engine: FlightEngine, shots: list[ShotRequest]) -> list[ShotResult | ShotFailure]:
-    """Many shots in engine batches (normalized replays ride along); results in order."""
-    return flown_shots(engine, shots)[0]
-
-
-def flown_shots(
+def fly_requests(
     engine: FlightEngine, shots: list[ShotRequest], shown: int = 0
 ) -> tuple[list[ShotResult | ShotFailure], dict[int, ShotFlight]]:
-    """`fly_shots`'s results, and the flights of the last `shown` shots that flew, their states kept through the
-    ground phase (for a renderer), by index. Shots asking for a trajectory or shown fly in a batch of their own, so
-    the rest do not keep every integrator state."""
+    """Many requests in engine batches (normalized replays and flat flights ride along): their results in order, and
+    the flights of the last `shown` shots that flew, their states kept through the ground phase (for a renderer), by
+    index. Shots asking for a trajectory or shown fly in a batch of their own, so the rest do not keep every
+    integrator state."""
     first_shown = len(shots) - min(shown, len(shots))
     traced = [i for i, shot in enumerate(shots) if shot.trajectory is not None or i >= first_shown]
     plain = [i for i, shot in enumerate(shots) if shot.trajectory is None and i < first_shown]

@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Annotated
 
 from golfflight.contract.bay import BayConditions, in_bay
-from golfflight.contract.flying import flown_shot
+from golfflight.contract.flying import fly_request
 from golfflight.contract.inputs import spin_from_components
 from golfflight.contract.refusals import answer_to, describe_errors, encodable
 from golfflight.contract.requests import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotRequest
@@ -265,7 +265,7 @@ def fly_message(
     flies messages through `service.runtime`, which keeps the flight's states for its screens too."""
     try:
         request = in_bay(shot_request(message), bay or BayConditions())
-        result, _ = flown_shot(engine, request, putt=putt, flat=False)
+        result, _ = fly_request(engine, request, putt=putt, flat=False)
     except (ValueError, FlightError) as error:
         return failed_reply(message, error)
     return shot_reply(message, result)

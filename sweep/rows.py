@@ -34,7 +34,6 @@ import annotated_types
 import numpy as np
 from golfflight.contract.columns import (
     AIR_COLUMNS,
-    AIR_DENSITY,
     GROUND_COLUMNS,
     REQUEST_COLUMNS,
     SECTION_COLUMNS,
@@ -356,8 +355,8 @@ def _made(checked: Checked, rows: np.ndarray, names, make) -> PerShot:
 
 
 def fly_checked(engine, checked: Checked) -> ShotColumns:
-    """The valid rows of `checked` flown as `contract.flying.fly_columns` flies their requests (module docstring),
-    as its columns over those rows, with the air density each was flown in (`AIR_DENSITY`, as `simulate` gives it)."""
+    """The valid rows of `checked` flown in the batch `contract.flying.batch_of` makes of their requests (module
+    docstring), as `contract.flying.columns_of`'s columns over those rows."""
     rows = np.flatnonzero(checked.valid)
     n = len(rows)
     airs = _made(checked, rows, AIR_COLUMNS, lambda request: _section(request, "air"))
@@ -395,7 +394,4 @@ def fly_checked(engine, checked: Checked) -> ShotColumns:
         own_grounds.plus(own_grounds.take(replays), PerShot([None], np.zeros(len(flats), dtype=np.intp))),
         n, replays, flats,
     )
-    flown = columns_of(engine.fly_batch(batch.launches, batch.conditions, batch.grounds), batch)
-    flown.values[AIR_DENSITY] = np.array([air.density_kg_m3 for air in air_of_group], dtype=float)[airs.index]
-    flown.present[AIR_DENSITY] = np.ones(n, dtype=bool)
-    return flown
+    return columns_of(engine.fly_batch(batch.launches, batch.conditions, batch.grounds), batch)

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import httpx
 import pytest
-from golfflight.contract.flying import flown_shot
+from golfflight.contract.flying import fly_request
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.api.http_protocol import DeadlineHttpProtocol
 from golfflight.service.app import create_app
@@ -37,7 +37,7 @@ from test_viewer import KEY, KEYED, next_event, reply_over_tcp
 def _session(engine, shots: int) -> ShotFeed:
     feed = ShotFeed()
     request = ShotRequest(ball_speed_mps=60.0, launch_angle_deg=14.0, spin_rpm=5000.0)
-    result, flight = flown_shot(engine, request, keep_states=True)
+    result, flight = fly_request(engine, request, keep_states=True)
     for _ in range(shots):
         feed.publish("http", request, result, flight.states, flight.flight_time_s)
     return feed
@@ -97,7 +97,7 @@ def test_a_shot_that_cannot_be_shown_is_left_out_and_the_stream_goes_on(engine, 
         feed = ShotFeed()
         viewer = feed.subscribe()
         request = ShotRequest(ball_speed_mps=60.0, launch_angle_deg=14.0, spin_rpm=5000.0)
-        result, flight = flown_shot(engine, request, keep_states=True)
+        result, flight = fly_request(engine, request, keep_states=True)
         feed.publish("http", request, result, flight.states, flight.flight_time_s, club_data={"odd": "\ud800"})
         feed.publish("http", request, result, flight.states, flight.flight_time_s)
         return [text async for text in events(feed, viewer, lifetime_s=0.3)]

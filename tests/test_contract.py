@@ -10,7 +10,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import psutil
 import pytest
-from golfflight.contract.flying import fly_shots
+from golfflight.contract.flying import fly_requests
 from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, RANGES, ShotRequest
 from golfflight.flight import limits
 from golfflight.service.api.guards import MAX_BODY_BYTES
@@ -219,7 +219,8 @@ def test_a_shot_that_does_not_land_in_time_fails_alone(app, http):
         detail = single.json()["detail"][0]
         assert detail["type"] == "flight_error" and "still in the air after 1.2 s" in detail["message"]
         shots = [ShotRequest(**shot) for shot in (putt, SEVEN_IRON, putt)]  # batches fly in a child process:
-        batch = [result.model_dump(exclude_none=True) for result in fly_shots(engine, shots)]  # same function here
+        results, _ = fly_requests(engine, shots)  # the function the child runs
+        batch = [result.model_dump(exclude_none=True) for result in results]
         assert "still in the air" in batch[1]["error"]
         assert batch[0]["carry_m"] > 0 and batch[2] == batch[0]
     finally:

@@ -149,14 +149,23 @@ def test_a_grid_is_written_in_chunks_in_order(tmp_path, capsys):
     assert drives[180.0, "rough"]["roll_m"] < drives[180.0, "green"]["roll_m"]
 
 
-def test_the_column_path_gives_fly_shots_numbers_bit_for_bit():
-    """The sweep's flat path (`fly_columns`: the engine batch straight into columns) and `fly_shots` (a result
+def requested_columns(engine, shots):
+    """The columns of the requests' engine batch (`contract.flying.batch_of`, `FlightEngine.fly_batch`,
+    `columns_of`): the flat path flown from requests made one by one."""
+    from golfflight.contract.flying import batch_of, columns_of
+
+    batch = batch_of(shots)
+    return columns_of(engine.fly_batch(np.array(batch.launches, dtype=float), batch.conditions, batch.grounds), batch)
+
+
+def test_the_column_path_gives_fly_requests_numbers_bit_for_bit():
+    """The flat path (`requested_columns`: the engine batch straight into columns) and `fly_requests` (a result
     object a shot, as simulate and the HTTP batch route) fly the same batch: every number equal, not just close,
     each column present exactly where the shot's flat row has it, the same errors (a ground the ball never reaches
     fails its shot alone), and the air density each flew in is the one simulate echoes."""
     from golfflight.commands.simulate import flown_air
     from golfflight.contract.columns import AIR_DENSITY, cell_value, check, flat_row, request_of_cells
-    from golfflight.contract.flying import fly_columns, fly_shots
+    from golfflight.contract.flying import fly_requests
     from golfflight.flight.bundle_location import model_dir
     from golfflight.flight.engine import FlightEngine
 
@@ -166,8 +175,8 @@ def test_the_column_path_gives_fly_shots_numbers_bit_for_bit():
     shots = [check(request_of_cells({k: cell_value(v) for k, v in row.items()})) for row in rows]
     assert all(not isinstance(shot, list) for shot in shots)
     engine = FlightEngine(model_dir(None), batch_threads=1)
-    expected = [flat_row(result.model_dump(exclude_none=True)) for result in fly_shots(engine, shots)]
-    columns = fly_columns(engine, shots)
+    expected = [flat_row(result.model_dump(exclude_none=True)) for result in fly_requests(engine, shots)[0]]
+    columns = requested_columns(engine, shots)
     assert columns.errors[5] is not None and columns.errors[12] is not None
     for i, want in enumerate(expected):
         assert columns.errors[i] == want.get("error"), i
@@ -238,12 +247,11 @@ def test_ray_sweep_with_two_actors_equals_simulate(launches, tmp_path, capfd, re
     assert_same_as_simulate(pq.read_table(out).to_pylist(), expected)
 
 
-def assert_columnar_flights_equal_fly_columns(table) -> int:
+def assert_columnar_flights_equal_requested(table) -> int:
     """The columnar path (`sweep.rows`: checked in bulk, launches in arrays, conditions once each) flies a chunk's
-    valid rows to the very numbers `fly_columns` gives for their requests made one by one: bit for bit, each column
-    present where it was, the same errors. Returns the rows flown."""
+    valid rows to the very numbers `requested_columns` gives for their requests made one by one: bit for bit, each
+    column present where it was, the same errors. Returns the rows flown."""
     from golfflight.contract.columns import cell_value
-    from golfflight.contract.flying import fly_columns
     from golfflight.flight.bundle_location import model_dir
     from golfflight.flight.engine import FlightEngine
     from golfflight.sweep.flyer import problems_of
@@ -252,7 +260,7 @@ def assert_columnar_flights_equal_fly_columns(table) -> int:
     shots = [problems_of({k: cell_value(v) for k, v in row.items()}) for row in table.to_pylist()]
     shots = [shot for shot in shots if not isinstance(shot, list)]
     engine = FlightEngine(model_dir(None), batch_threads=1)
-    want, got = fly_columns(engine, shots), fly_checked(engine, check_rows(table, problems_of))
+    want, got = requested_columns(engine, shots), fly_checked(engine, check_rows(table, problems_of))
     assert got.errors == want.errors
     assert got.values.keys() == want.values.keys()
     for name, values in want.values.items():
@@ -273,21 +281,21 @@ def test_the_columnar_path_flies_every_valid_row_as_its_request():
                    side_spin_rpm=-0.0)
     rows[8].update(spin_rpm=99999)  # refused: not flown, and not in the requests flown one by one
     text = pa.table({k: [None if r[k] == "" else str(r[k]) for r in rows] for k in rows[0]})
-    assert assert_columnar_flights_equal_fly_columns(text) == 299
+    assert assert_columnar_flights_equal_requested(text) == 299
     typed = pa.Table.from_pylist([{k: None if v == "" else v for k, v in r.items()} for r in rows])
     typed = typed.set_column(typed.column_names.index("spin_rpm"), "spin_rpm",
                              pa.array([None if r["spin_rpm"] == "" else int(r["spin_rpm"]) for r in rows], pa.int64()))
-    assert assert_columnar_flights_equal_fly_columns(typed) == 299
+    assert assert_columnar_flights_equal_requested(typed) == 299
     odd = typed.set_column(typed.column_names.index("ground_surface"), "ground_surface",
                            typed["ground_surface"].dictionary_encode())  # a pandas category in Parquet
     for name in ("launch_direction_deg", "wind_from_deg"):  # decimals, which the model takes as floats
         odd = odd.set_column(odd.column_names.index(name), name, odd[name].cast(pa.decimal128(12, 6), safe=False))
     odd = odd.set_column(odd.column_names.index("normalized"), "normalized",
                          pa.array([r["normalized"] == "true" for r in rows]))
-    assert assert_columnar_flights_equal_fly_columns(odd) == 299
+    assert assert_columnar_flights_equal_requested(odd) == 299
     grid = Grid.parse(["ball_speed_mps=40:70:8", "launch_angle_deg=8:20:4", "spin_rpm=2500,5000", "altitude_m=1600",
                        "wind_speed_mps=5", "ground_elevation_m=-2"])
-    assert assert_columnar_flights_equal_fly_columns(pa.table(grid.rows(0, len(grid)))) == 64
+    assert assert_columnar_flights_equal_requested(pa.table(grid.rows(0, len(grid)))) == 64
 
 
 def test_a_grid_sweep_equals_simulate_row_for_row(tmp_path):

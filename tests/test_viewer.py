@@ -15,7 +15,7 @@ import browser
 import httpx
 import numpy as np
 import pytest
-from golfflight.contract.flying import flown_shot
+from golfflight.contract.flying import fly_request
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.app import create_app
 from golfflight.service.settings import ServiceSettings
@@ -89,7 +89,7 @@ def test_the_event_schema_is_current():
 
 def publish(feed: ShotFeed, engine, request: ShotRequest, source: str = "http", putt: bool = False):
     """Fly a request as the runtime does (states kept) and publish it; the feed's entry."""
-    result, flight = flown_shot(engine, request, keep_states=True, putt=putt)
+    result, flight = fly_request(engine, request, keep_states=True, putt=putt)
     return feed.publish(source, request, result, flight.states, flight.flight_time_s, putt=putt)
 
 

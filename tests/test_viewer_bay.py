@@ -18,7 +18,7 @@ import browser
 import httpx
 import pytest
 from golfflight.contract.bay import GSPRO_CLUBS
-from golfflight.contract.flying import flown_shot
+from golfflight.contract.flying import fly_request
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.app import create_app
 from golfflight.service.settings import ServiceSettings
@@ -92,7 +92,7 @@ def test_a_quiet_stream_sends_keep_alive_comments(engine):
     async def stream() -> list[str]:
         feed = ShotFeed()
         viewer = feed.subscribe()
-        result, flight = flown_shot(engine, request, keep_states=True)
+        result, flight = fly_request(engine, request, keep_states=True)
         feed.publish("http", request, result, flight.states, flight.flight_time_s)
         return [frame async for frame in events(feed, viewer, lifetime_s=0.55, keepalive_s=0.1)]
 

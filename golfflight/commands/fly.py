@@ -202,14 +202,14 @@ def fly_reference_shot(shot) -> dict:
 
 def fly_model_shot(shot, model: str | None) -> tuple[dict, dict]:
     """A checked request flown by the served model as POST /v1/shots flies it: (the result, the model's identity)."""
-    from golfflight.contract.flying import fly_shot
+    from golfflight.contract.flying import fly_request
     from golfflight.flight.bundle_location import model_dir
     from golfflight.errors import FlightError
     from golfflight.flight.engine import FlightEngine
 
     engine = FlightEngine(model_dir(model))
     try:
-        result = fly_shot(engine, shot)
+        result, _ = fly_request(engine, shot)
     except FlightError as error:
         raise InputError(str(error)) from None
     identity = {"bundle": str(engine.bundle_dir), "variant": engine.variant, "sha256": engine.sha256}

@@ -219,18 +219,18 @@ def write_csv(out: str, fronts: list[dict], results: list[dict]) -> None:
 
 def fly_all(engine, shots: list[ShotRequest], putts: list[bool]) -> list[dict]:
     """Each shot's result as a dict, in order: the putts rolled one by one as the bay rolls them
-    (`flown_shot(..., putt=True)`), the rest in engine batches (`fly_shots`)."""
-    from golfflight.contract.flying import flown_shot, fly_shots
+    (`fly_request(..., putt=True)`), the rest in engine batches (`fly_requests`)."""
+    from golfflight.contract.flying import fly_request, fly_requests
     from golfflight.contract.results import ShotFailure
     from golfflight.errors import FlightError
 
     results: list = [None] * len(shots)
     full = [i for i, putt in enumerate(putts) if not putt]
-    for i, result in zip(full, fly_shots(engine, [shots[i] for i in full]), strict=True):
+    for i, result in zip(full, fly_requests(engine, [shots[i] for i in full])[0], strict=True):
         results[i] = result
     for i in (i for i, putt in enumerate(putts) if putt):
         try:
-            results[i] = flown_shot(engine, shots[i], putt=True)[0]
+            results[i] = fly_request(engine, shots[i], putt=True)[0]
         except FlightError as error:
             results[i] = ShotFailure(error=str(error))
     return [r.model_dump(exclude_none=True) for r in results]

@@ -10,7 +10,7 @@ import os
 import signal
 import time
 
-from golfflight.contract.flying import flown_shots
+from golfflight.contract.flying import fly_requests
 from golfflight.contract.requests import BatchRequest
 from golfflight.contract.results import BatchResult, ShotResult
 from golfflight.flight.engine import EulerStates, FlightEngine
@@ -59,7 +59,7 @@ def fly_and_encode(body: bytes, shown: int = 0) -> tuple[bytes, float, Shown]:
     assert _engine is not None
     shots = parse_batch(body).shots
     started = time.perf_counter()
-    results, flights = flown_shots(_engine, shots, shown)
+    results, flights = fly_requests(_engine, shots, shown)
     seconds = time.perf_counter() - started
     kept = {i: (results[i], flight.states, flight.flight_time_s) for i, flight in flights.items()}
     return BatchResult(results=results).model_dump_json(exclude_none=True).encode(), seconds, kept

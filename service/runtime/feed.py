@@ -1,7 +1,7 @@
 """The shots the bay's screens show: the last HISTORY shots flown, and one bounded queue per open viewer.
 
 Each entry holds the flight that was answered: its request as flown (the bay's conditions filled in), its result,
-and the states the result was read from, through the bounces and roll to rest (`contract.flying.flown_shot`), so a
+and the states the result was read from, through the bounces and roll to rest (`contract.flying.fly_request`), so a
 screen draws the very flight whose numbers the player got; nothing is flown again. Publishing never waits and costs
 a few appends: a slow or dead viewer only loses the oldest shots it has not been sent yet (its queue drops them).
 An entry's event text is rendered once, by the first viewer stream that sends it (`service.viewer`), and only that

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Callable, Literal
 
 from golfflight.contract.bay import CONDITION_FIELDS, PUTTER, BayConditions, Player, in_bay
-from golfflight.contract.flying import flown_shot, fly_shot
+from golfflight.contract.flying import fly_request
 from golfflight.contract.gspro import GSProMessage, GSProReply, failed_reply, shot_reply, shot_request
 from golfflight.contract.requests import BatchRequest, ShotRequest
 from golfflight.contract.results import ShotResult
@@ -144,7 +144,7 @@ class BayRuntime:
         putt = source in GSPRO_SOURCES and bay.player.club == PUTTER
         started = time.perf_counter()
         try:
-            result, flight = flown_shot(engine, request, keep_states=show, putt=putt, flat=flat)
+            result, flight = fly_request(engine, request, keep_states=show, putt=putt, flat=flat)
         finally:
             self._record_simulation("shot", time.perf_counter() - started)
         entry = None
@@ -188,7 +188,7 @@ class BayRuntime:
         now on the served single-shot path (in standard air, shown nowhere, left out of the windows)."""
         engine = self._ready_engine()
         started = time.perf_counter()
-        fly_shot(engine, PROBE_SHOT)
+        fly_request(engine, PROBE_SHOT)
         probe_ms = (time.perf_counter() - started) * 1e3
         return {
             "simulation": self._simulation.summary(),
