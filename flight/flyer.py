@@ -112,7 +112,7 @@ def step_count(max_time_s: float, dt_s: float) -> int:
     return math.ceil(max_time_s / dt_s - 1e-9)
 
 
-class _Flown(NamedTuple):
+class _FlownBatch(NamedTuple):
     """A batch's columns, the integrator's flight and the ground phase of its rolled shots (in shot order)."""
 
     columns: BatchFlights
@@ -207,7 +207,7 @@ class Flyer:
         conditions: Sequence[Conditions] | Conditions,
         keep_states: bool,
         grounds: Sequence[GroundSpec | None] | GroundSpec | None,
-    ) -> _Flown:
+    ) -> _FlownBatch:
         """The batch flight behind `fly_batch`."""
         n = len(launches)
         per_shot = PerShot.of(conditions, n, "conditions")
@@ -223,7 +223,7 @@ class Flyer:
                      flight.flight_time_s, flight.apex_m, flight.apex_time_s),
             shot_grounds, self.unlanded_message, roll,
         )
-        return _Flown(columns, flight, phase)
+        return _FlownBatch(columns, flight, phase)
 
     def _batch_field(self, per_shot: PerShot[Conditions]) -> BallInAir:
         """The equations of motion for a batch, each shot in its own air and wind."""
