@@ -46,6 +46,7 @@ from golfflight.discovery.fit import (
     per_shot,
     stratified_rows,
 )
+from golfflight.discovery.invariance import halves
 from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
 from golfflight.discovery.model import FlightModel
 from golfflight.discovery.noise import (
@@ -95,6 +96,10 @@ TRIPLE_ANCHORS = 2
 
 EXTENSION_FITS = 2
 """Effects added to each anchor and fitted through the simulator: the most promising by linearised cost."""
+
+MAX_FORM_ROUNDS = 3
+"""Rounds of setting aside the conditions that are the model's form (`Diagnoser.model_form`): the explanation left
+after one round is checked again, its values having been fitted anew."""
 
 
 @dataclass
@@ -458,9 +463,11 @@ class Diagnoser:
             chosen, restated = self.in_physical_terms(chosen, singles + richer, test)
             richer += restated
         scored = singles + richer
-        within = self.within_form(chosen)
-        if within:
-            chosen, refitted = self.form_instead(null, chosen, within, scored, test)
+        for _ in range(MAX_FORM_ROUNDS):
+            model_form = self.model_form(chosen, test)
+            if not model_form:
+                break
+            chosen, refitted = self.form_instead(null, chosen, model_form, scored)
             scored += refitted
         unlisted, left = None, self.structure_left(chosen) if structure and self.with_correction else []
         if left:
@@ -613,6 +620,20 @@ class Diagnoser:
                 return simpler, fresh
         return chosen, fresh
 
+    def model_form(self, chosen: Scored, test: dict) -> list[str]:
+        """The venue conditions and monitor biases of `chosen` that are the model's form, not claimed: those within
+        its own error (`within_form`) and those whose value changes with the launch (`discovery.invariance`), each
+        group added to the systematic test's entries."""
+        within = self.within_form(chosen)
+        varying = [h for h in halves(self.problem, chosen.fit, self.rows) if h.varies and h.effect not in within]
+        if within:
+            test["within_model_form"] = "+".join(filter(None, (test.get("within_model_form"), *within)))
+        if varying:
+            test["varies_with_ball_speed"] = "; ".join(
+                filter(None, (test.get("varies_with_ball_speed"), *(h.describe() for h in varying)))
+            )
+        return within + [h.effect for h in varying]
+
     def within_form(self, chosen: Scored) -> list[str]:
         """The venue conditions and monitor biases of `chosen` whose own part of its prediction moves every recorded
         observable by less (RMS over the shots) than the model's own error there (the card's `own_error`, measured
@@ -639,13 +660,12 @@ class Diagnoser:
         return max(part[OBSERVABLES.index(name)] / max(own.get(name, 0.0), 1e-12) for name in recorded)
 
     def form_instead(
-        self, null: Scored, chosen: Scored, within: list[str], scored: list[Scored], test: dict
+        self, null: Scored, chosen: Scored, within: list[str], scored: list[Scored]
     ) -> tuple[Scored, list[Scored]]:
-        """The choice without its effects `within` the model's own error (refitted), or an explanation of the
-        model's form alone (coefficient scales), whichever scores best among those that beat the model as is; the
+        """The choice without its effects `within` the model's form (`model_form`; refitted), or an explanation of
+        the model's form alone (coefficient scales), whichever scores best among those that beat the model as is; the
         model as is where none does (the learned correction, the model's form too, is tried after). (choice, the
         refit)."""
-        test["within_model_form"] = "+".join(within)
         options = [s for s in scored if s.fit.k and all(e.kind == "form" for e in s.fit.effects)]
         kept = [(e, block) for e, block in blocks(chosen.fit) if e.name not in within]
         refitted = []
