@@ -46,7 +46,7 @@ from golfflight.discovery.fit import (
     per_shot,
     stratified_rows,
 )
-from golfflight.discovery.invariance import halves
+from golfflight.discovery.invariance import halves, set_aside_sentence
 from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
 from golfflight.discovery.model import FlightModel
 from golfflight.discovery.noise import (
@@ -406,6 +406,8 @@ class Diagnoser:
             selection.scored,
             chosen,
         )
+        if selection.systematic and "varies_with_ball_speed" in selection.test:
+            words += set_aside_sentence(selection.test["varies_with_ball_speed"])
         return Report(
             recordings=recordings.source,
             n_shots=len(recordings),

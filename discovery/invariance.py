@@ -83,3 +83,9 @@ def halves(problem: Problem, chosen: Fit, rows: np.ndarray) -> list[Halves]:
             float(chi2.sf(statistic, len(apart))), float(np.linalg.norm(apart)) / max(size, 1e-12),
         ))
     return found
+
+
+def set_aside_sentence(entry: str) -> str:
+    """The statement's sentence for the conditions set aside as the model's form (`Halves.describe`, joined)."""
+    return (" Set aside as the model's form, each a value that changes with the launch where a venue condition or a "
+            f"monitor bias is one value for every shot: {entry}.")

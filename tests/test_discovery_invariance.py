@@ -64,3 +64,4 @@ def test_a_ferguson_clean_set_names_no_venue_condition():
     report = diagnose(recordings, model, seed=7, progress=False).report
     assert [e.kind for e in report.effects if e.kind != "form"] == [], [e.name for e in report.effects]
     assert "air_density: slower half" in report.systematic_test["varies_with_ball_speed"]
+    assert "Set aside as the model's form" in report.statement and "air_density: slower half" in report.statement
