@@ -46,7 +46,7 @@ from golfflight.discovery.fit import (
     per_shot,
     stratified_rows,
 )
-from golfflight.discovery.invariance import halves, set_aside_sentence
+from golfflight.discovery.invariance import Halves, halves, set_aside_sentence
 from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
 from golfflight.discovery.model import FlightModel
 from golfflight.discovery.noise import (
@@ -339,6 +339,7 @@ class Diagnoser:
             self.rows = stratified_rows(self.problem.recordings, MAX_FIT_SHOTS, self.rng)
         self.scored_fold = self.fold[self.scored]
         self._response_errors: dict[tuple[str, bytes], float] = {}  # memo: asked up to three times
+        self.set_aside: list[Halves] = []  # the conditions set aside as changing with the launch (`model_form`)
 
     def run(self) -> Diagnosis:
         """Locate the mismatch, choose its explanation, and report it with the arrays the plots need."""
@@ -361,7 +362,8 @@ class Diagnoser:
             ambiguity(self.problem, chosen, after.outcomes, selection.scored, self.rng) if selection.systematic else []
         )
         rival = (  # recordings without air: the venue's air set against the choice (`discovery.venue_air`)
-            air_rival(self.problem, chosen, after.outcomes, selection.scored, self.score, self.rows, start.expected)
+            air_rival(self.problem, chosen, after.outcomes, selection.scored, self.score, self.rows, start.expected,
+                      self.set_aside)
             if selection.systematic and not self.air_recorded
             else None
         )
@@ -630,6 +632,7 @@ class Diagnoser:
         varying = [h for h in halves(self.problem, chosen.fit, self.rows) if h.varies and h.effect not in within]
         if within:
             test["within_model_form"] = "+".join(filter(None, (test.get("within_model_form"), *within)))
+        self.set_aside += varying
         if varying:
             test["varies_with_ball_speed"] = "; ".join(
                 filter(None, (test.get("varies_with_ball_speed"), *(h.describe() for h in varying)))

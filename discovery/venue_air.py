@@ -15,11 +15,12 @@ their explanation.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from golfflight.discovery.effects import ALIASES, AIR_VARIANTS, DENSITY_ONLY, Context
 from golfflight.discovery.fit import Fit, Problem, Scored, blocks, cluster_bootstrap, per_shot
+from golfflight.discovery.invariance import Halves
 from golfflight.discovery.noise import ExpectedError
 from golfflight.discovery.physical import air_in_place
 from golfflight.discovery.recordings import LABELS, OBSERVABLES
@@ -69,6 +70,7 @@ def air_rival(
     score: Callable[[Fit], Scored],
     rows: np.ndarray,
     expected: ExpectedError,
+    set_aside: Sequence[Halves] = (),
 ) -> AirRival:
     """Air density against the chosen explanation (whose predictions are `predicted` [N, 5]) on recordings that carry
     no air: every air explanation of `air_explanations` (fitted and scored with `score` where `scored` lacks it),
@@ -77,7 +79,8 @@ def air_rival(
     beyond doubt on held-out shots AND predicting some recorded observable further apart (RMS over the shots) than
     the model's own error there (`expected.model`): a smaller difference can be the model's own error, not the
     physics (as a richer explanation that removes no more than the model's error of response is not claimed,
-    `Diagnoser.response_error`)."""
+    `Diagnoser.response_error`). Nor is air ruled out where it was `set_aside` as the model's form, its value changing
+    with the launch (`discovery.invariance`): the model's form is there, and the venue's air may be there beside it."""
     named = any(e.name in AIR_VARIANTS for e in chosen.fit.effects)
     rivals = [chosen] if named else air_explanations(problem, chosen, scored, score, rows)
     everyone = np.arange(len(problem.recordings))
@@ -90,7 +93,8 @@ def air_rival(
         difference = problem.predict(rival.fit.effects, rival.fit.theta, everyone)[0] - predicted
         within = _within_model_error(problem, difference, expected.model)
         judged.append((rival, (low, high), difference, within, rival is not chosen and low > 0 and not within))
-    separable = all(item[-1] for item in judged)
+    varied = next((h for h in set_aside if h.effect in AIR_VARIANTS), None)
+    separable = all(item[-1] for item in judged) and varied is None
     rival, (low, high), difference, within, _ = min(judged, key=lambda item: (item[-1], item[0].error))
     effect, block = next((e, b) for e, b in blocks(rival.fit) if e.name in AIR_VARIANTS)
     density = float(np.median(problem.base.density_kg_m3))
@@ -108,6 +112,9 @@ def air_rival(
         note = f"the recordings carry no air, and the air is named: {air}"
     else:
         note = _note(problem, chosen, rival, air, difference, measurements, (low, high), within)
+        if varied is not None:
+            note += (f"; yet air's value changes with the launch ({varied.describe()}): the model's form is there, "
+                     "and the venue's air beside it is not ruled out")
         if separable and len(judged) > 1:
             note += f" (every one of the {len(judged)} air explanations tried is worse beyond doubt)"
     return AirRival(

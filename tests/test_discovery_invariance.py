@@ -6,12 +6,13 @@ from __future__ import annotations
 import pytest
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import Diagnoser, diagnose
-from golfflight.discovery.effects import EFFECTS
+from golfflight.discovery.effects import DENSITY_ONLY, EFFECTS
 from golfflight.discovery.fit import fit, linear_starts
 from golfflight.discovery.invariance import SPLIT_LEVEL, SPLIT_SHARE, Halves, halves, speed_halves
 from golfflight.discovery.model import load_model, reference
 from golfflight.discovery.prove import ferguson_world, truth_world
 from golfflight.discovery.recordings import from_shot_set
+from golfflight.shots.records import ShotSet
 
 
 def _air_halves(recordings, model) -> Halves:
@@ -65,3 +66,17 @@ def test_a_ferguson_clean_set_names_no_venue_condition():
     assert [e.kind for e in report.effects if e.kind != "form"] == [], [e.name for e in report.effects]
     assert "air_density: slower half" in report.systematic_test["varies_with_ball_speed"]
     assert "Set aside as the model's form" in report.statement and "air_density: slower half" in report.statement
+
+
+def test_air_set_aside_as_the_model_s_form_is_not_ruled_out():
+    """1,900 m air as density alone (0.776) concealed in Ferguson 2022's world, the air left blank (seed 6 of
+    `scripts/venue_air_check.py`): the fitted air changes with the launch, so it is set aside as the model's form, and
+    the learned correction chosen instead beats air alone beyond doubt; that does not rule the venue's air out (it
+    can be there beside the form): air is listed first as an inseparable rival, near the truth."""
+    model = load_model(None)
+    records = conceal({DENSITY_ONLY: {"ratio": 0.776}}, 300, 6, model=truth_world("ferguson", model)).shots.records
+    report = diagnose(from_shot_set(ShotSet(records)), model, seed=6, progress=False).report
+    rival = report.air_rival
+    assert rival is not None and not rival.named and not rival.separable
+    assert "changes with the launch" in rival.note and rival.ratio == pytest.approx(0.776, abs=0.06)
+    assert report.ambiguities[0].effects[1] == rival.explanation
