@@ -43,6 +43,7 @@ class Halves:
 
     @property
     def varies(self) -> bool:
+        """Whether the halves differ beyond doubt and materially: the model's form, not one condition."""
         return self.p_value < SPLIT_LEVEL and self.share > SPLIT_SHARE
 
     def describe(self) -> str:
