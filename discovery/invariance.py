@@ -6,7 +6,8 @@ difference, seen in the effect's direction, and the form difference changes with
 falls off faster with speed than the recordings' reads as denser air on the slower shots and thinner air on the
 faster ones. So the chosen explanation is fitted again on the slower and on the faster half of the shots (split at
 the median ball speed, the launch value the clubs differ most in), and a venue condition or monitor bias whose two
-values differ beyond doubt (chi-square of their difference on the two fits' covariances, at SPLIT_LEVEL) and
+values differ beyond doubt (chi-square of their difference on the two fits' covariances, at SPLIT_LEVEL shared
+among the choice's conditions) and
 materially (further apart than SPLIT_SHARE of the effect's fitted size, its distance from no effect) is the model's
 form, not a condition of the recordings: `Diagnoser.select` does not claim it.
 """
@@ -20,7 +21,9 @@ from golfflight.discovery.fit import Fit, Problem, blocks, covariance, fit
 from scipy.stats import chi2
 
 SPLIT_LEVEL = 0.003
-"""The chance (about three standard deviations) below which the two halves' values are told apart."""
+"""The chance (about three standard deviations) below which the two halves' values are told apart, shared among the
+conditions of one choice (Bonferroni: each of k is tested at SPLIT_LEVEL / k), so that a choice of three conditions
+is no likelier to lose one to chance than a choice of one."""
 
 SPLIT_SHARE = 0.3
 """How far apart (a share of the effect's fitted size) the halves' values must lie to be a material difference:
@@ -40,11 +43,12 @@ class Halves:
     faster: tuple[float, ...]
     p_value: float
     share: float
+    level: float = SPLIT_LEVEL
 
     @property
     def varies(self) -> bool:
-        """Whether the halves differ beyond doubt and materially: the model's form, not one condition."""
-        return self.p_value < SPLIT_LEVEL and self.share > SPLIT_SHARE
+        """Whether the halves differ beyond doubt (at `level`) and materially: the model's form, not one condition."""
+        return self.p_value < self.level and self.share > SPLIT_SHARE
 
     def describe(self) -> str:
         def values(theta: tuple[float, ...]) -> str:
@@ -82,6 +86,7 @@ def halves(problem: Problem, chosen: Fit, rows: np.ndarray) -> list[Halves]:
         found.append(Halves(
             effect.name, tuple(low_theta[block].tolist()), tuple(high_theta[block].tolist()),
             float(chi2.sf(statistic, len(apart))), float(np.linalg.norm(apart)) / max(size, 1e-12),
+            SPLIT_LEVEL / len(conditions),
         ))
     return found
 

@@ -54,6 +54,7 @@ def test_a_difference_must_be_both_beyond_doubt_and_material():
     assert Halves("air_density", (0.946,), (0.909,), 1e-21, 0.48).varies
     assert not Halves("air_density", (0.87,), (0.84,), 1e-6, 0.17).varies, "beyond doubt but a small share"
     assert not Halves("air_density", (0.95,), (0.85,), 0.05, 0.9).varies, "a large share within the scatter"
+    assert not Halves("spin_axis_bias", (1.7,), (3.7,), 0.0027, 0.65, level=0.001).varies, "one of three conditions"
 
 
 def test_a_ferguson_clean_set_names_no_venue_condition():
