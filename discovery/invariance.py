@@ -7,9 +7,9 @@ falls off faster with speed than the recordings' reads as denser air on the slow
 faster ones. So the chosen explanation is fitted again on the slower and on the faster half of the shots (split at
 the median ball speed, the launch value the clubs differ most in), and a venue condition or monitor bias whose two
 values differ beyond doubt (chi-square of their difference on the two fits' covariances, at SPLIT_LEVEL shared
-among the choice's conditions) and
-materially (further apart than SPLIT_SHARE of the effect's fitted size, its distance from no effect) is the model's
-form, not a condition of the recordings: `Diagnoser.select` does not claim it.
+among the choice's conditions) and materially (further apart than SPLIT_SHARE of the effect's fitted size, its
+distance from no effect) is the model's form, not a condition of the recordings: `Diagnoser.select` does not claim
+it.
 """
 
 from __future__ import annotations
