@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from golfflight.discovery.fit import Fit, Problem, blocks, covariance, fit
+from golfflight.discovery.fit import Fit, Problem, blocks, fit
 from scipy.stats import chi2
 
 SPLIT_LEVEL = 0.003
@@ -71,11 +71,12 @@ def halves(problem: Problem, chosen: Fit, rows: np.ndarray) -> list[Halves]:
     slower = speed_halves(problem)
     if not conditions or min(slower[rows].sum(), (~slower[rows]).sum()) < MIN_HALF_SHOTS:
         return []
-    sessions = problem.recordings.session
     fitted = []
     for half in (slower, ~slower):
-        refit = fit(problem, chosen.effects, chosen.theta, rows[half[rows]])
-        fitted.append((refit.theta, covariance(refit.z[half], refit.jacobian[half], sessions[half])))
+        members = np.flatnonzero(half)
+        part = problem.subset(members)  # residuals and Jacobian of this half's shots only
+        refit = fit(part, chosen.effects, chosen.theta, np.searchsorted(members, rows[half[rows]]))
+        fitted.append((refit.theta, refit.covariance))
     (low_theta, low_cov), (high_theta, high_cov) = fitted
     found = []
     for effect, block in conditions:
