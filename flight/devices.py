@@ -3,6 +3,9 @@ line where this machine lacks it (a GPU asked for where torch sees none)."""
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
+
 import torch
 from golfflight.errors import InputError
 
@@ -30,3 +33,25 @@ def resolve_device(name: str) -> torch.device:
     if device.index is not None and device.index >= torch.cuda.device_count():
         raise DeviceError(f"--device {name}: this machine has {torch.cuda.device_count()} CUDA GPUs")
     return device
+
+
+M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
+"""glibc's mallopt parameters (malloc.h)."""
+
+KEPT_FREE_BYTES = 256 * 2**20
+"""Freed memory glibc keeps for the process's next allocations, at most, once `keep_freed_memory` has run."""
+
+
+def keep_freed_memory() -> bool:
+    """Have glibc keep the CPU memory torch frees for its next allocations instead of handing it back to the system.
+
+    Each Euler step of a part of 4,096 shots allocates and frees about 12 MB of the network's activations. glibc's
+    default hands freed memory back once more than twice the largest block freed lies free at the heap's top, so the
+    next step takes it back page by page from the kernel, zeroed: the torch engine on a CPU flew 0.72 of its speed
+    beside another process (benchmarks/bench_versus.py, docs/benchmarks.md). Process-wide: it keeps at most
+    KEPT_FREE_BYTES free. False where the C library has no mallopt (not glibc)."""
+    try:
+        mallopt = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").mallopt
+    except (OSError, AttributeError):
+        return False
+    return bool(mallopt(M_TRIM_THRESHOLD, KEPT_FREE_BYTES)) and bool(mallopt(M_MMAP_THRESHOLD, 32 * 2**20))

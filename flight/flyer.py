@@ -218,26 +218,13 @@ class Flyer:
         flight = integrate(start, field, self.dt_s, self.max_steps, self.rule, GroundPlane(heights),
                            record_for(keep_states))
         roll = partial(ground_phase, keep_path=keep_states)
-        columns, phase = landed_columns(
-            Landings(flight.landed, flight.landing_position, flight.landing_velocity, flight.landing_spin,
-                     flight.flight_time_s, flight.apex_m, flight.apex_time_s),
-            shot_grounds, self.unlanded_message, roll,
-        )
+        columns, phase = landed_columns(flight, shot_grounds, self.unlanded_message, roll)
         return _FlownBatch(columns, flight, phase)
 
     def _batch_field(self, per_shot: PerShot[Conditions]) -> BallInAir:
         """The equations of motion for a batch, each shot in its own air and wind."""
-        inputs = PerShot([air_inputs(c) for c in per_shot.objects], per_shot.index)
-        wind = Wind(
-            per_shot.column(lambda c: c.wind.speed_mps),
-            per_shot.column(lambda c: c.wind.from_deg),
-            per_shot.column(lambda c: c.wind.profile, None),
-            inputs.column(lambda a: a.reference_height_m),
-            inputs.column(lambda a: a.roughness_m),
-        )
-        viscosity = inputs.column(lambda a: a.kinematic_viscosity_m2_s)
-        density = inputs.column(lambda a: a.density_kg_m3)
-        return BallInAir(self.in_air(viscosity), density, wind)
+        air = batch_air(per_shot)
+        return BallInAir(self.in_air(air.kinematic_viscosity_m2_s), air.density_kg_m3, air.wind)
 
     def _shot_states(self, history: tuple[np.ndarray, np.ndarray], flight: Flight, shot: int) -> EulerStates:
         """One shot's states up to its landing, the interpolated landing last (history: every step's positions and
@@ -249,18 +236,26 @@ class Flyer:
         return EulerStates(times_s=times, positions=positions, velocities=velocities)
 
 
-@dataclass(frozen=True)
-class Landings:
-    """What a batch's flight hands its figures and ground phase, NumPy float64: whether each shot came down, its
-    landing state [N,3] (the last state where it did not), its flight time, apex height and apex time [N]."""
+class BatchAir(NamedTuple):
+    """A batch's air as the equations take it: density and kinematic viscosity [N], the wind of every shot."""
 
-    landed: np.ndarray
-    position: np.ndarray
-    velocity: np.ndarray
-    spin: np.ndarray
-    flight_time_s: np.ndarray
-    apex_m: np.ndarray
-    apex_time_s: np.ndarray
+    density_kg_m3: np.ndarray
+    kinematic_viscosity_m2_s: np.ndarray
+    wind: Wind
+
+
+def batch_air(per_shot: PerShot[Conditions]) -> BatchAir:
+    """Each shot's air and wind as [N] columns, read once for each distinct conditions (`air_inputs`)."""
+    inputs = PerShot([air_inputs(c) for c in per_shot.objects], per_shot.index)
+    wind = Wind(
+        per_shot.column(lambda c: c.wind.speed_mps),
+        per_shot.column(lambda c: c.wind.from_deg),
+        per_shot.column(lambda c: c.wind.profile, None),
+        inputs.column(lambda a: a.reference_height_m),
+        inputs.column(lambda a: a.roughness_m),
+    )
+    return BatchAir(inputs.column(lambda a: a.density_kg_m3), inputs.column(lambda a: a.kinematic_viscosity_m2_s),
+                    wind)
 
 
 Roll = Callable[..., GroundPhase]
@@ -269,14 +264,14 @@ Roll = Callable[..., GroundPhase]
 
 
 def landed_columns(
-    flight: Landings, grounds: PerShot[GroundSpec | None], unlanded: Callable[[float, float], str], roll: Roll
+    flight: Flight, grounds: PerShot[GroundSpec | None], unlanded: Callable[[float, float], str], roll: Roll
 ) -> tuple[BatchFlights, GroundPhase | None]:
-    """A batch's columns from its landings, for every backend: the figures (NaN where a shot never came down), an
+    """A batch's columns from its flight (NumPy), for every backend: the figures (NaN where a shot never came down), an
     error a shot that never came down (`unlanded(apex_m, ground_m)`) or whose figures are not finite, and the rests
     of the landed shots with a ground, bounced and rolled by `roll` in one batch; and that ground phase."""
     n = len(flight.landed)
-    x, y = flight.position[:, 0], flight.position[:, 1]
-    carry, angle, speed, spin = landing_figures(x, y, *flight.velocity.T, *flight.spin.T)
+    x, y = flight.landing_position[:, 0], flight.landing_position[:, 1]
+    carry, angle, speed, spin = landing_figures(x, y, *flight.landing_velocity.T, *flight.landing_spin.T)
     numbers = (x, y, carry, flight.apex_m, flight.apex_time_s, flight.flight_time_s, angle, speed, spin)
     finite = np.isfinite(np.stack(numbers)).all(axis=0)
     failed = np.flatnonzero(~(flight.landed & finite))
@@ -289,8 +284,9 @@ def landed_columns(
     phase = None
     if shots.size:
         on = grounds.take(shots)
-        phase = roll(flight.position[shots], flight.velocity[shots], flight.spin[shots], batch_surface(on),
-                     on.column(lambda g: g.slope_deg), on.column(lambda g: g.slope_dir_deg))
+        landing = (flight.landing_position[shots], flight.landing_velocity[shots], flight.landing_spin[shots])
+        phase = roll(*landing, batch_surface(on), on.column(lambda g: g.slope_deg),
+                     on.column(lambda g: g.slope_dir_deg))
     x, y, carry, angle, speed, spin, flight_time = (
         np.where(flight.landed, v, math.nan) for v in (x, y, carry, angle, speed, spin, flight.flight_time_s)
     )

@@ -72,14 +72,15 @@ class Wind:
         """Which shots' wind follows the log profile (a boolean, or one per shot)."""
         return np.asarray(self.profile) == "log"
 
+    @cached_property
+    def at_balls(self) -> WindAtBalls:
+        """This wind as the equations read it at every step."""
+        log = None if not self.is_log.any() else True if self.is_log.all() else self.is_log
+        return WindAtBalls(self.at_reference, log, self.reference_height_m, self.roughness_m, self.is_calm)
+
     def velocity(self, height_m: np.ndarray) -> np.ndarray:
         """Air velocity [N, 3] at the balls' heights [N]."""
-        if not self.is_log.any():
-            return np.broadcast_to(self.at_reference, np.shape(height_m) + (3,))
-        factor = log_profile_factor(height_m, self.reference_height_m, self.roughness_m)
-        if not self.is_log.all():
-            factor = np.where(self.is_log, factor, 1.0)
-        return self.at_reference * factor[..., None]
+        return np.broadcast_to(self.at_balls.velocity(height_m), np.shape(height_m) + (3,))
 
     @cached_property
     def is_calm(self) -> bool:
@@ -92,6 +93,40 @@ class Wind:
         if all(np.ndim(f) == 0 for f in fields):
             return self
         return Wind(*(f if np.ndim(f) == 0 else np.asarray(f)[index] for f in fields))
+
+
+@dataclass(frozen=True)
+class WindAtBalls:
+    """A batch's wind as the equations read it at every step, NumPy or torch (`flight.xp`): the air's velocity at
+    the reference height ([N,3], or [3] shared), which balls follow the log profile (flags [N], True for every
+    ball, None for none) and the profile's reference height and roughness (a float or [N])."""
+
+    at_reference: np.ndarray
+    log: np.ndarray | bool | None = None
+    reference_height_m: float | np.ndarray = STATION_HEIGHT_M
+    roughness_m: float | np.ndarray = FAIRWAY_ROUGHNESS_M
+    is_calm: bool = False
+
+    def velocity(self, height_m):
+        """Air velocity at the balls' heights [N]: [N,3], or the shared [3] of a uniform wind."""
+        if self.log is None:
+            return self.at_reference
+        factor = log_profile_factor(height_m, self.reference_height_m, self.roughness_m)
+        return self.at_reference * xp.where(self.log, factor, 1.0)[..., None]
+
+    def take(self, index) -> WindAtBalls:
+        """The wind of some of the balls."""
+        at_reference = self.at_reference[index] if self.at_reference.ndim == 2 else self.at_reference
+        log, height, roughness = (xp.rows(v, index) for v in (self.log, self.reference_height_m, self.roughness_m))
+        return WindAtBalls(at_reference, log, height, roughness, self.is_calm)
+
+    def to(self, convert) -> WindAtBalls:
+        """The same wind with its arrays made another kind by `convert` (a device's tensors)."""
+        at_reference, log, height, roughness = (
+            convert(v) if xp.is_array(v) else v
+            for v in (self.at_reference, self.log, self.reference_height_m, self.roughness_m)
+        )
+        return WindAtBalls(at_reference, log, height, roughness, self.is_calm)
 
 
 CALM = Wind()

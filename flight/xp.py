@@ -91,10 +91,17 @@ def where(condition, a, b):
     if isinstance(condition, np.ndarray):
         return np.where(condition, a, b)
     torch = sys.modules["torch"]
-    dtype = next((v.dtype for v in (a, b) if isinstance(v, torch.Tensor)), torch.float64)
-    return torch.where(condition, *(v if isinstance(v, torch.Tensor) else torch.as_tensor(v, dtype=dtype,
-                                                                                        device=condition.device)
-                                    for v in (a, b)))
+    if isinstance(a, torch.Tensor) or isinstance(b, torch.Tensor):
+        return torch.where(condition, a, b)  # a plain number takes the tensor's dtype
+    return torch.where(condition, *(torch.as_tensor(v, dtype=torch.float64, device=condition.device) for v in (a, b)))
+
+
+def lerp(start, end, weight):
+    """start + weight (end - start), one kernel for tensors (`torch.lerp`); weight [N] against [N,3] ends."""
+    weight = weight[:, None] if weight.ndim < start.ndim else weight
+    if isinstance(start, np.ndarray):
+        return start + weight * (end - start)
+    return sys.modules["torch"].lerp(start, end, weight)
 
 
 def stack(components) -> object:
@@ -116,6 +123,59 @@ def zeros(n: int, like, integer: bool = False):
         return np.zeros(n, dtype=np.int64 if integer else float)
     torch = sys.modules["torch"]
     return torch.zeros(n, dtype=torch.int64 if integer else like.dtype, device=like.device)
+
+
+def full(shape, value, like):
+    """An array of `shape` filled with `value`, of `like`'s kind (a float array; a tensor's dtype and device)."""
+    if isinstance(like, np.ndarray):
+        return np.full(shape, value, dtype=float)
+    shape = (shape,) if isinstance(shape, int) else shape
+    return sys.modules["torch"].full(shape, value, dtype=like.dtype, device=like.device)
+
+
+def falses(n: int, like):
+    """n False flags of `like`'s kind (a tensor's device)."""
+    if isinstance(like, np.ndarray):
+        return np.zeros(n, dtype=bool)
+    torch = sys.modules["torch"]
+    return torch.zeros(n, dtype=torch.bool, device=like.device)
+
+
+def nonzero(flags):
+    """The indices where a NumPy or torch array of flags holds (a tensor's answer waits for its device)."""
+    if isinstance(flags, np.ndarray):
+        return np.flatnonzero(flags)
+    return flags.nonzero().squeeze(1)
+
+
+def answers_now(flags) -> bool:
+    """Whether asking about these flags is answered at once: NumPy's, or a tensor on the CPU; a GPU's tensor would
+    first finish its queue of work (at every step, the step's own kernels)."""
+    return isinstance(flags, np.ndarray) or flags.device.type == "cpu"
+
+
+def rows_of(flags):
+    """The rows a masked write touches (`put`): those where `flags` hold, when that is answered at once; else every
+    row (a slice)."""
+    if isinstance(flags, np.ndarray):
+        return np.flatnonzero(flags)
+    return flags.nonzero().squeeze(1) if answers_now(flags) else slice(None)
+
+
+def put(flags, rows, current, values):
+    """`current` with `values` (of `rows_of(flags)`) in the rows where `flags` hold: those rows written in place (a
+    batch's landings are a few rows a step), or, on a GPU, every row merged by `where`, so that nothing waits for
+    the device to say which rows hold."""
+    if not isinstance(rows, slice):
+        current[rows] = values
+        return current
+    return where(flags[:, None] if getattr(values, "ndim", 0) > flags.ndim else flags, values, current)
+
+
+def may_hold(flags) -> bool:
+    """Whether any of these flags may hold, answered without waiting for a device: the answer where it is answered
+    at once (`answers_now`); True on a GPU."""
+    return bool(flags.any()) if answers_now(flags) else True
 
 
 def arange(n: int, like):

@@ -114,6 +114,20 @@ def test_step_rules_are_named_objects_and_both_records_give_the_same_flight():
     assert not np.allclose(euler, rk4, atol=1e-6)
 
 
+def test_a_ball_that_rises_again_below_its_ground_keeps_its_first_landing_and_apex(engine):
+    """A low, spinning drive is down through z = 0 within its first step, then its lift carries it up again (-0.10 m
+    at 0.1 s, back above the tee by 0.4 s). A batch sets landed balls aside only now and then (`SetAside`), and a
+    record of states flies every ball to the batch's last landing, so the ball flies on below its ground meanwhile:
+    it must keep the landing and apex of its first crossing, as the single shot (which stops there) does."""
+    low, drive = Launch(64.0, -1.0, 0.0, 6500.0, 0.0), Launch(60.0, 12.0, 0.0, 3000.0, 0.0)
+    single = engine.fly(low)
+    assert single.flight_time_s < engine.dt
+    for keep_states in (False, True):
+        flown = engine.fly_batch([low, drive], keep_states=keep_states).shots()[0]
+        for name in ("carry_m", "flight_time_s", "apex_m", "apex_time_s", "landing_speed_mps"):
+            assert getattr(flown, name) == pytest.approx(getattr(single, name), abs=1e-9), (keep_states, name)
+
+
 INSTALLED_DEFAULTS = """
 from golfflight.cli import build_parser
 from golfflight.discovery.model import load_model

@@ -159,31 +159,37 @@ def test_a_batch_split_into_parts_flies_the_same_numbers(shots):
 
 
 
-def test_shots_set_aside_as_they_land_fly_the_same_numbers(shots, monkeypatch):
-    """Shots that have come down are set aside while the rest fly on (`torch_engine.Aloft`): the same figures, errors
-    and rests as when every shot flies to the part's last step (a share of 1: never set aside), to the float32
-    network's ulp (a row of a matrix product can round differently beside other rows), and fewer shot-steps flown."""
+def test_shots_set_aside_as_they_land_fly_the_same_numbers(shots):
+    """Shots that have come down are set aside while the rest fly on (`flight.integrator.SetAside`, every ten steps
+    once an eighth are down): the same figures, errors and rests as when every shot flies to the part's last step (a
+    share of 1: never set aside), to the float32 network's ulp (a row of a matrix product can round differently
+    beside other rows), and fewer shot-steps flown."""
     bundle = load_flyer(None).bundle_dir
-    flown = []
-    step = torch_engine.flight_step
 
-    def counted(coefficients, dt, position, *rest):
-        flown.append(len(position))
-        return step(coefficients, dt, position, *rest)
+    def counted(engine: TorchEngine) -> list[int]:
+        flown, rule = [], engine.rule
 
-    monkeypatch.setattr(torch_engine, "flight_step", counted)
-    aside = TorchEngine(bundle, "cpu", "float64").fly_batch(*shots)
-    aside_steps, flown[:] = sum(flown), []
-    together = TorchEngine(bundle, "cpu", "float64", set_aside_share=1.0).fly_batch(*shots)
+        def step(state, field, dt):
+            flown.append(len(state.position))
+            return rule(state, field, dt)
+
+        engine.rule = step
+        return flown
+
+    aside_engine = TorchEngine(bundle, "cpu", "float64")
+    together_engine = TorchEngine(bundle, "cpu", "float64", set_aside_share=1.0)
+    aside_flown, together_flown = counted(aside_engine), counted(together_engine)
+    aside, together = aside_engine.fly_batch(*shots), together_engine.fly_batch(*shots)
     assert aside.errors == together.errors and {1, 2} <= set(aside.errors)
     for name in FIGURES:
         np.testing.assert_allclose(getattr(aside, name), getattr(together, name), rtol=1e-8, atol=1e-6, err_msg=name)
     np.testing.assert_allclose(aside.rest.total_m, together.rest.total_m, rtol=1e-8, atol=1e-6)
     np.testing.assert_array_equal(aside.rest.bounces, together.rest.bounces)
-    assert sum(flown) == SHOTS * load_flyer(None).max_steps  # two shots never land: every step flown
-    assert aside_steps < 0.6 * sum(flown)
+    assert sum(together_flown) == SHOTS * load_flyer(None).max_steps  # two shots never land: every step flown
+    assert sum(aside_flown) < 0.6 * sum(together_flown)
     with pytest.raises(ValueError, match="set_aside_share 0: must be more than 0 and at most 1"):
         TorchEngine(bundle, "cpu", set_aside_share=0)
+
 
 def sweep(*argv) -> int:
     return main(["sweep", *map(str, argv), "--no-progress"])
