@@ -1,12 +1,13 @@
 """The differentiable fixed-horizon rollout training needs (paper sections 2.1, 2.3), on the flight core's equations.
 
-The equations of motion are `flight.physics`'s, written once over floats, NumPy and torch (`flight.xp`): this module
-adds what training alone needs, the whole-horizon rollout kept as one graph, the soft landing and the landing and
-apex read back differentiably (the apex's parabola is `flight.outcomes.parabola_apex`'s), batched over shots and
-dtype-agnostic (float64 for the parity tests, float32 for training). Wind is uniform (one air velocity per shot):
-real-data training fits it as a per-group nuisance, where a uniform wind is the simplest stand-in for the profile.
-The landing and the apex are measured as `flight.integrator` measures them (`hard_landing`, `apex`), so training
-fits the figures the runtime reports.
+The equations of motion and the Euler step are the flight core's (`flight.field.BallInAir`, `flight.integrator`),
+written once over floats, NumPy and torch (`flight.xp`): this module adds what training alone needs, the
+whole-horizon rollout kept as one graph, the soft landing and the landing and apex read back differentiably (the
+apex's parabola is `flight.outcomes.parabola_apex`'s), batched over shots and dtype-agnostic (float64 for the parity
+tests, float32 for training). Wind is uniform (one air velocity per shot): real-data training fits it as a
+per-group nuisance, where a uniform wind is the simplest stand-in for the profile. The landing and the apex are
+measured as `flight.integrator` measures them (`hard_landing`, `apex`), so training fits the figures the runtime
+reports.
 """
 
 from __future__ import annotations
@@ -15,9 +16,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import torch
-from golfflight.flight.constants import GRAVITY_MPS2
+from golfflight.flight.field import BallInAir
+from golfflight.flight.integrator import FORWARD_EULER
 from golfflight.flight.outcomes import parabola_apex
-from golfflight.flight.physics import aerodynamics
+from golfflight.flight.physics import State
+from golfflight.flight.wind import CALM, WindAtBalls
 
 DT_S = 0.1
 """Euler step of the paper (section 2.3.2): the step the models are trained and served with."""
@@ -36,6 +39,9 @@ SOFT_ARGMAX_TEMPERATURE_M = 0.5
 """Default soft-argmax temperature (m of |r_z|). The weights then share out between the steps around the ground
 crossing much like a linear interpolation (so the landing time gets a gradient): over 2,000 Ferguson flights the
 soft landing was on average 0.16 m from the interpolated one, against 0.27 m at 0.25 m and 0.20 m at 1 m."""
+
+CALM_AT_BALLS = CALM.at_balls
+"""Calm air as the equations read it (a plain field, not `Wind`'s cached one: torch.compile cannot enter its lock)."""
 
 Coefficients = Callable[[torch.Tensor, torch.Tensor], torch.Tensor]
 """(v_rel [N,3], omega [N,3]) -> [N,4] = C_L, C_D, C_M, C_Q, as in `flight.physics.CoefficientModel`."""
@@ -75,26 +81,19 @@ class Landing:
     landed: torch.Tensor
 
 
-def derivatives(
-    position: torch.Tensor,
-    velocity: torch.Tensor,
-    spin: torch.Tensor,
-    coefficients: Coefficients,
-    density: torch.Tensor | float,
-    reynolds_scale: torch.Tensor | float = 1.0,
-    wind: torch.Tensor | None = None,
-    coefficient_scale: torch.Tensor | None = None,
-) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """d/dt of (position, velocity, spin) (paper eq. 14 with the errata). The aerodynamics use v_rel = v - `wind`
-    ([N,3] uniform air velocity; None = calm); the coefficient model is fed (k v_rel, k omega) with
-    k = `reynolds_scale` [N,1] (`flight.physics.reynolds_scale`), and its output is multiplied by
-    `coefficient_scale` [N,4] where given (a ball type's drag and lift relative to the ball the model learned)."""
-    v_rel = velocity if wind is None else velocity - wind
-    coefficient_values = coefficients(v_rel * reynolds_scale, spin * reynolds_scale)
-    if coefficient_scale is not None:
-        coefficient_values = coefficient_values * coefficient_scale
-    acceleration, spin_acceleration = aerodynamics(v_rel, spin, coefficient_values, density)
-    return velocity, acceleration - acceleration.new_tensor([0.0, 0.0, GRAVITY_MPS2]), spin_acceleration
+@dataclass(frozen=True)
+class InAir:
+    """A coefficient model in each shot's air, as training flies it: fed (k v_rel, k omega) at the shot's Reynolds
+    scale k [N,1] (`flight.physics.reynolds_scale`), its coefficients times `coefficient_scale` [N,4] where given
+    (a ball type's drag and lift relative to the ball the model learned)."""
+
+    model: Coefficients
+    reynolds_scale: torch.Tensor | float = 1.0
+    coefficient_scale: torch.Tensor | None = None
+
+    def __call__(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
+        values = self.model(v_rel * self.reynolds_scale, omega * self.reynolds_scale)
+        return values if self.coefficient_scale is None else values * self.coefficient_scale
 
 
 def euler_step(
@@ -108,11 +107,13 @@ def euler_step(
     wind: torch.Tensor | None = None,
     coefficient_scale: torch.Tensor | None = None,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """One forward-Euler step of `derivatives` (arguments as there): the position, velocity and spin dt later."""
-    d_position, d_velocity, d_spin = derivatives(
-        position, velocity, spin, coefficients, density, reynolds_scale, wind, coefficient_scale
-    )
-    return position + dt * d_position, velocity + dt * d_velocity, spin + dt * d_spin
+    """One forward-Euler step of the flight core's field (`flight.field.BallInAir`, `flight.integrator.FORWARD_EULER`)
+    in each shot's air (`InAir`) and uniform `wind` ([N,3] air velocity; None = calm): the position, velocity and spin
+    dt later."""
+    air = CALM_AT_BALLS if wind is None else WindAtBalls(wind)
+    field = BallInAir(InAir(coefficients, reynolds_scale, coefficient_scale), density, air)
+    new = FORWARD_EULER(State(position, velocity, spin), field, dt)
+    return new.position, new.velocity, new.spin
 
 
 EulerStep = Callable[..., tuple[torch.Tensor, torch.Tensor, torch.Tensor]]
