@@ -18,6 +18,10 @@ NUMBERS = (float, int, np.generic)
 """Plain numbers (NumPy's scalars among them): one ball's components, checked before anything slower."""
 
 
+FLAGS = (bool, np.bool_)
+"""One ball's flag (a comparison of plain numbers)."""
+
+
 def is_number(value) -> bool:
     """Whether a value is one plain number rather than an array (one ball's, or one air's: hashable, cacheable)."""
     return isinstance(value, NUMBERS)
@@ -86,7 +90,7 @@ expm1 = _unary("expm1", math.expm1, np.expm1)
 
 def where(condition, a, b):
     """a where `condition` holds, else b (both evaluated)."""
-    if isinstance(condition, (bool, np.bool_)):
+    if isinstance(condition, FLAGS):
         return a if condition else b
     if isinstance(condition, np.ndarray):
         return np.where(condition, a, b)
@@ -123,6 +127,26 @@ def zeros(n: int, like, integer: bool = False):
         return np.zeros(n, dtype=np.int64 if integer else float)
     torch = sys.modules["torch"]
     return torch.zeros(n, dtype=torch.int64 if integer else like.dtype, device=like.device)
+
+
+def anything(flags) -> bool:
+    """Whether any of these flags holds: one ball's flag, or an array's (a device's answer waits for it)."""
+    return bool(flags) if isinstance(flags, FLAGS) else bool(flags.any())
+
+
+def negated(flags):
+    """Not these flags: one ball's (a plain bool's `~` would be an integer), or an array's, element by element."""
+    return not flags if isinstance(flags, FLAGS) else ~flags
+
+
+def zeros_like(value, integer: bool = False):
+    """Zeros of `value`'s kind: one plain number, or an array's shape, dtype (int64 where `integer`) and device."""
+    if not is_array(value):
+        return 0 if integer else 0.0
+    if isinstance(value, np.ndarray):
+        return np.zeros_like(value, dtype=np.int64 if integer else value.dtype)
+    torch = sys.modules["torch"]
+    return torch.zeros_like(value, dtype=torch.int64 if integer else value.dtype)
 
 
 def full(shape, value, like):

@@ -19,9 +19,10 @@ On a hop the wind changes the air's push on the ball by as much as the ball's ow
 (above): a few per cent of a hop's length.
 
 The formulas are written once on (x, y, z) tuples of floats, arrays or tensors (`flight.ground.vectors`, `flight.xp`),
-and so is the batch's driver (`roll_to_rest`, NumPy or torch: `ground_phase` runs it on a batch, the torch engine on a
-device's tensors); `ground_phase_one` runs the formulas on one ball's plain floats (the engine's one-shot latency
-path, where NumPy's per-call cost on arrays of one row would cost more than the physics).
+and so is the driver (`_to_rest`): the balls of a batch go through the bounces and the slope's steps in step, a ball
+done keeping its values (`choose`), so the same lines run one ball on plain floats (`ground_phase_one`, the engine's
+one-shot latency path, where NumPy's per-call cost on arrays of one row would cost more than the physics), a batch
+on NumPy (`ground_phase`) and the torch engine's on its device (`roll_to_rest`).
 
 Every state of the phase can be kept (`keep_path`): after each impact, each touchdown, each roll step and the rest,
 with velocities, and a level roll's states every ROLL_STEP_S, so a renderer's cubic Hermite resampling follows the
@@ -39,7 +40,7 @@ from golfflight.errors import InputError
 from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
 from golfflight.flight.ground.impact import impact_components
 from golfflight.flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, holding_slope_deg
-from golfflight.flight.ground.vectors import TINY, add, cross, dot, norm, times
+from golfflight.flight.ground.vectors import TINY, add, choose, cross, dot, norm, times
 from golfflight.flight import xp
 from golfflight.flight.xp import expm1, log1p, maximum, where
 
@@ -174,131 +175,123 @@ def downhill_acceleration(normal: tuple) -> tuple:
     return times(ROLLING_GRAVITY_FRACTION, along)
 
 
-class _Recorder:
-    """Per-ball lists of (t, position, velocity), or nothing when paths are not kept."""
+class _Record:
+    """The states of a ground phase's balls when they are kept: a list for one ball on floats (`n` None), or one a
+    ball of a batch; nothing otherwise."""
 
-    def __init__(self, n: int, keep: bool) -> None:
-        self.rows: list[list[tuple]] | None = [[] for _ in range(n)] if keep else None
+    def __init__(self, n: int | None, keep: bool) -> None:
+        self.one = n is None
+        self.rows: list[list[tuple]] | None = ([[]] if self.one else [[] for _ in range(n)]) if keep else None
 
-    def add(self, ids: np.ndarray, t: np.ndarray, position: np.ndarray, velocity: np.ndarray) -> None:
+    def _balls(self, flags) -> list[int]:
+        return ([0] if flags else []) if self.one else np.flatnonzero(flags).tolist()
+
+    def _floats(self, values: tuple, i: int) -> tuple:
+        return tuple(float(v if self.one else v[i]) for v in values)
+
+    def add(self, flags, t, position: tuple, velocity: tuple) -> None:
+        """The state of the balls where `flags` hold, at time `t` of each."""
         if self.rows is None:
             return
-        for k, i in enumerate(ids.tolist()):
-            self.rows[i].append((float(t[k]), position[k].copy(), velocity[k].copy()))
+        for i in self._balls(flags):
+            self.rows[i].append((float(t if self.one else t[i]), self._floats(position, i), self._floats(velocity, i)))
+
+    def level(self, flags, start, position: tuple, rolling: tuple, resistance, drag, roll_time) -> None:
+        """The states of the level rolls where `flags` hold every ROLL_STEP_S from their start (closed form; the
+        rest is added by the caller)."""
+        if self.rows is None:
+            return
+        for i in self._balls(flags):
+            at, speed_vector = self._floats(position, i), self._floats(rolling, i)
+            resistance_i, drag_i, start_i, time_i = (float(v if self.one or np.ndim(v) == 0 else v[i])
+                                                     for v in (resistance, drag, start, roll_time))
+            speed = norm(speed_vector)
+            times_s = np.arange(ROLL_STEP_S, time_i - 1e-9, ROLL_STEP_S)
+            e1, e2 = decay(drag_i, times_s)
+            deceleration = resistance_i * GRAVITY_MPS2
+            run, now = speed * e1 - deceleration * e2, speed * (1.0 - drag_i * e1) - deceleration * e1
+            direction = times(1.0 / max(speed, TINY), speed_vector)
+            self.rows[i] += [(start_i + t, add(at, direction, r), times(v, direction))
+                             for t, r, v in zip(times_s.tolist(), run.tolist(), now.tolist(), strict=True)]
 
     def paths(self) -> list[GroundPath] | None:
         if self.rows is None:
             return None
-        return [
-            GroundPath(np.array([r[0] for r in rows]), np.array([r[1] for r in rows]), np.array([r[2] for r in rows]))
-            for rows in self.rows
-        ]
+        return [GroundPath(np.array([r[0] for r in rows]), np.array([r[1] for r in rows]).reshape(-1, 3),
+                           np.array([r[2] for r in rows]).reshape(-1, 3)) for rows in self.rows]
 
 
-def _bounce(position, velocity, spin, normal, surface: Surface, record: _Recorder):
-    """Impacts and hops until every ball rolls: (roll-start position, rolling velocity, time, hops)."""
-    n = len(position)
-    time, hops = xp.zeros(n, position), xp.zeros(n, position, integer=True)
-    position, velocity, spin = xp.copy(position), xp.copy(velocity), xp.copy(spin)
-    bouncing = xp.arange(n, position)
+def _bounce(position: tuple, velocity: tuple, spin: tuple, normal: tuple, surface: Surface, record: _Record):
+    """Impacts and hops until every ball rolls, the balls in step (one that has stopped hopping keeps its values):
+    (roll-start position, velocity, spin, time, hops)."""
+    time = xp.zeros_like(position[0])
+    hops, bouncing = xp.zeros_like(time, integer=True), time == 0.0  # every ball, to begin with
     record.add(bouncing, time, position, velocity)
-    while xp.size(bouncing):
-        ids = bouncing
-        v_out, w_out = impact_components(xp.columns(velocity[ids]), xp.columns(spin[ids]), xp.columns(normal[ids]),
-                                         surface.take(ids))
-        rebound = dot(v_out, xp.columns(normal[ids]))
-        hopping = (rebound > MIN_HOP_SPEED_MPS) & (hops[ids] < MAX_BOUNCES)
-        velocity[ids], spin[ids] = xp.stack(v_out), xp.stack(w_out)
-        flying = ids[hopping]
-        if xp.size(flying):
-            record.add(flying, time[flying], position[flying], velocity[flying])
-            duration = 2.0 * rebound[hopping] / (GRAVITY_MPS2 * normal[flying, 2])
-            landed, incoming = hop(xp.columns(position[flying]), xp.columns(velocity[flying]), duration)
-            position[flying], velocity[flying] = xp.stack(landed), xp.stack(incoming)
-            time[flying] += duration
-            hops[flying] += 1
-            record.add(flying, time[flying], position[flying], velocity[flying])
-        bouncing = flying
-    rolling = xp.stack(rolling_velocity(xp.columns(velocity), xp.columns(spin), xp.columns(normal)))
-    return position, rolling, time, hops
+    while xp.anything(bouncing):
+        velocity_out, spin_out = impact_components(velocity, spin, normal, surface)
+        velocity, spin = choose(bouncing, velocity_out, velocity), choose(bouncing, spin_out, spin)
+        rebound = dot(velocity, normal)
+        bouncing = bouncing & (rebound > MIN_HOP_SPEED_MPS) & (hops < MAX_BOUNCES)
+        record.add(bouncing, time, position, velocity)
+        duration = where(bouncing, 2.0 * rebound / (GRAVITY_MPS2 * normal[2]), 0.0)
+        position, velocity = hop(position, velocity, duration)  # a hop of no time leaves a ball as it is
+        time, hops = time + duration, hops + bouncing
+        record.add(bouncing, time, position, velocity)
+    return position, velocity, spin, time, hops
 
 
-def _level_states(speed, deceleration, drag, t):
-    """Distance run and speed [K] of a level roll at times t [K] from its start (closed form)."""
-    e1, e2 = decay(drag, t)
-    return speed * e1 - deceleration * e2, speed * (1.0 - drag * e1) - deceleration * e1
-
-
-def _record_level(record: _Recorder, ids, start_time, position, velocity, resistance, drag, roll_time) -> None:
-    """The states of level rolls every ROLL_STEP_S (the rest is recorded by the caller)."""
-    if record.rows is None:
-        return
-    deceleration = resistance * GRAVITY_MPS2
-    for k, i in enumerate(ids.tolist()):
-        speed = float(np.linalg.norm(velocity[k]))
-        times_s = np.arange(ROLL_STEP_S, roll_time[k] - 1e-9, ROLL_STEP_S)
-        run, now = _level_states(speed, deceleration[k], drag[k], times_s)
-        direction = velocity[k] / max(speed, TINY)
-        record.add(np.full(len(times_s), i), start_time[k] + times_s, position[k] + run[:, None] * direction,
-                   now[:, None] * direction)
-
-
-def _roll_level(position, velocity, resistance, drag):
-    """Rest point and roll time on level ground (closed form, `stopping`)."""
-    speed = norm(xp.columns(velocity))
-    distance, time = stopping(speed, resistance * GRAVITY_MPS2, drag)
-    direction = velocity / maximum(speed, TINY)[:, None]
-    return position + direction * distance[:, None], time
-
-
-def _roll_slope(position, velocity, normal, resistance, drag, record: _Recorder, ids, start):
-    """Rest point and roll time on slopes, in `slope_step`s until every ball has stopped."""
-    downhill = xp.stack(downhill_acceleration(xp.columns(normal)))
-    brake = resistance * GRAVITY_MPS2 * normal[:, 2]
-    position, velocity = xp.copy(position), xp.copy(velocity)
-    rest, time = xp.copy(position), xp.zeros(len(position), position)
-    moving = xp.arange(len(position), position)
+def _roll_slope(position: tuple, velocity: tuple, normal: tuple, resistance, drag, moving, record: _Record, start):
+    """Rest point and roll time of the balls `moving` on slopes, in `slope_step`s, in step, until each has stopped."""
+    downhill = downhill_acceleration(normal)
+    brake = resistance * GRAVITY_MPS2 * normal[2]
+    rest, elapsed = position, xp.zeros_like(start)
     for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
-        if not xp.size(moving):
+        if not xp.anything(moving):
             break
-        stops, taken, stop_at, moved, after = slope_step(
-            xp.columns(position[moving]), xp.columns(velocity[moving]), xp.columns(downhill[moving]), brake[moving],
-            drag[moving],
-        )
-        stopped, going = moving[stops], moving[~stops]
-        rest[stopped] = xp.stack(stop_at)[stops]
-        time[moving] += taken
-        position[going], velocity[going] = xp.stack(moved)[~stops], xp.stack(after)[~stops]
-        record.add(ids[going], start[going] + time[going], position[going], velocity[going])
-        moving = going
-    rest[moving] = position[moving]
-    return rest, time
+        stops, taken, stop_at, moved, after = slope_step(position, velocity, downhill, brake, drag)
+        rest, elapsed = choose(moving & stops, stop_at, rest), elapsed + where(moving, taken, 0.0)
+        moving = moving & xp.negated(stops)
+        position, velocity = choose(moving, moved, position), choose(moving, after, velocity)
+        record.add(moving, start + elapsed, position, velocity)
+    return choose(moving, position, rest), elapsed
 
 
-def roll_to_rest(position, velocity, spin, normal, surface: Surface, record: _Recorder | None = None):
-    """The batch's ground phase, NumPy arrays or torch tensors alike (the torch engine's on its device): bounce every
-    ball, then roll those on level ground (a normal straight up) in closed form and the rest in slope steps. Landing
-    states and plane normals [N,3]; `surface` holds floats or [N] values of the same kind. (rest [N,3], hops [N],
-    time on the ground [N]); `record` (NumPy only) keeps every state."""
-    n = len(position)
-    record = record or _Recorder(n, keep=False)
-    resistance = xp.zeros(n, position) + surface.rolling_resistance
-    drag = xp.zeros(n, position) + surface.grass_drag_per_s
-    level = normal[:, 2] == 1.0
-    everyone = xp.arange(n, position)
-    start, rolling, time, hops = _bounce(position, velocity, spin, normal, surface, record)
-    record.add(everyone[norm(xp.columns(rolling)) > 0.0], time, start, rolling)
-    rest, roll_time = xp.copy(start), xp.zeros(n, position)
-    rest[level], roll_time[level] = _roll_level(start[level], rolling[level], resistance[level], drag[level])
-    _record_level(record, everyone[level], time[level], start[level], rolling[level], resistance[level], drag[level],
-                  roll_time[level])
-    sloped = ~level
-    if bool(sloped.any()):
-        ids = everyone[sloped]
-        rest[sloped], roll_time[sloped] = _roll_slope(
-            start[sloped], rolling[sloped], normal[sloped], resistance[sloped], drag[sloped], record, ids, time[sloped]
-        )
-    return rest, hops, time + roll_time
+def _roll(position: tuple, rolling: tuple, normal: tuple, surface: Surface, record: _Record, start):
+    """Rest point and roll time of balls rolling off from `position` at `rolling` velocity, their time on the ground
+    `start` so far: on level ground (a normal straight up) in closed form (`stopping`), on slopes in steps."""
+    resistance, drag = surface.rolling_resistance, surface.grass_drag_per_s
+    speed = norm(rolling)
+    distance, roll_time = stopping(speed, resistance * GRAVITY_MPS2, drag)
+    guarded = maximum(speed, TINY)
+    rest = add(position, (rolling[0] / guarded, rolling[1] / guarded, rolling[2] / guarded), distance)
+    level = normal[2] == 1.0
+    record.level(level, start, position, rolling, resistance, drag, roll_time)
+    sloped = xp.negated(level)
+    if xp.anything(sloped):
+        slope_rest, slope_time = _roll_slope(position, rolling, normal, resistance, drag, sloped, record, start)
+        rest, roll_time = choose(level, rest, slope_rest), where(level, roll_time, slope_time)
+    return rest, roll_time
+
+
+def _to_rest(position: tuple, velocity: tuple, spin: tuple, normal: tuple, surface: Surface, record: _Record):
+    """THE ground phase, written once for one ball on floats and for a batch on NumPy or torch: (x, y, z) tuples of
+    floats or of [N] arrays, `surface` holding floats or [N] values; bounce every ball, then roll it. (rest (x, y,
+    z), hops, time on the ground), the rest added to `record` with a velocity of zero."""
+    position, velocity, spin, time, hops = _bounce(position, velocity, spin, normal, surface, record)
+    rolling = rolling_velocity(velocity, spin, normal)
+    record.add(norm(rolling) > 0.0, time, position, rolling)
+    rest, roll_time = _roll(position, rolling, normal, surface, record, time)
+    total = time + roll_time
+    record.add(total >= 0.0, total, rest, times(0.0, rest))  # every ball
+    return rest, hops, total
+
+
+def roll_to_rest(position, velocity, spin, normal, surface: Surface):
+    """The batch's ground phase on [N,3] arrays or tensors (the torch engine's on its device: `surface` holds floats
+    or [N] values of the same kind): (rest [N,3], hops [N], time on the ground [N])."""
+    columns = (xp.columns(v) for v in (position, velocity, spin, normal))
+    rest, hops, total = _to_rest(*columns, surface, _Record(len(position), keep=False))
+    return xp.stack(rest), hops, total
 
 
 def ground_phase(
@@ -317,11 +310,10 @@ def ground_phase(
     n = len(position)
     slope = np.broadcast_to(np.asarray(slope_deg, dtype=float), (n,))
     _check_slopes(slope, np.broadcast_to(np.asarray(surface.rolling_resistance, dtype=float), (n,)))
-    normal = plane_normals(slope, slope_dir_deg, n)
-    record = _Recorder(n, keep_path)
-    rest, hops, total = roll_to_rest(position, velocity, spin, normal, surface, record)
-    record.add(np.arange(n), total, rest, np.zeros_like(rest))
-    return GroundPhase(rest, hops, total, record.paths())
+    record = _Record(n, keep_path)
+    columns = (xp.columns(v) for v in (position, velocity, spin, plane_normals(slope, slope_dir_deg, n)))
+    rest, hops, total = _to_rest(*columns, surface, record)
+    return GroundPhase(xp.stack(rest), hops, total, record.paths())
 
 
 def plane_normal_one(surface: Surface, slope_deg: float, slope_dir_deg: float) -> tuple[float, float, float]:
@@ -341,60 +333,10 @@ def ground_phase_one(
     slope_dir_deg: float = 0.0,
     keep_path: bool = False,
 ) -> OneRest:
-    """`ground_phase` of one ball on plain floats (the same formulas): from its landing (x, y, z) tuples to its
-    rest, with the path `ground_phase` would record when `keep_path` (the served shot a screen draws). ValueError if
-    the slope is steeper than the surface holds a ball on."""
+    """`ground_phase` of one ball on plain floats (the same driver, `_to_rest`): from its landing (x, y, z) tuples
+    to its rest, with the path `ground_phase` would record when `keep_path` (the served shot a screen draws).
+    ValueError if the slope is steeper than the surface holds a ball on."""
     normal = plane_normal_one(surface, slope_deg, slope_dir_deg)
-    path: list[tuple[float, tuple, tuple]] | None = [(0.0, position, velocity)] if keep_path else None
-    time, hops = 0.0, 0
-    while True:
-        velocity, spin = impact_components(velocity, spin, normal, surface)
-        rebound = dot(velocity, normal)
-        if not (rebound > MIN_HOP_SPEED_MPS and hops < MAX_BOUNCES):
-            break
-        duration = 2.0 * rebound / (GRAVITY_MPS2 * normal[2])
-        if path is not None:
-            path.append((time, position, velocity))
-        position, velocity = hop(position, velocity, duration)
-        time, hops = time + duration, hops + 1
-        if path is not None:
-            path.append((time, position, velocity))
-    rolling = rolling_velocity(velocity, spin, normal)
-    if path is not None and norm(rolling) > 0.0:
-        path.append((time, position, rolling))
-    rest, roll_time = _roll_one(position, rolling, normal, surface, slope_deg, path, time)
-    if path is not None:
-        path.append((time + roll_time, rest, (0.0, 0.0, 0.0)))
-    return OneRest(rest, hops, time + roll_time, None if path is None else _ground_path(path))
-
-
-def _roll_one(position: tuple, rolling: tuple, normal: tuple, surface: Surface, slope_deg: float,
-              path: list | None, start: float) -> tuple[tuple, float]:
-    """One ball's roll from `position` at `rolling` velocity: (rest point, roll time), its states added to `path`
-    as `ground_phase` records them (every ROLL_STEP_S)."""
-    drag = float(surface.grass_drag_per_s)
-    if slope_deg == 0.0:
-        speed = norm(rolling)
-        distance, roll_time = stopping(speed, surface.rolling_resistance * GRAVITY_MPS2, drag)
-        direction = times(1.0 / max(speed, TINY), rolling)
-        if path is not None:
-            times_s = np.arange(ROLL_STEP_S, float(roll_time) - 1e-9, ROLL_STEP_S)
-            run, now = _level_states(speed, surface.rolling_resistance * GRAVITY_MPS2, drag, times_s)
-            path += [(start + t, add(position, direction, r), times(v, direction))
-                     for t, r, v in zip(times_s.tolist(), run.tolist(), now.tolist(), strict=True)]
-        return add(position, direction, float(distance)), float(roll_time)
-    downhill, brake = downhill_acceleration(normal), surface.rolling_resistance * GRAVITY_MPS2 * normal[2]
-    elapsed = 0.0
-    for _ in range(int(MAX_ROLL_TIME_S / ROLL_STEP_S)):
-        stops, taken, stop_at, position, rolling = slope_step(position, rolling, downhill, brake, drag)
-        elapsed += float(taken)
-        if stops:
-            return stop_at, elapsed
-        if path is not None:
-            path.append((start + elapsed, position, rolling))
-    return position, elapsed
-
-
-def _ground_path(rows: list[tuple[float, tuple, tuple]]) -> GroundPath:
-    return GroundPath(np.array([r[0] for r in rows]), np.array([[float(v) for v in r[1]] for r in rows]),
-                      np.array([[float(v) for v in r[2]] for r in rows]))
+    record = _Record(None, keep_path)
+    rest, hops, time = _to_rest(position, velocity, spin, normal, surface, record)
+    return OneRest(rest, hops, time, None if record.rows is None else record.paths()[0])

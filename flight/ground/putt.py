@@ -26,8 +26,8 @@ from typing import NamedTuple
 from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
 from golfflight.flight.ground.phase import (
     GroundPath,
-    _ground_path,
-    _roll_one,
+    _Record,
+    _roll,
     downhill_acceleration,
     plane_normal_one,
     rolling_velocity,
@@ -82,10 +82,10 @@ def putt_phase(
     downhill = downhill_acceleration(normal)
     rolling = add(rolling_velocity(velocity, spin, normal), downhill, skid_time)
     start = add(times(0.5 * skid_time, velocity), rolling, 0.5 * skid_time)
-    rows = [(0.0, _ORIGIN, velocity)] + ([(skid_time, start, rolling)] if skid_time > 0.0 else [])
-    path = rows if keep_path else None
-    rest, roll_time = _roll_one(start, rolling, normal, surface, slope_deg, path, skid_time)
+    record = _Record(None, keep_path)
+    record.add(True, 0.0, _ORIGIN, velocity)
+    record.add(skid_time > 0.0, skid_time, start, rolling)
+    rest, roll_time = _roll(start, rolling, normal, surface, record, skid_time)
     rest, time = tuple(float(c) for c in rest), skid_time + roll_time
-    if path is not None:
-        path.append((time, rest, (0.0, 0.0, 0.0)))
-    return PuttPhase(rest, time, skid_time, norm(start), None if path is None else _ground_path(path))
+    record.add(True, time, rest, (0.0, 0.0, 0.0))
+    return PuttPhase(rest, time, skid_time, norm(start), None if record.rows is None else record.paths()[0])

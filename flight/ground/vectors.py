@@ -4,6 +4,8 @@ device, as `flight.physics` does for the flight; the scalar functions beside the
 
 from __future__ import annotations
 
+from golfflight.flight.xp import FLAGS, where
+
 TINY = 1e-12
 """Guards the direction of a zero vector."""
 
@@ -27,3 +29,10 @@ def times(scale, a: tuple) -> tuple:
 
 def norm(a: tuple):
     return dot(a, a) ** 0.5
+
+
+def choose(flags, a: tuple, b: tuple) -> tuple:
+    """a where `flags` hold, else b, component by component (`flight.xp.where`; one ball's flag picks at once)."""
+    if isinstance(flags, FLAGS):
+        return a if flags else b
+    return where(flags, a[0], b[0]), where(flags, a[1], b[1]), where(flags, a[2], b[2])
