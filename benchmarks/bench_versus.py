@@ -1,8 +1,9 @@
 """This checkout against an earlier one, interleaved in one sitting (the machines drift by tens of per cent from minute
 to minute): the single shot in process (`FlightEngine.fly`, the tour 7-iron and driver rolled to rest on the
-fairway), the engine's batch of 1,024 mixed launches to rest as one ShotFlight a shot (what the HTTP batch reads),
-the torch engine's batch in process on the CPU (8,192 mixed launches, one thread) and whole `golfflight
-sweep` runs of one grid, `--engine local --workers 1` and `--engine torch --device cpu --threads 1` (rows/s, process
+fairway), the engine's batch of 1,024 and of 16 mixed launches to rest as one ShotFlight a shot (what the HTTP batch
+reads), the ground phase alone (one driver landing on floats, 1,024 landings on NumPy, level and on a slope), the
+torch engine's batch in process on the CPU (8,192 mixed launches, one thread) and whole `golfflight sweep` runs of
+one grid, `--engine local --workers 1` and `--engine torch --device cpu --threads 1` (rows/s, process
 start to file written).
 
 The in-process figures come from one worker process per checkout, both alive throughout, timing short blocks in turn
@@ -74,11 +75,33 @@ mixed = [Launch(*row) for row in np.stack([rng.uniform(30, 80, 1024), rng.unifor
                                            rng.normal(0, 5, 1024)], -1).tolist()]
 
 
-def objects_batch():
+def objects_batch(n=1024):
     started = time.perf_counter()
-    flown = engine.fly_batch(mixed, grounds=fairway)
+    flown = engine.fly_batch(mixed[:n], grounds=fairway)
     if hasattr(flown, "shots"):  # one batch method, columns, since issue 44's; a list of ShotFlight before
         flown.shots()
+    return (time.perf_counter() - started) * 1e3
+
+
+from golfflight.flight.ground import ground_phase, ground_phase_one
+
+landing = ((0.0, 200.0, 0.0), (1.0, 30.0, -20.0), (200.0, 0.0, 0.0))  # a driver's, on the ground at 30 m/s
+landings = [np.stack([rng.normal(0, 3, 1024), rng.uniform(10, 40, 1024), -rng.uniform(10, 30, 1024)], -1),
+            rng.normal(0, 300, (1024, 3))]
+
+
+def ground_one(slope_deg, count):  # the ground phase alone of one driver landing on floats (us, median of count)
+    times = []
+    for _ in range(count):
+        started = time.perf_counter()
+        ground_phase_one(*landing, fairway.surface, slope_deg, 40.0)
+        times.append(time.perf_counter() - started)
+    return sorted(times)[len(times) // 2] * 1e6
+
+
+def ground_batch(slope_deg):  # the ground phase alone of 1,024 landings on NumPy (ms)
+    started = time.perf_counter()
+    ground_phase(np.zeros((1024, 3)), *landings, fairway.surface, slope_deg, 40.0)
     return (time.perf_counter() - started) * 1e3
 
 
@@ -89,7 +112,9 @@ print("ready", flush=True)
 for line in sys.stdin:
     kind, *args = line.split()
     runs = {"single": lambda: single(args[0], int(args[1])), "torch": lambda: torch_batch(int(args[0])),
-            "objects": objects_batch}
+            "objects": lambda: objects_batch(int(args[0])),
+            "ground-one": lambda: ground_one(float(args[0]), int(args[1])),
+            "ground-batch": lambda: ground_batch(float(args[0]))}
     print(json.dumps(runs[kind]()), flush=True)
 """
 
@@ -97,7 +122,12 @@ BLOCKS = {
     "single shot, 7-iron (ms, median of 50)": "single 7-iron 50",
     "single shot, driver (ms, median of 50)": "single driver 50",
     "torch engine in process, 8,192 mixed shots (shots/s)": "torch 8192",
-    "engine batch of 1,024 mixed shots to rest, one ShotFlight a shot (ms)": "objects",
+    "engine batch of 1,024 mixed shots to rest, one ShotFlight a shot (ms)": "objects 1024",
+    "engine batch of 16 mixed shots to rest, one ShotFlight a shot (ms)": "objects 16",
+    "ground phase alone, one driver landing on floats, level fairway (us, median of 50)": "ground-one 0 50",
+    "ground phase alone, one driver landing on floats, 3 deg slope (us, median of 50)": "ground-one 3 50",
+    "ground phase alone, 1,024 landings on NumPy, level fairway (ms)": "ground-batch 0",
+    "ground phase alone, 1,024 landings on NumPy, 3 deg slope (ms)": "ground-batch 3",
 }
 
 

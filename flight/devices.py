@@ -47,9 +47,9 @@ def keep_freed_memory() -> bool:
 
     Each Euler step of a part of 4,096 shots allocates and frees about 12 MB of the network's activations. glibc's
     default hands freed memory back once more than twice the largest block freed lies free at the heap's top, so the
-    next step takes it back page by page from the kernel, zeroed: the torch engine on a CPU flew 0.72 of its speed
-    beside another process (benchmarks/bench_versus.py, docs/benchmarks.md). Process-wide: it keeps at most
-    KEPT_FREE_BYTES free. False where the C library has no mallopt (not glibc)."""
+    next step takes it back page by page from the kernel, zeroed: the torch engine on a CPU flew about 0.72 of its
+    speed beside another process (an interleaved A/B during issue 44, docs/benchmarks.md). Process-wide: it keeps at
+    most KEPT_FREE_BYTES free. False where the C library has no mallopt (not glibc)."""
     try:
         mallopt = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").mallopt
     except (OSError, AttributeError):

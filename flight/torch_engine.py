@@ -73,6 +73,10 @@ SET_ASIDE_SHARE = 0.125
 """The share of a part's flying shots that must have come down before the rest fly on without them (each setting
 aside gathers the rest's states and air: not worth it for a few)."""
 
+LANDING_FIELDS = ("landed", "landing_position", "landing_velocity", "landing_spin", "flight_time_s", "apex_m",
+                  "apex_time_s")
+"""What a part's Flight brings back from the device: its landings and apexes."""
+
 
 @dataclass(frozen=True)
 class NetworkInAir:
@@ -91,6 +95,7 @@ class NetworkInAir:
 
 
 def _euler(state: State, field: BallInAir, dt: float) -> State:
+    """FORWARD_EULER as a plain function, the form torch.compile takes."""
     return FORWARD_EULER(state, field, dt)
 
 
@@ -215,11 +220,6 @@ class TorchEngine:
                            GroundPlane(tensor(heights[rows])), self.record)
         return Flight(*(getattr(flight, name).to(device="cpu", dtype=torch.float64 if name != "landed" else None)
                         .numpy() for name in LANDING_FIELDS))
-
-
-LANDING_FIELDS = ("landed", "landing_position", "landing_velocity", "landing_spin", "flight_time_s", "apex_m",
-                  "apex_time_s")
-"""What a part's Flight brings back from the device: its landings and apexes."""
 
 
 @dataclass(frozen=True)

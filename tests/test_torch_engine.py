@@ -309,3 +309,17 @@ def test_training_on_the_default_device_is_training_on_the_cpu_bit_for_bit(tiny_
 def _numbers(row: dict) -> dict:
     """An epoch's history row less its timings."""
     return {k: v for k, v in row.items() if "seconds" not in k}
+
+
+def test_on_glibc_the_torch_engine_keeps_freed_memory_for_its_next_step():
+    """Each step frees the network's activations; glibc's default hands them back to the kernel once twice the largest
+    block freed lies free, and the next step takes them back page by page (docs/benchmarks.md). mallopt raises the
+    threshold, and answers 1 where it took the setting."""
+    import ctypes.util
+    import platform
+
+    from golfflight.flight.devices import keep_freed_memory
+
+    if platform.libc_ver()[0] != "glibc" or ctypes.util.find_library("c") is None:
+        pytest.skip("not glibc: the engine leaves the C library's allocator as it is")
+    assert keep_freed_memory() is True
