@@ -323,3 +323,20 @@ def test_on_glibc_the_torch_engine_keeps_freed_memory_for_its_next_step():
     if platform.libc_ver()[0] != "glibc" or ctypes.util.find_library("c") is None:
         pytest.skip("not glibc: the engine leaves the C library's allocator as it is")
     assert keep_freed_memory() is True
+
+
+def test_marks_kept_as_on_a_gpu_give_the_same_figures(shots, monkeypatch):
+    """On a GPU the integrator asks nothing mid-step (`flight.xp.answers_now` False): every step merges each ball's
+    peak and landing by `where` instead of writing the rows that rose or landed. Forced here on the CPU, the same
+    figures, errors and rests, bit for bit."""
+    from golfflight.flight import xp
+
+    bundle = load_flyer(None).bundle_dir
+    launches, conditions, grounds = (part[:120] for part in shots)
+    asked = TorchEngine(bundle, "cpu", "float64").fly_batch(launches, conditions, grounds)
+    monkeypatch.setattr(xp, "answers_now", lambda flags: isinstance(flags, np.ndarray))
+    merged = TorchEngine(bundle, "cpu", "float64").fly_batch(launches, conditions, grounds)
+    assert merged.errors == asked.errors
+    for name in FIGURES:
+        np.testing.assert_array_equal(getattr(merged, name), getattr(asked, name), err_msg=name)
+    np.testing.assert_array_equal(merged.rest.total_m, asked.rest.total_m)
