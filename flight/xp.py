@@ -22,6 +22,11 @@ FLAGS = (bool, np.bool_)
 """One ball's flag (a comparison of plain numbers)."""
 
 
+def is_flag(value) -> bool:
+    """Whether a value is one ball's flag rather than an array of flags."""
+    return isinstance(value, FLAGS)
+
+
 def is_number(value) -> bool:
     """Whether a value is one plain number rather than an array (one ball's, or one air's: hashable, cacheable)."""
     return isinstance(value, NUMBERS)

@@ -4,7 +4,7 @@ device, as `flight.physics` does for the flight; the scalar functions beside the
 
 from __future__ import annotations
 
-from golfflight.flight.xp import FLAGS, where
+from golfflight.flight.xp import is_flag, where
 
 TINY = 1e-12
 """Guards the direction of a zero vector."""
@@ -33,6 +33,6 @@ def norm(a: tuple):
 
 def choose(flags, a: tuple, b: tuple) -> tuple:
     """a where `flags` hold, else b, component by component (`flight.xp.where`; one ball's flag picks at once)."""
-    if isinstance(flags, FLAGS):
+    if is_flag(flags):
         return a if flags else b
     return where(flags, a[0], b[0]), where(flags, a[1], b[1]), where(flags, a[2], b[2])
