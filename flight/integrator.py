@@ -123,9 +123,9 @@ class _Marks:
         self.frac, self.last_step = xp.full(n, math.nan, like), xp.zeros(n, like, integer=True) - 1
         self.down = xp.falses(n, like)
 
-    def update(self, step: int, dt: float, old: State, new: State, event: GroundPlane) -> bool:
+    def update(self, step: int, dt: float, old: State, new: State, event: GroundPlane) -> None:
         """Mark the step from `old` to `new` (the balls not yet down): a new peak, the height after the peak, a
-        landing. Whether any ball may have landed in it (NumPy knows; a device is not asked)."""
+        landing."""
         z_before, z_after = old.position[:, 2], new.position[:, 2]
         aloft = ~self.down  # a ball down flies on until it is set aside: a low, spinning one may rise again
         higher = (z_after > self.peak) & aloft
@@ -137,7 +137,7 @@ class _Marks:
             self.peak_step, self.after = xp.where(higher, step, self.peak_step), xp.where(higher, math.nan, self.after)
         landed = event.crossed(z_before, z_after) & aloft
         if not xp.may_hold(landed):
-            return False
+            return
         rows = xp.rows_of(landed)
         frac = event.take(rows).fraction(z_before[rows], z_after[rows], landed[rows])
         for name in ("position", "velocity", "spin"):
@@ -146,7 +146,6 @@ class _Marks:
         self.frac = xp.put(landed, rows, self.frac, frac)
         self.last_step = xp.put(landed, rows, self.last_step, step - 1)
         self.down = self.down | landed
-        return True
 
     def take(self, index: np.ndarray) -> _Marks:
         """The marks of some balls not yet down: their apex's; they have no landing yet."""
@@ -194,13 +193,11 @@ class SummaryRecord:
         self.marks, self.set_aside, self.finished = _Marks(state), set_aside, False
         self.field, self.event = field, event
         self.ids, self.batch = None, self.marks  # ids: the flying balls' rows of the batch (None: every row)
-        self.unset = False  # whether a ball may have landed since the last setting aside
 
-    def keep(self, new: State, step: int, maybe_landed: bool) -> State:
+    def keep(self, new: State, step: int) -> State:
         """The batch's next state, after setting aside the balls down, when `set_aside` says so."""
         rule = self.set_aside
-        self.unset = self.unset or maybe_landed
-        if step % rule.every_steps or not self.unset:
+        if step % rule.every_steps:
             return new
         down = self.marks.down
         count, flying = int(down.sum()), len(down)
@@ -215,7 +212,6 @@ class SummaryRecord:
             self.marks.put(self.batch, self.ids[leave], leave)
             self.ids = self.ids[stay]
         self.marks, self.field, self.event = self.marks.take(stay), self.field.take(stay), self.event.take(stay)
-        self.unset = False
         return new.take(stay)
 
     def flight(self, dt: float) -> Flight:
@@ -231,9 +227,9 @@ class StatesRecord(SummaryRecord):
         super().__init__(state, field, event)
         self.history = [state]
 
-    def keep(self, new: State, step: int, maybe_landed: bool) -> State:
+    def keep(self, new: State, step: int) -> State:
         self.history.append(new)
-        self.finished = maybe_landed and bool(self.marks.down.all())
+        self.finished = bool(self.marks.down.all())
         return new
 
     def flight(self, dt: float) -> Flight:
@@ -264,8 +260,8 @@ def integrate(
     recorder = record(state, field, event)
     for i in range(1, steps + 1):
         new = rule(state, recorder.field, dt)
-        maybe_landed = recorder.marks.update(i, dt, state, new, recorder.event)
-        state = recorder.keep(new, i, maybe_landed)
+        recorder.marks.update(i, dt, state, new, recorder.event)
+        state = recorder.keep(new, i)
         if recorder.finished:
             break
     return recorder.flight(dt)

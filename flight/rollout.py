@@ -16,6 +16,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import torch
+from golfflight.flight import xp
 from golfflight.flight.field import BallInAir
 from golfflight.flight.integrator import FORWARD_EULER
 from golfflight.flight.outcomes import parabola_apex
@@ -83,17 +84,29 @@ class Landing:
 
 @dataclass(frozen=True)
 class InAir:
-    """A coefficient model in each shot's air, as training flies it: fed (k v_rel, k omega) at the shot's Reynolds
-    scale k [N,1] (`flight.physics.reynolds_scale`), its coefficients times `coefficient_scale` [N,4] where given
-    (a ball type's drag and lift relative to the ball the model learned)."""
+    """A coefficient model in each shot's air: fed (k v_rel, k omega) at the shot's Reynolds scale k [N,1]
+    (`flight.physics.reynolds_scale`), its coefficients times `coefficient_scale` [N,4] where given (a ball type's
+    drag and lift relative to the ball the model learned). `run_in`: the dtype the model runs in (a bundle's graph:
+    float32, as it was exported), its coefficients given back in the physics' dtype; None: the physics' own.
+    Training's model, and the torch engine's network (`take`: some shots' share, as the integrator sets shots
+    aside)."""
 
     model: Coefficients
     reynolds_scale: torch.Tensor | float = 1.0
     coefficient_scale: torch.Tensor | None = None
+    run_in: torch.dtype | None = None
 
     def __call__(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
-        values = self.model(v_rel * self.reynolds_scale, omega * self.reynolds_scale)
+        inputs = v_rel * self.reynolds_scale, omega * self.reynolds_scale
+        if self.run_in is None:
+            values = self.model(*inputs)
+        else:
+            values = self.model(*(x.to(self.run_in) for x in inputs)).to(v_rel.dtype)
         return values if self.coefficient_scale is None else values * self.coefficient_scale
+
+    def take(self, index: torch.Tensor) -> InAir:
+        scale = None if self.coefficient_scale is None else self.coefficient_scale[index]
+        return InAir(self.model, xp.rows(self.reynolds_scale, index), scale, self.run_in)
 
 
 def euler_step(

@@ -47,7 +47,7 @@ from golfflight.flight.integrator import FORWARD_EULER, GroundPlane, SetAside, S
 from golfflight.flight.outcomes import BatchFlights, Flight
 from golfflight.flight.per_shot import PerShot
 from golfflight.flight.physics import State, initial_state, reynolds_scale
-from golfflight.flight.rollout import LANDING_CHECK_STEPS
+from golfflight.flight.rollout import LANDING_CHECK_STEPS, InAir
 from golfflight.flight.torch_network import network_from_bundle
 
 DTYPES = {"float32": torch.float32, "float64": torch.float64}
@@ -76,22 +76,6 @@ aside gathers the rest's states and air: not worth it for a few)."""
 LANDING_FIELDS = ("landed", "landing_position", "landing_velocity", "landing_spin", "flight_time_s", "apex_m",
                   "apex_time_s")
 """What a part's Flight brings back from the device: its landings and apexes."""
-
-
-@dataclass(frozen=True)
-class NetworkInAir:
-    """The bundle's network as a coefficient model of the flight core: fed (k v_rel, k omega) at each ball's
-    Reynolds scale k [N,1] (`flight.physics.reynolds_scale`) in float32, as the graph runs, its coefficients given
-    back in the physics' dtype."""
-
-    network: torch.nn.Module
-    scale: torch.Tensor
-
-    def __call__(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
-        return self.network((v_rel * self.scale).float(), (omega * self.scale).float()).to(v_rel.dtype)
-
-    def take(self, index: torch.Tensor) -> NetworkInAir:
-        return NetworkInAir(self.network, self.scale[index])
 
 
 def _euler(state: State, field: BallInAir, dt: float) -> State:
@@ -132,10 +116,6 @@ class TorchEngine:
         self.rule = torch.compile(_euler, dynamic=True) if compile_step else FORWARD_EULER
         # a share of 1 never sets aside; one row left flying would be compiled again
         self.record = partial(SummaryRecord, set_aside=SetAside(LANDING_CHECK_STEPS, set_aside_share, keep_rows=2))
-
-    def coefficients(self, v_rel: torch.Tensor, omega: torch.Tensor) -> torch.Tensor:
-        """C_L, C_D, C_M, C_Q [N,4] in the physics' dtype from the network run in float32, as the graph runs."""
-        return self.network(v_rel.float(), omega.float()).to(v_rel.dtype)
 
     def part_shots(self) -> int:
         """Shots flown at once: `part_shots` if given, else what the device's free memory holds (a GPU: free to the
@@ -213,8 +193,8 @@ class TorchEngine:
             return torch.as_tensor(array, dtype=torch.bool if array.dtype == bool else self.dtype, device=self.device)
 
         scale = reynolds_scale(air.kinematic_viscosity_m2_s[rows], self.flyer.kinematic_viscosity_m2_s)
-        field = BallInAir(NetworkInAir(self.network, tensor(scale[:, None])), tensor(air.density_kg_m3[rows]),
-                          air.wind.at_balls.take(rows).to(tensor))
+        network = InAir(self.network, tensor(scale[:, None]), run_in=torch.float32)  # the graph runs in float32
+        field = BallInAir(network, tensor(air.density_kg_m3[rows]), air.wind.at_balls.take(rows).to(tensor))
         state = State(tensor(start.position), tensor(start.velocity), tensor(start.spin))
         flight = integrate(state, field, self.flyer.dt_s, self.flyer.max_steps, self.rule,
                            GroundPlane(tensor(heights[rows])), self.record)

@@ -186,9 +186,7 @@ def answers_now(flags) -> bool:
 def rows_of(flags):
     """The rows a masked write touches (`put`): those where `flags` hold, when that is answered at once; else every
     row (a slice)."""
-    if isinstance(flags, np.ndarray):
-        return np.flatnonzero(flags)
-    return flags.nonzero().squeeze(1) if answers_now(flags) else slice(None)
+    return nonzero(flags) if answers_now(flags) else slice(None)
 
 
 def put(flags, rows, current, values):

@@ -19,6 +19,7 @@ from golfflight.flight.devices import DeviceError, resolve_device
 from golfflight.flight.flyer import Flyer, load_flyer
 from golfflight.flight.ground import SURFACES, GroundSpec
 from golfflight.flight.physics import reynolds_scale
+from golfflight.flight.rollout import InAir
 from golfflight.flight.torch_engine import STAGES, TorchEngine
 from golfflight.flight.wind import Wind
 from golfflight.model_export.training import TrainConfig, load_checkpoint, train
@@ -124,7 +125,7 @@ class TorchNetwork:
     @torch.no_grad()
     def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
         inputs = (torch.as_tensor(a * self.scale, dtype=torch.float64) for a in (v_rel, omega))
-        return self.engine.coefficients(*inputs).numpy()
+        return InAir(self.engine.network, run_in=torch.float32)(*inputs).numpy()
 
 
 def test_in_float64_the_landing_and_apex_rules_are_the_integrators(engines, shots):
