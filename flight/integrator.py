@@ -112,7 +112,7 @@ class _Marks:
     def __init__(self, state: State) -> None:
         z = state.position[:, 2]
         n = len(z)
-        self.peak, self.peak_step = xp.copy(z), xp.zeros(n, z, integer=True)
+        self.peak, self.peak_step = xp.copy(z), xp.zeros_like(z, integer=True)
         self.before, self.after = xp.full(n, math.nan, z), xp.full(n, math.nan, z)
         self.rose = False  # whether some ball may have risen to a new peak in the last step
         self.unlanded(n, z)
@@ -120,7 +120,7 @@ class _Marks:
     def unlanded(self, n: int, like) -> None:
         """No ball of these has landed yet."""
         self.position, self.velocity, self.spin = (xp.full((n, 3), math.nan, like) for _ in range(3))
-        self.frac, self.last_step = xp.full(n, math.nan, like), xp.zeros(n, like, integer=True) - 1
+        self.frac, self.last_step = xp.full(n, math.nan, like), xp.zeros_like(like, integer=True) - 1
         self.down = xp.falses(n, like)
 
     def update(self, step: int, dt: float, old: State, new: State, event: GroundPlane) -> None:

@@ -126,14 +126,6 @@ def columns(a) -> tuple:
     return a[..., 0], a[..., 1], a[..., 2]
 
 
-def zeros(n: int, like, integer: bool = False):
-    """n zeros of `like`'s kind (its dtype and device for a tensor; int64 where `integer`)."""
-    if isinstance(like, np.ndarray):
-        return np.zeros(n, dtype=np.int64 if integer else float)
-    torch = sys.modules["torch"]
-    return torch.zeros(n, dtype=torch.int64 if integer else like.dtype, device=like.device)
-
-
 def anything(flags) -> bool:
     """Whether any of these flags holds: one ball's flag, or an array's (a device's answer waits for it)."""
     return bool(flags) if isinstance(flags, FLAGS) else bool(flags.any())
@@ -205,18 +197,6 @@ def may_hold(flags) -> bool:
     return bool(flags.any()) if answers_now(flags) else True
 
 
-def arange(n: int, like):
-    """0 .. n-1 as indices of `like`'s kind."""
-    if isinstance(like, np.ndarray):
-        return np.arange(n)
-    return sys.modules["torch"].arange(n, device=like.device)
-
-
 def copy(a):
     """A copy of an array or a tensor."""
     return a.copy() if isinstance(a, np.ndarray) else a.clone()
-
-
-def size(a) -> int:
-    """How many elements."""
-    return int(a.size) if isinstance(a, np.ndarray) else int(a.numel())
