@@ -15,14 +15,12 @@ import os
 from dataclasses import dataclass, field
 from typing import Literal
 
-import numpy as np
 from golfflight.discovery.recordings import OBSERVABLES
-from golfflight.discovery.simulator import Correction, Outcomes, Setup, fly_setup, simulate_setup
+from golfflight.discovery.simulator import Correction, Outcomes, Setup, setup_flight, simulate_setup
 from golfflight.flight.air import Air
 from golfflight.flight.flyer import Flyer, load_flyer
 from golfflight.flight.integrator import RUNGE_KUTTA_4
 from golfflight.flight.outcomes import Flight
-from golfflight.flight.physics import CoefficientModel
 from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics, ReferenceParameters
 from golfflight.flight.wind import Wind
 
@@ -67,23 +65,16 @@ class FlightModel:
     def method(self) -> Literal["euler", "rk4"]:
         return self.flyer.rule.name
 
-    def coefficients_for(self, setup: Setup) -> CoefficientModel:
-        """The coefficients for a setup's shots, each at the kinematic viscosity of the air it flies in (the
-        recorded or the model's air, times the effects' ratio: `Setup.viscosity`)."""
-        return self.flyer.in_air(setup.viscosity(self.flyer.kinematic_viscosity_m2_s))
-
     def simulate(self, setup: Setup, correction: Correction | None = None, keep_positions: bool = False) -> Outcomes:
-        """Fly a setup's shots through this model (`discovery.simulator.simulate_setup`)."""
-        settings = (self.dt_s, self.t_max_s, self.method, correction, keep_positions)
-        return simulate_setup(setup, self.coefficients_for, *settings)
+        """A setup's outcomes through this model (`discovery.simulator.simulate_setup`)."""
+        return simulate_setup(setup, self.flyer, correction, keep_positions)
 
     def fly(
         self, setup: Setup, correction: Correction | None = None, keep_states: bool = False, air: Wind | None = None
     ) -> Flight:
-        """The flight core's own `Flight` of a setup through this model (`discovery.simulator.fly_setup`; `air`
+        """The flight core's own `Flight` of a setup through this model (`discovery.simulator.setup_flight`; `air`
         replaces the setup's uniform wind)."""
-        settings = (self.dt_s, self.t_max_s, self.method, correction, keep_states, air)
-        return fly_setup(setup, self.coefficients_for, *settings)
+        return setup_flight(setup, self.flyer, correction, keep_states, air)
 
 
 def from_bundle(directory: str | os.PathLike | None = None, control: bool = False) -> FlightModel:

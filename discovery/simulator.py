@@ -1,8 +1,8 @@
 """Fly recorded launches through the diagnosed model under modified conditions, many variants in one batch.
 
 A `Setup` holds everything per shot (launch, air, uniform wind, landing ground, coefficient scales, correction
-weights); `simulate` flies it through the flight core (`flight.integrator.integrate`) with the field of
-`flight.field`: effect fits fly the same shots under several parameter sets stacked into one batch.
+weights); `simulate_setup` flies it through the model's `flight.flyer.Flyer` (`Flyer.flight`, the one batch flight):
+effect fits fly the same shots under several parameter sets stacked into one batch.
 """
 
 from __future__ import annotations
@@ -11,20 +11,16 @@ from collections.abc import Callable
 from dataclasses import dataclass, fields
 
 import numpy as np
-from golfflight.flight.field import BallInAir, ScaledCoefficients, WeightedCorrection
-from golfflight.flight.integrator import STEP_RULES, GroundPlane, Method, integrate, record_for
+from golfflight.flight.field import WeightedCorrection
+from golfflight.flight.flyer import Flyer
 from golfflight.flight.outcomes import Flight
-from golfflight.flight.physics import CoefficientModel, initial_state
+from golfflight.flight.physics import initial_state
 from golfflight.flight.wind import Wind
 
 CHUNK_SHOTS = 25_000
 """Batches larger than this are flown in chunks of it when no positions are kept: the flight of each shot is its own,
 so the outcomes are the same, and the memory a batch needs stays bounded (a 100,000-shot diagnosis flies batches of
 up to five times its shots at once)."""
-
-CoefficientsFor = Callable[["Setup"], CoefficientModel]
-"""Builds the model's coefficient function for a setup's shots, each read at the Reynolds numbers of the air it
-flies in (`Setup.viscosity`)."""
 
 Correction = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 """Extra acceleration [N,3] from (air-relative velocity [N,3], spin [N,3], position [N,3], per-shot weights [N,K])."""
@@ -117,53 +113,45 @@ FLOWN_OUTCOMES = ("landing_xy", "apex_m", "flight_time_s", "landing_angle_deg")
 """The per-shot fields of an `Outcomes` batch, in order."""
 
 
-def fly_setup(
+def setup_flight(
     setup: Setup,
-    coefficients_for: CoefficientsFor,
-    dt_s: float,
-    t_max_s: float,
-    method: Method = "euler",
+    flyer: Flyer,
     correction: Correction | None = None,
     keep_states: bool = False,
     air: Wind | None = None,
 ) -> Flight:
-    """The flight core's `Flight` of every shot down through its landing ground (or t_max): what `simulate_setup`
-    summarises, and what `discovery.conceal` records when it hides effects in the diagnosed model's own flights.
+    """The Flyer's `Flight` of every shot of a setup down through its landing ground (`Flyer.flight`, the one batch
+    flight): what `simulate_setup` summarises, and what `discovery.conceal` records when it hides effects in the
+    diagnosed model's own flights. Each shot flies in its true air (assumed density and viscosity times the effects'
+    ratios) with its coefficient scales and correction weights.
 
     `air` replaces the setup's uniform wind with air whose motion depends on the ball's height (an outside effect's,
     `discovery.outside.HeightGust`), so the gust acts through the model's own coefficients like any wind."""
     density = setup.density_kg_m3 * setup.density_ratio
-    coefficients = ScaledCoefficients(coefficients_for(setup), setup.coefficient_scale)
     wind = air if air is not None else Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1])
     extra = None if correction is None else WeightedCorrection(correction, setup.correction_weights)
-    field = BallInAir(coefficients, density, wind, extra)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        start, ground = initial_state(**setup.launch), GroundPlane(setup.ground_height_m)
-        return integrate(start, field, dt_s, round(t_max_s / dt_s), STEP_RULES[method], ground, record_for(keep_states))
+        return flyer.flight(initial_state(**setup.launch), density, setup.viscosity(flyer.kinematic_viscosity_m2_s),
+                            wind, setup.ground_height_m, keep_states, coefficient_scale=setup.coefficient_scale,
+                            correction=extra)
 
 
 def simulate_setup(
-    setup: Setup,
-    coefficients_for: CoefficientsFor,
-    dt_s: float,
-    t_max_s: float,
-    method: Method = "euler",
-    correction: Correction | None = None,
-    keep_positions: bool = False,
+    setup: Setup, flyer: Flyer, correction: Correction | None = None, keep_positions: bool = False
 ) -> Outcomes:
-    """Fly every shot through the flight core until it comes down through its landing ground (or t_max).
+    """Every shot's outcomes (`setup_flight`), down through its landing ground (or the Flyer's maximum time).
 
     A parameter set far outside reality may make a ball diverge; its outcome is then NaN (not landed), silently.
     """
     if not keep_positions and len(setup) > CHUNK_SHOTS:
-        settings = (coefficients_for, dt_s, t_max_s, method, correction)
+        settings = (flyer, correction)
         chunks = [
             simulate_setup(setup.take(np.arange(start, min(start + CHUNK_SHOTS, len(setup)))), *settings)
             for start in range(0, len(setup), CHUNK_SHOTS)
         ]
         values = [np.concatenate([getattr(c, name) for c in chunks]) for name in FLOWN_OUTCOMES]
-        return Outcomes(*values, dt_s=dt_s)
-    flight = fly_setup(setup, coefficients_for, dt_s, t_max_s, method, correction, keep_positions)
+        return Outcomes(*values, dt_s=flyer.dt_s)
+    flight = setup_flight(setup, flyer, correction, keep_positions)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         landing_angle = flight.landing_angle_deg
     landing_xy, apex, flight_time = flight.landing_position[:, :2].copy(), flight.apex_m, flight.flight_time_s
@@ -171,7 +159,8 @@ def simulate_setup(
     finite = np.isfinite(landing_xy).all(axis=1) & np.isfinite(landing_angle)
     for values in (landing_xy, apex, flight_time, landing_angle):
         values[~finite] = np.nan
-    return Outcomes(landing_xy, apex, flight_time, landing_angle, _positions(flight) if keep_positions else None, dt_s)
+    positions = _positions(flight) if keep_positions else None
+    return Outcomes(landing_xy, apex, flight_time, landing_angle, positions, flyer.dt_s)
 
 
 def _positions(flight: Flight) -> np.ndarray:

@@ -2,7 +2,7 @@
 
 Torch-free (NumPy and ONNX Runtime only), so it runs in the serving install. Each club of `shots.clubs.CLUBS` is
 flown through the runtime path (`evaluation.accuracy_flyers.ModelFlyer`: the bundle's ONNX graph in
-`flight.integrator.simulate`, forward Euler at the card's step) in ICAO standard air, calm. At every step above the
+`flight.flyer.Flyer.flight`, forward Euler at the card's step) in ICAO standard air, calm. At every step above the
 ground it records the Reynolds number Re = |v_rel| d / nu and spin ratio S = R |omega| / |v_rel| the ball meets, and
 the coefficients the graph gives there, converted to the literature's convention (below). Two checks:
 
@@ -471,7 +471,7 @@ def _model_lines(report: PhysicsReport) -> list[str]:
     card, air = report.flyer.card, report.air
     return [
         (f"Model: {report.flyer.label}, {card.variant}, ONNX {card.onnx.sha256[:12]}, p_M {card.architecture.p_m:.5g}. "
-        f"Each club of `shots.clubs.CLUBS` flown straight and calm through `flight.integrator.simulate` (forward "
+        f"Each club of `shots.clubs.CLUBS` flown straight and calm through `flight.flyer.Flyer.flight` (forward "
         f"Euler, dt {card.physics.dt_s:g} s) in ICAO standard air (rho {float(air.density_kg_m3):.4f} kg/m^3, nu "
         f"{float(air.kinematic_viscosity_m2_s):.4g} m^2/s); every step from launch to the last one above the ground "
         "is a flight point, at Re = |v_rel| d / nu and S = R |omega| / |v_rel|. Coefficients in the literature's "

@@ -24,7 +24,7 @@ import numpy as np
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.constants import BALL_MASS_KG, BALL_RADIUS_M
-from golfflight.flight.field import BallInAir
+from golfflight.flight.field import BallInAir, ScaledCoefficients
 from golfflight.flight.ground import GroundPhase, GroundSpec, batch_surface, elevations, ground_phase
 from golfflight.flight.integrator import FORWARD_EULER, GroundPlane, StepRule, integrate, record_for
 from golfflight.flight.limits import FLIGHT_TIME_S
@@ -37,7 +37,7 @@ from golfflight.flight.outcomes import (
     landing_figures,
 )
 from golfflight.flight.per_shot import PerShot
-from golfflight.flight.physics import CoefficientModel, State, initial_state
+from golfflight.flight.physics import CoefficientModel, ExtraAcceleration, State, initial_state
 from golfflight.flight.wind import CALM, Wind
 from golfflight.weights_schema.bundle import CARD_FILE, BundleError
 from golfflight.weights_schema.model_card import ModelCard
@@ -154,11 +154,18 @@ class Flyer:
         ground_height_m: float | np.ndarray = 0.0,
         keep_states: bool = False,
         max_time_s: float | None = None,
+        coefficient_scale: np.ndarray | None = None,
+        correction: ExtraAcceleration | None = None,
     ) -> Flight:
-        """The integrator's Flight of a batch from `state` in this air (None: the nominal) and wind down to ground
-        planes, for the maximum flight time (or `max_time_s`, for a caller that compares states at fixed times)."""
+        """THE batch flight: the integrator's Flight from `state` in this air (None: the nominal) and wind down to
+        ground planes, for the maximum flight time (or `max_time_s`, for a caller that compares states at fixed
+        times); the coefficients times `coefficient_scale` [N,3] and an extra acceleration where given (discovery's
+        effects and corrections). `fly_batch` plans launches and conditions into this call."""
         density = self.density_kg_m3 if density_kg_m3 is None else density_kg_m3
-        field = BallInAir(self.in_air(kinematic_viscosity_m2_s), density, wind)
+        model = self.in_air(kinematic_viscosity_m2_s)
+        if coefficient_scale is not None:
+            model = ScaledCoefficients(model, coefficient_scale)
+        field = BallInAir(model, density, wind, correction)
         steps = self.max_steps if max_time_s is None else step_count(max_time_s, self.dt_s)
         event = GroundPlane(np.asarray(ground_height_m, dtype=float))
         return integrate(state, field, self.dt_s, steps, self.rule, event, record_for(keep_states))
@@ -214,17 +221,11 @@ class Flyer:
         shot_grounds = PerShot.of(grounds, n, "grounds")
         heights = elevations(shot_grounds)
         start = initial_state(*np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH).T)
-        field = self._batch_field(per_shot)
-        flight = integrate(start, field, self.dt_s, self.max_steps, self.rule, GroundPlane(heights),
-                           record_for(keep_states))
+        air = batch_air(per_shot)
+        flight = self.flight(start, air.density_kg_m3, air.kinematic_viscosity_m2_s, air.wind, heights, keep_states)
         roll = partial(ground_phase, keep_path=keep_states)
         columns, phase = landed_columns(flight, shot_grounds, self.unlanded_message, roll)
         return _FlownBatch(columns, flight, phase)
-
-    def _batch_field(self, per_shot: PerShot[Conditions]) -> BallInAir:
-        """The equations of motion for a batch, each shot in its own air and wind."""
-        air = batch_air(per_shot)
-        return BallInAir(self.in_air(air.kinematic_viscosity_m2_s), air.density_kg_m3, air.wind)
 
     def _shot_states(self, history: tuple[np.ndarray, np.ndarray], flight: Flight, shot: int) -> EulerStates:
         """One shot's states up to its landing, the interpolated landing last (history: every step's positions and

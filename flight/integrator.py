@@ -25,10 +25,9 @@ from typing import Literal, Protocol
 
 import numpy as np
 from golfflight.flight import xp
-from golfflight.flight.field import BallInAir, VectorField
+from golfflight.flight.field import VectorField
 from golfflight.flight.outcomes import Flight, parabola_apex
-from golfflight.flight.physics import CoefficientModel, State
-from golfflight.flight.wind import CALM, Wind
+from golfflight.flight.physics import State
 
 
 class StepRule(Protocol):
@@ -73,7 +72,7 @@ class RungeKutta4:
 
 FORWARD_EULER, RUNGE_KUTTA_4 = ForwardEuler(), RungeKutta4()
 STEP_RULES: dict[str, StepRule] = {rule.name: rule for rule in (FORWARD_EULER, RUNGE_KUTTA_4)}
-"""The step rules by the names a card, a report or `simulate(method=...)` gives them."""
+"""The step rules by the names a card or a report gives them."""
 Method = Literal["euler", "rk4"]
 
 
@@ -266,21 +265,3 @@ def integrate(
             break
     return recorder.flight(dt)
 
-
-def simulate(
-    state: State,
-    coefficient_model: CoefficientModel,
-    density: np.ndarray | float,
-    wind: Wind = CALM,
-    dt: float = 0.1,
-    t_max: float = 10.0,
-    method: Method = "euler",
-    ground_height_m: np.ndarray | float = 0.0,
-    keep_states: bool = False,
-) -> Flight:
-    """Fly a batch through the equations of motion in the air (`BallInAir`) down to a ground plane, for t_max at
-    most: the common case of `integrate`."""
-    field = BallInAir(coefficient_model, density, wind)
-    steps = int(round(t_max / dt))
-    event = GroundPlane(np.asarray(ground_height_m, dtype=float))
-    return integrate(state, field, dt, steps, STEP_RULES[method], event, record_for(keep_states))

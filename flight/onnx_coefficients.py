@@ -1,7 +1,7 @@
 """Coefficient model backed by an exported bundle's ONNX graph (ONNX Runtime, no torch).
 
 model = OnnxCoefficients(path); card = model.card
-flight.integrator.simulate(state, model, card.physics.air_density_kg_m3, card.physics.dt_s, card.physics.t_sim_s)
+flown by a `flight.flyer.Flyer` (`flight.flyer.load_flyer` assembles one from a bundle at its card's step and air).
 In other air: `model.in_air(air.kinematic_viscosity_m2_s)` (the same graph, inputs at that air's Reynolds scale) and
 that air's density.
 """

@@ -22,7 +22,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from golfflight.flight.air import Air  # noqa: E402
 from golfflight.flight.coefficients import FERGUSON_2022, QuadraticSpinRatio  # noqa: E402
 from golfflight.flight.constants import FOOT_M  # noqa: E402
-from golfflight.flight.integrator import simulate  # noqa: E402
+from golfflight.flight.flyer import FixedCoefficients, Flyer  # noqa: E402
+from golfflight.flight.integrator import RUNGE_KUTTA_4  # noqa: E402
 from golfflight.flight.outcomes import Flight  # noqa: E402
 from golfflight.flight.physics import initial_state  # noqa: E402
 from golfflight.flight.reference_aero import REFERENCE_DT_S, REFERENCE_T_MAX_S  # noqa: E402
@@ -56,8 +57,10 @@ class ApexPrediction:
 
 def ferguson(state) -> Flight:
     """Ferguson 2022's quadratic C_L, C_D, C_M in the spin ratio, RK4 at the reference world's step."""
-    return simulate(state, QuadraticSpinRatio(FERGUSON_2022), DENSITY_KG_M3, dt=REFERENCE_DT_S,
-                    t_max=REFERENCE_T_MAX_S, method="rk4", keep_states=True)
+    standard = Air.standard()
+    flyer = Flyer(FixedCoefficients(QuadraticSpinRatio(FERGUSON_2022)), REFERENCE_DT_S, REFERENCE_T_MAX_S,
+                  DENSITY_KG_M3, standard.kinematic_viscosity_m2_s, RUNGE_KUTTA_4)
+    return flyer.flight(state, keep_states=True)
 
 
 def reference(state) -> Flight:

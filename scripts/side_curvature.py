@@ -19,9 +19,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from golfflight.evaluation.accuracy_flyers import EvaluatedModel, ModelFlyer, ferguson_flyer
 from golfflight.evaluation.accuracy_sets import outcome_errors
-from golfflight.flight.field import ScaledCoefficients
-from golfflight.flight.integrator import simulate
-from golfflight.flight.physics import CoefficientModel, initial_state
+from golfflight.flight.physics import initial_state
 from golfflight.model_export.real_data import trackman_outdoor
 from golfflight.shots.markdown import table
 from golfflight.shots.paths import shared_data_dir
@@ -29,11 +27,6 @@ from golfflight.shots.records import ShotSet
 
 AXIS_STEP_DEG = 1.0
 """The axis step of each model's own side sensitivity (a central difference)."""
-
-
-def scaled(base: CoefficientModel, lift_scale: float, drag_scale: float, n_shots: int) -> ScaledCoefficients:
-    """`base` with C_L and C_D multiplied by constants for n_shots balls (the library's lift_scale and drag_scale)."""
-    return ScaledCoefficients(base, np.tile([lift_scale, drag_scale, 1.0], (n_shots, 1)))
 
 
 def axis_slope(errors: np.ndarray, launch: dict[str, np.ndarray],
@@ -81,11 +74,10 @@ def scale_rows(flyer: ModelFlyer, shots: ShotSet, lift_scales: tuple[float, ...]
     """The bundle with its C_L and C_D scaled: side, carry, apex and landing-angle errors."""
     rows = []
     launch = shots.launch()
-    base = flyer.coefficients_in(None)
     for lift in lift_scales:
         for drag in drag_scales:
-            flight = simulate(initial_state(**launch), scaled(base, lift, drag, len(shots)), flyer.density_kg_m3,
-                              dt=flyer.dt_s, t_max=flyer.t_sim_s)
+            scale = np.tile([lift, drag, 1.0], (len(shots), 1))
+            flight = flyer.flyer.flight(initial_state(**launch), coefficient_scale=scale)
             errors = outcome_errors(flight, shots)
             slope, _ = axis_slope(errors["side_m"], launch)
             rows.append([f"{lift:.2f}", f"{drag:.2f}", f"{np.mean(errors['landing_m']):.2f}",

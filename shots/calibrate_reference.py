@@ -18,7 +18,8 @@ from golfflight.errors import InputError
 from golfflight.flight.air import Air
 from golfflight.flight.coefficients import QuadraticSpinRatio
 from golfflight.flight.constants import YARD_M
-from golfflight.flight.integrator import simulate
+from golfflight.flight.flyer import FixedCoefficients, Flyer
+from golfflight.flight.integrator import RUNGE_KUTTA_4
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import State, initial_state
 from golfflight.flight.reference_aero import (
@@ -336,11 +337,9 @@ def evaluate_clubs(
 
 def evaluate_clubs_ferguson(clubs: list[ClubAverage], air: Air = CALIBRATION_AIR) -> CalibrationClub:
     """The same shots with Ferguson 2022's quadratics (the open-model baseline), same integrator and air."""
-    flight = simulate(
-        club_launch_state(clubs), QuadraticSpinRatio(), air.density_kg_m3, dt=REFERENCE_DT_S,
-        t_max=REFERENCE_T_MAX_S, method="rk4",
-    )
-    return _club_check(flight, clubs)
+    flyer = Flyer(FixedCoefficients(QuadraticSpinRatio()), REFERENCE_DT_S, REFERENCE_T_MAX_S, air.density_kg_m3,
+                  air.kinematic_viscosity_m2_s, RUNGE_KUTTA_4)
+    return _club_check(flyer.flight(club_launch_state(clubs)), clubs)
 
 
 def parameters_literal(params: ReferenceParameters) -> str:

@@ -11,10 +11,11 @@ import pytest
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.coefficients import QuadraticSpinRatio
 from golfflight.flight.engine import FlightEngine
-from golfflight.flight.integrator import simulate
 from golfflight.flight.physics import initial_state
 from golfflight.shots.heldout import ROUND_COLUMN, HeldOutSet, held_out_set
 from golfflight.shots.records import ShotRecord, write_shots
+
+from flights import simulate
 
 
 def random_launches(n: int, seed: int = 0) -> dict[str, np.ndarray]:

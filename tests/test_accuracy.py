@@ -49,7 +49,6 @@ from golfflight.evaluation.held_out import held_out_results
 from golfflight.flight.air import Air
 from golfflight.flight.coefficients import FERGUSON_2022, QuadraticSpinRatio
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS, YARD_M
-from golfflight.flight.integrator import simulate
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import State, initial_state
 from golfflight.flight.wind import Wind, wind_vector
@@ -66,6 +65,8 @@ from golfflight.weights_schema.bundle import load_bundle
 from scipy.stats import f_oneway
 
 from golfflight.cli import main
+
+from flights import simulate
 
 torch.set_num_threads(1)
 FIXTURES = Path(__file__).parent / "fixtures"

@@ -1,4 +1,5 @@
-"""Discovery: the simulator matches flight.integrator.simulate, and each library effect moves a flight the right way."""
+"""Discovery: a setup flies as the flight core's integrator flies the same shots, and each library effect moves a
+flight the right way."""
 
 from __future__ import annotations
 
@@ -8,7 +9,9 @@ from golfflight.discovery.effects import EFFECTS, LIBRARY, apply_all, wind_from_
 from golfflight.discovery.model import reference
 from golfflight.discovery.simulator import Setup, simulate_setup
 from golfflight.flight.air import Air
-from golfflight.flight.integrator import simulate
+from golfflight.flight.field import BallInAir
+from golfflight.flight.flyer import Flyer
+from golfflight.flight.integrator import STEP_RULES, GroundPlane, integrate
 from golfflight.flight.physics import initial_state
 from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics
 from golfflight.flight.wind import Wind, wind_vector
@@ -45,7 +48,7 @@ def outcomes(name: str, **parameters: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 @pytest.mark.parametrize("method", ["euler", "rk4"])
-def test_simulator_matches_service_simulate(method):
+def test_a_setup_flies_as_the_integrator_flies_its_shots(method):
     rng = np.random.default_rng(0)
     n = 40
     launch = {
@@ -56,28 +59,15 @@ def test_simulator_matches_service_simulate(method):
         "spin_axis_deg": rng.uniform(-20, 20, n),
     }
     air = Air.standard()
-    model = ReferenceAerodynamics(CALIBRATED, air.kinematic_viscosity_m2_s)
     wind = rng.normal(0, 3, (n, 2))
     ground = rng.uniform(-5, 5, n)
     speed, from_deg = np.hypot(wind[:, 0], wind[:, 1]), np.degrees(np.arctan2(-wind[:, 0], -wind[:, 1]))
-    expected = simulate(
-        initial_state(**launch),
-        model,
-        air.density_kg_m3,
-        Wind(speed, from_deg),
-        dt=0.1,
-        t_max=15,
-        method=method,
-        ground_height_m=ground,
-    )
+    model = ReferenceAerodynamics(CALIBRATED, air.kinematic_viscosity_m2_s)
+    field = BallInAir(model, air.density_kg_m3, Wind(speed, from_deg))
+    expected = integrate(initial_state(**launch), field, 0.1, 150, STEP_RULES[method], GroundPlane(ground))
     conditions = Setup(launch, np.ones(n), np.full(n, float(air.density_kg_m3)), wind, ground, np.ones((n, 3)))
-    got = simulate_setup(
-        conditions,
-        lambda setup: ReferenceAerodynamics(CALIBRATED, setup.viscosity(air.kinematic_viscosity_m2_s)),
-        0.1,
-        15.0,
-        method,
-    )
+    flyer = Flyer(model, 0.1, 15.0, air.density_kg_m3, air.kinematic_viscosity_m2_s, STEP_RULES[method])
+    got = simulate_setup(conditions, flyer)
     assert expected.landed.all()
     np.testing.assert_allclose(got.landing_xy, expected.landing_position[:, :2], atol=1e-9)
     np.testing.assert_allclose(got.apex_m, expected.apex_m, atol=1e-9)

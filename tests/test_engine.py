@@ -14,10 +14,11 @@ from golfflight.errors import FlightError
 from golfflight.flight.air import Air
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.engine import Launch, ShotFlight
-from golfflight.flight.integrator import simulate
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state, reynolds_scale
 from golfflight.flight.wind import Wind
+
+from flights import simulate
 
 PAPER_SINGLE_SHOT_MS = 34.9
 """Phys-NN+ one shot on a CPU, the paper's Table 2."""

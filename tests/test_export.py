@@ -13,7 +13,6 @@ import pytest
 import torch
 from conftest import random_launches
 from golfflight.flight import constants
-from golfflight.flight.integrator import simulate
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state
 from golfflight.flight.rollout import euler_rollout, hard_landing
@@ -23,6 +22,8 @@ from golfflight.weights_schema import BundleError, load_bundle
 from golfflight.weights_schema.model_card import SCHEMA_PATH, schema_text
 
 from golfflight.cli import main
+
+from flights import simulate
 
 torch.set_num_threads(1)  # tiny models: one thread is as fast, and immune to other jobs on the 2 cores
 

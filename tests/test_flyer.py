@@ -18,8 +18,9 @@ from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.flight.air import Air
 from golfflight.flight.bundle_location import MODEL_ENV, model_dir
 from golfflight.flight.coefficients import QuadraticSpinRatio
+from golfflight.flight.constants import GRAVITY_MPS2
 from golfflight.flight.field import BallInAir
-from golfflight.flight.flyer import MAX_FLIGHT_TIME_S, Launch, load_flyer
+from golfflight.flight.flyer import MAX_FLIGHT_TIME_S, FixedCoefficients, Flyer, Launch, load_flyer
 from golfflight.flight.integrator import (
     FORWARD_EULER,
     RUNGE_KUTTA_4,
@@ -112,6 +113,25 @@ def test_step_rules_are_named_objects_and_both_records_give_the_same_flight():
         np.testing.assert_array_equal(summary.flight_time_s, states.flight_time_s)
     euler, rk4 = (integrate(state, field, 0.05, 400, rule, heights).carry_m for rule in (FORWARD_EULER, RUNGE_KUTTA_4))
     assert not np.allclose(euler, rk4, atol=1e-6)
+
+
+def test_the_batch_flight_scales_coefficients_and_adds_an_acceleration_per_ball():
+    """`Flyer.flight` takes discovery's per-ball coefficient scales and extra acceleration: ones and a zero term
+    change nothing, bit for bit; more drag on one ball shortens that ball's carry alone; a constant 1 m/s^2 push to
+    the right moves a flight in a vacuum 0.5 a t^2 right."""
+    flyer = Flyer(FixedCoefficients(QuadraticSpinRatio()), 0.01, 15.0, 1.225, 1.5e-5, RUNGE_KUTTA_4)
+    state = initial_state(np.full(3, 70.0), np.full(3, 11.0), np.zeros(3), np.full(3, 2500.0), np.zeros(3))
+    plain = flyer.flight(state)
+    ones = flyer.flight(state, coefficient_scale=np.ones((3, 3)), correction=lambda v, w, r: np.zeros_like(v))
+    np.testing.assert_array_equal(ones.landing_position, plain.landing_position)
+    draggy = flyer.flight(state, coefficient_scale=np.array([[1.0, 1.0, 1.0], [1.0, 1.2, 1.0], [1.0, 1.0, 1.0]]))
+    assert draggy.carry_m[1] < plain.carry_m[1] - 5 and draggy.carry_m[[0, 2]] == pytest.approx(plain.carry_m[[0, 2]])
+    vacuum = Flyer(FixedCoefficients(lambda v, w: np.zeros((len(v), 4))), 0.01, 15.0, 1.225, 1.5e-5, RUNGE_KUTTA_4)
+    pushed = vacuum.flight(state, correction=lambda v, w, r: np.tile([1.0, 0.0, 0.0], (len(v), 1)))
+    vz, z0 = 70.0 * np.sin(np.radians(11.0)), state.position[0, 2]
+    time_s = (vz + np.sqrt(vz**2 + 2 * GRAVITY_MPS2 * z0)) / GRAVITY_MPS2
+    assert pushed.flight_time_s == pytest.approx(time_s, abs=1e-4)  # the landing interpolated across a 0.01 s step
+    assert pushed.landing_position[:, 0] == pytest.approx(0.5 * time_s**2, abs=1e-3)
 
 
 def test_a_ball_that_rises_again_below_its_ground_keeps_its_first_landing_and_apex(engine):

@@ -6,9 +6,10 @@ import pytest
 from golfflight.flight.air import Air
 from golfflight.flight.coefficients import ConstantCoefficients, QuadraticSpinRatio
 from golfflight.flight.constants import BALL_INERTIA_KG_M2, BALL_MASS_KG, BALL_RADIUS_M, GRAVITY_MPS2, TEE_HEIGHT_M
-from golfflight.flight.integrator import simulate
 from golfflight.flight.physics import State, derivatives, initial_state, mechanical_energy
 from golfflight.flight.wind import Wind
+
+from flights import simulate
 
 RHO = Air.standard().density_kg_m3
 

@@ -10,7 +10,6 @@ import pytest
 from conftest import trainable_copy
 from golfflight.flight.air import Air
 from golfflight.flight.constants import BALL_RADIUS_M, MPH_TO_MPS, YARD_M
-from golfflight.flight.integrator import simulate
 from golfflight.flight.physics import initial_state
 from golfflight.flight.reference_aero import CALIBRATED, REFERENCE_DT_S, REFERENCE_T_MAX_S, ReferenceAerodynamics
 from golfflight.model_export.reference_targets import FITTED_AIR_FACTORS, NORMALIZED_7IRON_FILE, calibration_cells
@@ -40,6 +39,8 @@ from golfflight.shots.reference_world import (
     read_tour_averages,
 )
 from golfflight.shots.source_air import PGA_2023_TABLE
+
+from flights import simulate
 
 NU = float(CALIBRATION_AIR.kinematic_viscosity_m2_s)
 LIFT, DRAG, MOMENT, Q = range(4)

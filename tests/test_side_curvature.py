@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from golfflight.flight.field import ScaledCoefficients
 
 SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "side_curvature.py"
 spec = importlib.util.spec_from_file_location("side_curvature", SCRIPT)
@@ -27,7 +28,7 @@ def test_scaled_coefficients_scale_lift_and_drag_only():
         def __call__(self, v_rel, omega):
             return np.tile([0.2, 0.3, 0.01, 0.5], (len(v_rel), 1))
 
-    scaled = side_curvature.scaled(Constant(), 1.1, 0.9, 3).take(np.array([0, 1]))
+    scaled = ScaledCoefficients(Constant(), np.tile([1.1, 0.9, 1.0], (3, 1))).take(np.array([0, 1]))
     out = scaled(np.ones((2, 3)), np.ones((2, 3)))
     np.testing.assert_allclose(out, [[0.22, 0.27, 0.01, 0.5]] * 2)
 

@@ -8,7 +8,6 @@ import torch
 from conftest import random_launches
 from golfflight.flight.air import Air
 from golfflight.flight.coefficients import ConstantCoefficients, QuadraticSpinRatio
-from golfflight.flight.integrator import simulate
 from golfflight.flight.physics import State, initial_state
 from golfflight.flight.physics import derivatives as np_derivatives
 from golfflight.flight.rollout import (
@@ -20,6 +19,8 @@ from golfflight.flight.rollout import (
     soft_landing,
 )
 from golfflight.model_export.variants import PhysQ
+
+from flights import simulate
 
 torch.set_num_threads(1)  # tiny models: one thread is as fast, and immune to other jobs on the 2 cores
 
@@ -99,7 +100,7 @@ def _low_and_high_launches() -> State:
 @torch.no_grad()
 def test_landing_and_apex_are_measured_as_the_runtime_measures_them(name, numpy_model, torch_model, t_max):
     """Short flights (landing within 1 s, or on the first step) and, at 2.5 s, flights still in the air at the end:
-    the same landing x/y, time and apex as `flight.integrator.simulate` within 1e-6 m."""
+    the same landing x/y, time and apex as the flight core's batch flight (`Flyer.flight`) within 1e-6 m."""
     state = _low_and_high_launches()
     flight = simulate(state, numpy_model, DENSITY, dt=0.1, t_max=t_max)
     trajectory = euler_rollout(
