@@ -5,7 +5,7 @@ process's RSS, sampled, Ray's raylet, GCS and workers included; and the sum of P
 and Ray's overhead (local shots/s over Ray's). Prints a table, writes results.json.
 
 With --validation instead (section sweep_validation): a chunk's rows checked against the request model one row at a
-time (`sweep.flyer.problems_of` each row, as every sweep did before `sweep.rows`) against the columnar check
+time (`contract.columns.check_cells` each row, as every sweep did before `sweep.rows`) against the columnar check
 (`sweep.rows.check_rows`), rows/s in this process on three inputs (a 3-column grid, an 8-column grid with
 conditions, a CSV's text cells of mixed launches), the two interleaved round by round; and, with --before a checkout of
 an earlier commit, a whole `golfflight sweep --engine torch --device cpu --threads 1` of a grid of --grid-rows
@@ -151,23 +151,22 @@ def validation_inputs() -> dict:
 def per_row_check(table) -> int:
     """Every row through the request model on its own, as a sweep checked rows before `sweep.rows`: rows valid."""
     from golfflight.contract.columns import cell_value
-    from golfflight.sweep.flyer import problems_of
+    from golfflight.contract.columns import check_cells
 
     columns, names = table.to_pydict(), table.column_names
-    return sum(not isinstance(problems_of(dict(zip(names, map(cell_value, values), strict=True))), list)
+    return sum(not isinstance(check_cells(dict(zip(names, map(cell_value, values), strict=True))), list)
                for values in zip(*columns.values(), strict=True))
 
 
 def validation_rates(rounds: int) -> list[dict]:
     """Rows/s of the per-row check and the columnar one on each input, interleaved (medians of the rounds)."""
-    from golfflight.sweep.flyer import problems_of
     from golfflight.sweep.rows import check_rows
 
     rows = []
     for name, table in validation_inputs().items():
         seconds = {"per_row": [], "columnar": []}
         for _ in range(rounds):
-            for way, check in (("per_row", per_row_check), ("columnar", lambda t: int(check_rows(t, problems_of).valid.sum()))):
+            for way, check in (("per_row", per_row_check), ("columnar", lambda t: int(check_rows(t).valid.sum()))):
                 started = time.perf_counter()
                 valid = check(table)
                 seconds[way].append(time.perf_counter() - started)

@@ -2,12 +2,14 @@
 
 `golfflight simulate` (CSV) and `golfflight sweep` (CSV, Parquet, grids) read and write the same columns, so both
 go through this module: a row's cells become a `ShotRequest` dict (`request_of_cells`), are validated by the
-request model with every problem naming its column and allowed range (`check`), and a result comes back as one
-flat row (`flat_row`). The standard library and the request models only: the serving install runs `simulate`.
+request model with every problem naming its column and allowed range (`check`; `check_cells` does both for a row),
+and a result comes back as one flat row (`flat_row`). The standard library and the request models only: the serving
+install runs `simulate`.
 """
 
 from __future__ import annotations
 
+import math
 import re
 
 from golfflight.contract.refusals import describe_errors
@@ -202,6 +204,24 @@ def check(item, csv_columns: bool = True) -> ShotRequest | list[str]:
             where = f"column '{REQUEST_TO_COLUMN.get(field, field)}'" if csv_columns else f"field '{field}'"
             problems.append(f"{where}: {message}")
         return problems
+
+
+NUMERIC_REQUEST_COLUMNS = tuple(c for c in REQUEST_COLUMNS if c not in TEXT_COLUMNS and c != "normalized")
+"""The request's number columns, where a NaN (a Parquet float, or a CSV cell reading NaN) is refused as not a
+number."""
+
+
+def check_cells(cells: dict) -> ShotRequest | list[str]:
+    """The validated request of one row's cells (as `cell_value` reads them), or its problems: `check`'s, each naming
+    its column, with a NaN cell said to be "not a number" (the model would call it not finite)."""
+    checked = check(request_of_cells(cells))
+    if not isinstance(checked, list):
+        return checked
+    nan = [c for c in NUMERIC_REQUEST_COLUMNS if isinstance(cells.get(c), float) and math.isnan(cells[c])]
+    if not nan:
+        return checked
+    named = tuple(f"column '{c}':" for c in nan)
+    return [f"column '{c}': not a number (got NaN)" for c in nan] + [p for p in checked if not p.startswith(named)]
 
 
 AIR_DENSITY = "air_density_kg_m3"

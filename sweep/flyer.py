@@ -9,7 +9,6 @@ flight, for the driver to report with the row's place in the input (only the dri
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
@@ -18,12 +17,9 @@ from typing import TYPE_CHECKING, Protocol
 from golfflight.contract.columns import (
     AIR_DENSITY,
     ELEVATION_COLUMNS,
-    REQUEST_COLUMNS,
     TEXT_COLUMNS,
     cell_value,
-    check,
     is_flag_set,
-    request_of_cells,
     result_columns,
 )
 from golfflight.errors import InputError
@@ -81,24 +77,6 @@ def _number(value) -> float | None:
     return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
 
 
-NUMERIC_REQUEST_COLUMNS = tuple(c for c in REQUEST_COLUMNS if c not in TEXT_COLUMNS and c != "normalized")
-"""The request's number columns, where a NaN (a Parquet float, or a CSV cell reading NaN) is refused as not a
-number."""
-
-
-def problems_of(cells: dict):
-    """The validated request of one row's cells, or its problems: the request model's, each naming its column, with
-    a NaN cell said to be "not a number" (the model would call it not finite)."""
-    checked = check(request_of_cells(cells))
-    if not isinstance(checked, list):
-        return checked
-    nan = [c for c in NUMERIC_REQUEST_COLUMNS if isinstance(cells.get(c), float) and math.isnan(cells[c])]
-    if not nan:
-        return checked
-    named = tuple(f"column '{c}':" for c in nan)
-    return [f"column '{c}': not a number (got NaN)" for c in nan] + [p for p in checked if not p.startswith(named)]
-
-
 def echo(column: str, value):
     """An input cell as its results column holds it: text, a flag, or a number (None where blank)."""
     if column in TEXT_COLUMNS:
@@ -150,7 +128,7 @@ class SweepWorker:
         layout = self.layout
         table = table.select(list(layout.columns))
         n = table.num_rows
-        checked = check_rows(table, problems_of)
+        checked = check_rows(table)
         flew = checked.valid
         flown = np.flatnonzero(flew)
         problems = np.full(n, None, dtype=object)

@@ -13,7 +13,7 @@ not restate them.
   (`tests/test_sweep_errors.py` reads the validators to hold this): the rows whose every cell passes are grouped by
   those, and one row of each group goes through the whole model, which decides for its group.
 - Every other row (a cell out of range, not a number, NaN; a group the model refuses) goes through the model on its
-  own (`sweep.flyer.problems_of`), so a refused row gets exactly the problem lines it got before.
+  own (`contract.columns.check_cells`), so a refused row gets exactly the problem lines it got before.
 
 Flying. The valid rows' launches are converted as `contract.inputs.launch_of` converts them, in arrays (back and side
 spin by `spin_from_components` itself); their conditions, grounds and normalized replays come from the contract's own
@@ -39,6 +39,7 @@ from golfflight.contract.columns import (
     SECTION_COLUMNS,
     WIND_COLUMNS,
     cell_value,
+    check_cells,
     request_of_cells,
 )
 from golfflight.contract.flying import Batch, ShotColumns, columns_of
@@ -290,9 +291,9 @@ def cells_of(table, rows, names) -> dict[int, dict]:
     return {i: {name: cell_value(value) for name, value in row.items()} for i, row in zip(rows.tolist(), taken)}
 
 
-def check_rows(table, problems_of) -> Checked:
-    """Every row of `table` (an Arrow table of a sweep's columns) checked as `problems_of(cells)` checks one row
-    (module docstring); `problems_of` runs on the groups' representatives and on each row not shown valid in bulk."""
+def check_rows(table) -> Checked:
+    """Every row of `table` (an Arrow table of a sweep's columns) checked as `check_cells(cells)` checks one row
+    (module docstring); `check_cells` runs on the groups' representatives and on each row not shown valid in bulk."""
     n = table.num_rows
     columns = {name: read_column(name, table[name]) for name in table.column_names if name in REQUEST_COLUMNS}
     fields_ok = np.ones(n, dtype=bool)
@@ -302,12 +303,12 @@ def check_rows(table, problems_of) -> Checked:
     presence = [column.given.astype(np.int64) for column in columns.values()]
     firsts, group = _groups(presence + _key(columns, sorted(VALUE_RULE_COLUMNS)), candidates)
     firsts_cells = cells_of(table, firsts, REQUEST_COLUMNS)
-    group_valid = np.array([not isinstance(problems_of(firsts_cells[i]), list) for i in firsts.tolist()], dtype=bool)
+    group_valid = np.array([not isinstance(check_cells(firsts_cells[i]), list) for i in firsts.tolist()], dtype=bool)
     valid = np.zeros(n, dtype=bool)
     valid[candidates] = group_valid[group] if len(candidates) else False
     problems = {}
     for i, cells in cells_of(table, np.flatnonzero(~valid), REQUEST_COLUMNS).items():
-        checked = problems_of(cells)
+        checked = check_cells(cells)
         if isinstance(checked, list):
             problems[i] = checked
         else:  # shown valid on its own: in a group whose representative the model refused for a rule of its own

@@ -254,13 +254,13 @@ def assert_columnar_flights_equal_requested(table) -> int:
     from golfflight.contract.columns import cell_value
     from golfflight.flight.bundle_location import model_dir
     from golfflight.flight.engine import FlightEngine
-    from golfflight.sweep.flyer import problems_of
+    from golfflight.contract.columns import check_cells
     from golfflight.sweep.rows import check_rows, fly_checked
 
-    shots = [problems_of({k: cell_value(v) for k, v in row.items()}) for row in table.to_pylist()]
+    shots = [check_cells({k: cell_value(v) for k, v in row.items()}) for row in table.to_pylist()]
     shots = [shot for shot in shots if not isinstance(shot, list)]
     engine = FlightEngine(model_dir(None), batch_threads=1)
-    want, got = requested_columns(engine, shots), fly_checked(engine, check_rows(table, problems_of))
+    want, got = requested_columns(engine, shots), fly_checked(engine, check_rows(table))
     assert got.errors == want.errors
     assert got.values.keys() == want.values.keys()
     for name, values in want.values.items():

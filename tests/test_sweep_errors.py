@@ -78,9 +78,9 @@ def test_nan_is_not_a_number_at_its_line_and_column(tmp_path, capsys):
     assert "launches.csv line 2 column 'launch_angle_deg': not a number (got NaN)" in err
     assert "launches.csv line 3 column 'spin_rpm': not a number (got NaN)" in err
     assert "Field required" not in err and "spin: give exactly one" not in err
-    from golfflight.sweep.flyer import problems_of
+    from golfflight.contract.columns import check_cells
 
-    assert problems_of({"ball_speed_mps": float("nan"), "launch_angle_deg": 12.0, "spin_rpm": 99999.0}) == [
+    assert check_cells({"ball_speed_mps": float("nan"), "launch_angle_deg": 12.0, "spin_rpm": 99999.0}) == [
         "column 'ball_speed_mps': not a number (got NaN)",
         "column 'spin_rpm': Input should be less than or equal to 15000 (got 99999.0); allowed 0 to 15000 rpm",
     ]
@@ -132,20 +132,19 @@ def test_the_ray_noise_filter_drops_only_its_line(capfd):
 
 
 def per_row(table) -> list:
-    """Each row of `table` through the request model on its own (`problems_of`): its request, or its problem lines."""
+    """Each row of `table` through the request model on its own (`check_cells`): its request, or its problem lines."""
     from golfflight.contract.columns import cell_value
-    from golfflight.sweep.flyer import problems_of
+    from golfflight.contract.columns import check_cells
 
-    return [problems_of({k: cell_value(v) for k, v in row.items()}) for row in table.to_pylist()]
+    return [check_cells({k: cell_value(v) for k, v in row.items()}) for row in table.to_pylist()]
 
 
 def assert_checked_as_per_row(table) -> None:
     """The columnar check (`sweep.rows.check_rows`) gives every row the per-row verdict and, for a refused row, the
     same problem lines (each naming its column and range)."""
-    from golfflight.sweep.flyer import problems_of
     from golfflight.sweep.rows import check_rows
 
-    checked = check_rows(table, problems_of)
+    checked = check_rows(table)
     for i, want in enumerate(per_row(table)):
         assert bool(checked.valid[i]) == (not isinstance(want, list)), (i, table.slice(i, 1).to_pylist(), want)
         assert checked.problems.get(i) == (want if isinstance(want, list) else None), i
@@ -210,10 +209,9 @@ def test_the_columnar_check_gives_every_row_the_models_verdict_and_lines(form):
         table = pa.table(columns)
         table = table.append_column("wind_reference_height_m", pa.array([True if i % 50 == 0 else None for i in range(2000)]))
     assert_checked_as_per_row(table)
-    from golfflight.sweep.flyer import problems_of
     from golfflight.sweep.rows import check_rows
 
-    valid = check_rows(table, problems_of).valid
+    valid = check_rows(table).valid
     assert 100 < valid.sum() < 1900  # both verdicts well represented
 
 
