@@ -73,8 +73,8 @@ def measure(data: Path, device: str, folder: Path, runs: int, compile_step: bool
     """An epoch's seconds: the second of two (the first compiles where `compile_step`; with `jobs` processes, the
     slowest process's second epoch, all of them training at once), and, eager in one process where `count_ops`, the
     operations one epoch dispatches (a third epoch, slower for the counting). Compiled runs start from an empty
-    compile cache: torch.compile keeps its versions of `euler_step` by the function, so the runs' counts before would
-    add up to its limit of eight (then it runs eager)."""
+    compile cache: torch.compile keeps its versions of the Euler step (`flight.rollout.step_rule`) by the function,
+    so the runs' counts before would add up to its limit of eight (then it runs eager)."""
     if compile_step:
         torch._dynamo.reset()
     results = train(data, device, folder / "timed", runs, 2, compile_step, jobs)

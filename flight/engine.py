@@ -164,10 +164,8 @@ class FlightEngine:
         carry, angle, speed, spin = (float(v) for v in landing_figures(land[0], land[1], *land[3:]))
         states = None
         if history is not None:
-            history.append(tuple(land[:6]))
             rows = np.array(history)
-            times = np.append(np.round(dt * np.arange(len(history) - 1), 9), flight_time)
-            states = EulerStates(times_s=times, positions=rows[:, :3], velocities=rows[:, 3:])
+            states = EulerStates.to_landing(rows[:, :3], rows[:, 3:], land[:3], land[3:6], dt, flight_time)
         apex, apex_time = parabola_apex(before_apex, apex, after_apex, apex_step * dt, dt)
         numbers = (land[0], land[1], carry, apex, apex_time, flight_time, angle, speed, spin)
         if not (all(map(math.isfinite, numbers)) and (states is None or states.finite)):

@@ -231,10 +231,9 @@ class Flyer:
         """One shot's states up to its landing, the interpolated landing last (history: every step's positions and
         velocities, [T, N, 3] each)."""
         last = int(flight.last_step[shot])
-        positions = np.vstack([history[0][: last + 1, shot], flight.landing_position[shot]])
-        velocities = np.vstack([history[1][: last + 1, shot], flight.landing_velocity[shot]])
-        times = np.append(np.round(self.dt_s * np.arange(last + 1), 9), flight.flight_time_s[shot])
-        return EulerStates(times_s=times, positions=positions, velocities=velocities)
+        return EulerStates.to_landing(history[0][: last + 1, shot], history[1][: last + 1, shot],
+                                      flight.landing_position[shot], flight.landing_velocity[shot], self.dt_s,
+                                      flight.flight_time_s[shot])
 
 
 class BatchAir(NamedTuple):

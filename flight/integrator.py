@@ -6,11 +6,12 @@ torch engine's): a step rule x a vector field x an event x a record.
 - vector field (`flight.field`): the right-hand side bound to the batch's per-ball values;
 - event (`GroundPlane`): where the phase ends for a ball; at the first step that crosses it the state is
   interpolated linearly to the event (exact for Euler's straight segments);
-- record (`Record`): `SummaryRecord` (landing, apex, times; landed balls leave the batch now and then, `SetAside`)
-  or `StatesRecord` (also every step's state of every ball until the last one lands: a landed ball flies on below
-  its ground, so that states at fixed times exist for the whole batch). The loop hands the record's marks each step
-  (`_Marks`: the apex and the landing as they happen) and the record each new state; it never branches on which
-  record it has.
+- record (`Recorder`): `SummaryRecord` (landing, apex, times; landed balls leave the batch now and then,
+  `SetAside`), `StatesRecord` (also every step's state of every ball until the last one lands: a landed ball flies
+  on below its ground, so that states at fixed times exist for the whole batch), or training's differentiable
+  fixed-horizon trajectory (`flight.rollout.TrajectoryRecord`). The loop hands the record each step's old and new
+  states: the record marks them (`_Marks`: the apex and the landing as they happen), keeps what it keeps and says
+  when the flight is finished; the loop never branches on which record it has.
 
 The apex is interpolated between steps (`flight.outcomes.parabola_apex`). A later phase (bounce and roll on the
 ground) starts from the landing state this returns, with its own field and event.
@@ -122,7 +123,7 @@ class _Marks:
         self.frac, self.last_step = xp.full(n, math.nan, like), xp.zeros_like(like, integer=True) - 1
         self.down = xp.falses(n, like)
 
-    def update(self, step: int, dt: float, old: State, new: State, event: GroundPlane) -> None:
+    def update(self, step: int, old: State, new: State, event: GroundPlane) -> None:
         """Mark the step from `old` to `new` (the balls not yet down): a new peak, the height after the peak, a
         landing."""
         z_before, z_after = old.position[:, 2], new.position[:, 2]
@@ -193,8 +194,10 @@ class SummaryRecord:
         self.field, self.event = field, event
         self.ids, self.batch = None, self.marks  # ids: the flying balls' rows of the batch (None: every row)
 
-    def keep(self, new: State, step: int) -> State:
-        """The batch's next state, after setting aside the balls down, when `set_aside` says so."""
+    def keep(self, old: State, new: State, step: int) -> State:
+        """Mark the step from `old` to `new`; the batch's next state, after setting aside the balls down, when
+        `set_aside` says so."""
+        self.marks.update(step, old, new, self.event)
         rule = self.set_aside
         if step % rule.every_steps:
             return new
@@ -226,7 +229,8 @@ class StatesRecord(SummaryRecord):
         super().__init__(state, field, event)
         self.history = [state]
 
-    def keep(self, new: State, step: int) -> State:
+    def keep(self, old: State, new: State, step: int) -> State:
+        self.marks.update(step, old, new, self.event)
         self.history.append(new)
         self.finished = bool(self.marks.down.all())
         return new
@@ -235,9 +239,21 @@ class StatesRecord(SummaryRecord):
         return self.marks.flight(dt, dt * np.arange(len(self.history)), self.history)
 
 
-Record = Callable[[State, VectorField, GroundPlane], SummaryRecord]
-"""What `integrate` records: `SummaryRecord` (or one with its own `SetAside`) or `StatesRecord`, made once a
-flight."""
+class Recorder(Protocol):
+    """What `integrate` hands each step: the field it steps (a record may set balls aside), whether the flight is
+    finished, and what the flight comes to."""
+
+    field: VectorField
+    finished: bool
+
+    def keep(self, old: State, new: State, step: int) -> State: ...
+
+    def flight(self, dt: float): ...
+
+
+Record = Callable[[State, VectorField, GroundPlane], Recorder]
+"""What `integrate` records: `SummaryRecord` (or one with its own `SetAside`), `StatesRecord` or training's
+`flight.rollout.TrajectoryRecord`, made once a flight."""
 
 
 def record_for(keep_states: bool) -> Record:
@@ -254,13 +270,12 @@ def integrate(
     event: GroundPlane = GroundPlane(),
     record: Record = SummaryRecord,
 ) -> Flight:
-    """Step a batch from `state` until every ball has met the event or `steps` steps have passed; balls that never
-    meet it keep NaN landing values (`landed` False). NumPy arrays or torch tensors (`flight.xp`) alike."""
+    """Step a batch from `state` until every ball has met the event (or the record says it is finished) or `steps`
+    steps have passed: the record's flight (a `Flight`, where balls that never meet the event keep NaN landing values,
+    `landed` False). NumPy arrays or torch tensors (`flight.xp`) alike."""
     recorder = record(state, field, event)
     for i in range(1, steps + 1):
-        new = rule(state, recorder.field, dt)
-        recorder.marks.update(i, dt, state, new, recorder.event)
-        state = recorder.keep(new, i)
+        state = recorder.keep(state, rule(state, recorder.field, dt), i)
         if recorder.finished:
             break
     return recorder.flight(dt)

@@ -99,6 +99,15 @@ class EulerStates:
     positions: np.ndarray
     velocities: np.ndarray
 
+    @classmethod
+    def to_landing(cls, positions: np.ndarray, velocities: np.ndarray, landing_position, landing_velocity, dt: float,
+                   flight_time_s: float) -> EulerStates:
+        """A shot's states at t = 0, dt, 2 dt, ... ([K,3] each) up to its last step above the ground, the landing
+        interpolated after them (the single shot's and the batch's states alike)."""
+        times = np.append(np.round(dt * np.arange(len(positions)), 9), flight_time_s)
+        return cls(times_s=times, positions=np.vstack([positions, landing_position]),
+                   velocities=np.vstack([velocities, landing_velocity]))
+
     @property
     def finite(self) -> bool:
         """Whether every recorded state is finite (a broken model's NaN never reaches a client)."""

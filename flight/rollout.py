@@ -1,24 +1,26 @@
 """The differentiable fixed-horizon rollout training needs (paper sections 2.1, 2.3), on the flight core's equations.
 
 The equations of motion and the Euler step are the flight core's (`flight.field.BallInAir`, `flight.integrator`),
-written once over floats, NumPy and torch (`flight.xp`): this module adds what training alone needs, the
-whole-horizon rollout kept as one graph, the soft landing and the landing and apex read back differentiably (the
-apex's parabola is `flight.outcomes.parabola_apex`'s), batched over shots and dtype-agnostic (float64 for the parity
-tests, float32 for training). Wind is uniform (one air velocity per shot): real-data training fits it as a
-per-group nuisance, where a uniform wind is the simplest stand-in for the profile. The landing and the apex are
-measured as `flight.integrator` measures them (`hard_landing`, `apex`), so training fits the figures the runtime
-reports.
+written once over floats, NumPy and torch (`flight.xp`), and so is the loop: the rollout is the integrator with
+training's record (`TrajectoryRecord`, every state kept as one graph). This module adds what training alone needs:
+that record, the soft landing, and the landing and apex read back differentiably (the apex's parabola is
+`flight.outcomes.parabola_apex`'s, the landing's fraction the integrator's `GroundPlane.fraction`), batched over
+shots and dtype-agnostic (float64 for the parity tests, float32 for training). Wind is uniform (one air velocity per
+shot): real-data training fits it as a per-group nuisance, where a uniform wind is the simplest stand-in for the
+profile. The landing and the apex are measured as `flight.integrator` measures them (`hard_landing`, `apex`), so
+training fits the figures the runtime reports.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import torch
 from golfflight.flight import xp
 from golfflight.flight.field import BallInAir
-from golfflight.flight.integrator import FORWARD_EULER
+from golfflight.flight.integrator import FORWARD_EULER, GroundPlane, StepRule, integrate
 from golfflight.flight.outcomes import parabola_apex
 from golfflight.flight.physics import State
 from golfflight.flight.wind import CALM, WindAtBalls
@@ -109,34 +111,40 @@ class InAir:
         return InAir(self.model, xp.rows(self.reynolds_scale, index), scale, self.run_in)
 
 
-def euler_step(
-    position: torch.Tensor,
-    velocity: torch.Tensor,
-    spin: torch.Tensor,
-    coefficients: Coefficients,
-    density: torch.Tensor | float,
-    dt: float,
-    reynolds_scale: torch.Tensor | float = 1.0,
-    wind: torch.Tensor | None = None,
-    coefficient_scale: torch.Tensor | None = None,
-) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """One forward-Euler step of the flight core's field (`flight.field.BallInAir`, `flight.integrator.FORWARD_EULER`)
-    in each shot's air (`InAir`) and uniform `wind` ([N,3] air velocity; None = calm): the position, velocity and spin
-    dt later."""
-    air = CALM_AT_BALLS if wind is None else WindAtBalls(wind)
-    field = BallInAir(InAir(coefficients, reynolds_scale, coefficient_scale), density, air)
-    new = FORWARD_EULER(State(position, velocity, spin), field, dt)
-    return new.position, new.velocity, new.spin
+def step_rule(compiled: bool) -> StepRule:
+    """The forward-Euler step training and the torch engine fly, or, `compiled`, the same with its kernels fused by
+    torch.compile, forward and backward (`dynamic=True`: one compilation for every batch size)."""
+    return torch.compile(_euler, dynamic=True) if compiled else FORWARD_EULER
 
 
-EulerStep = Callable[..., tuple[torch.Tensor, torch.Tensor, torch.Tensor]]
-"""`euler_step` or the same compiled (`torch.compile`), as `euler_rollout` takes it."""
+def _euler(state: State, field: BallInAir, dt: float) -> State:
+    """FORWARD_EULER as a plain function, the form torch.compile takes."""
+    return FORWARD_EULER(state, field, dt)
 
 
-def training_step(compiled: bool) -> EulerStep:
-    """`euler_step`, or, `compiled`, the same with its kernels fused by torch.compile, forward and backward
-    (`dynamic=True`: one compilation for every batch size)."""
-    return torch.compile(euler_step, dynamic=True) if compiled else euler_step
+class TrajectoryRecord:
+    """The integrator's record of training's rollout (`euler_rollout`): every step's state of every shot, kept in
+    one graph, no shot set aside and nothing marked (the landing and apex are read back from the states,
+    `hard_landing` and `apex`). With `stop_after_s`, the flight is finished at the first check (every
+    LANDING_CHECK_STEPS steps) at or after that time where every shot has come down: started above the event's
+    plane and below it now."""
+
+    def __init__(self, state: State, field: BallInAir, event: GroundPlane, dt: float,
+                 stop_after_s: float | None = None) -> None:
+        self.field, self.event, self.dt, self.stop_after_s = field, event, dt, stop_after_s
+        self.states, self.finished = [state], False
+        self.started_up = state.position[:, 2].detach() > event.height_m
+
+    def keep(self, old: State, new: State, step: int) -> State:
+        self.states.append(new)
+        self.finished = (self.stop_after_s is not None and step % LANDING_CHECK_STEPS == 0
+                         and step * self.dt >= self.stop_after_s
+                         and bool((self.started_up & (new.position[:, 2].detach() <= self.event.height_m)).all()))
+        return new
+
+    def flight(self, dt: float) -> Trajectory:
+        return Trajectory(*(torch.stack([getattr(state, name) for state in self.states])
+                            for name in ("position", "velocity", "spin")), dt)
 
 
 def euler_rollout(
@@ -150,28 +158,19 @@ def euler_rollout(
     reynolds_scale: torch.Tensor | float = 1.0,
     wind: torch.Tensor | None = None,
     coefficient_scale: torch.Tensor | None = None,
-    step: EulerStep = euler_step,
+    step: StepRule = FORWARD_EULER,
     stop_after_s: float | None = None,
 ) -> Trajectory:
-    """Forward Euler for every shot together (fixed shapes stay batched, differentiable) over the whole t_sim, or,
-    with `stop_after_s`, to the first check (every LANDING_CHECK_STEPS steps) at or after that time where every shot
-    has come down: started above z = 0 and below it now. What reads the states only up to each shot's landing and up
-    to `stop_after_s` (`hard_landing`, `apex`, `positions_at` up to that time) then reads the same numbers, and the
-    steps after the last landing are not flown. `wind` and `coefficient_scale` as in `derivatives`; `step` is
-    `euler_step`, eager or compiled."""
-    positions, velocities, spins = [position], [velocity], [spin]
-    started_up = position[:, 2].detach() > 0
-    for done in range(1, round(t_sim / dt) + 1):
-        position, velocity, spin = step(
-            position, velocity, spin, coefficients, density, dt, reynolds_scale, wind, coefficient_scale
-        )
-        positions.append(position)
-        velocities.append(velocity)
-        spins.append(spin)
-        if (stop_after_s is not None and done % LANDING_CHECK_STEPS == 0 and done * dt >= stop_after_s
-                and bool((started_up & (position[:, 2].detach() <= 0)).all())):
-            break
-    return Trajectory(torch.stack(positions), torch.stack(velocities), torch.stack(spins), dt)
+    """Forward Euler for every shot together (fixed shapes stay batched, differentiable) through the flight core's
+    integrator (`flight.integrator.integrate`, its field `BallInAir` with the model in each shot's air, `InAir`, and
+    uniform `wind`, [N,3] air velocity, None = calm) over the whole t_sim, or, with `stop_after_s`, to the first check
+    at or after that time where every shot has come down (`TrajectoryRecord`). What reads the states only up to each
+    shot's landing and up to `stop_after_s` (`hard_landing`, `apex`, `positions_at` up to that time) then reads the
+    same numbers, and the steps after the last landing are not flown. `step`: `step_rule`'s, eager or compiled."""
+    air = CALM_AT_BALLS if wind is None else WindAtBalls(wind)
+    field = BallInAir(InAir(coefficients, reynolds_scale, coefficient_scale), density, air)
+    record = partial(TrajectoryRecord, dt=dt, stop_after_s=stop_after_s)
+    return integrate(State(position, velocity, spin), field, dt, round(t_sim / dt), step, GroundPlane(), record)
 
 
 def _search_start(trajectory: Trajectory, start_s: float) -> int:
@@ -210,8 +209,7 @@ def hard_landing(trajectory: Trajectory) -> Landing:
     before, landed = _first_crossing(z)
     shots = torch.arange(z.shape[1], device=z.device)
     z_before, z_after = z[before, shots], z[before + 1, shots]
-    drop = torch.where(landed, z_before - z_after, torch.ones_like(z_before))
-    frac = torch.where(landed, z_before / drop, torch.ones_like(z_before))
+    frac = torch.where(landed, GroundPlane().fraction(z_before, z_after, landed), torch.ones_like(z_before))
 
     def interpolate(states: torch.Tensor) -> torch.Tensor:
         old, new = states[before, shots], states[before + 1, shots]

@@ -43,11 +43,11 @@ from golfflight.flight.field import BallInAir
 from golfflight.flight.flyer import LAUNCH_WIDTH, BatchAir, Launch, batch_air, landed_columns, load_flyer
 from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, elevations, ground_phase
 from golfflight.flight.ground.phase import plane_normals, roll_to_rest
-from golfflight.flight.integrator import FORWARD_EULER, GroundPlane, SetAside, SummaryRecord, integrate
+from golfflight.flight.integrator import GroundPlane, SetAside, SummaryRecord, integrate
 from golfflight.flight.outcomes import BatchFlights, Flight
 from golfflight.flight.per_shot import PerShot
 from golfflight.flight.physics import State, initial_state, reynolds_scale
-from golfflight.flight.rollout import LANDING_CHECK_STEPS, InAir
+from golfflight.flight.rollout import LANDING_CHECK_STEPS, InAir, step_rule
 from golfflight.flight.torch_network import network_from_bundle
 
 DTYPES = {"float32": torch.float32, "float64": torch.float64}
@@ -76,11 +76,6 @@ aside gathers the rest's states and air: not worth it for a few)."""
 LANDING_FIELDS = ("landed", "landing_position", "landing_velocity", "landing_spin", "flight_time_s", "apex_m",
                   "apex_time_s")
 """What a part's Flight brings back from the device: its landings and apexes."""
-
-
-def _euler(state: State, field: BallInAir, dt: float) -> State:
-    """FORWARD_EULER as a plain function, the form torch.compile takes."""
-    return FORWARD_EULER(state, field, dt)
 
 
 class TorchEngine:
@@ -113,7 +108,7 @@ class TorchEngine:
         self.ground_on_device = self.device.type == "cuda" if ground_on_device is None else ground_on_device
         self.seconds = dict.fromkeys(STAGES, 0.0)
         self._timing = threading.Lock()
-        self.rule = torch.compile(_euler, dynamic=True) if compile_step else FORWARD_EULER
+        self.rule = step_rule(compile_step)
         # a share of 1 never sets aside; one row left flying would be compiled again
         self.record = partial(SummaryRecord, set_aside=SetAside(LANDING_CHECK_STEPS, set_aside_share, keep_rows=2))
 

@@ -39,16 +39,15 @@ from golfflight.model_export.observations import (
     load_observed,
 )
 from golfflight.model_export.stacked_runs import StackedNetworks, clip_per_run, run_of_rows, runs_held
+from golfflight.flight.integrator import FORWARD_EULER, StepRule
 from golfflight.flight.rollout import (
     DT_S,
     T_SIM_S,
     Coefficients,
-    EulerStep,
     euler_rollout,
-    euler_step,
     hard_landing,
     positions_at,
-    training_step,
+    step_rule,
 )
 from golfflight.model_export.training import CHECKPOINT_FORMAT, GRAD_CLIP_NORM, load_checkpoint, save_checkpoint
 from golfflight.shots.files import write_text_atomic
@@ -224,12 +223,13 @@ class Predicted:
 
 def fly(model: Coefficients, shots: ObservedShots, config: JointConfig, latent: LatentConditions | None,
         source_density: torch.Tensor | None = None, run: torch.Tensor | None = None,
-        step: EulerStep = euler_step) -> Predicted:
+        step: StepRule = FORWARD_EULER) -> Predicted:
     """Euler rollout of the shots: with their latent conditions, or, when `latent` is None, calm in their recorded
     air times their source's fitted density factor (`source_density` [runs, sources], where given). `run` [n] is
     each shot's run where `model` is several stacked (`stacked_runs.StackedNetworks`); None: all of run 0. `step`:
-    `euler_step`, eager or compiled. The rollout stops once every shot has come down and its last path sample is
-    flown (`euler_rollout`'s `stop_after_s`): what is read of it, the landing, apex and path, is the same."""
+    `flight.rollout.step_rule`'s forward Euler, eager or compiled. The rollout stops once every shot has come down
+    and its last path sample is flown (`euler_rollout`'s `stop_after_s`): what is read of it, the landing, apex and
+    path, is the same."""
     if run is None:
         run = torch.zeros(len(shots), dtype=torch.long, device=shots.source.device)
     if latent is None:
@@ -295,7 +295,7 @@ def weighted_mean(values: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
 
 @torch.no_grad()
 def evaluate(model: Coefficients, shots: ObservedShots, config: JointConfig, sources: list[str],
-             source_density: torch.Tensor | None = None, runs: int = 1, step: EulerStep = euler_step
+             source_density: torch.Tensor | None = None, runs: int = 1, step: StepRule = FORWARD_EULER
              ) -> list[dict[str, Any]]:
     """Each run's (of `runs` stacked in `model`) loss and per-source errors in physical units on `shots`, flown calm
     in their air times `source_density` [runs, sources] (`fly`, with `step`): landing error (m), mean absolute error
@@ -409,13 +409,13 @@ def train_joint_runs(data_path: str | os.PathLike, out_dirs: list[str | os.PathL
     try:
         return _train_joint(Path(data_path), [Path(d) for d in out_dirs], configs,
                             StackedNetworks(init, len(configs)).to(where), progress, where,
-                            training_step(compile_step))
+                            step_rule(compile_step))
     finally:
         torch.set_flush_denormal(False)
 
 
 def _train_joint(data_path: Path, out_dirs: list[Path], configs: list[JointConfig], networks: StackedNetworks,
-                 progress: bool, device: torch.device, step: EulerStep) -> list[JointResult]:
+                 progress: bool, device: torch.device, step: StepRule) -> list[JointResult]:
     config, runs = configs[0], len(configs)
     for out_dir in out_dirs:
         out_dir.mkdir(parents=True, exist_ok=True)

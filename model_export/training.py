@@ -21,16 +21,15 @@ from golfflight.flight.constants import YARD_M
 from golfflight.flight.devices import DEFAULT_DEVICE, resolve_device
 from golfflight.model_export import DEFAULT_HIDDEN, VARIANTS
 from golfflight.model_export.data import MIN_APEX_M, DataSummary, ShotTensors, load_training_data
+from golfflight.flight.integrator import FORWARD_EULER, StepRule
 from golfflight.flight.rollout import (
     DT_S,
     SOFT_ARGMAX_TEMPERATURE_M,
     T_SIM_S,
-    EulerStep,
     euler_rollout,
-    euler_step,
     hard_landing,
     soft_landing,
-    training_step,
+    step_rule,
 )
 from golfflight.model_export.variants import build_model
 from golfflight.shots.files import write_atomic, write_text_atomic
@@ -89,12 +88,12 @@ class RunResult:
 
 
 def predict(
-    model: nn.Module, shots: ShotTensors, config: TrainConfig, soft: bool, step: EulerStep = euler_step
+    model: nn.Module, shots: ShotTensors, config: TrainConfig, soft: bool, step: StepRule = FORWARD_EULER
 ) -> tuple[torch.Tensor, torch.Tensor | None]:
     """Landing point [N,2] and apex [N] (None for the NN baseline): soft-argmax landing for training, the runtime's
     landing (first crossing interpolated to r_z = 0) for validation; the apex as the runtime measures it. The soft
     landing weighs every step; validation's rollout stops once every shot has come down (`euler_rollout`). `step`:
-    `euler_step`, eager or compiled."""
+    `flight.rollout.step_rule`'s forward Euler, eager or compiled."""
     if config.variant == "nn":
         return model(shots.velocity, shots.spin), None
     trajectory = euler_rollout(
@@ -130,7 +129,7 @@ def errors(landing: torch.Tensor, apex: torch.Tensor | None, shots: ShotTensors)
 
 
 @torch.no_grad()
-def validate(model: nn.Module, shots: ShotTensors, config: TrainConfig, step: EulerStep = euler_step
+def validate(model: nn.Module, shots: ShotTensors, config: TrainConfig, step: StepRule = FORWARD_EULER
              ) -> dict[str, float]:
     """Validation metrics with the runtime's landing and apex (`rollout.hard_landing`, `apex`), in m and yd
     (`step` as `predict` takes it)."""
@@ -201,7 +200,7 @@ def _train_epoch(
     config: TrainConfig,
     epoch: int,
     progress: bool,
-    step: EulerStep,
+    step: StepRule,
 ) -> dict[str, Any]:
     """One pass over the training shots in a seeded order (drawn on the CPU, so every device takes the same); a
     batch whose loss or gradient is not finite is skipped (no optimiser step) and counted. Returns the mean L_p, L_h
@@ -264,7 +263,8 @@ def train(
     own last.pt wins); `skip_bad_rows` leaves malformed rows of the data file out (listed in the result's data
     summary) instead of refusing it; `device` is where the model and the shots live ("cpu", "cuda"; the model is
     initialised and the batches drawn on the CPU either way, `devices.DeviceError` where it is missing);
-    `compile_step` fuses each Euler step's kernels, forward and backward, with torch.compile (`training_step`).
+    `compile_step` fuses each Euler step's kernels, forward and backward, with torch.compile
+    (`flight.rollout.step_rule`).
     Denormal floats are flushed to zero while training (without it the first backward passes through the rollout
     hit denormals and a CPU batch runs 20-100x slower), and the CPU's normal mode is restored afterwards."""
     if config.loss == "observables":
@@ -273,7 +273,7 @@ def train(
     torch.set_flush_denormal(True)
     try:
         return _train(data_path, out_dir, config, resume, progress, init_state, skip_bad_rows, where,
-                      training_step(compile_step))
+                      step_rule(compile_step))
     finally:
         torch.set_flush_denormal(False)
 
@@ -287,7 +287,7 @@ def _train(
     init_state: dict[str, torch.Tensor] | None,
     skip_bad_rows: bool,
     device: torch.device,
-    step: EulerStep,
+    step: StepRule,
 ) -> RunResult:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -157,7 +157,7 @@ def test_stacked_seeds_on_a_gpu_are_one_process(tmp_path, capsys, monkeypatch):
 def test_a_compiled_step_trains_the_runs_the_eager_step_trains(tmp_path, seeds):
     """`train-real --compile` (and with `--stack-seeds`): the Euler step fused by torch.compile, forward and
     backward, changes rounding only. Each case starts from an empty compile cache: torch.compile keeps its versions
-    of `euler_step` by the function, and past eight it would run eager unseen."""
+    of the Euler step (`flight.rollout.step_rule`) by the function, and past eight it would run eager unseen."""
     torch._dynamo.reset()
     _windy_set(tmp_path / "windy.csv", {"a": (0.0, 1.0)}, n_per_group=6)
     torch.manual_seed(0)

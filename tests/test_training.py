@@ -111,7 +111,8 @@ def test_nn_baseline_trains_on_landing_only(tiny_shots, tmp_path):
 def test_a_compiled_step_trains_what_the_eager_step_trains(run, tiny_shots, tmp_path):
     """`golfflight train --compile`: the Euler step fused by torch.compile, forward and backward (the soft landing's
     rollout and validation's), changes rounding only: the eager run's weights and validation errors after three
-    epochs. Compiled from an empty cache: torch.compile keeps its versions of `euler_step` by the function."""
+    epochs. Compiled from an empty cache: torch.compile keeps its versions of the Euler step
+    (`flight.rollout.step_rule`) by the function."""
     torch._dynamo.reset()
     assert main(["train", "--data", str(tiny_shots), "--out", str(tmp_path), "--variant", TINY["variant"],
                  "--hidden", ",".join(map(str, TINY["hidden"])), "--batch-size", str(TINY["batch_size"]),
