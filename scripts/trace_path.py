@@ -43,6 +43,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import dataclasses
+import importlib.util
 import itertools
 import json
 import sys
@@ -56,19 +57,16 @@ from typing import Any, Self
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-FLOORS = {
-    "weights_schema": 0,
-    "flight": 1,
-    "shots": 2,
-    "contract": 2,
-    "service": 3,
-    "sweep": 3,
-    "discovery": 3,
-    "evaluation": 3,
-    "model_export": 4,
-    "golfflight": 5,
-}
-"""Each package folder's floor (tests/test_imports.py FLOORS)."""
+def _import_rules():
+    """tests/test_imports.py, where the package folders' floors are set and held."""
+    spec = importlib.util.spec_from_file_location("test_imports", ROOT / "tests" / "test_imports.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+FLOORS: dict[str, int] = _import_rules().FLOORS
+"""Each package folder's floor, the import rules' own."""
 
 MPH_TO_MPS = 0.44704
 BALL_SPEED_MPH = 150.123

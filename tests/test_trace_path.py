@@ -61,8 +61,3 @@ def test_moves_and_climbs_are_those_of_the_recorded_sequence(http_journey):
     document = http_journey.to_json()
     assert (document["moves"], document["climbs"]) == http_journey.counts and document["ups"] == trace_path.ups(folders)
 
-
-def test_its_floors_are_the_import_rules():
-    from test_imports import FLOORS
-
-    assert trace_path.FLOORS == FLOORS
