@@ -2,12 +2,13 @@
 
 `load_flyer` is the only code that finds and assembles a model bundle: the lookup (`flight.bundle_location`), the
 card's step, maximum flight time (its t_sim, or the shot records' limit if longer), air and ball, checked against
-`flight.constants`. A Flyer puts its model in a given air (`in_air`: the graph fed at that air's Reynolds scale) and
-flies launches [N, LAUNCH_WIDTH] x conditions x grounds through `flight.integrator.integrate`: each shot down to
-its ground's plane (the state interpolated linearly to it), failing alone if it is still in the air at the maximum
+`flight.constants`. A Flyer puts its model in a given air (`in_air`: the graph fed at that air's Reynolds scale).
+`Flyer.flight` is the one batch flight: a state through `flight.integrator.integrate` in given air and wind, down to
+ground planes. `fly_batch` plans launches [N, LAUNCH_WIDTH] x conditions x grounds into it: each shot down to its
+ground's plane (the state interpolated linearly to it), failing alone if it is still in the air at the maximum
 flight time, then bounced and rolled to rest on that ground (`flight.ground`) unless the flight alone was asked for.
-The engine's single-shot path (`flight.engine`), discovery, accuracy, evaluation and the ground fit all fly
-through it, so every one of them flies the same shot to the same numbers.
+The engine's batches (`flight.engine`), discovery, accuracy, evaluation, the reference world and the ground fit all
+fly through it, so every one of them flies the same shot to the same numbers.
 """
 
 from __future__ import annotations
