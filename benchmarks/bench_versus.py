@@ -2,7 +2,9 @@
 to minute): the single shot in process (`FlightEngine.fly`, the tour 7-iron and driver rolled to rest on the
 fairway), the engine's batch of 1,024 and of 16 mixed launches to rest as one ShotFlight a shot (what the HTTP batch
 reads), the ground phase alone (one driver landing on floats, 1,024 landings on NumPy, level and on a slope), the
-torch engine's batch in process on the CPU (8,192 mixed launches, one thread) and whole `golfflight sweep` runs of
+torch engine's batch in process on the CPU (8,192 mixed launches, one thread), training's rollout (256 mixed
+launches through a phys-nn+ network (32, 32) in float32, one thread: the soft landing's whole horizon forward and
+backward, and validation's, stopped once every shot is down) and whole `golfflight sweep` runs of
 one grid, `--engine local --workers 1` and `--engine torch --device cpu --threads 1` (rows/s, process
 start to file written).
 
@@ -105,6 +107,31 @@ def ground_batch(slope_deg):  # the ground phase alone of 1,024 landings on NumP
     return (time.perf_counter() - started) * 1e3
 
 
+rollout_inputs = None
+
+
+def rollout(training):  # training's rollout of 256 mixed launches, float32, one thread (ms)
+    global rollout_inputs
+    import torch
+    from golfflight.flight.rollout import apex, euler_rollout, hard_landing, soft_landing
+    if rollout_inputs is None:
+        from golfflight.flight.physics import initial_state
+        from golfflight.model_export.variants import build_model
+        torch.set_num_threads(1)
+        torch.manual_seed(0)
+        start = initial_state(*(np.array(column) for column in zip(*mixed[:256])))
+        rollout_inputs = [torch.tensor(v, dtype=torch.float32) for v in (start.position, start.velocity, start.spin)]
+        rollout_inputs.append(build_model("phys-nn+", (32, 32)))
+    started = time.perf_counter()
+    if training:  # the soft landing's whole horizon, forward and backward
+        trajectory = euler_rollout(*rollout_inputs, 1.2, 0.1, 10.0)
+        (soft_landing(trajectory).sum() + apex(trajectory).height_m.sum()).backward()
+    else:  # validation's: no gradient, stopped once every shot is down
+        with torch.no_grad():
+            hard_landing(euler_rollout(*rollout_inputs, 1.2, 0.1, 10.0, stop_after_s=0.0))
+    return (time.perf_counter() - started) * 1e3
+
+
 for name in shots:
     single(name, 100)
 objects_batch()
@@ -114,7 +141,7 @@ for line in sys.stdin:
     runs = {"single": lambda: single(args[0], int(args[1])), "torch": lambda: torch_batch(int(args[0])),
             "objects": lambda: objects_batch(int(args[0])),
             "ground-one": lambda: ground_one(float(args[0]), int(args[1])),
-            "ground-batch": lambda: ground_batch(float(args[0]))}
+            "ground-batch": lambda: ground_batch(float(args[0])), "rollout": lambda: rollout(args[0] == "training")}
     print(json.dumps(runs[kind]()), flush=True)
 """
 
@@ -128,6 +155,8 @@ BLOCKS = {
     "ground phase alone, one driver landing on floats, 3 deg slope (us, median of 50)": "ground-one 3 50",
     "ground phase alone, 1,024 landings on NumPy, level fairway (ms)": "ground-batch 0",
     "ground phase alone, 1,024 landings on NumPy, 3 deg slope (ms)": "ground-batch 3",
+    "training's rollout, 256 launches, soft landing and backward (ms)": "rollout training",
+    "validation's rollout, 256 launches, stopped once down (ms)": "rollout validation",
 }
 
 

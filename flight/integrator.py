@@ -271,8 +271,9 @@ def integrate(
     record: Record = SummaryRecord,
 ) -> Flight:
     """Step a batch from `state` until every ball has met the event (or the record says it is finished) or `steps`
-    steps have passed: the record's flight (a `Flight`, where balls that never meet the event keep NaN landing values,
-    `landed` False). NumPy arrays or torch tensors (`flight.xp`) alike."""
+    steps have passed: the record's flight, a `Flight` where balls that never meet the event keep NaN landing values
+    (`landed` False), or training's `Trajectory` from its own record. NumPy arrays or torch tensors (`flight.xp`)
+    alike."""
     recorder = record(state, field, event)
     for i in range(1, steps + 1):
         state = recorder.keep(state, rule(state, recorder.field, dt), i)
