@@ -145,12 +145,14 @@ def euler_step(x, y, z, vx, vy, vz, wx, wy, wz, coefficients, density, air_vx, a
     )
 
 
-def aerodynamics(v_rel, omega, coefficients, density):
-    """Aerodynamic acceleration [N,3] (drag + Magnus lift) and spin acceleration [N,3] from the coefficients [N,4]
-    (C_L, C_D, C_M, C_Q); NumPy arrays or torch tensors alike, density a float or [N]."""
+def aerodynamics(v_rel, omega, coefficients, density, gravity_mps2: float = 0.0):
+    """Aerodynamic acceleration [N,3] (drag + Magnus lift), less `gravity_mps2` on z where given (the equations'
+    whole acceleration: subtracted from the column before it is stacked, so a gradient needs no in-place write), and
+    spin acceleration [N,3] from the coefficients [N,4] (C_L, C_D, C_M, C_Q); NumPy arrays or torch tensors alike,
+    density a float or [N]."""
     v, w = xp.columns(v_rel), xp.columns(omega)
-    components = accelerations(*v, *w, *(coefficients[..., i] for i in range(4)), density)
-    return xp.stack(components[:3]), xp.stack(components[3:])
+    ax, ay, az, *spin = accelerations(*v, *w, *(coefficients[..., i] for i in range(4)), density)
+    return xp.stack((ax, ay, az - gravity_mps2)), xp.stack(spin)
 
 
 def derivatives(
@@ -164,8 +166,7 @@ def derivatives(
     optional extra acceleration of the air-relative velocity, spin and position (discovery's learned correction)."""
     v_rel = state.velocity if wind.is_calm else state.velocity - wind.velocity(state.position[:, 2])
     coefficients = coefficient_model(v_rel, state.spin)
-    acceleration, spin_acceleration = aerodynamics(v_rel, state.spin, coefficients, density)
-    acceleration[:, 2] -= GRAVITY_MPS2
+    acceleration, spin_acceleration = aerodynamics(v_rel, state.spin, coefficients, density, GRAVITY_MPS2)
     if extra is not None:
         acceleration += extra(v_rel, state.spin, state.position)
     return State(state.velocity, acceleration, spin_acceleration)
