@@ -58,10 +58,6 @@ class FlightModel:
         return self.flyer.dt_s
 
     @property
-    def t_max_s(self) -> float:
-        return self.flyer.max_flight_time_s
-
-    @property
     def method(self) -> Literal["euler", "rk4"]:
         return self.flyer.rule.name
 

@@ -63,6 +63,7 @@ def code_lines(path: str, name: str) -> int:
 
 
 def count(functions: dict[str, list[str]]) -> list[tuple[str, int]]:
+    """("path: function", code lines) of each function listed."""
     return [(f"{path}: {name}", code_lines(path, name)) for path, names in functions.items() for name in names]
 
 

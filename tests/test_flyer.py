@@ -72,7 +72,7 @@ def test_every_caller_flies_the_shot_to_the_engines_carry_for_the_same_time(engi
     times = {
         "engine": engine.max_steps * engine.dt,
         "flyer": flyer.max_flight_time_s,
-        "discovery": discovery.t_max_s,
+        "discovery": discovery.flyer.max_flight_time_s,
         "accuracy": accuracy.t_sim_s,
         "ground fit and evaluate (load_flyer)": load_flyer().max_flight_time_s,
     }
