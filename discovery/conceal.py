@@ -3,8 +3,9 @@ the model being diagnosed (its own flights, as the service flies them, so clean 
 
 The base sessions are the synthetic generator's (players and robots, several clubs, realistic launch scatter and
 launch-monitor noise) but in calm air at ICAO standard conditions, the air the shipped model assumes, so the hidden
-effect is the only thing that differs from what the model is told. Launch biases are hidden by recording
-recorded = true - offset (or true / scale) before the noise is added.
+effect is the only thing that differs from what the model is told. Each library effect says how it is hidden
+(`effects.Effect.hiding`): what the launch monitor records (launch biases: recorded = true - offset, or true / scale,
+before the noise is added), the reference world with it and the model's own flights with it.
 """
 
 from __future__ import annotations
@@ -13,17 +14,17 @@ from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
-from golfflight.discovery.effects import AIR_VARIANTS, DENSITY_ONLY, Context, equivalent_altitude_m
+from golfflight.discovery.effects import EFFECTS, NOMINAL_AIR, Effect, World
+from golfflight.discovery.effects import NOMINAL_CONTEXT as NOMINAL_CONTEXT
 from golfflight.discovery.model import FlightModel
 from golfflight.discovery.noise import RADAR_NOISE
 from golfflight.discovery.outside import OUTSIDE, air_motion, term_and_weights
 from golfflight.discovery.simulator import Setup
 from golfflight.errors import InputError
-from golfflight.flight.air import Air
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import initial_state
 from golfflight.flight.reference_aero import CALIBRATED
-from golfflight.flight.wind import Wind, uniform_equivalent_factor, wind_vector
+from golfflight.flight.wind import Wind, uniform_equivalent_factor
 from golfflight.shots.records import ShotRecord, ShotSet
 from golfflight.shots.reference_world import fly_reference
 from golfflight.shots.synth import (
@@ -37,23 +38,9 @@ from golfflight.shots.synth import (
 )
 from pydantic import ValidationError
 
-NOMINAL_AIR = Air.standard()
-"""The air of the base sessions and the air the model is told: 15 degC, sea level, dry (1.225 kg/m^3)."""
-
-NOMINAL_CONTEXT = Context(float(NOMINAL_AIR.density_kg_m3), 15.0)
-
 OUTSIDE_EFFECT = "critical_reynolds"
 """The effect outside the library that `prove` hides: the ball's drag crisis sits at another Reynolds number
 (a different ball or dimple pattern), which changes drag and lift mostly at low speed, unlike any library effect."""
-
-LAUNCH_BIASES = {
-    "launch_angle_bias": ("launch_angle_deg", "offset_deg", True),
-    "launch_direction_bias": ("launch_direction_deg", "offset_deg", True),
-    "spin_axis_bias": ("spin_axis_deg", "offset_deg", True),
-    "ball_speed_bias": ("ball_speed_mps", "scale", False),
-    "spin_bias": ("spin_rpm", "scale", False),
-}
-KNOBS = {"drag_scale": "drag_scale", "lift_scale": "lift_scale", "spin_decay": "spin_decay_scale"}
 
 
 @dataclass
@@ -77,6 +64,7 @@ def conceal(
     trajectories: bool = False,
     wind_profile: Literal["uniform", "log"] = "uniform",
     model: FlightModel | None = None,
+    launch_seed: int | None = None,
 ) -> Concealed:
     """Draw sessions, fly them with the hidden effects through the reference world (or `model`) and record them
     with noise.
@@ -84,39 +72,33 @@ def conceal(
     hidden uses the report's parameter conventions, e.g. {"wind": {"speed_mps": 4, "from_deg": 0}}, plus
     {"critical_reynolds": {"value": 9e4}} for the reference world's effect outside the library, or one of
     `discovery.outside.OUTSIDE` for a model's (the gust, `height_gust`, is air motion: either world takes it).
+    With `launch_seed`, the sessions are `seed`'s and their launches and noise are drawn afresh from it.
     """
     rng = np.random.default_rng(seed)
     config = SynthConfig(n_shots=n_shots, seed=seed, calm=True)
     sessions = draw_sessions(rng, n_shots, config)
+    if launch_seed is not None:  # the same players and clubs, other launches and noise (a baseline session)
+        rng = np.random.default_rng([seed, launch_seed])
     true = draw_launches(rng, sessions)
     recorded = LaunchTable(**{k: getattr(true, k).copy() for k in true.__dataclass_fields__})
-    for name, (column, key, offset) in LAUNCH_BIASES.items():
-        if name in hidden:
-            value = hidden[name][key]
-            setattr(recorded, column, getattr(true, column) - value if offset else getattr(true, column) / value)
-    air, wind, ground = NOMINAL_AIR, Wind(), 0.0
-    if "air_density" in hidden:
-        altitude = equivalent_altitude_m(hidden["air_density"]["ratio"], NOMINAL_CONTEXT)
-        air = Air.from_conditions(15.0, altitude, 0.0)
-    if DENSITY_ONLY in hidden:
-        ratio = hidden[DENSITY_ONLY]["ratio"]
-        air = Air(NOMINAL_AIR.density_kg_m3 * ratio, NOMINAL_AIR.kinematic_viscosity_m2_s)
-    if "wind" in hidden:
-        wind = Wind(hidden["wind"]["speed_mps"], hidden["wind"]["from_deg"], profile=wind_profile)
-    if "landing_elevation" in hidden:
-        ground = hidden["landing_elevation"]["height_m"]
-    params = CALIBRATED
-    for name, knob in KNOBS.items():
-        if name in hidden:
-            params = replace(params, **{knob: hidden[name]["scale"]})
-    if OUTSIDE_EFFECT in hidden:
-        params = replace(params, critical_reynolds=hidden[OUTSIDE_EFFECT]["value"])
+    library = _hideable(hidden)
+    for effect in library:
+        recorded = effect.hiding.recorded(hidden[effect.name], recorded)
     keep = trajectories or wind_profile == "log"
     if model is None:
-        wind = air_motion(hidden, wind)
-        flight = fly_reference(initial_state(**true.launch()), air, wind, ground, keep_states=keep, params=params)
+        world = World(NOMINAL_AIR, Wind(), 0.0, CALIBRATED, wind_profile)
+        for effect in library:
+            world = effect.hiding.reference(hidden[effect.name], world)
+        params = world.params
+        if OUTSIDE_EFFECT in hidden:
+            params = replace(params, critical_reynolds=hidden[OUTSIDE_EFFECT]["value"])
+        wind = air_motion(hidden, world.wind)
+        flight = fly_reference(
+            initial_state(**true.launch()), world.air, wind, world.ground_m, keep_states=keep, params=params
+        )
     else:
-        flight = _fly_model(model, hidden, true, wind_profile, trajectories)
+        wind = Wind()
+        flight = _fly_model(model, hidden, library, true, wind_profile, trajectories)
     values = measure(rng, recorded, flight, noise)
     records, dropped, paths, kept = [], 0, {}, []
     order = np.zeros(len(sessions), dtype=int)
@@ -145,34 +127,33 @@ def conceal(
     return Concealed(ShotSet(records), hidden, dropped, paths, factor)
 
 
+def _hideable(hidden: dict[str, dict[str, float]]) -> list[Effect]:
+    """The hidden effects that say how they are hidden (`Effect.hiding`), in the registry's order: the order they
+    change the recorded launches and the worlds in (real air before density alone)."""
+    return [effect for name, effect in EFFECTS.items() if name in hidden and effect.hiding is not None]
+
+
 def _fly_model(
     model: FlightModel,
     hidden: dict[str, dict[str, float]],
+    library: list[Effect],
     true: LaunchTable,
     wind_profile: str,
     trajectories: bool,
 ) -> Flight:
-    """The true launches flown through the model with the hidden effects, in its flight core."""
-    unknown = (
-        set(hidden) - set(KNOBS) - set(LAUNCH_BIASES) - set(OUTSIDE) - {*AIR_VARIANTS, "wind", "landing_elevation"}
-    )
+    """The true launches flown through the model with the hidden effects (`library` those of the library), in its
+    flight core."""
+    unknown = set(hidden) - {effect.name for effect in library} - set(OUTSIDE)
     if unknown or wind_profile != "uniform":
         raise InputError(f"a model's own flights take library effects, uniform wind and discovery.outside: {unknown}")
     n = len(true.club)
-    scale = np.ones((n, 3))
-    for column, name in enumerate(("lift_scale", "drag_scale", "spin_decay")):
-        if name in hidden:
-            scale[:, column] = hidden[name]["scale"]
-    wind = np.zeros((n, 2))
-    if "wind" in hidden:
-        wind[:] = wind_vector(hidden["wind"]["speed_mps"], hidden["wind"]["from_deg"])[:2]
-    real, only = (hidden.get(name, {"ratio": 1.0})["ratio"] for name in AIR_VARIANTS)
-    ratio = np.full(n, real * only)
-    density = np.full(n, model.density_kg_m3)
-    term, weights = term_and_weights(hidden, density * ratio)
-    ground = np.full(n, hidden.get("landing_elevation", {"height_m": 0.0})["height_m"])
-    setup = Setup(true.launch(), ratio, density, wind, ground, scale, weights, viscosity_ratio=np.full(n, 1.0 / real))
-    air = air_motion(hidden, Wind.from_components(wind[:, 0], wind[:, 1]))
+    setup = Setup(
+        true.launch(), np.ones(n), np.full(n, model.density_kg_m3), np.zeros((n, 2)), np.zeros(n), np.ones((n, 3))
+    )
+    for effect in library:
+        setup = effect.hiding.model(np.repeat(effect.internal(hidden[effect.name])[None], n, axis=0), setup)
+    term, setup.correction_weights = term_and_weights(hidden, setup.density_kg_m3 * setup.density_ratio)
+    air = air_motion(hidden, Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1]))
     return model.fly(setup, term, keep_states=trajectories, air=air)
 
 

@@ -25,7 +25,8 @@ from typing import Literal
 import numpy as np
 from golfflight.discovery.conceal import NOMINAL_AIR, NOMINAL_CONTEXT, OUTSIDE_EFFECT, conceal
 from golfflight.discovery.diagnose import diagnose
-from golfflight.discovery.effects import AIR_VARIANTS, DENSITY_ONLY, EFFECTS, LIBRARY, equivalent_altitude_m
+from golfflight.discovery.effects import AIR_VARIANTS, DENSITY_ONLY, EFFECTS, LIBRARY, Draw, equivalent_altitude_m
+from golfflight.discovery.effects.parts import sign, uniform
 from golfflight.discovery.model import MIN_T_MAX_S, FlightModel
 from golfflight.discovery.outside import HEIGHT_GUST, HIGH_SPIN_LIFT_LOSS, LOW_SPEED_DRAG, OUTSIDE
 from golfflight.discovery.recordings import from_shot_set
@@ -33,7 +34,6 @@ from golfflight.flight.coefficients import QuadraticSpinRatio
 from golfflight.flight.flyer import FixedCoefficients, Flyer
 from golfflight.flight.integrator import RUNGE_KUTTA_4
 from golfflight.flight.reference_aero import CALIBRATED
-from golfflight.flight.wind import wind_vector
 from golfflight.shots.files import write_text_atomic
 from golfflight.shots.markdown import write_generated_section
 from golfflight.shots.progress import progress_bar
@@ -96,43 +96,26 @@ def command(
     return f"prove --model {model_spec} --truth {truth}{extra}"
 
 
-def _sign(rng: np.random.Generator) -> float:
-    return 1.0 if rng.random() < 0.5 else -1.0
+def _moved_crisis(rng: np.random.Generator) -> dict[str, float]:
+    """The drag crisis 12-25 % above or below the calibrated critical Reynolds number."""
+    return {"value": float(CALIBRATED.critical_reynolds * (1 + sign(rng) * rng.uniform(0.12, 0.25)))}
+
+
+OUTSIDE_DRAWS: dict[str, Draw] = {
+    OUTSIDE_EFFECT: _moved_crisis,
+    LOW_SPEED_DRAG: uniform(rise=(0.08, 0.2), speed_mps=(35.0, 50.0)),
+    HIGH_SPIN_LIFT_LOSS: uniform(loss=(0.15, 0.35), spin_ratio=(0.2, 0.28)),
+    HEIGHT_GUST: uniform(rate_mps_per_m=(0.15, 0.35), height_m=(6.0, 14.0), from_deg=(0.0, 360.0)),
+}
+"""Realistic sizes of the effects outside the library (a library effect's are its own, `Effect.hiding.draw`)."""
 
 
 def draw_effect(name: str, rng: np.random.Generator) -> dict[str, float]:
     """A realistic size and direction of one effect, in the report's conventions."""
-    if name == "wind":
-        return {"speed_mps": float(rng.uniform(2.0, 7.0)), "from_deg": float(rng.uniform(0.0, 360.0))}
-    if name in AIR_VARIANTS:
-        thinner = rng.random() < 0.75
-        return {"ratio": float(1 - rng.uniform(0.05, 0.22) if thinner else 1 + rng.uniform(0.03, 0.08))}
-    if name == OUTSIDE_EFFECT:
-        return {"value": float(CALIBRATED.critical_reynolds * (1 + _sign(rng) * rng.uniform(0.12, 0.25)))}
-    if name == LOW_SPEED_DRAG:
-        return {"rise": float(rng.uniform(0.08, 0.2)), "speed_mps": float(rng.uniform(35.0, 50.0))}
-    if name == HIGH_SPIN_LIFT_LOSS:
-        return {"loss": float(rng.uniform(0.15, 0.35)), "spin_ratio": float(rng.uniform(0.2, 0.28))}
-    if name == HEIGHT_GUST:
-        return {
-            "rate_mps_per_m": float(rng.uniform(0.15, 0.35)),
-            "height_m": float(rng.uniform(6.0, 14.0)),
-            "from_deg": float(rng.uniform(0.0, 360.0)),
-        }
-    ranges = {
-        "launch_angle_bias": ("offset_deg", 0.7, 2.0, 0.0),
-        "launch_direction_bias": ("offset_deg", 1.0, 3.0, 0.0),
-        "spin_axis_bias": ("offset_deg", 2.0, 5.0, 0.0),
-        "landing_elevation": ("height_m", 3.0, 12.0, 0.0),
-        "ball_speed_bias": ("scale", 0.015, 0.04, 1.0),
-        "spin_bias": ("scale", 0.06, 0.15, 1.0),
-        "drag_scale": ("scale", 0.04, 0.10, 1.0),
-        "lift_scale": ("scale", 0.05, 0.12, 1.0),
-    }
-    if name == "spin_decay":
-        return {"scale": float(rng.uniform(1.6, 2.5) if rng.random() < 0.5 else rng.uniform(0.35, 0.6))}
-    key, low, high, centre = ranges[name]
-    return {key: float(centre + _sign(rng) * rng.uniform(low, high))}
+    effect = EFFECTS.get(name)
+    if effect is not None and effect.hiding is not None:
+        return effect.hiding.draw(rng)
+    return OUTSIDE_DRAWS[name](rng)
 
 
 def cases(truth: Truth = "model", campaign: Campaign = "library") -> list[tuple[str, tuple[str, ...]]]:
@@ -161,12 +144,8 @@ def _outside(effects: tuple[str, ...] | dict) -> bool:
 
 
 def internal(name: str, parameters: dict[str, float]) -> np.ndarray:
-    """A hidden or fitted effect as the library's internal parameter vector."""
-    if name == "wind":
-        return wind_vector(parameters["speed_mps"], parameters["from_deg"])[:2]
-    if name in AIR_VARIANTS:
-        return np.array([parameters["ratio"]])
-    return np.array([next(iter(v for k, v in parameters.items() if k in ("offset_deg", "scale", "height_m")))])
+    """A hidden or fitted effect as the library's internal parameter vector (`Effect.internal`)."""
+    return EFFECTS[name].internal(parameters)
 
 
 def truth_world(truth: Truth, model: FlightModel) -> FlightModel | None:
@@ -195,12 +174,12 @@ def ferguson_world() -> FlightModel:
 
 
 def fitted_as(name: str, fitted: dict[str, dict[str, float]]) -> str | None:
-    """The fitted effect that stands for the hidden `name`: itself, or for air either variant; None if not fitted."""
+    """The fitted effect that stands for the hidden `name`: itself, or one of its stand-ins (`Effect.stand_ins`: for
+    air either variant); None if not fitted."""
     if name in fitted:
         return name
-    if name in AIR_VARIANTS:
-        return next((other for other in AIR_VARIANTS if other in fitted), None)
-    return None
+    stand_ins = EFFECTS[name].stand_ins if name in EFFECTS else ()
+    return next((other for other in stand_ins if other in fitted), None)
 
 
 def relative_error(name: str, fitted: dict[str, float], hidden: dict[str, float]) -> float:

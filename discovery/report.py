@@ -4,38 +4,19 @@ ambiguities (explanations the data cannot tell apart, and what measurement would
 from __future__ import annotations
 
 import numpy as np
-from golfflight.discovery.effects import AIR_VARIANTS, DENSITY_ONLY, Context
+from golfflight.discovery.effects import EFFECTS, Context
+from golfflight.discovery.effects.parts import plus_minus as plus_minus
 from golfflight.discovery.fit import Fit, Problem, Scored, cluster_bootstrap, per_shot
 from golfflight.discovery.locate import has_structure
 from golfflight.discovery.recordings import OBSERVABLES
-from golfflight.discovery.schema import (
-    AirAltitude,
-    AirDensity,
-    Ambiguity,
-    EffectResult,
-    Heldout,
-    Located,
-    CorrectionSettings,
-    Unlisted,
-    WindSetting,
-)
+from golfflight.discovery.schema import Ambiguity, CorrectionSettings, EffectResult, Heldout, Located, Unlisted
 from golfflight.discovery.words import OBSERVABLE_WORDS, UNITS, effect_words, key_words, quantity, unit_of, with_unit
-from golfflight.flight.wind import STATION_HEIGHT_M
 
 MATERIAL = 0.05
 """Share above the expected error that counts as a material excess (as in `discovery.diagnose`)."""
 
 CARRY_ALIKE = {"wind", "air_density", "air_density_only", "ball_speed_bias", "landing_elevation", "drag_scale"}
 """Effects that all move carry along the line and need the other observables to be told apart."""
-
-LAUNCH_SETTINGS = {
-    "launch_angle_bias": ("launch_angle_deg_add", "offset_deg"),
-    "launch_direction_bias": ("launch_direction_deg_add", "offset_deg"),
-    "spin_axis_bias": ("spin_axis_deg_add", "offset_deg"),
-    "ball_speed_bias": ("ball_speed_scale", "scale"),
-    "spin_bias": ("spin_rpm_scale", "scale"),
-}
-COEFFICIENT_SETTINGS = {"drag_scale": "drag_scale", "lift_scale": "lift_scale", "spin_decay": "spin_decay_scale"}
 
 
 def effect_results(result: Fit, context: Context) -> list[EffectResult]:
@@ -52,33 +33,14 @@ def effect_results(result: Fit, context: Context) -> list[EffectResult]:
 def service_settings(
     effects: list[EffectResult], context: Context, wind_factor: float | None = None
 ) -> CorrectionSettings:
-    """The correction as the service's request options (wind, air) plus launch and model corrections.
-    `wind_factor` (the log profile's uniform-equivalent factor along the corrected flights) adds the fitted wind as
-    a 10 m station reading with the log profile."""
+    """The correction as the service's request options (wind, air) plus launch and model corrections, each effect's
+    own (`Effect.setting`). `wind_factor` (the log profile's uniform-equivalent factor along the corrected flights)
+    adds the fitted wind as a 10 m station reading with the log profile."""
     settings = CorrectionSettings()
     for effect in effects:
-        p = effect.parameters
-        if effect.name == "wind":
-            settings.wind = WindSetting(speed_mps=p["speed_mps"], from_deg=p["from_deg"])
-            if wind_factor:
-                settings.wind_at_station = WindSetting(
-                    speed_mps=p["speed_mps"] / wind_factor,
-                    from_deg=p["from_deg"],
-                    profile="log",
-                    reference_height_m=STATION_HEIGHT_M,
-                )
-        elif effect.name in AIR_VARIANTS:
-            settings.air = AirDensity(density_kg_m3=p["density_kg_m3"])
-            settings.air_as_altitude = AirAltitude(
-                altitude_m=p["equivalent_altitude_m"], temperature_c=context.temperature_c
-            )
-        elif effect.name == "landing_elevation":
-            settings.ground_height_m = p["height_m"]
-        elif effect.name in LAUNCH_SETTINGS:
-            key, parameter = LAUNCH_SETTINGS[effect.name]
-            settings.launch_corrections[key] = p[parameter]
-        elif effect.name in COEFFICIENT_SETTINGS:
-            settings.coefficient_scales[COEFFICIENT_SETTINGS[effect.name]] = p["scale"]
+        known = EFFECTS.get(effect.name)
+        if known is not None and known.setting is not None:
+            known.setting(settings, effect.parameters, context, wind_factor)
     return settings
 
 
@@ -148,61 +110,17 @@ def ambiguity(
     return out
 
 
-def plus_minus(value: float, sd: float, unit: str = "") -> str:
-    """'4.03 ± 0.02 unit' with as many decimals as the uncertainty's second significant digit needs."""
-    decimals = int(np.clip(1 - np.floor(np.log10(sd)), 0, 6)) if sd > 0 and np.isfinite(sd) else 2
-    return f"{value:.{decimals}f} ± {sd:.{decimals}f}{unit}"
-
-
 def effect_phrase(effect: EffectResult) -> str:
     """The fitted effect in words with its size ± 1 sigma and units ('air 0.914 ± 0.002 times as dense as assumed
-    (as at about 755 ± 12 m)'); an effect this module has no words for lists its parameters."""
+    (as at about 755 ± 12 m)'), each effect's own (`Effect.phrase`); an effect without one lists its parameters."""
     p, u = effect.parameters, effect.uncertainty
-    name = effect.name
-    if name == "wind":
-        direction = p["from_deg"]
-        kind = (
-            "headwind"
-            if min(direction, 360 - direction) < 30
-            else "tailwind"
-            if abs(direction - 180) < 30
-            else "wind from the right"
-            if direction < 180
-            else "wind from the left"
-        )
-        return (
-            f"a steady {plus_minus(p['speed_mps'], u['speed_mps'], ' m/s')} wind from "
-            f"{plus_minus(direction, u['from_deg'], '°')} (mostly a {kind})"
-        )
-    if name in AIR_VARIANTS:
-        return (
-            f"air {plus_minus(p['ratio'], u['ratio'])} times as dense as assumed "
-            f"(as at about {p['equivalent_altitude_m']:.0f} ± {u['equivalent_altitude_m']:.0f} m"
-            + ("; density alone, the Reynolds number unchanged)" if name == DENSITY_ONLY else ")")
-        )
-    if name == "landing_elevation":
-        where = "below" if p["height_m"] < 0 else "above"
-        return f"landing ground {plus_minus(abs(p['height_m']), u['height_m'], ' m')} {where} the tee"
-    if name == "unlisted":
+    known = EFFECTS.get(effect.name)
+    if known is not None and known.phrase is not None:
+        return known.phrase(p, u)
+    if effect.name == "unlisted":
         return "a learned extra acceleration (see unlisted)"
-    if name == "reynolds_scale":
-        return (
-            f"the coefficients read at {plus_minus(p['scale'], u['scale'])} times the Reynolds number of the recorded "
-            "air (1 / the density ratio for a flight model that takes density alone)"
-        )
-    if "offset_deg" in p:
-        return f"a {name.replace('_', ' ')} of {plus_minus(p['offset_deg'], u['offset_deg'], '°')} (true − recorded)"
-    what = {
-        "spin_decay": "spin decay scaled by",
-        "drag_scale": "drag scaled by",
-        "lift_scale": "lift scaled by",
-        "ball_speed_bias": "true/recorded ball speed of",
-        "spin_bias": "true/recorded spin of",
-    }.get(name)
-    if what is None or "scale" not in p:
-        sizes = ", ".join(f"{key_words(k)} {quantity(v, u.get(k), unit_of(k))}" for k, v in p.items())
-        return f"{effect_words(name)} ({sizes})"
-    return f"{what} {plus_minus(p['scale'], u['scale'])}"
+    sizes = ", ".join(f"{key_words(k)} {quantity(v, u.get(k), unit_of(k))}" for k, v in p.items())
+    return f"{effect_words(effect.name)} ({sizes})"
 
 
 def _mismatch(located: Located) -> str:

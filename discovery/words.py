@@ -4,6 +4,7 @@ numbers written with their units, so report.html never shows a field name where 
 from __future__ import annotations
 
 import numpy as np
+from golfflight.discovery.effects import EFFECTS
 
 OBSERVABLE_WORDS = {
     "carry_y_m": "carry",
@@ -36,23 +37,11 @@ COVARIATE_WORDS = {
 }
 """Each launch value the residuals are tested against, in words, with its unit."""
 
-EFFECT_WORDS = {
-    "wind": "wind",
-    "air_density": "air density",
-    "air_density_only": "air density alone",
-    "reynolds_scale": "Reynolds number",
-    "launch_angle_bias": "launch angle reading",
-    "launch_direction_bias": "launch direction reading",
-    "ball_speed_bias": "ball speed reading",
-    "spin_bias": "spin reading",
-    "spin_axis_bias": "spin axis reading",
-    "landing_elevation": "landing ground height",
-    "spin_decay": "spin decay",
-    "drag_scale": "drag",
-    "lift_scale": "lift",
-    "unlisted": "learned extra acceleration",
+EFFECT_WORDS = {name: effect.words for name, effect in EFFECTS.items() if effect.words} | {
+    "unlisted": "learned extra acceleration"
 }
-"""Each library effect in words (an effect not listed reads as its name with spaces)."""
+"""Each effect in words (`Effect.words`), and the learned correction (an effect not listed reads as its name with
+spaces)."""
 
 PARAMETER_UNITS = (
     ("_kg_m3", "kg/m³"),
