@@ -85,10 +85,11 @@ class EffectResult(_ReportModel):
     """A named effect with its fitted parameters and their 1-sigma uncertainties."""
 
     name: str
-    kind: Literal["venue", "monitor", "form"] = Field(
+    kind: Literal["venue", "monitor", "ball", "form"] = Field(
         "form",
-        description="a condition of the venue (air, wind, ground), a bias of the launch monitor, or the model's form "
-        "(coefficient scales or a learned correction: the recordings' physics differs from the model's in form)",
+        description="a condition of the venue (air, wind, ground), a bias of the launch monitor, another ball than a "
+        "baseline session's, or the model's form (coefficient scales or a learned correction: the recordings' physics "
+        "differs from the model's in form)",
     )
     parameters: dict[str, float]
     uncertainty: dict[str, float]

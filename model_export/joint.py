@@ -4,7 +4,7 @@ Every observable a shot has (landing point, apex, flight time, landing angle, pa
 units of its measurement noise (`model_export.observations`), through a Huber function (outliers count linearly).
 Each conditions group gets a latent uniform wind, each air group a latent density factor, each non-reference ball
 type a latent lift and drag scale, all with Gaussian priors whose widths are the typical sizes of the matching
-discovery effects (`discovery.effects`: wind, air_density, lift_scale, drag_scale), so the network does not absorb
+discovery effects (`discovery.effects`: wind, air_density, ball), so the network does not absorb
 a session's weather into the aerodynamics. Each source's mean air is held at its stated air where it is known
 (`shots.source_air`) and fitted where it is not (range sessions), so the sources with known air set the level of a
 carry. Validation shots are flown calm in their recorded air (a range session's in its source's fitted mean air), as
@@ -97,7 +97,7 @@ class JointConfig:
     weights: dict[str, float] = field(default_factory=lambda: dict(SOURCE_WEIGHTS))
     wind_prior_mps: float = field(default_factory=lambda: _typical("wind"))
     density_prior: float = field(default_factory=lambda: _typical("air_density"))
-    ball_prior: float = field(default_factory=lambda: _typical("drag_scale"))
+    ball_prior: float = field(default_factory=lambda: _typical("ball"))
     select_on: tuple[str, ...] = ("trackman-outdoor", "sentry-2022", "players-2020", "tour-championship-2020",
                                   "trackman-model", "pga-2023-table")
     """Sources whose validation error compares runs, each counting equally (`selection_loss`)."""

@@ -22,6 +22,7 @@ from golfflight.discovery.effects.air import (
     REYNOLDS_SCALE,
     equivalent_altitude_m,
 )
+from golfflight.discovery.effects.ball import BALL
 from golfflight.discovery.effects.base import (
     KINDS,
     Context,
@@ -61,12 +62,15 @@ LIBRARY: tuple[Effect, ...] = (
 )
 """Every library effect, in report order."""
 
-EFFECTS: dict[str, Effect] = {effect.name: effect for effect in (*LIBRARY, REYNOLDS_SCALE)}
-"""Every effect by name, in the order `discovery.conceal` hides them (real air before density alone)."""
+EFFECTS: dict[str, Effect] = {effect.name: effect for effect in (*LIBRARY, REYNOLDS_SCALE, BALL)}
+"""Every effect by name, in the order `discovery.conceal` hides them (real air before density alone): the library,
+and those offered only where they apply (the Reynolds scale where the air is recorded, another ball against a
+baseline session)."""
 
 __all__ = [
     "AIR_VARIANTS",
     "ALIASES",
+    "BALL",
     "DENSITY_ONLY",
     "EFFECTS",
     "KINDS",

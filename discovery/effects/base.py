@@ -39,15 +39,16 @@ class Parameter:
 
 Reported = tuple[dict[str, float], dict[str, float]]
 
-Kind = Literal["venue", "monitor", "form"]
+Kind = Literal["venue", "monitor", "ball", "form"]
 """What an effect says about the recordings: a condition of the venue (air, wind, ground), a bias of the launch
-monitor's launch values, or the model's form (its coefficients or a learned correction: the recordings' physics
-differs from the model's in form). Venue and monitor findings are what a user acts on; a form finding says the model
-itself differs, whatever the venue."""
+monitor's launch values, another ball than a baseline session's, or the model's form (its coefficients or a learned
+correction: the recordings' physics differs from the model's in form). Venue and monitor findings are what a user
+acts on; a form finding says the model itself differs, whatever the venue."""
 
 KINDS: dict[Kind, str] = {
     "venue": "a condition of the venue",
     "monitor": "a bias of the launch monitor",
+    "ball": "another ball",
     "form": "the model's form",
 }
 
