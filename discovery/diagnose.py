@@ -46,6 +46,7 @@ from golfflight.discovery.fit import (
     per_shot,
     stratified_rows,
 )
+from golfflight.discovery.headline import headline
 from golfflight.discovery.invariance import Halves, halves, set_aside_sentence
 from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
 from golfflight.discovery.model import FlightModel
@@ -410,7 +411,7 @@ class Diagnoser:
         )
         if selection.systematic and "varies_with_ball_speed" in selection.test:
             words += set_aside_sentence(selection.test["varies_with_ball_speed"])
-        return Report(
+        report = Report(
             recordings=recordings.source,
             n_shots=len(recordings),
             n_sessions=recordings.n_sessions,
@@ -437,6 +438,7 @@ class Diagnoser:
             service_settings=service_settings(effects, context, after.wind_factor),
             seconds=time.perf_counter() - self.started,
         )
+        return report.model_copy(update={"headline": headline(report)})
 
     def null_candidate(self) -> Scored:
         """The model as is, scored like any candidate (no parameters, no penalty)."""

@@ -1,4 +1,5 @@
-"""report.html, written for a reader: the verdict first in plain words (`discovery.verdict`: what differs, which
+"""report.html, written for a reader: the headline first (`discovery.headline`: what differs, the most likely cause,
+the runner-up, read in ten seconds), then the verdict in plain words (`discovery.verdict`: what differs, which
 physics explains it, the rivals, how sure, what to record next), then numbered sections of evidence, each table
 with its units in the headers, and the interactive figures (`discovery.figures`: residuals against the launch
 values that matter and along the flight, per-session means, held-out residuals and trajectories before and after the
@@ -15,6 +16,7 @@ from __future__ import annotations
 from html import escape
 
 from golfflight.discovery import tables
+from golfflight.discovery.headline import headline
 from golfflight.discovery.schema import Report
 from golfflight.discovery.style import STYLE
 from golfflight.discovery.verdict import Verdict, verdict
@@ -100,6 +102,7 @@ KNOWN_FIELDS = {
     "air_rival",
     "heldout",
     "statement",
+    "headline",
     "service_settings",
     "seconds",
 }
@@ -111,8 +114,15 @@ def _items(lines: list[str]) -> str:
     return "<ul>" + "".join(f"<li>{escape(line[0].upper() + line[1:])}</li>" for line in lines) + "</ul>"
 
 
+def headline_block(report: Report) -> str:
+    """The headline, one paragraph per sentence: what differs, the most likely cause, the runner-up (a value and its
+    ± kept on one line)."""
+    sentences = "".join(f"<p>{escape(s).replace(' ± ', '&nbsp;±&nbsp;')}</p>" for s in headline(report))
+    return f"<div class=headline>{sentences}</div>"
+
+
 def verdict_section(report: Report, found: Verdict) -> str:
-    """The verdict: the answer in one sentence, one list per question, and the report's own paragraph."""
+    """The verdict: the headline, one list per question, and the report's own paragraph."""
     rows = "".join(
         f"<dt>{title}</dt><dd>{_items(getattr(found, field))}</dd>"
         for field, title in VERDICT_ROWS
@@ -120,7 +130,7 @@ def verdict_section(report: Report, found: Verdict) -> str:
     )
     return (
         f"<section class=verdict id=verdict aria-labelledby=verdict-title><h2 id=verdict-title>Verdict</h2>"
-        f"<p class=headline>{escape(found.headline)}</p><dl>{rows}</dl>"
+        f"{headline_block(report)}<dl>{rows}</dl>"
         f"<p class=paragraph>In one paragraph (report.json's statement): {escape(report.statement)}</p></section>"
     )
 

@@ -280,6 +280,12 @@ class Report(_ReportModel):
     )
     heldout: Heldout
     statement: str
+    headline: list[str] = Field(
+        default_factory=list,
+        description="the verdict read in ten seconds (`discovery.headline`): at most three sentences of at most 35 "
+        "words, what differs (carry, apex, side with their sizes and directions), the most likely cause with its "
+        "value, the runner-up",
+    )
     service_settings: CorrectionSettings
     seconds: float
 

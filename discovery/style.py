@@ -1,6 +1,7 @@
 """report.html's stylesheet, inlined in the page so it opens offline: system fonts only (nothing fetched), a clear
-hierarchy (title block, the verdict in a ruled box, numbered sections), booktabs-like tables with right-aligned
-tabular numbers, and a print layout (A4, no page break inside a table row or the verdict, the raw data left out)."""
+hierarchy (title block, the verdict in a ruled box opening with its headline, numbered sections), booktabs-like
+tables with right-aligned tabular numbers, one column at a phone's width, and a print layout (A4, no page break
+inside a table row or the verdict, the raw data left out)."""
 
 STYLE = """
 :root{--ink:#1c2228;--muted:#5a6571;--rule:#cfd6dd;--soft:#f4f6f8;--accent:#1f5f99;--chosen:#eef5ec;--flag:#8a4b00}
@@ -21,7 +22,10 @@ section.verdict{margin:1.6rem 0 0;padding:1.1rem 1.4rem 1.2rem;background:var(--
  border-left:6px solid var(--accent);break-inside:avoid}
 section.verdict h2{margin:0 0 .4rem;border:0;padding:0;font-size:.85rem;color:var(--muted);letter-spacing:.08em;
  text-transform:uppercase}
-section.verdict .headline{font-size:1.3rem;line-height:1.4;font-weight:600;margin:0 0 .9rem}
+section.verdict .headline{margin:0 0 1rem;overflow-wrap:break-word}
+section.verdict .headline p{font-size:1.25rem;line-height:1.4;font-weight:600;margin:0 0 .35rem}
+section.verdict .headline p:first-child{font-weight:700}
+section.verdict .headline p:nth-child(3){font-size:1.05rem;font-weight:400}
 section.verdict dl{display:grid;grid-template-columns:11rem 1fr;gap:.55rem 1.2rem;margin:0}
 section.verdict dt{font-weight:650;color:var(--accent)}
 section.verdict dd{margin:0}section.verdict ul{margin:0;padding-left:1.1rem}section.verdict li+li{margin-top:.25rem}
@@ -44,6 +48,13 @@ details.raw{margin:2.4rem 0 1rem;border-top:1px solid var(--rule);padding-top:.6
 details.raw summary{cursor:pointer;color:var(--muted)}
 details.raw pre{font-size:.78rem;background:var(--soft);padding:.8rem;overflow-x:auto;max-height:40rem}
 footer{padding-top:.6rem;padding-bottom:2rem;color:var(--muted);font-size:.8rem}
+@media (max-width:40rem){
+ header.title,main,footer{padding-left:.9rem;padding-right:.9rem}
+ section.verdict{padding:.9rem 1rem 1rem;border-left-width:4px}
+ section.verdict .headline p{font-size:1.1rem}
+ section.verdict dl{grid-template-columns:1fr;gap:.2rem}
+ section.verdict dd+dt{margin-top:.6rem}
+}
 @media print{
  @page{size:A4;margin:16mm 14mm}
  html{font-size:10pt}

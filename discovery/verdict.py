@@ -1,8 +1,8 @@
-"""The verdict that opens report.html, in plain words: what differs (the quantity, by how much, with its unit and
-sign, on what share of shots), which physics explains it (the named effect and its fitted size ± 1 sigma, or none
-found), the rivals the data cannot tell from it and why, how sure the tool is (its tests in words) and what to record
-next. Built from report.json alone (the per-shot residuals, where given, add the share of shots), so a reader
-never has to read the JSON to learn the answer."""
+"""The verdict that follows report.html's headline (`discovery.headline`), in plain words: what differs (the
+quantity, by how much, with its unit and sign, on what share of shots), which physics explains it (the named effect
+and its fitted size ± 1 sigma, or none found), the rivals the data cannot tell from it and why, how sure the tool is
+(its tests in words) and what to record next. Built from report.json alone (the per-shot residuals, where given, add
+the share of shots), so a reader never has to read the JSON to learn the answer."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import numpy as np
 from golfflight.discovery.effects import DENSITY_ONLY
 from golfflight.discovery.recordings import LABELS, OBSERVABLES
 from golfflight.discovery.report import effect_phrase, share_interval
-from golfflight.discovery.schema import Ambiguity, Candidate, Located, ObservableStat, Report
+from golfflight.discovery.schema import Ambiguity, Candidate, CovariateStat, Located, ObservableStat, Report
 from golfflight.discovery.words import (
     COVARIATE_WORDS,
     DIRECTIONS,
@@ -27,9 +27,8 @@ from golfflight.discovery.words import (
 
 @dataclass(frozen=True)
 class Verdict:
-    """The answer in one sentence, then one short list per question a reader asks."""
+    """One short list per question a reader asks, after the headline (`discovery.headline`)."""
 
-    headline: str
     differs: list[str]
     physics: list[str]
     rivals: list[str]
@@ -94,18 +93,37 @@ def _observable_line(o: ObservableStat, residual: np.ndarray | None, bias_found:
     return line + f" (this shift alone is not significant; the scatter is {o.rms_ratio:.1f} times the expected error)"
 
 
+@dataclass(frozen=True)
+class Flagged:
+    """One observable and whether the systematic test's Holm family flags its mean difference and its scatter."""
+
+    stat: ObservableStat
+    bias: bool
+    scatter: bool
+
+
+def flagged(located: Located) -> list[Flagged]:
+    """Every observable with the systematic test's decisions on its mean difference and its scatter."""
+    adjusted = holm_adjusted(np.array([t.p for t in family_tests(located)]))
+    found = adjusted <= located.alpha
+    return [Flagged(o, bool(found[2 * k]), bool(found[2 * k + 1])) for k, o in enumerate(located.observables)]
+
+
+def strongest_trend(located: Located) -> CovariateStat | None:
+    """The significant trend of a difference with a launch value that is furthest from chance (None without one)."""
+    return max((c for c in located.covariates if c.significant), key=lambda c: abs(c.t), default=None)
+
+
 def differences(report: Report, residual: np.ndarray | None = None) -> list[str]:
     """What differs, strongest first: each observable the systematic test flags (its mean difference ± standard
     error, with its unit and direction), then the strongest trend with a launch value and group difference."""
     located = report.located
-    adjusted = holm_adjusted(np.array([t.p for t in family_tests(located)]))
-    found = adjusted <= located.alpha
     ranked = []
-    for k, o in enumerate(located.observables):
-        bias_found, excess_found = found[2 * k], found[2 * k + 1]
-        if bias_found or excess_found:
-            strength = abs(o.bias) / o.bias_se if bias_found and o.bias_se > 0 else 0.0
-            ranked.append((strength, _observable_line(o, residual, bias_found)))
+    for f in flagged(located):
+        if f.bias or f.scatter:
+            o = f.stat
+            strength = abs(o.bias) / o.bias_se if f.bias and o.bias_se > 0 else 0.0
+            ranked.append((strength, _observable_line(o, residual, f.bias)))
     out = [line for _, line in sorted(ranked, key=lambda item: -item[0])]
     if not out and located.observables:
         worst = max(located.observables, key=lambda o: o.rms_ratio)
@@ -114,7 +132,7 @@ def differences(report: Report, residual: np.ndarray | None = None) -> list[str]
             f"{worst.rms_ratio:.2f} times its expected error (mean difference "
             f"{quantity(worst.bias, worst.bias_se, UNITS[worst.name])})"
         )
-    for c in sorted((c for c in located.covariates if c.significant), key=lambda c: -abs(c.t))[:1]:
+    if (c := strongest_trend(located)) is not None:
         words = COVARIATE_WORDS.get(c.covariate, (c.covariate,))[0]
         size = quantity(abs(c.slope_per_sd), None, UNITS[c.observable])
         way = "rises" if c.slope_per_sd > 0 else "falls"
@@ -228,14 +246,27 @@ def _worse(report: Report, air: dict) -> str:
     return f" (held-out error {error:.2f} against {report.heldout.after_error:.2f})" if isinstance(error, float) else ""
 
 
-def _candidate(report: Report, name: str) -> Candidate | None:
+def candidate(report: Report, name: str) -> Candidate | None:
+    """The candidate of this name ('wind+spin_bias'), where the report has it."""
     return next((c for c in report.candidates if c.name == name), None)
+
+
+def ruled_out(report: Report) -> list[Candidate]:
+    """The other explanations of the same size the held-out shots tell apart from the chosen one: candidates with as
+    many effects, none of them the chosen one's, that are not among the ambiguities."""
+    ambiguous = {item.effects[1] for item in report.ambiguities}
+    named = {e.name for e in report.effects}
+    return [
+        c
+        for c in report.candidates
+        if c.name not in ambiguous and len(c.effects) == len(named) and not named & {e.name for e in c.effects}
+    ]
 
 
 def _rival_line(report: Report, item: Ambiguity) -> str:
     """One rival: its fitted size, that it fits held-out shots about as well, and why the data cannot tell them
     apart (the interval is in the rivals table)."""
-    rival = _candidate(report, item.effects[1])
+    rival = candidate(report, item.effects[1])
     sizes = "; ".join(effect_phrase(e) for e in rival.effects) if rival else ""
     return (
         f"{effect_words(item.effects[1]).capitalize()}{f' ({sizes})' if sizes else ''} fits held-out shots about "
@@ -248,13 +279,7 @@ def rivals(report: Report) -> list[str]:
     if not report.systematic:
         return []
     out = [_rival_line(report, item) for item in report.ambiguities]
-    ambiguous = {item.effects[1] for item in report.ambiguities}
-    named = {e.name for e in report.effects}
-    others = [
-        c
-        for c in report.candidates
-        if c.name not in ambiguous and len(c.effects) == len(named) and not named & {e.name for e in c.effects}
-    ]
+    others = ruled_out(report)
     air = venue_air(report)
     if air and air.get("separable"):
         out.append(
@@ -294,32 +319,10 @@ def record_next(report: Report) -> list[str]:
     return out
 
 
-def _headline(report: Report, differs: list[str]) -> str:
-    """The answer in one sentence."""
-    first = differs[0] if differs else "the recordings depart from the model"
-    first = first[0].upper() + first[1:]
-    if not report.systematic:
-        if any(s.significant for s in (*report.located.observables, *report.located.covariates)):
-            return f"{first}, but no explanation accounts for it consistently on held-out shots."
-        return "No systematic mismatch: the recordings agree with the model within its expected error."
-    if report.unlisted is not None:
-        return f"{first}; no library effect explains it, a learned extra acceleration does."
-    named = " plus ".join(effect_words(e.name) for e in report.effects)
-    rivals_clause = (
-        f", though these recordings cannot yet tell it from {len(report.ambiguities)} rival"
-        f"{'s' if len(report.ambiguities) > 1 else ''}"
-        if report.ambiguities
-        else ""
-    )
-    return f"{first}: {named} explains it{rivals_clause}."
-
-
 def verdict(report: Report, residual: np.ndarray | None = None) -> Verdict:
     """The verdict of a report; `residual` [N, 5] (recorded − model) adds the share of shots each difference has."""
-    differs = differences(report, residual)
     return Verdict(
-        headline=_headline(report, differs),
-        differs=differs,
+        differs=differences(report, residual),
         physics=_physics(report),
         rivals=rivals(report),
         sure=sureness(report),

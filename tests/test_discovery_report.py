@@ -1,10 +1,11 @@
 """report.html (issue 14, item 7; issue 32, item 3): plotly figures in one self-contained file that opens offline
 (plotly.js and the stylesheet inline once, no CDN), every shot-level point carrying its shot id, session and club for
-hover; the tables alone, naming the extra to install, without plotly; the verdict first, in plain words (what
-differs with its unit, sign and share of shots, which physics with its size, the rivals and why, how sure, what to
-record next); and the page in a real headless Chromium: no console errors, every figure drawn, a hover shows a shot
-id, the verdict is the first thing in the main content, no JSON in the prose, a unit under every numeric header,
-and a screenshot (skipped where chromium or Playwright is missing)."""
+hover; the tables alone, naming the extra to install, without plotly; the verdict first, opening with report.json's
+headline (issue 54, item 4), then in plain words (what differs with its unit, sign and share of shots, which physics
+with its size, the rivals and why, how sure, what to record next); and the page in a real headless Chromium: no
+console errors, every figure drawn, a hover shows a shot id, the verdict is the first thing in the main content, no
+JSON in the prose, a unit under every numeric header, the headline within a 400 px window, and a screenshot (skipped
+where chromium or Playwright is missing)."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ import numpy as np
 import pytest
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import Diagnosis, diagnose
+from golfflight.discovery.headline import MAX_WORDS, headline
 from golfflight.discovery.html import PLOTS_MISSING, render
 from golfflight.discovery.locate import holm
 from golfflight.discovery.model import reference
@@ -166,7 +168,7 @@ def test_the_report_in_chromium_draws_every_figure_and_hovers_a_shot_id(diagnosi
 def test_the_verdict_says_what_differs_which_physics_and_how_sure(diagnosis):
     report = diagnosis.report
     found = verdict(report, diagnosis.recordings.observed - diagnosis.before)
-    assert found.headline.endswith(": wind explains it.")
+    assert re.fullmatch(r"Most likely a \d\.\d+ ± \d\.\d+ m/s wind from \d+° \(.+\)\.", headline(report)[1])
     assert re.fullmatch(
         r"carry across the line \d+\.\d+ ± \d\.\d+ m further left than the model, on \d+ % of shots", found.differs[0]
     ), found.differs
@@ -183,7 +185,10 @@ def test_the_verdict_names_the_rivals_apex_alone_cannot_separate_and_what_to_rec
     found = verdict(report)
     assert report.effects[0].name == "air_density"
     assert report.effects[0].parameters["ratio"] == pytest.approx(0.912, abs=0.02)
-    assert re.match(r"Apex [\d.]+ ± [\d.]+ m lower than the model: air density explains it, though", found.headline)
+    first, cause, runner_up = headline(report)
+    assert re.fullmatch(r"Shots peak [\d.]+ m lower than the model\.", first)
+    assert re.fullmatch(r"Most likely thin air: 0\.9\d+ ± 0\.0\d+ × standard density, as at [\d,]+ m\.", cause)
+    assert runner_up.startswith("Runner-up, fitting about as well: ") and "; recording " in runner_up
     assert len(found.rivals) == len(report.ambiguities) >= 1
     assert all("not recorded" in line and " apart" in line for line in found.rivals)
     by_carry = [line.split(" (")[0].lower() for line in found.rivals if "carry is not recorded" in line]
@@ -198,7 +203,7 @@ def test_the_verdict_names_the_rivals_apex_alone_cannot_separate_and_what_to_rec
 def test_a_clean_set_reads_as_no_mismatch():
     clean = diagnose(from_shot_set(conceal({}, 150, seed=2).shots), reference(), seed=0, with_correction=False)
     found = verdict(clean.report)
-    assert found.headline.startswith("No systematic mismatch")
+    assert headline(clean.report)[0].startswith("The recordings match the model within noise")
     assert found.differs[0].startswith("nothing beyond the expected error") and found.rivals == []
     assert found.physics[0].startswith("None needed") and found.record_next == []
     assert "None of the" in found.sure[0] and "no explanation is claimed" in found.sure[1]
@@ -210,6 +215,9 @@ def test_holm_adjusted_p_values_decide_as_the_systematic_test_does():
         p = rng.uniform(0, 0.05, 30) ** rng.uniform(1, 3)
         assert list(holm_adjusted(p) <= 0.01) == holm(list(p), 0.01)
 
+
+HEADLINE_TEXT = "ps => ps.map(p => p.innerText.replace(/\\u00a0/g, ' '))"
+"""The headline's sentences as shown, each no-break space (that keeps a value with its ±) read as a space."""
 
 VISIBLE_PROSE = """() => [...document.querySelectorAll('main > *:not(details.raw)')]
     .map(e => e.innerText).join('\\n')"""
@@ -231,19 +239,45 @@ def test_the_report_reads_verdict_first_offline_in_chromium(apex_only, tmp_path)
             timeout=20_000,
         )
         first = page.evaluate("() => document.querySelector('main').firstElementChild.id")
-        headline = page.text_content("#verdict .headline") or ""
+        shown = page.eval_on_selector_all("#verdict .headline p", HEADLINE_TEXT)
         prose = page.evaluate(VISIBLE_PROSE)
         bare = page.eval_on_selector_all("th.num", "ths => ths.filter(t => !t.querySelector('.unit')).length")
         raw_open = page.evaluate("() => document.querySelector('details.raw').open")
         png = page.screenshot(full_page=False)
     assert errors == [] and fetched == []
-    assert first == "verdict" and headline.startswith("Apex") and "air density explains it" in headline
+    assert first == "verdict" and shown == headline(apex_only.report) == apex_only.report.headline
     for question in ("What differs", "Which physics", "Rivals", "How sure", "Record next"):
         assert question in prose
     assert '{"' not in prose and "':" not in prose, "no JSON or Python mapping in the visible text"
     assert bare == 0, "every numeric column has its unit under its header"
     assert raw_open is False
     assert len(png) > 50_000, "the screenshot shows a page, not a blank window"
+
+
+OVERFLOWING = """() => {
+    const width = document.documentElement.clientWidth;
+    const box = document.querySelector('#verdict .headline');
+    return [box, ...box.querySelectorAll('*')]
+        .filter(e => e.scrollWidth > e.clientWidth + 1 || e.getBoundingClientRect().right > width + 0.5)
+        .map(e => e.outerHTML.slice(0, 120));
+}"""
+"""The headline's elements wider than their box or than the window."""
+
+
+@pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
+@pytest.mark.parametrize("case", ["apex_only", "diagnosis"])
+def test_the_headline_fits_a_phone_in_chromium(case, request, tmp_path):
+    """At 400 px wide (a phone) the headline is on the first screen and nothing in it runs past its box or the
+    window."""
+    page_file = write_diagnosis(request.getfixturevalue(case), tmp_path)[1]
+    with browser.headless_page(400, 800) as page:
+        page.goto(page_file.as_uri())
+        overflowing = page.evaluate(OVERFLOWING)
+        top = page.evaluate("() => document.querySelector('#verdict .headline').getBoundingClientRect().top")
+        sentences = page.eval_on_selector_all("#verdict .headline p", HEADLINE_TEXT)
+    assert overflowing == []
+    assert top < 800 and 2 <= len(sentences) <= 3
+    assert all(len(s.split()) <= MAX_WORDS for s in sentences)
 
 
 def test_a_field_the_page_has_no_place_for_is_shown_in_words(diagnosis, monkeypatch):
@@ -295,6 +329,5 @@ def test_a_learned_term_is_said_when_no_library_effect_explains(diagnosis):
         library_heldout_error=1.6,
     )
     found = verdict(diagnosis.report.model_copy(update={"unlisted": learned}))
-    assert found.headline.endswith("no library effect explains it, a learned extra acceleration does.")
     assert found.physics[0].startswith("No library effect explains it (best: a steady")
     assert found.physics[1] == "A learned extra acceleration does: a = -0.0012 |v| v (a drag that grows with speed)."

@@ -95,6 +95,7 @@ def run_diagnose(args: argparse.Namespace) -> int:
     )
     progress_step(f"writing the report to {args.out}...", not args.quiet)
     paths = write_diagnosis(diagnosis, args.out)
+    print("\n".join(diagnosis.report.headline), end="\n\n")
     print(diagnosis.report.statement)
     print(f"wrote {', '.join(str(p) for p in paths)} ({diagnosis.report.seconds:.1f} s)")
     if not plots_available():
