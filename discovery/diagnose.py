@@ -28,7 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from golfflight.discovery import correction as learned
-from golfflight.discovery.effects import AIR_VARIANTS, LIBRARY, REYNOLDS_SCALE, Context, Effect
+from golfflight.discovery.as_is import AsIs, as_is
+from golfflight.discovery.effects import AIR_VARIANTS, BALL, LIBRARY, REYNOLDS_SCALE, Context, Effect
 from golfflight.discovery.fit import (
     MAX_FIT_SHOTS,
     SCORED_SHOTS,
@@ -47,30 +48,20 @@ from golfflight.discovery.fit import (
     stratified_rows,
 )
 from golfflight.discovery.headline import headline
+from golfflight.discovery.form import LearnedForm, formed_model
 from golfflight.discovery.invariance import Halves, halves, set_aside_sentence
 from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
 from golfflight.discovery.model import FlightModel
-from golfflight.discovery.noise import (
-    RADAR_NOISE,
-    ExpectedError,
-    Scatter,
-    base_conditions,
-    expected_error,
-    recording_scatter,
-    with_scatter,
-)
+from golfflight.discovery.noise import RADAR_NOISE, Scatter
 from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from golfflight.discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
 from golfflight.discovery.schema import AirRival, Candidate, Heldout, Located, ModelInfo, Report, ScatterStat, Unlisted
-from golfflight.discovery.simulator import Outcomes, Setup
-from golfflight.discovery.physical import restatements
+from golfflight.discovery.physical import ball_agrees, restatements
+from golfflight.discovery.reach import baseline_info, baseline_sentence
 from golfflight.discovery.venue_air import air_explanations, air_rival, air_sentence, with_air
 from golfflight.flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
 from golfflight.shots.progress import progress_bar, progress_step
 from golfflight.shots.synth import MeasurementNoise
-
-OUTLIER_MAD = 8.0
-"""A residual further than this many robust SDs from the median is a wild reading, left out of the fits."""
 
 MIN_RELATIVE_IMPROVEMENT = MATERIAL
 """A correction must remove at least this share of the held-out error to count (materiality)."""
@@ -119,22 +110,6 @@ class Diagnosis:
 
 
 @dataclass(frozen=True)
-class Baseline:
-    """The model as is on the recordings: its predictions (the control's known error taken out), the residuals, the
-    wild readings left out of the fits, the error each shot is expected to miss by and the recordings' own scatter."""
-
-    base: Setup
-    flown: Outcomes
-    predicted: np.ndarray
-    offset: np.ndarray
-    residual: np.ndarray
-    wild: np.ndarray
-    use: np.ndarray
-    expected: ExpectedError
-    scatter: Scatter
-
-
-@dataclass(frozen=True)
 class Selection:
     """What the candidates decided: the null, every candidate fitted, the choice (the null unless the mismatch is
     systematic), the systematic test's numbers, the learned correction if chosen, and structure the choice leaves."""
@@ -180,60 +155,19 @@ def inside(candidate: Scored) -> bool:
     return True
 
 
-def library_for(air_recorded: bool, wind_recorded: bool = False) -> tuple[Effect, ...]:
+def library_for(air_recorded: bool, wind_recorded: bool = False, against_baseline: bool = False) -> tuple[Effect, ...]:
     """The effects offered: the whole library for recordings without air; for recordings that carry their air, no
     air density (with the air recorded there is no air finding) but the Reynolds scale (`effects.REYNOLDS_SCALE`,
     the model's form: how the recordings' physics reads that air). Recordings that carry their wind get no wind
     either, as with the air: a recorded wind of 0 says the carry was flown, or computed by the launch monitor, in
-    still air."""
+    still air. Against a baseline session the model's form is the baseline's, so the coefficient scales give way to
+    another ball (`effects.BALL`: drag, lift and spin decay changed as one cause)."""
     recorded = ({"wind"} if wind_recorded else set()) | (set(AIR_VARIANTS) if air_recorded else set())
-    return tuple(e for e in LIBRARY if e.name not in recorded) + ((REYNOLDS_SCALE,) if air_recorded else ())
+    offered = tuple(e for e in LIBRARY if e.name not in recorded and not (against_baseline and e.kind == "form"))
+    return offered + ((BALL,) if against_baseline else ()) + ((REYNOLDS_SCALE,) if air_recorded else ())
 
 
-def outlier_mask(residual: np.ndarray) -> np.ndarray:
-    """True where a residual is a wild reading (far outside the bulk of its observable)."""
-    out = np.zeros(residual.shape, dtype=bool)
-    for j in range(residual.shape[1]):
-        r = residual[:, j]
-        finite = np.isfinite(r)
-        if finite.sum() < 10:
-            continue
-        median = np.median(r[finite])
-        mad = 1.4826 * np.median(np.abs(r[finite] - median))
-        out[:, j] = finite & (np.abs(r - median) > OUTLIER_MAD * max(mad, 1e-9))
-    return out
-
-
-def baseline(
-    recordings: Recordings,
-    model: FlightModel,
-    noise: MeasurementNoise,
-    seed: int,
-    estimate_scatter: bool,
-    progress: bool = False,
-) -> Baseline:
-    """Fly the recorded launches through the model (and its control), and measure how far off it is expected to be
-    (with `progress`, the expected error's flights, five times the model's, are named as they start)."""
-    base = base_conditions(recordings, model)
-    flown = model.simulate(base, keep_positions=bool(recordings.trajectories))
-    predicted = flown.outcomes()
-    progress_step("the model's response to the launch monitor's noise (five more flights of every shot)...", progress)
-    expected = expected_error(model, recordings, base, predicted, noise)
-    offset = np.zeros_like(predicted)
-    if model.control is not None:  # the model's known error on these launches, taken out of every prediction
-        offset = np.nan_to_num(model.control.simulate(base).outcomes() - predicted)
-        predicted = predicted + offset
-    residual = recordings.observed - predicted
-    wild = outlier_mask(residual)
-    use = np.isfinite(recordings.observed) & ~wild
-    own_rng = np.random.default_rng([seed, 1])  # its own stream: the fits' draws stay as they were
-    scatter = recording_scatter(recordings, np.where(use, residual / expected.sigma, np.nan), own_rng)
-    if estimate_scatter:
-        expected = with_scatter(expected, scatter)
-    return Baseline(base, flown, predicted, offset, residual, wild, use, expected, scatter)
-
-
-def located_mismatch(recordings: Recordings, start: Baseline) -> Located:
+def located_mismatch(recordings: Recordings, start: AsIs) -> Located:
     """The systematic test on the model's residuals, along the recorded trajectories too."""
     flown = start.flown
     along = (
@@ -262,7 +196,7 @@ def corrected(
     return Corrected(flown.outcomes() + problem.offset, flown.positions, factor)
 
 
-def model_info(model: FlightModel, context: Context, start: Baseline, estimate_scatter: bool) -> ModelInfo:
+def model_info(model: FlightModel, context: Context, start: AsIs, estimate_scatter: bool) -> ModelInfo:
     """The report's account of the model: its settings, the error it is expected to make and its known error."""
     expected, scatter = start.expected, start.scatter
     return ModelInfo(
@@ -301,11 +235,11 @@ def candidates(selection: Selection, context: Context) -> list[Candidate]:
 
 
 class Diagnoser:
-    """One diagnosis. Making it flies the model on the recordings (`baseline`) and sets up the problem, folds and fit
+    """One diagnosis. Making it flies the model on the recordings (`as_is`) and sets up the problem, folds and fit
     rows every candidate shares; its methods read only those, and `run` fits, chooses and reports. With `progress`,
     each step and a bar over the fits go to standard error (`shots.progress`): a large set takes minutes.
 
-    The baseline, the systematic test and the chosen explanation's held-out errors use every shot (`everyone`);
+    The model as is, the systematic test and the chosen explanation's held-out errors use every shot (`everyone`);
     candidates are fitted and scored on `problem`: every shot up to `scored_shots`, above that a stratified
     subsample of that many (`scored`, by session and club), with the least-squares fits on at most MAX_FIT_SHOTS of
     those (`rows`); the report says how many."""
@@ -320,16 +254,17 @@ class Diagnoser:
         estimate_scatter: bool = True,
         progress: bool = True,
         scored_shots: int = SCORED_SHOTS,
+        baseline: LearnedForm | None = None,
     ):
         self.started = time.perf_counter()
-        self.recordings, self.model = recordings, model
+        self.recordings, self.model, self.baseline = recordings, model, baseline
         self.air_recorded = recordings.density_kg_m3 is not None
-        self.library = library_for(self.air_recorded, recordings.wind_xy_mps is not None)
+        self.library = library_for(self.air_recorded, recordings.wind_xy_mps is not None, baseline is not None)
         self.with_correction, self.estimate_scatter, self.progress = with_correction, estimate_scatter, progress
         self.rng = np.random.default_rng(seed)
         self.step(f"flying {len(recordings):,} recorded shots through the model and its expected error...")
-        self.baseline = baseline(recordings, model, noise, seed, estimate_scatter, progress)
-        start = self.baseline
+        self.as_is = as_is(recordings, model, noise, seed, estimate_scatter, progress)
+        start = self.as_is
         self.everyone = Problem(model, recordings, start.base, start.expected.sigma, start.use, start.offset)
         self.fold, self.grouping = folds(recordings.session)
         self.scored = stratified_rows(recordings, scored_shots, np.random.default_rng([seed, 2]))
@@ -344,7 +279,7 @@ class Diagnoser:
 
     def run(self) -> Diagnosis:
         """Locate the mismatch, choose its explanation, and report it with the arrays the plots need."""
-        start = self.baseline
+        start = self.as_is
         self.step("locating the mismatch...")
         located = located_mismatch(self.recordings, start)
         selection = self.select(has_structure(located))
@@ -397,7 +332,7 @@ class Diagnoser:
     ) -> Report:
         """The report of a finished selection."""
         recordings, model, chosen = self.recordings, self.model, selection.chosen
-        context = Context(float(np.median(self.baseline.base.density_kg_m3)), model.temperature_c)
+        context = Context(float(np.median(self.as_is.base.density_kg_m3)), model.temperature_c)
         effects = effect_results(chosen.fit, context)
         words = statement(
             selection.systematic,
@@ -411,6 +346,9 @@ class Diagnoser:
         )
         if selection.systematic and "varies_with_ball_speed" in selection.test:
             words += set_aside_sentence(selection.test["varies_with_ball_speed"])
+        against = (
+            None if self.baseline is None else baseline_info(self.baseline, recordings, self.as_is.base.density_kg_m3)
+        )
         report = Report(
             recordings=recordings.source,
             n_shots=len(recordings),
@@ -419,7 +357,7 @@ class Diagnoser:
             scored_shots=len(self.scored),
             observables=list(recordings.observed_names),
             trajectories=len(recordings.trajectories),
-            model=model_info(model, context, self.baseline, self.estimate_scatter),
+            model=model_info(model, context, self.as_is, self.estimate_scatter),
             systematic=selection.systematic,
             systematic_test=selection.test,
             located=located,
@@ -429,11 +367,13 @@ class Diagnoser:
             ambiguities=ambiguities,
             air_rival=rival,
             heldout=heldout_block,
-            statement=words
+            baseline=against,
+            statement=("" if against is None else baseline_sentence(against, len(recordings)))
+            + words
             + air_sentence(rival)
             + left_sentence(selection.unexplained)
-            + control_sentence(model, self.baseline.offset, self.response_error(chosen))
-            + (scatter_sentence(self.baseline.scatter) if self.estimate_scatter else "")
+            + control_sentence(model, self.as_is.offset, self.response_error(chosen))
+            + (scatter_sentence(self.as_is.scatter) if self.estimate_scatter else "")
             + sampling_sentence(len(recordings), len(self.scored), len(self.rows)),
             service_settings=service_settings(effects, context, after.wind_factor),
             seconds=time.perf_counter() - self.started,
@@ -442,7 +382,7 @@ class Diagnoser:
 
     def null_candidate(self) -> Scored:
         """The model as is, scored like any candidate (no parameters, no penalty)."""
-        null_z = self.problem.standardize(self.baseline.predicted[self.scored], np.arange(len(self.scored)))
+        null_z = self.problem.standardize(self.as_is.predicted[self.scored], np.arange(len(self.scored)))
         empty = Fit((), np.zeros(0), null_z, np.zeros(null_z.shape + (0,)), np.zeros((0, 0)))
         return Scored(empty, null_z, _mean_sq(null_z), 0.0)
 
@@ -453,7 +393,7 @@ class Diagnoser:
             return candidate
         result, n = candidate.fit, len(self.recordings)
         if result.k == 0:
-            z = self.everyone.standardize(self.baseline.predicted, np.arange(n))
+            z = self.everyone.standardize(self.as_is.predicted, np.arange(n))
         else:
             z = heldout(self.everyone, result, self.fold, fold_thetas(result, self.scored_fold))
         error = _mean_sq(z)
@@ -611,7 +551,7 @@ class Diagnoser:
         (`discovery.physical`) and in place of its main effect (`venue_air.air_explanations`); an air explanation
         with fewer parameters stands unless the choice beats it beyond doubt and materially. Recordings that carry
         their air get no air explanation at all (the library leaves air out for them). (choice, the explanations
-        fitted)."""
+        fitted). Another ball whose drag and lift agree is air (`physical.ball_agrees`)."""
         if self.air_recorded:
             return chosen, []
         known = {frozenset(e.name for e in s.fit.effects): s for s in scored}
@@ -620,6 +560,11 @@ class Diagnoser:
         seen = {id(s) for s in scored}
         fresh = list({id(s): s for s in tried if id(s) not in seen}.values())
         simpler_ones = {id(s): s for s in tried if s.fit.k < chosen.fit.k and inside(s)}.values()
+        airs = [s for s in simpler_ones if not any(e.kind == "ball" for e in s.fit.effects)]
+        if ball_agrees(chosen.fit) and airs:  # a ball changed as air changes it is air
+            simpler = min(airs, key=lambda s: s.error)
+            test.update(in_physical_terms=simpler.fit.name, in_physical_terms_from=chosen.fit.name)
+            return simpler, fresh
         for simpler in sorted(simpler_ones, key=lambda s: s.error):
             if not self.better(chosen, simpler, COMBINATION_LEVEL)[0]:
                 test.update(in_physical_terms=simpler.fit.name, in_physical_terms_from=chosen.fit.name)
@@ -646,7 +591,7 @@ class Diagnoser:
         observable by less (RMS over the shots) than the model's own error there (the card's `own_error`, measured
         where the truth is known): the model's form alone makes differences that large, so they are not claimed.
         Empty against a model without an own error (the reference world, a controlled bundle)."""
-        if not chosen.fit.k or not any(self.baseline.expected.model.values()):
+        if not chosen.fit.k or not any(self.as_is.expected.model.values()):
             return []
         return [
             effect.name
@@ -658,7 +603,7 @@ class Diagnoser:
         """How far one effect of a candidate (its parameters at `block`) moves the candidate's predictions (with and
         without it, RMS over the shots), in units of the model's own error, on the recorded observable it moves
         most."""
-        own, recorded = self.baseline.expected.model, self.problem.recordings.observed_names
+        own, recorded = self.as_is.expected.model, self.problem.recordings.observed_names
         without = candidate.fit.theta.copy()
         without[block] = effect.null
         rows = np.arange(len(self.scored))
@@ -725,14 +670,14 @@ class Diagnoser:
         after = problem.predict(explanation.fit.effects, explanation.fit.theta, np.arange(len(self.scored)))[0]
         residual = problem.observed - after
         use = problem.use & np.isfinite(after)
-        dilution = {name: slopes[self.scored] for name, slopes in self.baseline.expected.dilution.items()}
+        dilution = {name: slopes[self.scored] for name, slopes in self.as_is.expected.dilution.items()}
         left = locate(problem.recordings, residual, problem.sigma, use, [], {}, dilution)
         return left.summary if has_structure(left) else []
 
     def heldout_summary(self, null: Scored, chosen: Scored) -> Heldout:
         """Held-out errors before and after the choice, its improvement with bootstrap intervals, and how much of
         the excess over the noise floor it explains."""
-        expected = self.baseline.expected
+        expected = self.as_is.expected
         sigma = expected.sigma
         before_r, after_r = null.heldout_z * sigma, chosen.heldout_z * sigma
         names = [(j, n) for j, n in enumerate(OBSERVABLES) if np.isfinite(null.heldout_z[:, j]).any()]
@@ -787,9 +732,15 @@ def diagnose(
     with_correction: bool = True,
     estimate_scatter: bool = True,
     progress: bool = True,
+    baseline: LearnedForm | None = None,
 ) -> Diagnosis:
-    """Run the whole diagnosis of recordings against a model (its steps on standard error with `progress`)."""
-    return Diagnoser(recordings, model, noise, seed, with_correction, estimate_scatter, progress).run()
+    """Run the whole diagnosis of recordings against a model (its steps on standard error with `progress`); with
+    what a `baseline` session taught (`discovery.form.learn_form`), against the model with that form: what changed."""
+    if baseline is not None:
+        model = formed_model(model, baseline)
+    return Diagnoser(
+        recordings, model, noise, seed, with_correction, estimate_scatter, progress, baseline=baseline
+    ).run()
 
 
 def scatter_sentence(scatter: Scatter) -> str:

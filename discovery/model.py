@@ -15,6 +15,7 @@ import os
 from dataclasses import dataclass, field
 from typing import Literal
 
+from golfflight.discovery.discrepancy import Discrepancy
 from golfflight.discovery.recordings import OBSERVABLES
 from golfflight.discovery.simulator import Correction, Outcomes, Setup, setup_flight, simulate_setup
 from golfflight.flight.air import Air
@@ -47,6 +48,9 @@ class FlightModel:
     """The physics the model was trained to imitate. When set, diagnose flies the recorded launches through it
     too and adds the difference to every prediction: the model's own known error on these launches is taken out
     before anything is fitted, so it is not mistaken for left-out physics."""
+    discrepancy: Discrepancy | None = None
+    """What a baseline session taught beyond the form held in `flyer` (`discovery.form`): its mean at the launches
+    flown is added to every prediction (`simulate`) and its SD to every shot's expected error."""
 
     @property
     def density_kg_m3(self) -> float:
@@ -62,8 +66,10 @@ class FlightModel:
         return self.flyer.rule.name
 
     def simulate(self, setup: Setup, correction: Correction | None = None, keep_positions: bool = False) -> Outcomes:
-        """A setup's outcomes through this model (`discovery.simulator.simulate_setup`)."""
-        return simulate_setup(setup, self.flyer, correction, keep_positions)
+        """A setup's outcomes through this model (`discovery.simulator.simulate_setup`), with the discrepancy's mean at
+        the launches flown where a baseline taught one."""
+        flown = simulate_setup(setup, self.flyer, correction, keep_positions)
+        return flown if self.discrepancy is None else self.discrepancy.shifted(flown, setup.launch)
 
     def fly(
         self, setup: Setup, correction: Correction | None = None, keep_states: bool = False, air: Wind | None = None

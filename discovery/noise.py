@@ -209,3 +209,14 @@ def with_scatter(expected: ExpectedError, scatter: Scatter) -> ExpectedError:
     """The expected error with each `applied` observable's sigma scaled by the recordings' own scatter."""
     scale = np.array([scatter.applied.get(name, 1.0) for name in OBSERVABLES])
     return replace(expected, sigma=expected.sigma * scale[None], noise_sigma=expected.noise_sigma * scale[None])
+
+
+def with_discrepancy(expected: ExpectedError, sd: np.ndarray) -> ExpectedError:
+    """The expected error with a baseline's discrepancy SD [N,5] (`discovery.discrepancy`) added to each shot's
+    model error: small near the baseline's launches, the whole discrepancy far from them."""
+    sd = np.nan_to_num(sd)
+    model = {
+        name: float(np.sqrt(expected.model[name] ** 2 + np.mean(sd[:, j] ** 2))) for j, name in enumerate(OBSERVABLES)
+    }
+    source = {name: "the baseline session: its discrepancy at these launches (RMS)" for name in OBSERVABLES}
+    return replace(expected, sigma=np.sqrt(expected.sigma**2 + sd**2), model=model, model_source=source)

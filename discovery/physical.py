@@ -16,6 +16,24 @@ from golfflight.discovery.fit import Fit, Problem, Scored, blocks, fit
 
 Score = Callable[[Fit], Scored]
 
+BALL_AGREEMENT = 0.03
+"""Another ball whose drag and lift scales lie within this share of each other, and its spin decay within
+DECAY_AGREEMENT of them, is air in other words: density alone scales drag, lift and the spin torque by one ratio, so
+a ball that differs from the baseline's by one share in all three is a change of air, not of ball. The shares allow
+for what the baseline cannot teach (how the flight responds to air it never flew in tilts the three apart: a 1,900 m
+venue flown as density alone in Ferguson 2022's world, 0.776, read as a ball of 0.844, 0.865 and 0.911)."""
+DECAY_AGREEMENT = 0.15
+"""The spin decay is measured far less well than drag and lift (its campaign sizes are 10-30 %)."""
+
+
+def ball_agrees(result: Fit) -> bool:
+    """Whether the fit holds another ball whose three scales agree (BALL_AGREEMENT, DECAY_AGREEMENT)."""
+    for effect, block in blocks(result):
+        if effect.kind == "ball":
+            drag, lift, decay = np.log(result.theta[block])
+            return bool(abs(drag - lift) < BALL_AGREEMENT and abs(decay - (drag + lift) / 2) < DECAY_AGREEMENT)
+    return False
+
 
 def aliased(result: Fit) -> list[tuple[Effect, slice]]:
     """The coefficient scales of a fit that air density is made of."""

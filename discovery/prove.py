@@ -25,8 +25,9 @@ from typing import Literal
 import numpy as np
 from golfflight.discovery.conceal import NOMINAL_AIR, NOMINAL_CONTEXT, OUTSIDE_EFFECT, conceal
 from golfflight.discovery.diagnose import diagnose
-from golfflight.discovery.effects import AIR_VARIANTS, DENSITY_ONLY, EFFECTS, LIBRARY, Draw, equivalent_altitude_m
+from golfflight.discovery.effects import AIR_VARIANTS, BALL, DENSITY_ONLY, EFFECTS, LIBRARY, Draw, equivalent_altitude_m
 from golfflight.discovery.effects.parts import sign, uniform
+from golfflight.discovery.form import LearnedForm, learn_form
 from golfflight.discovery.model import MIN_T_MAX_S, FlightModel
 from golfflight.discovery.outside import HEIGHT_GUST, HIGH_SPIN_LIFT_LOSS, LOW_SPEED_DRAG, OUTSIDE
 from golfflight.discovery.recordings import from_shot_set
@@ -77,8 +78,17 @@ PAIRS = (
 """The two-effect cases of the `pairs` campaign: each library family beside another, so that the step from a single
 to a pair is measured on its own (issue 41: pairs had regressed after the triple step)."""
 
-Campaign = Literal["library", "pairs", "triples"]
-CAMPAIGNS: tuple[Campaign, ...] = ("library", "pairs", "triples")
+Campaign = Literal["library", "pairs", "triples", "baseline"]
+CAMPAIGNS: tuple[Campaign, ...] = ("library", "pairs", "triples", "baseline")
+
+HIGH_VENUE = "1,900 m air, density only"
+"""The baseline campaign's fixed case: a venue at about 1,900 m (0.776 x ICAO) flown as density alone, against a
+sea-level baseline: the air must be named, within 0.03."""
+HIGH_VENUE_RATIO = 0.776
+
+BASELINE_LAUNCHES = 1
+"""The baseline session's launch stream (`conceal`'s launch_seed): the new session's players and clubs, other
+launches and noise, in the truth world's calm ICAO air."""
 
 
 def command(
@@ -125,6 +135,8 @@ def cases(truth: Truth = "model", campaign: Campaign = "library") -> list[tuple[
     campaign, clean and the three-effect cases `TRIPLES` (`pairs`: the two-effect cases `PAIRS`)."""
     if campaign in ("pairs", "triples"):
         return [("clean", ())] + [("+".join(group), group) for group in (PAIRS if campaign == "pairs" else TRIPLES)]
+    if campaign == "baseline":
+        return baseline_cases(truth)
     library = [(e.name, (e.name,)) for e in LIBRARY]
     if truth == "density-only":  # the air is recorded there: an air finding is wrong by construction
         library = [(name, effects) for name, effects in library if name not in AIR_VARIANTS]
@@ -137,6 +149,31 @@ def cases(truth: Truth = "model", campaign: Campaign = "library") -> list[tuple[
         + [("+".join(COMBINATION), COMBINATION)]
         + [(f"outside: {name}", (name,)) for name in outside]
     )
+
+
+def baseline_cases(truth: Truth) -> list[tuple[str, tuple[str, ...]]]:
+    """The baseline campaign's cases: no change, each venue condition and monitor bias, another ball, and a high
+    venue flown as density alone (none of the air cases where the world's venue air is recorded)."""
+    changes = [e.name for e in LIBRARY if e.kind in ("venue", "monitor")] + [BALL.name]
+    if truth == "density-only":
+        changes = [name for name in changes if name not in AIR_VARIANTS]
+    venue = [] if truth == "density-only" else [(HIGH_VENUE, (DENSITY_ONLY,))]
+    return [("clean", ())] + [(name, (name,)) for name in changes] + venue
+
+
+_LEARNED: dict[tuple[str, str, int, int], LearnedForm] = {}
+
+
+def baseline_form(model: FlightModel, truth: Truth, n_shots: int, seed: int) -> LearnedForm:
+    """What the clean baseline session of a seed's players and clubs teaches (other launches and noise, the truth
+    world's calm ICAO air); the same for every case of the seed, so learned once and kept for the seed's cases."""
+    key = (model.name, truth, n_shots, seed)
+    if key not in _LEARNED:
+        world = truth_world(truth, model)
+        clean = conceal({}, n_shots, seed, model=world, launch_seed=BASELINE_LAUNCHES).shots
+        _LEARNED.clear()
+        _LEARNED[key] = learn_form(from_shot_set(clean, source=f"clean baseline seed {seed}"), model, seed=seed)
+    return _LEARNED[key]
 
 
 def _outside(effects: tuple[str, ...] | dict) -> bool:
@@ -225,11 +262,21 @@ def expected_label(case_effects: tuple[str, ...]) -> str:
 
 
 def run_case(
-    model: FlightModel, case: str, effects: tuple[str, ...], seed: int, n_shots: int, truth: Truth = "model"
+    model: FlightModel,
+    case: str,
+    effects: tuple[str, ...],
+    seed: int,
+    n_shots: int,
+    truth: Truth = "model",
+    against_baseline: bool = False,
 ) -> Run:
-    """Conceal (in the model's own flights or the reference world's), diagnose blind, score."""
+    """Conceal (in the model's own flights or the reference world's), diagnose blind, score; `against_baseline`: a
+    clean baseline session of the same players and clubs in the world's calm ICAO air (other launches and noise)
+    is diagnosed against first, and the set is diagnosed for what changed since."""
     rng = np.random.default_rng(10_000 + seed)
     hidden = {name: draw_effect(name, rng) for name in effects}
+    if case == HIGH_VENUE:
+        hidden = {DENSITY_ONLY: {"ratio": HIGH_VENUE_RATIO}}
     profile = "log" if case == LOG_WIND else "uniform"
     world, venue = truth_world(truth, model), {}
     if truth == "density-only":
@@ -241,8 +288,9 @@ def run_case(
         air = {"temperature_c": 15.0, "altitude_m": altitude, "humidity_pct": 0.0}
         shots = ShotSet([r.model_copy(update=air) for r in shots.records])
     recordings = from_shot_set(shots, source=f"concealed {case} seed {seed}")
+    baseline = baseline_form(model, truth, n_shots, seed) if against_baseline else None
     started = time.perf_counter()
-    report = diagnose(recordings, model, seed=seed, progress=False).report
+    report = diagnose(recordings, model, seed=seed, progress=False, baseline=baseline).report
     seconds = time.perf_counter() - started
     fitted = {e.name: dict(e.parameters) for e in report.effects}
     if profile == "log":
@@ -304,9 +352,11 @@ def prove(
         if only is None or re.search(only, case)
         for seed in range(seeds if effects else clean_sets)
     ]
+    if campaign == "baseline":  # a seed's cases share its baseline session, learned once
+        planned.sort(key=lambda plan: plan[2])
     runs = []
     for case, effects, seed in progress_bar(planned, "concealed sets", unit="set", shown=progress):
-        run = run_case(model, case, effects, seed, n_shots, truth)
+        run = run_case(model, case, effects, seed, n_shots, truth, against_baseline=campaign == "baseline")
         runs.append(run)
         if report:
             report(
@@ -338,8 +388,40 @@ def _within(run: Run, tolerance: float = 0.1) -> bool:
 
 
 def _acted_on(run: Run) -> bool:
-    """A venue condition or a launch-monitor bias was named: the findings a user acts on."""
-    return run.systematic and any(kind in ("venue", "monitor") for kind in run.named_kinds)
+    """A venue condition, a launch-monitor bias or another ball was named: the findings a user acts on."""
+    return run.systematic and any(kind in ("venue", "monitor", "ball") for kind in run.named_kinds)
+
+
+def _air_within(run: Run, tolerance: float = 0.03) -> bool:
+    """Air density (either variant) was named with its ratio within `tolerance` of the hidden one."""
+    fitted = run.fitted if run.systematic else {}
+    found = fitted_as(DENSITY_ONLY, fitted)
+    return found is not None and abs(fitted[found]["ratio"] - run.hidden[DENSITY_ONLY]["ratio"]) <= tolerance
+
+
+def _baseline_rows(runs: list[Run]) -> list[str]:
+    """The baseline campaign's headline rows: no-change sessions, the change named within 10 %, the high venue."""
+    clean = [r for r in runs if r.case == "clean"]
+    changed = [r for r in runs if r.case not in ("clean", HIGH_VENUE)]
+    venue = [r for r in runs if r.case == HIGH_VENUE]
+    errors = [e for r in changed for e in r.parameter_error.values()]
+    rows = []
+    if clean:
+        rows.append(
+            f"| no-change sessions naming no venue condition, monitor bias or ball | "
+            f"{_share([not _acted_on(r) for r in clean])} | ≥ 95 % |"
+        )
+    if changed:
+        rows += [
+            f"| the change named (beside others or not), within 10 % of its size | "
+            f"{_share([_among(r) and _within(r) for r in changed])} | ≥ 90 % |",
+            f"| the change named alone | {_share([r.correct for r in changed])} | - |",
+            f"| parameters within 10 % of the change's size | {sum(e <= 0.1 for e in errors)} of {len(errors)} "
+            f"(median error {np.median(errors):.1%}) | - |" if errors else "",
+        ]
+    if venue:
+        rows.append(f"| {HIGH_VENUE}: air named within 0.03 | {_share([_air_within(r) for r in venue])} | all |")
+    return [row for row in rows if row]
 
 
 def _share(flags: list[bool]) -> str:
@@ -505,7 +587,13 @@ def tables(runs: list[Run], model_name: str, truth: Truth = "model", campaign: C
         f"each on average; diagnose took {np.median([r.seconds for r in runs]):.1f} s per set (median)."
     )
     present = [(case, effects) for case, effects in cases(truth, campaign) if any(r.case == case for r in runs)]
-    lines = [opening, "", "| measure | reached | target |", "|---|---:|---:|", *_measure_rows(runs, truth), ""]
+    measures = _baseline_rows(runs) if campaign == "baseline" else _measure_rows(runs, truth)
+    if campaign == "baseline":
+        opening += (
+            " Each set is diagnosed against a clean baseline session of the same players and clubs (other launches "
+            "and noise) in the world's calm ICAO air."
+        )
+    lines = [opening, "", "| measure | reached | target |", "|---|---:|---:|", *measures, ""]
     lines += [*_confusion(runs, present), "", *_per_case(runs, present), "", *_every_run(runs)]
     return "\n".join(lines) + "\n"
 

@@ -250,6 +250,40 @@ class ModelInfo(_ReportModel):
     )
 
 
+class BaselineInfo(_ReportModel):
+    """The baseline session a diagnosis was made against (`golfflight diagnose NEW --baseline BASELINE`): what it
+    taught about the model's form, and where the new session's launches lie outside it."""
+
+    source: str
+    n_shots: int
+    heldout_error_before: float = Field(
+        description="the baseline against the model as is: mean squared standardized residual (1 = noise alone)"
+    )
+    heldout_error_after: float = Field(
+        description="the same on held-out baseline shots, with the form and discrepancy learned without their fold"
+    )
+    form: dict[str, float] = Field(
+        description="the learned form's weights (`discovery.form_terms`): log-multipliers of C_L, C_D and C_M over "
+        "the spin ratio and the Reynolds number"
+    )
+    discrepancy_sd: dict[str, float] = Field(
+        description="per observable, the discrepancy's amplitude (its unit): what a shot far outside the baseline's "
+        "launches is expected to miss by beyond noise"
+    )
+    baseline_density_kg_m3: list[float] = Field(description="the lowest and highest air density the baseline flew in")
+    new_density_kg_m3: list[float] = Field(description="the lowest and highest air density assumed for the new shots")
+    baseline_launch: dict[str, list[float]] = Field(
+        description="per launch value, the baseline's 1st and 99th percentiles"
+    )
+    outside_shots: int = Field(description="new shots outside the baseline's launches (the learned form extrapolated)")
+    outside_launch: dict[str, list[float]] = Field(
+        description="per launch value, the lowest and highest among the new shots outside the baseline's launches"
+    )
+    outside_clubs: list[str] = Field(description="the clubs of the new shots outside the baseline's launches")
+    needed: str = Field(description="the baseline shots that would cover the new session, in words; empty if none")
+    cannot_inform: list[str] = Field(description="what the baseline cannot teach about these new shots, in words")
+
+
 class Report(_ReportModel):
     """report.json of `golfflight diagnose`."""
 
@@ -279,6 +313,9 @@ class Report(_ReportModel):
         default=None, description="air density against the chosen explanation, where the recordings carry no air"
     )
     heldout: Heldout
+    baseline: BaselineInfo | None = Field(
+        default=None, description="the baseline session the new shots were diagnosed against; null without one"
+    )
     statement: str
     headline: list[str] = Field(
         default_factory=list,

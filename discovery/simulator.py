@@ -1,7 +1,7 @@
 """Fly recorded launches through the diagnosed model under modified conditions, many variants in one batch.
 
 A `Setup` holds everything per shot (launch, air, uniform wind, landing ground, coefficient scales, correction
-weights); `simulate_setup` flies it through the model's `flight.flyer.Flyer` (`Flyer.flight`, the one batch flight):
+weights, a form's weights); `simulate_setup` flies it through the model's `flight.flyer.Flyer` (`Flyer.flight`, the one batch flight):
 effect fits fly the same shots under several parameter sets stacked into one batch.
 """
 
@@ -11,6 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, fields
 
 import numpy as np
+from golfflight.discovery.form_terms import formed_flyer
 from golfflight.flight.field import WeightedCorrection
 from golfflight.flight.flyer import Flyer
 from golfflight.flight.outcomes import Flight
@@ -49,6 +50,8 @@ class Setup:
     viscosity_ratio: np.ndarray | None = None
     """True kinematic viscosity over the assumed one [N] (ones where not given): real thinner air has a
     proportionally larger one (the Reynolds number falls with the density), a density-only change leaves it."""
+    form_weights: np.ndarray | None = None
+    """Weights [N,K] of a form's coefficient multipliers (`discovery.form_terms`), None = the model's own form."""
 
     def __post_init__(self) -> None:
         if self.viscosity_ratio is None:
@@ -130,6 +133,8 @@ def setup_flight(
     density = setup.density_kg_m3 * setup.density_ratio
     wind = air if air is not None else Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1])
     extra = None if correction is None else WeightedCorrection(correction, setup.correction_weights)
+    if setup.form_weights is not None:
+        flyer = formed_flyer(flyer, setup.form_weights)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         return flyer.flight(initial_state(**setup.launch), density, setup.viscosity(flyer.kinematic_viscosity_m2_s),
                             wind, setup.ground_height_m, keep_states, coefficient_scale=setup.coefficient_scale,

@@ -89,8 +89,8 @@ def test_diagnose_names_its_steps_before_flying_and_writes_the_same(tmp_path, ca
     shots = tmp_path / "shots.csv"
     assert main(["synth", "--shots", "150", "--seed", "5", "--calm", "--out", str(shots), "--quiet"]) == 0
     capsys.readouterr()
-    first_flight = ErrAtFirstCall(capsys, diagnose.baseline)
-    monkeypatch.setattr(diagnose, "baseline", first_flight)
+    first_flight = ErrAtFirstCall(capsys, diagnose.as_is)
+    monkeypatch.setattr(diagnose, "as_is", first_flight)
     argv = ["diagnose", str(shots), "--model", "reference"]
     assert main([*argv, "--out", str(tmp_path / "loud")]) == 0
     loud = capsys.readouterr()

@@ -7,6 +7,7 @@ import re
 from pathlib import Path
 
 from golfflight.discovery.diagnose import diagnose
+from golfflight.discovery.form import learn_form
 from golfflight.discovery.html import PLOTS_MISSING, plots_available
 from golfflight.discovery.model import REFERENCE, load_model
 from golfflight.discovery.outputs import write_diagnosis
@@ -17,6 +18,8 @@ from golfflight.errors import InputError
 from golfflight.shots.progress import print_line, progress_step
 
 QUIET_HELP = "no progress on standard error"
+MIN_BASELINE_SHOTS = 30
+"""A baseline session needs at least this many shots: the form has 19 weights and the discrepancy a process each."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -26,6 +29,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--model",
         help=f"model bundle directory, or '{REFERENCE}' for the reference world (default: the served default, "
         "`golfflight serve`'s lookup)",
+    )
+    parser.add_argument(
+        "--baseline",
+        metavar="BASELINE.csv",
+        help="a session in known conditions (air recorded, or standard when blank; wind calm unless recorded) with the "
+        "same launch monitor and ball: the model's form is learned from it and the recordings are explained as what "
+        "changed since",
     )
     parser.add_argument("--out", required=True, help="folder for report.json, report.html, service_settings.json")
     parser.add_argument("--seed", type=int, default=0, help="seed of the fitting subsample and the bootstraps")
@@ -64,6 +74,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="every library effect, the pair and the effects outside the library (default), two effects at once "
         "(pairs) or three (triples)",
     )
+    prove.add_argument(
+        "--baseline",
+        action="store_true",
+        help="the same as --campaign baseline: every set diagnosed against a clean baseline session of the same "
+        "players and clubs",
+    )
     prove.add_argument("--seeds", type=int, default=4, help="concealed sets per case")
     prove.add_argument("--clean-sets", type=int, default=CLEAN_SETS, help="clean sets (false-alarm count)")
     prove.add_argument("--shots", type=int, default=300, help="shots per concealed set")
@@ -90,8 +106,22 @@ def run_diagnose(args: argparse.Namespace) -> int:
     if len(recordings) < 3:
         raise InputError(f"{args.recordings}: {len(recordings)} shots with an observed outcome; at least 3 are needed")
     model = load_model(args.model, control=args.reference_control)
+    baseline = None
+    if args.baseline is not None:
+        session = read_recordings(args.baseline)
+        if len(session) < MIN_BASELINE_SHOTS:
+            raise InputError(
+                f"--baseline {args.baseline}: {len(session)} shots with an observed outcome; at least "
+                f"{MIN_BASELINE_SHOTS} are needed to learn the model's form from it"
+            )
+        baseline = learn_form(session, model, seed=args.seed, progress=not args.quiet)
     diagnosis = diagnose(
-        recordings, model, seed=args.seed, estimate_scatter=not args.assumed_noise, progress=not args.quiet
+        recordings,
+        model,
+        seed=args.seed,
+        estimate_scatter=not args.assumed_noise,
+        progress=not args.quiet,
+        baseline=baseline,
     )
     progress_step(f"writing the report to {args.out}...", not args.quiet)
     paths = write_diagnosis(diagnosis, args.out)
@@ -110,6 +140,8 @@ def run_prove(args: argparse.Namespace) -> int:
         except re.error as error:
             raise InputError(f"--cases {args.cases!r} is not a regular expression: {error}") from None
     model = load_model(args.model)
+    if args.baseline:
+        args.campaign = "baseline"
     if args.tables_from:
         results = read_runs(Path(args.tables_from))
     else:

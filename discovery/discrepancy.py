@@ -1,0 +1,123 @@
+"""The model discrepancy a baseline session teaches beyond its learned form (Kennedy & O'Hagan 2001): per observable,
+a Gaussian process over the recorded launch, fitted to the residuals the form leaves, its mean added to every
+prediction and its variance to every shot's expected error.
+
+Near the baseline's launches the mean carries what the form's coefficients could not (a forward-Euler model's own
+step error, say) and the variance is small; far from them the mean fades to zero and the variance grows to the whole
+discrepancy the baseline showed: a new session's shots outside the baseline are expected to miss by that much
+(`discovery.reach` says which they are).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from golfflight.discovery.recordings import OBSERVABLES
+from golfflight.discovery.simulator import Outcomes
+from scipy.linalg import solve_triangular
+
+INPUTS: tuple[str, ...] = ("ball_speed_mps", "launch_angle_deg", "spin_rpm", "spin_axis_deg")
+"""The launch values the discrepancy depends on (the launch direction only turns a flight about the vertical)."""
+LENGTHSCALES = (0.5, 1.0, 2.0)
+"""Candidate length scales, in standard deviations of the baseline's launch values."""
+AMPLITUDES = (0.1, 0.3, 1.0, 2.0)
+"""Candidate amplitudes, as shares of the residuals' standard deviation."""
+MAX_POINTS = 1500
+"""At most this many baseline shots condition each process (a random share): its cost grows as their cube."""
+
+
+def _kernel(a: np.ndarray, b: np.ndarray, lengthscale: float) -> np.ndarray:
+    squared = ((a[:, None, :] - b[None, :, :]) ** 2).sum(-1)
+    return np.exp(-0.5 * squared / lengthscale**2)
+
+
+@dataclass(frozen=True)
+class Process:
+    """One observable's Gaussian process: its conditioning points, weights, Cholesky factor and hyperparameters."""
+
+    points: np.ndarray
+    weights: np.ndarray
+    cholesky: np.ndarray
+    lengthscale: float
+    amplitude: float
+
+    def mean(self, z: np.ndarray) -> np.ndarray:
+        """Mean [N] at standardized launches z [N, len(INPUTS)]."""
+        if not len(self.points):
+            return np.zeros(len(z))
+        return self.amplitude**2 * _kernel(z, self.points, self.lengthscale) @ self.weights
+
+    def sd(self, z: np.ndarray) -> np.ndarray:
+        """SD [N] at standardized launches z (a triangular solve per shot: what the mean alone does not need)."""
+        if not len(self.points):
+            return np.zeros(len(z))
+        cross = self.amplitude**2 * _kernel(z, self.points, self.lengthscale)
+        solved = solve_triangular(self.cholesky, cross.T, lower=True)
+        return np.sqrt(np.maximum(self.amplitude**2 - (solved**2).sum(axis=0), 0.0))
+
+
+def fit_process(z: np.ndarray, residual: np.ndarray, noise_sd: np.ndarray, rng: np.random.Generator) -> Process:
+    """The process of highest marginal likelihood over the candidate length scales and amplitudes, conditioned on
+    the shots with a residual (at most MAX_POINTS of them); none where fewer than 10 shots have one."""
+    used = np.flatnonzero(np.isfinite(residual) & np.isfinite(noise_sd))
+    if len(used) < 10:
+        return Process(np.zeros((0, z.shape[1])), np.zeros(0), np.zeros((0, 0)), 1.0, 0.0)
+    if len(used) > MAX_POINTS:
+        used = np.sort(rng.choice(used, MAX_POINTS, replace=False))
+    points, y, noise = z[used], residual[used], noise_sd[used]
+    spread = float(np.std(y)) or 1.0
+    best: tuple[float, Process] | None = None
+    for lengthscale in LENGTHSCALES:
+        base = _kernel(points, points, lengthscale)
+        for share in AMPLITUDES:
+            amplitude = share * spread
+            cholesky = np.linalg.cholesky(amplitude**2 * base + np.diag(noise**2))
+            weights = np.linalg.solve(cholesky.T, np.linalg.solve(cholesky, y))
+            likelihood = -0.5 * y @ weights - np.log(np.diag(cholesky)).sum()
+            if best is None or likelihood > best[0]:
+                best = (likelihood, Process(points, weights, cholesky, lengthscale, amplitude))
+    return best[1]
+
+
+@dataclass(frozen=True)
+class Discrepancy:
+    """The baseline's discrepancy per observable over its standardized launches."""
+
+    centre: np.ndarray
+    scale: np.ndarray
+    processes: tuple[Process, ...]
+    """One per observable, in OBSERVABLES order."""
+
+    def standardized(self, launch: dict[str, np.ndarray]) -> np.ndarray:
+        return (np.stack([launch[k] for k in INPUTS], axis=1) - self.centre) / self.scale
+
+    def mean(self, launch: dict[str, np.ndarray]) -> np.ndarray:
+        """Mean [N,5] of the discrepancy at launches."""
+        z = self.standardized(launch)
+        return np.stack([process.mean(z) for process in self.processes], axis=1)
+
+    def predict(self, launch: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """Mean and SD [N,5] of the discrepancy at launches."""
+        z = self.standardized(launch)
+        return self.mean(launch), np.stack([process.sd(z) for process in self.processes], axis=1)
+
+    def shifted(self, flown: Outcomes, launch: dict[str, np.ndarray]) -> Outcomes:
+        """A batch's outcomes with the discrepancy's mean at its flown launches added (positions left as flown)."""
+        mean = self.mean(launch)
+        landing = flown.landing_xy + mean[:, [1, 0]]
+        return Outcomes(landing, flown.apex_m + mean[:, 2], flown.flight_time_s + mean[:, 3],
+                        flown.landing_angle_deg + mean[:, 4], flown.positions, flown.dt_s)
+
+
+def fit_discrepancy(
+    launch: dict[str, np.ndarray], residual: np.ndarray, noise_sd: np.ndarray, seed: int = 0
+) -> Discrepancy:
+    """The discrepancy of residuals [N,5] with each shot's expected noise SD [N,5], over the recorded launches."""
+    values = np.stack([launch[k] for k in INPUTS], axis=1)
+    centre, scale = values.mean(axis=0), values.std(axis=0)
+    scale = np.where(scale > 0, scale, 1.0)
+    z = (values - centre) / scale
+    rng = np.random.default_rng([seed, 4])
+    processes = tuple(fit_process(z, residual[:, j], noise_sd[:, j], rng) for j in range(len(OBSERVABLES)))
+    return Discrepancy(centre, scale, processes)

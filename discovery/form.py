@@ -1,0 +1,167 @@
+"""The model's form learned from a baseline session: smooth multipliers of C_L, C_D and C_M as functions of the spin
+ratio and the Reynolds number, fitted through the simulator on shots recorded in known conditions.
+
+A model's form error and a venue or monitor cause are confounded within one session (Kennedy & O'Hagan 2001;
+Brynjarsdottir & O'Hagan 2014): what informs the form is a baseline session with the same monitor and ball in known
+air. The form lives in the coefficients, so it flies through every later change as the ball's own aerodynamics
+would: thinner air scales it with the dynamic pressure, a wind or a launch bias moves it with the spin ratio and
+the Reynolds number the ball then meets. What the baseline cannot inform (how the flight responds to air it never
+flew in, launches far from its own) is reported, not assumed (`Coverage`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from golfflight.discovery.as_is import as_is
+from golfflight.discovery.discrepancy import Discrepancy, fit_discrepancy
+from golfflight.discovery.effects import Context, Effect, Parameter, Reported
+from golfflight.discovery.fit import Fit, Problem, fit, fit_rows, folds, linear_starts
+from golfflight.discovery.form_terms import TERMS, formed_flyer
+from golfflight.discovery.model import FlightModel
+from golfflight.discovery.noise import RADAR_NOISE
+from golfflight.discovery.recordings import OBSERVABLES, Recordings
+from golfflight.discovery.simulator import Setup
+from golfflight.errors import InputError
+from golfflight.shots.progress import progress_step
+from golfflight.shots.synth import MeasurementNoise
+
+NAME = "form"
+FIT_ROUNDS = 3
+
+
+def _apply(theta: np.ndarray, conditions: Setup) -> Setup:
+    return replace(conditions.copy(), form_weights=theta)
+
+
+def _describe(theta: np.ndarray, covariance: np.ndarray, context: Context) -> Reported:
+    names = [term.name for term in TERMS]
+    return (
+        {n: float(t) for n, t in zip(names, theta)},
+        {n: float(np.sqrt(max(covariance[i, i], 0.0))) for i, n in enumerate(names)},
+    )
+
+
+FORM = Effect(
+    NAME,
+    tuple(Parameter(term.name, "1", 0.0, -term.bound, term.bound, 0.05, 0.005) for term in TERMS),
+    _apply,
+    _describe,
+    "the model's form learned from the baseline: C_L, C_D and C_M times smooth functions of the spin ratio and the "
+    "Reynolds number",
+    kind="form",
+)
+"""The form as an effect the fitter treats like any other (fitted on the baseline session only)."""
+
+
+@dataclass(frozen=True)
+class LearnedForm:
+    """What a baseline session teaches: the form's weights and covariance, the discrepancy it leaves, how much of the
+    baseline's held-out error the two remove, and the launches and airs they were learned in."""
+
+    source: str
+    n_shots: int
+    theta: np.ndarray
+    covariance: np.ndarray
+    discrepancy: Discrepancy
+    error_before: float
+    """Mean squared standardized residual of the model as is on the baseline (1 = noise alone)."""
+    error_after: float
+    """The same on held-out baseline shots: the form fitted on every shot, the discrepancy without their fold."""
+    launches: dict[str, np.ndarray]
+    """The baseline's recorded launch values."""
+    density_kg_m3: np.ndarray
+    """The air density each baseline shot flew in (recorded, else the model's): the airs it was learned in."""
+
+    def weights(self) -> dict[str, float]:
+        """The form's weights by term name."""
+        return {term.name: float(value) for term, value in zip(TERMS, self.theta, strict=True)}
+
+
+def learn_form(
+    recordings: Recordings,
+    model: FlightModel,
+    noise: MeasurementNoise = RADAR_NOISE,
+    seed: int = 0,
+    progress: bool = False,
+) -> LearnedForm:
+    """Learn the form (`FORM`) and the discrepancy it leaves from a baseline session in its known conditions
+    (recorded air and wind, else the model's air, calm), expecting measurement noise only (and the session's own
+    scatter where larger), and score both on held-out sessions."""
+    if model.control is not None:
+        raise InputError("a baseline session and --reference-control cannot be combined: the baseline is the control")
+    bare = replace(
+        model,
+        model_error={name: 0.0 for name in OBSERVABLES},
+        error_source={name: "none: the baseline session informs it" for name in OBSERVABLES},
+    )
+    progress_step(f"learning the model's form from the baseline session's {len(recordings):,} shots...", progress)
+    start = as_is(recordings, bare, noise, seed, estimate_scatter=True)
+    problem = Problem(bare, recordings, start.base, start.expected.sigma, start.use, start.offset)
+    rows = fit_rows(recordings, np.random.default_rng([seed, 3]))
+    result = converged(problem, linear_starts(problem, None, (FORM,), rows)[0][0], rows)
+    everyone = np.arange(len(recordings))
+    discrepancy = _discrepancy(problem, result.theta, everyone, seed)
+    after = heldout_with_discrepancy(problem, result.theta, seed)
+    return LearnedForm(
+        recordings.source or "the baseline session",
+        len(recordings),
+        result.theta,
+        result.covariance,
+        discrepancy,
+        float(np.nanmean(problem.standardize(start.predicted, everyone) ** 2)),
+        float(np.nanmean(after**2)),
+        {k: v.copy() for k, v in recordings.launch.items()},
+        start.base.density_kg_m3.copy(),
+    )
+
+
+def _discrepancy(problem: Problem, theta: np.ndarray, rows: np.ndarray, seed: int) -> Discrepancy:
+    """The discrepancy the form at `theta` leaves on the shots at `rows`."""
+    residual = problem.observed[rows] - problem.predict((FORM,), theta, rows)[0]
+    residual = np.where(problem.use[rows], residual, np.nan)
+    launch = {k: v[rows] for k, v in problem.recordings.launch.items()}
+    return fit_discrepancy(launch, residual, problem.sigma[rows], seed)
+
+
+def converged(problem: Problem, start: np.ndarray, rows: np.ndarray, rounds: int = FIT_ROUNDS) -> Fit:
+    """The form fitted from `start`, restarted from where each fit stopped (a fit stops after a fixed number of
+    evaluations; the form's many weights may need more) until its error stops falling by 1 %."""
+    result = fit(problem, (FORM,), start, rows)
+    for _ in range(rounds - 1):
+        again = fit(problem, (FORM,), result.theta, rows)
+        if np.nanmean(again.z**2) > 0.99 * np.nanmean(result.z**2):
+            return again
+        result = again
+    return result
+
+
+def heldout_with_discrepancy(problem: Problem, theta: np.ndarray, seed: int) -> np.ndarray:
+    """Standardized residuals [N,5] of every shot predicted by the form at `theta` (fitted on every shot: its few
+    weights against five outcomes a shot) and the discrepancy learned without its fold (whole sessions, or blocks of
+    shots), the expected error including that discrepancy's SD there, as a new session's would."""
+    fold, _ = folds(problem.recordings.session)
+    everyone = np.arange(len(problem.recordings))
+    formed = problem.predict((FORM,), theta, everyone)[0]
+    z = np.full(problem.observed.shape, np.nan)
+    for f in np.unique(fold):
+        held, train = np.flatnonzero(fold == f), np.flatnonzero(fold != f)
+        launch = {k: v[held] for k, v in problem.recordings.launch.items()}
+        mean, sd = _discrepancy(problem, theta, train, seed).predict(launch)
+        sigma = np.sqrt(problem.sigma[held] ** 2 + sd**2)
+        z[held] = np.where(problem.use[held], (problem.observed[held] - formed[held] - mean) / sigma, np.nan)
+    return z
+
+
+def formed_model(model: FlightModel, form: LearnedForm) -> FlightModel:
+    """The model with the learned form held in its coefficients and the discrepancy beside it: what a new session is
+    diagnosed against (its own error is the discrepancy's SD at each shot's launch)."""
+    return FlightModel(
+        f"{model.name}, with the form learned from {form.source} ({form.n_shots:,} shots)",
+        formed_flyer(model.flyer, form.theta),
+        {name: 0.0 for name in OBSERVABLES},
+        {name: "the baseline session: its discrepancy at each shot's launch" for name in OBSERVABLES},
+        model.temperature_c,
+        discrepancy=form.discrepancy,
+    )

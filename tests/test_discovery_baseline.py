@@ -1,0 +1,144 @@
+"""Discovery against a baseline session: the form's coefficients, the discrepancy, learning both from a baseline, and
+a change named against it where the model's form alone would be confounded with it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from golfflight.discovery.conceal import conceal
+from golfflight.discovery.diagnose import diagnose, library_for
+from golfflight.discovery.discrepancy import fit_discrepancy
+from golfflight.discovery.effects import BALL, EFFECTS
+from golfflight.discovery.form import FORM, formed_model, learn_form
+from golfflight.discovery.form_terms import REYNOLDS_REF, SPIN_RATIO_REF, TERMS, log_multipliers
+from golfflight.discovery.model import reference
+from golfflight.discovery.noise import base_conditions
+from golfflight.discovery.prove import ferguson_world
+from golfflight.discovery.recordings import OBSERVABLES, from_shot_set
+from golfflight.discovery.reach import needed_words, outside_baseline
+from golfflight.discovery.schema import Report
+from golfflight.flight.constants import BALL_RADIUS_M
+from golfflight.shots.records import write_shots
+
+from golfflight.cli import main
+
+WEIGHTS = {term.name: k for k, term in enumerate(TERMS)}
+
+
+def _weights(**named: float) -> np.ndarray:
+    theta = np.zeros(len(TERMS))
+    for name, value in named.items():
+        theta[WEIGHTS[name.replace("_", " ")]] = value
+    return theta
+
+
+def test_the_form_features_at_a_hand_worked_state():
+    """A ball at 40 m/s spinning 750 rad/s in air of nu = 1.5e-5: S = 0.021335 * 750 / 40 = 0.4000 (s = ln 2), Re =
+    2 * 0.021335 * 40 / 1.5e-5 = 113,787 (r = ln(0.7586)); C_L is multiplied by exp(0.1 s + 0.2 r)."""
+    v, w = np.array([[0.0, 40.0, 0.0]]), np.array([[-750.0, 0.0, 0.0]])
+    theta = _weights(lift_x_s=0.1, lift_x_r=0.2, drag_x_1=0.05, spin_decay=0.3)
+    out = log_multipliers(v, w, 1.5e-5, theta)[0]
+    s = np.log(BALL_RADIUS_M * 750 / 40 / SPIN_RATIO_REF)
+    r = np.log(2 * BALL_RADIUS_M * 40 / 1.5e-5 / REYNOLDS_REF)
+    assert s == pytest.approx(np.log(2.0), rel=1e-3) and r == pytest.approx(np.log(0.75858), rel=1e-3)
+    assert out == pytest.approx([0.1 * s + 0.2 * r, 0.05, 0.3])
+
+
+def test_a_constant_drag_weight_flies_as_the_drag_scale():
+    """exp(b0) on C_D everywhere is the library's drag scale of exp(b0), to rounding."""
+    recordings = from_shot_set(conceal({}, 40, seed=3).shots)
+    model = reference()
+    base = base_conditions(recordings, model)
+    scaled = EFFECTS["drag_scale"].apply(np.full((len(base), 1), 1.05), base)
+    formed = FORM.apply(np.repeat(_weights(drag_x_1=np.log(1.05))[None], len(base), 0), base)
+    assert model.simulate(formed).outcomes() == pytest.approx(model.simulate(scaled).outcomes(), abs=1e-9)
+    none = FORM.apply(np.zeros((len(base), len(TERMS))), base)
+    assert np.array_equal(model.simulate(none).outcomes(), model.simulate(base).outcomes())
+
+
+def test_the_discrepancy_follows_a_smooth_function_and_doubts_far_launches():
+    rng = np.random.default_rng(0)
+    n = 300
+    launch = {
+        "ball_speed_mps": rng.normal(60, 5, n),
+        "launch_angle_deg": rng.normal(15, 2, n),
+        "spin_rpm": rng.normal(5000, 800, n),
+        "spin_axis_deg": rng.normal(0, 3, n),
+    }
+    truth = 2.0 * np.sin((launch["ball_speed_mps"] - 60) / 5)
+    residual = np.zeros((n, len(OBSERVABLES)))
+    residual[:, 0] = truth + rng.normal(0, 0.3, n)
+    discrepancy = fit_discrepancy(launch, residual, np.full((n, len(OBSERVABLES)), 0.3))
+    mean, sd = discrepancy.predict(launch)
+    assert np.sqrt(np.mean((mean[:, 0] - truth) ** 2)) < 0.2
+    assert np.all(sd[:, 0] < 0.3)
+    far = {k: np.array([v.mean() + 10 * v.std()]) for k, v in launch.items()}
+    far_mean, far_sd = discrepancy.predict(far)
+    assert abs(far_mean[0, 0]) < 0.1 and far_sd[0, 0] > 0.9 * discrepancy.processes[0].amplitude
+
+
+@pytest.fixture(scope="module")
+def ferguson_baseline():
+    """What a clean 200-shot baseline in Ferguson 2022's world teaches the reference world (another form)."""
+    clean = conceal({}, 200, seed=4, model=ferguson_world(), launch_seed=1)
+    return learn_form(from_shot_set(clean.shots, source="home"), reference(), seed=4)
+
+
+def test_the_baseline_teaches_the_form_on_held_out_shots(ferguson_baseline):
+    """Against the model as is a clean Ferguson set misses by several times the noise; with the form and the
+    discrepancy learned without each fold, its held-out shots miss by about the noise."""
+    assert ferguson_baseline.error_before > 3.0
+    assert ferguson_baseline.error_after < 0.5 * ferguson_baseline.error_before and ferguson_baseline.error_after < 2.0
+
+
+def test_a_wind_is_named_against_the_baseline_where_the_form_differs(ferguson_baseline):
+    hidden = {"wind": {"speed_mps": 4.0, "from_deg": 20.0}}
+    new = from_shot_set(conceal(hidden, 200, seed=4, model=ferguson_world()).shots, source="windy")
+    report = diagnose(new, reference(), seed=4, progress=False, baseline=ferguson_baseline).report
+    assert [e.name for e in report.effects] == ["wind"]
+    assert report.effects[0].parameters["speed_mps"] == pytest.approx(4.0, rel=0.1)
+    assert report.baseline is not None and report.baseline.source == "home"
+    assert report.statement.startswith("Against the baseline session home (200 shots)")
+
+
+def test_a_no_change_session_claims_nothing_against_the_baseline(ferguson_baseline):
+    new = from_shot_set(conceal({}, 200, seed=4, model=ferguson_world()).shots, source="same")
+    report = diagnose(new, reference(), seed=4, progress=False, baseline=ferguson_baseline).report
+    assert not any(e.kind in ("venue", "monitor", "ball") for e in report.effects)
+
+
+def test_against_a_baseline_the_coefficient_scales_give_way_to_another_ball():
+    plain, against = library_for(False), library_for(False, against_baseline=True)
+    assert "drag_scale" in {e.name for e in plain} and BALL not in plain
+    assert BALL in against and not {"drag_scale", "lift_scale", "spin_decay"} & {e.name for e in against}
+    assert {e.name for e in plain if e.kind != "form"} == {e.name for e in against if e.kind != "ball"}
+
+
+def test_new_shots_outside_the_baseline_are_found_and_named(ferguson_baseline):
+    """The formed model on launches far from the baseline's: those shots are outside and the report says which
+    baseline shots would cover them."""
+    launch = {k: v.copy() for k, v in ferguson_baseline.launches.items()}
+    assert not outside_baseline(ferguson_baseline, launch).any()
+    slow = {k: v[:5] for k, v in launch.items()}
+    slow["ball_speed_mps"] = np.full(5, 15.0)
+    assert outside_baseline(ferguson_baseline, slow).all()
+    model = formed_model(reference(), ferguson_baseline)
+    assert (model.discrepancy.predict(slow)[1] >= model.discrepancy.predict(launch)[1].max(axis=0) * 0.99).all()
+    words = needed_words({"ball_speed_mps": [15.0, 15.0]}, ["putter"])
+    assert words == "Record baseline shots at ball speed 15–15 m/s (the new session's putter), with the same launch " \
+        "monitor and ball."
+
+
+def test_the_cli_diagnoses_against_a_baseline_and_refuses_a_tiny_one(tmp_path, capsys):
+    home = conceal({}, 120, seed=9, launch_seed=1)
+    windy = conceal({"wind": {"speed_mps": 5.0, "from_deg": 180.0}}, 120, seed=9)
+    write_shots(tmp_path / "home.csv", home.shots.records)
+    write_shots(tmp_path / "new.csv", windy.shots.records)
+    argv = ["diagnose", str(tmp_path / "new.csv"), "--model", "reference", "--quiet"]
+    assert main([*argv, "--baseline", str(tmp_path / "home.csv"), "--out", str(tmp_path / "out")]) == 0
+    report = Report.model_validate_json((tmp_path / "out" / "report.json").read_text())
+    assert report.baseline is not None and report.baseline.n_shots == len(home.shots.records)
+    assert [e.name for e in report.effects] == ["wind"]
+    write_shots(tmp_path / "tiny.csv", home.shots.records[:10])
+    assert main([*argv, "--baseline", str(tmp_path / "tiny.csv"), "--out", str(tmp_path / "x")]) == 2
+    assert "--baseline" in capsys.readouterr().err
