@@ -104,10 +104,9 @@ def _joined(parts: list[str]) -> str:
 
 def _subject(report: Report) -> tuple[str, str]:
     """Who differs and from what: the shots from the model, or the new shots from the baseline session."""
-    baseline = getattr(report, "baseline", None)
-    if baseline is None:
+    if report.baseline is None:
         return "Shots", " than the model"
-    return f"Against the baseline session ({baseline.n_shots:,} shots), the new shots", ""
+    return f"Against the baseline session ({report.baseline.n_shots:,} shots), the new shots", ""
 
 
 def _outcome(f: Flagged) -> str:

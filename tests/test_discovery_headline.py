@@ -7,7 +7,6 @@ hand-made reports, reads as a person says it."""
 from __future__ import annotations
 
 import re
-from types import SimpleNamespace
 
 import pytest
 from golfflight.discovery.conceal import conceal
@@ -18,6 +17,7 @@ from golfflight.discovery.recordings import OBSERVABLES, from_shot_set
 from golfflight.discovery.schema import (
     AirRival,
     Ambiguity,
+    BaselineInfo,
     Candidate,
     CorrectionSettings,
     EffectResult,
@@ -224,7 +224,22 @@ def test_the_first_sentence_says_what_differs_in_metres_with_its_direction():
 
 def test_a_baseline_session_is_what_the_new_shots_are_compared_with():
     report = _report([THIN_AIR])
-    baseline = SimpleNamespace(source="last week.csv", n_shots=412)
+    baseline = BaselineInfo(
+        source="last week.csv",
+        n_shots=412,
+        heldout_error_before=1.8,
+        heldout_error_after=1.05,
+        form={},
+        discrepancy_sd={},
+        baseline_density_kg_m3=[1.2, 1.23],
+        new_density_kg_m3=[1.2, 1.23],
+        baseline_launch={},
+        outside_shots=0,
+        outside_launch={},
+        outside_clubs=[],
+        needed="",
+        cannot_inform=[],
+    )
     against = report.model_copy(update={"baseline": baseline})
     assert headline(against)[0] == (
         "Against the baseline session (412 shots), the new shots carry 12.3 m shorter and peak 2.1 m lower."
