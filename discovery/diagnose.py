@@ -260,7 +260,9 @@ class Diagnoser:
         self.recordings, self.model, self.baseline = recordings, model, baseline
         self.air_recorded = recordings.density_kg_m3 is not None
         self.library = library_for(self.air_recorded, recordings.wind_xy_mps is not None, baseline is not None)
-        self.with_correction, self.estimate_scatter, self.progress = with_correction, estimate_scatter, progress
+        self.estimate_scatter, self.progress = estimate_scatter, progress
+        # against a baseline the form it taught is held: a learned correction would trade against the change itself
+        self.with_correction = with_correction and baseline is None
         self.rng = np.random.default_rng(seed)
         self.step(f"flying {len(recordings):,} recorded shots through the model and its expected error...")
         self.as_is = as_is(recordings, model, noise, seed, estimate_scatter, progress)

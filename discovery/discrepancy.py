@@ -10,12 +10,13 @@ discrepancy the baseline showed: a new session's shots outside the baseline are 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from golfflight.discovery.recordings import OBSERVABLES
 from golfflight.discovery.simulator import Outcomes
-from scipy.linalg import solve_triangular
+from scipy.linalg import cho_solve, solve_triangular
 
 INPUTS: tuple[str, ...] = ("ball_speed_mps", "launch_angle_deg", "spin_rpm", "spin_axis_deg")
 """The launch values the discrepancy depends on (the launch direction only turns a flight about the vertical)."""
@@ -23,13 +24,22 @@ LENGTHSCALES = (0.5, 1.0, 2.0)
 """Candidate length scales, in standard deviations of the baseline's launch values."""
 AMPLITUDES = (0.1, 0.3, 1.0, 2.0)
 """Candidate amplitudes, as shares of the residuals' standard deviation."""
-MAX_POINTS = 1500
-"""At most this many baseline shots condition each process (a random share): its cost grows as their cube."""
+MAX_POINTS = 1000
+"""At most this many baseline shots condition each process's mean (a random share): its cost grows as their cube."""
+MAX_SD_POINTS = 300
+"""The SD is read from the process conditioned on the first this many of them: a triangular solve per shot costs
+their square, and fewer points only widen the SD (a new session's 100,000 shots in seconds)."""
+CHUNK = 10_000
+"""Shots whose kernel rows are built at once (a chunk of 10,000 against 1,000 points is 80 MB)."""
 
 
 def _kernel(a: np.ndarray, b: np.ndarray, lengthscale: float) -> np.ndarray:
-    squared = ((a[:, None, :] - b[None, :, :]) ** 2).sum(-1)
-    return np.exp(-0.5 * squared / lengthscale**2)
+    squared = (a**2).sum(1)[:, None] + (b**2).sum(1)[None, :] - 2.0 * a @ b.T
+    return np.exp(-0.5 * np.maximum(squared, 0.0) / lengthscale**2)
+
+
+def _chunked(z: np.ndarray, read: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    return np.concatenate([read(z[start : start + CHUNK]) for start in range(0, len(z), CHUNK)]) if len(z) else z[:, 0]
 
 
 @dataclass(frozen=True)
@@ -38,7 +48,8 @@ class Process:
 
     points: np.ndarray
     weights: np.ndarray
-    cholesky: np.ndarray
+    sd_cholesky: np.ndarray
+    """The Cholesky factor of the first MAX_SD_POINTS points' covariance (with their noise)."""
     lengthscale: float
     amplitude: float
 
@@ -46,25 +57,29 @@ class Process:
         """Mean [N] at standardized launches z [N, len(INPUTS)]."""
         if not len(self.points):
             return np.zeros(len(z))
-        return self.amplitude**2 * _kernel(z, self.points, self.lengthscale) @ self.weights
+        return _chunked(z, lambda part: self.amplitude**2 * _kernel(part, self.points, self.lengthscale) @ self.weights)
 
     def sd(self, z: np.ndarray) -> np.ndarray:
         """SD [N] at standardized launches z (a triangular solve per shot: what the mean alone does not need)."""
         if not len(self.points):
             return np.zeros(len(z))
-        cross = self.amplitude**2 * _kernel(z, self.points, self.lengthscale)
-        solved = solve_triangular(self.cholesky, cross.T, lower=True)
-        return np.sqrt(np.maximum(self.amplitude**2 - (solved**2).sum(axis=0), 0.0))
+        points = self.points[: len(self.sd_cholesky)]
+
+        def read(part: np.ndarray) -> np.ndarray:
+            cross = self.amplitude**2 * _kernel(part, points, self.lengthscale)
+            solved = solve_triangular(self.sd_cholesky, cross.T, lower=True)
+            return np.sqrt(np.maximum(self.amplitude**2 - (solved**2).sum(axis=0), 0.0))
+
+        return _chunked(z, read)
 
 
 def fit_process(z: np.ndarray, residual: np.ndarray, noise_sd: np.ndarray, rng: np.random.Generator) -> Process:
     """The process of highest marginal likelihood over the candidate length scales and amplitudes, conditioned on
-    the shots with a residual (at most MAX_POINTS of them); none where fewer than 10 shots have one."""
+    the shots with a residual (at most MAX_POINTS of them, in random order); none where fewer than 10 shots have one."""
     used = np.flatnonzero(np.isfinite(residual) & np.isfinite(noise_sd))
     if len(used) < 10:
         return Process(np.zeros((0, z.shape[1])), np.zeros(0), np.zeros((0, 0)), 1.0, 0.0)
-    if len(used) > MAX_POINTS:
-        used = np.sort(rng.choice(used, MAX_POINTS, replace=False))
+    used = rng.permutation(used)[:MAX_POINTS]
     points, y, noise = z[used], residual[used], noise_sd[used]
     spread = float(np.std(y)) or 1.0
     best: tuple[float, Process] | None = None
@@ -72,11 +87,13 @@ def fit_process(z: np.ndarray, residual: np.ndarray, noise_sd: np.ndarray, rng: 
         base = _kernel(points, points, lengthscale)
         for share in AMPLITUDES:
             amplitude = share * spread
-            cholesky = np.linalg.cholesky(amplitude**2 * base + np.diag(noise**2))
-            weights = np.linalg.solve(cholesky.T, np.linalg.solve(cholesky, y))
+            covariance = amplitude**2 * base + np.diag(noise**2)
+            cholesky = np.linalg.cholesky(covariance)
+            weights = cho_solve((cholesky, True), y)
             likelihood = -0.5 * y @ weights - np.log(np.diag(cholesky)).sum()
             if best is None or likelihood > best[0]:
-                best = (likelihood, Process(points, weights, cholesky, lengthscale, amplitude))
+                sd_cholesky = np.linalg.cholesky(covariance[:MAX_SD_POINTS, :MAX_SD_POINTS])
+                best = (likelihood, Process(points, weights, sd_cholesky, lengthscale, amplitude))
     return best[1]
 
 
