@@ -17,6 +17,7 @@ from html import escape
 
 from golfflight.discovery import tables
 from golfflight.discovery.headline import headline
+from golfflight.discovery.reach import baseline_sentence
 from golfflight.discovery.schema import Report
 from golfflight.discovery.style import STYLE
 from golfflight.discovery.verdict import Verdict, verdict
@@ -84,6 +85,7 @@ VERDICT_ROWS = (
 
 KNOWN_FIELDS = {
     "schema_version",
+    "baseline",
     "recordings",
     "n_shots",
     "n_sessions",
@@ -184,6 +186,7 @@ def _sections(report: Report, plots: Plots) -> list[str]:
     trajectory = tables.trajectory_table(report) + plots.div("along")
     rivals = tables.rivals_table(report)
     return [
+        *_baseline(report),
         "<h2>1. What differs</h2>"
         + tables.observables_table(report)
         + tables.trends_table(report)
@@ -204,6 +207,14 @@ def _sections(report: Report, plots: Plots) -> list[str]:
         "<h2>Expected error</h2>" + tables.expected_table(report),
         *_further(report),
     ]
+
+
+def _baseline(report: Report) -> list[str]:
+    """The baseline session the shots were diagnosed against, where there is one."""
+    if report.baseline is None:
+        return []
+    words = escape(baseline_sentence(report.baseline, report.n_shots))
+    return [f"<h2>Against the baseline session</h2><p>{words}</p>" + tables.baseline_table(report.baseline)]
 
 
 def _unlisted(report: Report) -> list[str]:

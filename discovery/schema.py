@@ -8,8 +8,9 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-SCHEMA_VERSION = "1.1"
-"""1.1: the held-out noise floor and absorbs_noise; the systematic test decides (structure_found)."""
+SCHEMA_VERSION = "1.2"
+"""1.1: the held-out noise floor and absorbs_noise; the systematic test decides (structure_found). 1.2: the headline,
+the baseline session (`baseline`) and another ball (effect kind "ball")."""
 SCHEMA_PATH = Path(__file__).with_name("report.schema.json")
 
 
@@ -287,7 +288,7 @@ class BaselineInfo(_ReportModel):
 class Report(_ReportModel):
     """report.json of `golfflight diagnose`."""
 
-    schema_version: Literal["1.1"] = SCHEMA_VERSION
+    schema_version: Literal["1.2"] = SCHEMA_VERSION
     recordings: str
     n_shots: int
     n_sessions: int

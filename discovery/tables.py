@@ -9,7 +9,7 @@ from html import escape
 import numpy as np
 from golfflight.discovery.recordings import LABELS, OBSERVABLES
 from golfflight.discovery.report import effect_phrase
-from golfflight.discovery.schema import Ambiguity, Report
+from golfflight.discovery.schema import Ambiguity, BaselineInfo, Report
 from golfflight.discovery.words import COVARIATE_WORDS, effect_words, key_words, unit_of
 
 ROW_UNIT = "row's unit"
@@ -326,3 +326,30 @@ def decision_table(report: Report) -> str:
     rows = [[key_words(k).replace("gain low", "gain, lower bound"), _decision_value(k, v)] for k, v in test.items()]
     columns = [TableColumn("quantity", "", False), TableColumn("value", f"{SCORE_UNIT} where a number")]
     return table(columns, rows)
+
+
+def baseline_table(baseline: BaselineInfo) -> str:
+    """What the baseline session taught and how far it reaches: its held-out error before and after the learned form,
+    the discrepancy left per observable, its airs and the new shots outside its launches."""
+    def span(values: list[float]) -> str:
+        return " – ".join(number(v, 3) for v in values)
+
+    discrepancy = [
+        [f"discrepancy far from the baseline: {LABELS[name]}", sd, unit_of(name)]
+        for name, sd in baseline.discrepancy_sd.items()
+    ]
+    rows: list[list[object]] = [
+        ["baseline shots", baseline.n_shots, "shots"],
+        ["held-out error of the model as is", baseline.heldout_error_before, SCORE_UNIT],
+        ["held-out error with the learned form", baseline.heldout_error_after, SCORE_UNIT],
+        *discrepancy,
+        ["air density of the baseline, lowest – highest", span(baseline.baseline_density_kg_m3), "kg/m³"],
+        ["air density assumed for the new shots", span(baseline.new_density_kg_m3), "kg/m³"],
+        ["new shots outside the baseline's launches", baseline.outside_shots, "shots"],
+    ]
+    columns = [
+        TableColumn("quantity", "", False),
+        TableColumn("value", "in the unit beside it"),
+        TableColumn("unit", "", False),
+    ]
+    return SCORE_NOTE + table(columns, rows)
