@@ -18,7 +18,9 @@ scales that agree as air density, and on recordings without air, air set against
 (`Diagnoser.in_physical_terms`); a venue condition or monitor bias that moves no recorded observable by more than
 the model's own error is left to the model's form (`Diagnoser.within_form`). Structure the library explanation
 leaves (the test run again on its residuals) leads to the learned correction; a library effect stays beside it only
-if it beats the correction alone beyond doubt.
+if it beats the correction alone beyond doubt. Against a baseline session (`discovery.form`) the model carries the
+form the baseline taught, the coefficient scales give way to another ball, and no correction is learned: what is
+named is what changed since the baseline.
 """
 
 from __future__ import annotations
@@ -47,8 +49,8 @@ from golfflight.discovery.fit import (
     per_shot,
     stratified_rows,
 )
-from golfflight.discovery.headline import headline
 from golfflight.discovery.form import LearnedForm, formed_model
+from golfflight.discovery.headline import headline
 from golfflight.discovery.invariance import Halves, halves, set_aside_sentence
 from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
 from golfflight.discovery.model import FlightModel

@@ -26,6 +26,8 @@ AMPLITUDES = (0.1, 0.3, 1.0, 2.0)
 """Candidate amplitudes, as shares of the residuals' standard deviation."""
 MAX_POINTS = 1000
 """At most this many baseline shots condition each process's mean (a random share): its cost grows as their cube."""
+SEARCH_POINTS = 300
+"""The length scale and amplitude are chosen on this many of them (twelve candidates, each a Cholesky factor)."""
 MAX_SD_POINTS = 300
 """The SD is read from the process conditioned on the first this many of them: a triangular solve per shot costs
 their square, and fewer points only widen the SD (a new session's 100,000 shots in seconds)."""
@@ -73,28 +75,38 @@ class Process:
         return _chunked(z, read)
 
 
-def fit_process(z: np.ndarray, residual: np.ndarray, noise_sd: np.ndarray, rng: np.random.Generator) -> Process:
-    """The process of highest marginal likelihood over the candidate length scales and amplitudes, conditioned on
-    the shots with a residual (at most MAX_POINTS of them, in random order); none where fewer than 10 shots have one."""
+def _likelihood(points: np.ndarray, y: np.ndarray, noise: np.ndarray, lengthscale: float, amplitude: float) -> float:
+    cholesky = np.linalg.cholesky(amplitude**2 * _kernel(points, points, lengthscale) + np.diag(noise**2))
+    return float(-0.5 * y @ cho_solve((cholesky, True), y) - np.log(np.diag(cholesky)).sum())
+
+
+def fit_process(
+    z: np.ndarray,
+    residual: np.ndarray,
+    noise_sd: np.ndarray,
+    rng: np.random.Generator,
+    hyper: tuple[float, float] | None = None,
+) -> Process:
+    """The process conditioned on the shots with a residual (at most MAX_POINTS of them, in random order), its length
+    scale and amplitude those of highest marginal likelihood among the candidates on the first SEARCH_POINTS of them
+    (or `hyper`, another process's); none where fewer than 10 shots have a residual."""
     used = np.flatnonzero(np.isfinite(residual) & np.isfinite(noise_sd))
     if len(used) < 10:
         return Process(np.zeros((0, z.shape[1])), np.zeros(0), np.zeros((0, 0)), 1.0, 0.0)
     used = rng.permutation(used)[:MAX_POINTS]
     points, y, noise = z[used], residual[used], noise_sd[used]
-    spread = float(np.std(y)) or 1.0
-    best: tuple[float, Process] | None = None
-    for lengthscale in LENGTHSCALES:
-        base = _kernel(points, points, lengthscale)
-        for share in AMPLITUDES:
-            amplitude = share * spread
-            covariance = amplitude**2 * base + np.diag(noise**2)
-            cholesky = np.linalg.cholesky(covariance)
-            weights = cho_solve((cholesky, True), y)
-            likelihood = -0.5 * y @ weights - np.log(np.diag(cholesky)).sum()
-            if best is None or likelihood > best[0]:
-                sd_cholesky = np.linalg.cholesky(covariance[:MAX_SD_POINTS, :MAX_SD_POINTS])
-                best = (likelihood, Process(points, weights, sd_cholesky, lengthscale, amplitude))
-    return best[1]
+    if hyper is None:
+        spread = float(np.std(y)) or 1.0
+        search = slice(0, SEARCH_POINTS)
+        hyper = max(
+            ((lengthscale, share * spread) for lengthscale in LENGTHSCALES for share in AMPLITUDES),
+            key=lambda h: _likelihood(points[search], y[search], noise[search], *h),
+        )
+    lengthscale, amplitude = hyper
+    covariance = amplitude**2 * _kernel(points, points, lengthscale) + np.diag(noise**2)
+    weights = cho_solve((np.linalg.cholesky(covariance), True), y)
+    sd_cholesky = np.linalg.cholesky(covariance[:MAX_SD_POINTS, :MAX_SD_POINTS])
+    return Process(points, weights, sd_cholesky, lengthscale, amplitude)
 
 
 @dataclass(frozen=True)
@@ -128,13 +140,21 @@ class Discrepancy:
 
 
 def fit_discrepancy(
-    launch: dict[str, np.ndarray], residual: np.ndarray, noise_sd: np.ndarray, seed: int = 0
+    launch: dict[str, np.ndarray],
+    residual: np.ndarray,
+    noise_sd: np.ndarray,
+    seed: int = 0,
+    like: Discrepancy | None = None,
 ) -> Discrepancy:
-    """The discrepancy of residuals [N,5] with each shot's expected noise SD [N,5], over the recorded launches."""
+    """The discrepancy of residuals [N,5] with each shot's expected noise SD [N,5], over the recorded launches (with
+    the length scales and amplitudes of `like`, where given: a held-out fold's)."""
     values = np.stack([launch[k] for k in INPUTS], axis=1)
     centre, scale = values.mean(axis=0), values.std(axis=0)
     scale = np.where(scale > 0, scale, 1.0)
     z = (values - centre) / scale
     rng = np.random.default_rng([seed, 4])
-    processes = tuple(fit_process(z, residual[:, j], noise_sd[:, j], rng) for j in range(len(OBSERVABLES)))
+    hypers = [None] * len(OBSERVABLES) if like is None else [(p.lengthscale, p.amplitude) for p in like.processes]
+    processes = tuple(
+        fit_process(z, residual[:, j], noise_sd[:, j], rng, hypers[j]) for j in range(len(OBSERVABLES))
+    )
     return Discrepancy(centre, scale, processes)

@@ -120,8 +120,9 @@ def learn_form(
     rows = fit_rows(recordings, np.random.default_rng([seed, 3]))
     result = converged(problem, linear_starts(problem, None, (FORM,), rows)[0][0], rows)
     everyone = np.arange(len(recordings))
-    discrepancy = _discrepancy(problem, result.theta, everyone, seed)
-    after = heldout_with_discrepancy(problem, result.theta, seed)
+    formed = problem.predict((FORM,), result.theta, everyone)[0]
+    discrepancy = _discrepancy(problem, formed, everyone, seed)
+    after = heldout_with_discrepancy(problem, formed, discrepancy, seed)
     return LearnedForm(
         recordings.source or "the baseline session",
         len(recordings),
@@ -135,12 +136,13 @@ def learn_form(
     )
 
 
-def _discrepancy(problem: Problem, theta: np.ndarray, rows: np.ndarray, seed: int) -> Discrepancy:
-    """The discrepancy the form at `theta` leaves on the shots at `rows`."""
-    residual = problem.observed[rows] - problem.predict((FORM,), theta, rows)[0]
-    residual = np.where(problem.use[rows], residual, np.nan)
+def _discrepancy(
+    problem: Problem, formed: np.ndarray, rows: np.ndarray, seed: int, like: Discrepancy | None = None
+) -> Discrepancy:
+    """The discrepancy the form's predictions `formed` [N,5] leave on the shots at `rows`."""
+    residual = np.where(problem.use[rows], problem.observed[rows] - formed[rows], np.nan)
     launch = {k: v[rows] for k, v in problem.recordings.launch.items()}
-    return fit_discrepancy(launch, residual, problem.sigma[rows], seed)
+    return fit_discrepancy(launch, residual, problem.sigma[rows], seed, like)
 
 
 def converged(problem: Problem, start: np.ndarray, rows: np.ndarray, rounds: int = FIT_ROUNDS) -> Fit:
@@ -155,18 +157,17 @@ def converged(problem: Problem, start: np.ndarray, rows: np.ndarray, rounds: int
     return result
 
 
-def heldout_with_discrepancy(problem: Problem, theta: np.ndarray, seed: int) -> np.ndarray:
-    """Standardized residuals [N,5] of every shot predicted by the form at `theta` (fitted on every shot: its few
+def heldout_with_discrepancy(problem: Problem, formed: np.ndarray, whole: Discrepancy, seed: int) -> np.ndarray:
+    """Standardized residuals [N,5] of every shot predicted by the form (`formed`: fitted on every shot, its few
     weights against five outcomes a shot) and the discrepancy learned without its fold (whole sessions, or blocks of
-    shots), the expected error including that discrepancy's SD there, as a new session's would."""
+    shots; the length scales and amplitudes of the `whole` one), the expected error including that discrepancy's SD
+    there, as a new session's would."""
     fold, _ = folds(problem.recordings.session)
-    everyone = np.arange(len(problem.recordings))
-    formed = problem.predict((FORM,), theta, everyone)[0]
     z = np.full(problem.observed.shape, np.nan)
     for f in np.unique(fold):
         held, train = np.flatnonzero(fold == f), np.flatnonzero(fold != f)
         launch = {k: v[held] for k, v in problem.recordings.launch.items()}
-        mean, sd = _discrepancy(problem, theta, train, seed).predict(launch)
+        mean, sd = _discrepancy(problem, formed, train, seed, whole).predict(launch)
         sigma = np.sqrt(problem.sigma[held] ** 2 + sd**2)
         z[held] = np.where(problem.use[held], (problem.observed[held] - formed[held] - mean) / sigma, np.nan)
     return z
