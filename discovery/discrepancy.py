@@ -122,9 +122,11 @@ class Discrepancy:
         return (np.stack([launch[k] for k in INPUTS], axis=1) - self.centre) / self.scale
 
     def mean(self, launch: dict[str, np.ndarray]) -> np.ndarray:
-        """Mean [N,5] of the discrepancy at launches."""
-        z = self.standardized(launch)
-        return np.stack([process.mean(z) for process in self.processes], axis=1)
+        """Mean [N,5] of the discrepancy at launches, read once for each distinct launch (a fit flies the same shots
+        under many parameter sets)."""
+        distinct, inverse = np.unique(self.standardized(launch), axis=0, return_inverse=True)
+        means = np.stack([process.mean(distinct) for process in self.processes], axis=1)
+        return means[inverse.reshape(-1)]
 
     def predict(self, launch: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """Mean and SD [N,5] of the discrepancy at launches."""
