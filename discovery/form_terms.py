@@ -1,7 +1,8 @@
 """The form's terms: smooth multipliers of C_L, C_D and C_M as functions of the spin ratio and the Reynolds number,
 applied inside a Flyer's coefficients (`formed_flyer`), so a learned form flies through any air, wind or launch.
 
-    C_L' = C_L exp(a0 + a1 s + a2 s^2 + a3 r),  C_D' = C_D exp(b0 + b1 s + b2 s^2 + b3 r),  C_M' = C_M exp(c0)
+    C_L' = C_L exp(sum_k a_k f_k),  C_D' = C_D exp(sum_k b_k f_k),  f = 1, s, s^2, r, s r, s^2 r, r^2, s r^2
+    C_M' = C_M exp(c0 + c1 s + c2 r)
     s = ln(S / 0.2), S = R |w| / |v| (spin ratio);  r = ln(Re / 1.5e5), Re = 2 R |v| / nu
 """
 
@@ -27,7 +28,6 @@ SPIN_RATIO_FLOOR = 1e-3
 """The spin ratio below which s is held (a ball with no spin has no spin-ratio dependence to read)."""
 
 
-
 @dataclass(frozen=True)
 class FormTerm:
     """One term of the form: which coefficient it multiplies (0 = C_L, 1 = C_D, 2 = C_M) and its feature."""
@@ -35,7 +35,7 @@ class FormTerm:
     name: str
     column: int
     feature: str
-    """'1', 's', 's^2', 'r' or 's r'."""
+    """One of SURFACE's features of s and r (the spin decay's: '1', 's', 'r')."""
     bound: float = 1.0
     """The largest |log-multiplier weight| allowed: the spin torque differs most between flight models."""
 
