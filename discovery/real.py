@@ -1,6 +1,7 @@
 """Diagnose the real data sets (read from the shared folder, never copied) and render a summary for the docs.
 
 python -m golfflight.discovery.real --out runs/discovery-real [--model DIR|reference] [--venue-air]
+python -m golfflight.discovery.real --baseline-pairs --out runs/discovery-baseline [--model DIR|reference] [--only RE]
 
 Sets: the outdoor, radar-tracked TrackMan driver shots (all balls, the held-out lines alone, and Premium only), the
 PGA TOUR TrackMan trajectories of the Sentry 2022 (spin from the play-by-play) and the Sony Open 2022 (spin estimated
@@ -12,6 +13,14 @@ and the TOUR Championship's rounds 3-4), trained on by `models/default`, or neit
 others (the range sessions, the Sony Open) in the model's air. With --venue-air each set whose air is known is
 diagnosed a second time with its air concealed (as `golfflight convert pbp`, which records no air, gives it), and
 venue_air.md tabulates what each run says about air (`discovery.venue_air`).
+
+With --baseline-pairs, one set is diagnosed against another as its baseline session (`golfflight diagnose NEW
+--baseline BASELINE`, issue 54) instead (`baseline_pairs`): on the driver file's trained lines (before 2943; the
+held-out lines are not read), the shots of one ball type, the ball column dropped, against those of another; and
+the tour events one may train on (the Sentry, the Sony Open, East Lake's rounds 1-2; never its held-out rounds 3-4)
+one against another, the new event's air concealed where it is known, so that a change of air can be named and
+compared with the venue's. baseline_pairs.md tabulates what each pair names, its rivals and what the baseline cannot
+teach; baseline_pairs.json holds each report's statement, headline, candidates and baseline account.
 """
 
 from __future__ import annotations
@@ -25,6 +34,7 @@ from pathlib import Path
 import numpy as np
 from golfflight.discovery import svg
 from golfflight.discovery.diagnose import Diagnosis, diagnose
+from golfflight.discovery.form import learn_form
 from golfflight.discovery.locate import binned_means
 from golfflight.discovery.model import FlightModel, load_model
 from golfflight.discovery.outputs import write_diagnosis
@@ -321,6 +331,233 @@ def venue_air_row(item: RealSet, diagnosis: Diagnosis, venue: float | None) -> l
     return [cell.replace("|", "\\|") for cell in cells + [verdict, separate]]  # |v| in a learned term
 
 
+def concealed_air(recordings: Recordings) -> Recordings:
+    """The same shots carrying no air (flown in the model's air), as `golfflight convert pbp` gives them."""
+    return replace(recordings, density_kg_m3=None, kinematic_viscosity_m2_s=None)
+
+
+@dataclass
+class BaselinePair:
+    """A new set diagnosed against a baseline set (`golfflight diagnose NEW --baseline BASELINE`)."""
+
+    key: str
+    baseline_title: str
+    baseline: Recordings
+    new_title: str
+    new: Recordings
+    known: str
+    """What is known to differ between the two (the question the pair asks)."""
+    venue: float | None = None
+    """The new set's venue air (x ICAO) where it is known but concealed from the diagnosis."""
+
+
+def training_driver_balls(shared: Path) -> dict[str, list[ShotRecord]]:
+    """The driver file's measured shots on its trained lines only (before the first held-out line; the held-out
+    lines are not read), grouped by the "Ball" column, each record's ball dropped (the diagnosis is not told)."""
+    held = held_out_set(TRACKMAN)
+    assert held is not None, "the driver file's second half is held out (shots.heldout)"
+    conversion = load_trackman(shared / TRACKMAN, lines=(1, held.first_line - 1), skip_bad_rows=True)
+    balls: dict[str, list[ShotRecord]] = {}
+    for record in conversion.records:
+        assert int(record.shot_id) < held.first_line
+        balls.setdefault(record.ball or "(blank)", []).append(record.model_copy(update={"ball": None}))
+    return balls
+
+
+def driver_ball_pairs(shared: Path) -> list[BaselinePair]:
+    """The Premium shots of the driver file's trained lines as the baseline of each other ball type there, and the
+    reverse: one session, one monitor, the ball changed (and whatever weather changed between the ball's blocks)."""
+    balls = training_driver_balls(shared)
+    held = held_out_set(TRACKMAN)
+    lines = f"lines before {held.first_line}"
+
+    def recordings(ball: str) -> Recordings:
+        return from_shot_set(ShotSet(balls[ball]), source=f"{shared / TRACKMAN} ({ball}, {lines}, ball dropped)")
+
+    pairs = []
+    for other in sorted(set(balls) - {"Premium"}):
+        slug = re.sub(r"\W+", "_", other.lower())
+        for a, b, key in (
+            ("Premium", other, f"driver_premium_to_{slug}"),
+            (other, "Premium", f"driver_{slug}_to_premium"),
+        ):
+            pairs.append(
+                BaselinePair(
+                    key,
+                    f"TrackMan driver, {a} ({lines})",
+                    recordings(a),
+                    f"TrackMan driver, {b} ({lines})",
+                    recordings(b),
+                    f"the ball ({a} → {b}; the ball column dropped), and any weather between the ball's blocks of "
+                    "shots; no air recorded (the model's air for both)",
+                )
+            )
+    return pairs
+
+
+def tour_pairs(shared: Path) -> list[BaselinePair]:
+    """The tour events one may train on, one as the baseline of another: the Sentry (its air given) against the Sony
+    Open (no air known) and against East Lake's rounds 1-2 (air concealed), East Lake's rounds 1-2 (air given)
+    against the Sentry (air concealed), and East Lake's round 1 against its round 2 (air given to both). East Lake's
+    held-out rounds 3-4 are not used."""
+    sets = {item.key: item for item in tourcast_sets(shared) + tour_championship_sets(shared)}
+    sentry, sony, east_lake = sets["sentry"], sets["sony"], sets["tour_championship_trained"]
+    assert {shot_round(s) for s in east_lake.recordings.shot_id} == {1, 2}
+    rounds = {int(s.split("-R")[-1]): s for s in np.unique(east_lake.recordings.session)}
+    r1, r2 = (east_lake.recordings.subset(east_lake.recordings.session == rounds[n]) for n in (1, 2))
+    given, concealed = "air given", "air concealed"
+    east = "TOUR Championship 2020 (East Lake), rounds 1-2"
+    return [
+        BaselinePair(
+            "sentry_to_sony",
+            f"{sentry.title} ({given})",
+            sentry.recordings,
+            f"{sony.title} (no air known)",
+            sony.recordings,
+            "venue, days and air (Kapalua → Waialae; Sony's air not recorded: the model's air); Sony's spin is "
+            "estimated from its initial lift",
+        ),
+        BaselinePair(
+            "sentry_to_east_lake",
+            f"{sentry.title} ({given})",
+            sentry.recordings,
+            f"{east} ({concealed})",
+            concealed_air(east_lake.recordings),
+            "venue, year and air (Kapalua 0.951 → East Lake 0.912 × ICAO); East Lake records the apex only",
+            venue_ratio(east_lake.recordings),
+        ),
+        BaselinePair(
+            "east_lake_to_sentry",
+            f"{east} ({given})",
+            east_lake.recordings,
+            f"{sentry.title} ({concealed})",
+            concealed_air(sentry.recordings),
+            "venue, year and air (East Lake 0.912 → Kapalua 0.951 × ICAO); the baseline records the apex only",
+            venue_ratio(sentry.recordings),
+        ),
+        BaselinePair(
+            "east_lake_r1_to_r2",
+            "TOUR Championship 2020 (East Lake), round 1 (air given)",
+            r1,
+            "TOUR Championship 2020 (East Lake), round 2 (air given)",
+            r2,
+            "the day (same venue and air as recorded; the wind and the pins are not recorded); apex only",
+        ),
+    ]
+
+
+def baseline_pairs(shared: Path) -> list[BaselinePair]:
+    """Every baseline pair (`driver_ball_pairs`, `tour_pairs`)."""
+    return driver_ball_pairs(shared) + tour_pairs(shared)
+
+
+def _effect_words(report, digits: int = 3) -> str:
+    parts = []
+    for e in report.effects:
+        values = ", ".join(
+            f"{k} {v:.{digits}g} ± {e.uncertainty.get(k, float('nan')):.2g}"
+            for k, v in e.parameters.items()
+            if k != "density_kg_m3"
+        )
+        parts.append(f"{e.name} [{e.kind}] ({values})")
+    if report.unlisted is not None:
+        parts.append(f"unlisted ({report.unlisted.expression})")
+    return " + ".join(parts) or "–"
+
+
+RIVALS = 5
+"""Candidates listed per pair (the best by score, the chosen among them)."""
+
+
+def baseline_pair_row(pair: BaselinePair, diagnosis: Diagnosis) -> list[str]:
+    """One pair's row: the two sets, what the baseline taught, what is named and its rivals, what it cannot teach."""
+    report = diagnosis.report
+    info, held = report.baseline, report.heldout
+    assert info is not None
+    stats = {o.name: o for o in report.located.observables}
+    bias = ", ".join(
+        f"{LABELS[n].split(' (')[0]} {stats[n].bias:+.2f} ({stats[n].rms_ratio:.1f}x)"
+        for n in OBSERVABLES
+        if n in stats
+    )
+    named = _effect_words(report) if report.systematic else "– (not systematic)"
+    ranked = sorted(report.candidates, key=lambda c: c.score)[:RIVALS]
+    rivals = "; ".join(f"{c.name} {c.heldout_error:.2f}" for c in ranked) or "–"
+    rival = report.air_rival
+    if rival is None:
+        air = "–"
+    else:
+        verdict = "named" if rival.named else "ruled out" if rival.separable else "inseparable"
+        air = f"{rival.ratio:.3f} ± {rival.ratio_sd:.3f} ({verdict}; held-out {rival.heldout_error:.2f})"
+        if pair.venue is not None:
+            air += f"; venue {pair.venue:.3f}"
+    fraction = "" if held.explained_fraction is None or not report.systematic else f" ({held.explained_fraction:.0%})"
+    cells = [
+        pair.key,
+        f"{pair.baseline_title}: {info.n_shots}",
+        f"{pair.new_title}: {report.n_shots}",
+        f"{info.heldout_error_before:.2f} → {info.heldout_error_after:.2f}",
+        f"{info.outside_shots}",
+        bias,
+        named,
+        f"{held.before_error:.2f} → {held.after_error:.2f}{fraction}",
+        rivals,
+        air,
+        " / ".join(info.cannot_inform) or "–",
+    ]
+    return [cell.replace("|", "\\|") for cell in cells]
+
+
+BASELINE_HEADER = [
+    "pair",
+    "baseline: shots",
+    "new: shots",
+    "baseline held-out error (as is → form)",
+    "new shots outside it",
+    "new against the formed model: bias (RMS/expected)",
+    "named",
+    "new held-out error (explained)",
+    "best candidates (held-out error)",
+    "air against it",
+    "the baseline cannot teach",
+]
+
+
+def run_baseline_pairs(pairs: list[BaselinePair], model: FlightModel, out: Path, seed: int = 0) -> list[list[str]]:
+    """Diagnose each pair's new set against its baseline; baseline_pairs.md, baseline_pairs.json and each report."""
+    rows, details = [], {}
+    for pair in pairs:
+        form = learn_form(pair.baseline, model, seed=seed)
+        diagnosis = diagnose(pair.new, model, seed=seed, progress=False, baseline=form)
+        report = diagnosis.report
+        write_diagnosis(diagnosis, out / pair.key)
+        rows.append(baseline_pair_row(pair, diagnosis))
+        details[pair.key] = {
+            "baseline": pair.baseline_title,
+            "new": pair.new_title,
+            "known": pair.known,
+            "venue": pair.venue,
+            "statement": report.statement,
+            "headline": report.headline,
+            "baseline_info": None if report.baseline is None else report.baseline.model_dump(),
+            "candidates": [
+                {"name": c.name, "heldout_error": c.heldout_error, "score": c.score, "n_parameters": c.n_parameters,
+                 "effects": [e.model_dump() for e in c.effects]}
+                for c in sorted(report.candidates, key=lambda c: c.score)
+            ],
+            "ambiguities": [a.model_dump() for a in report.ambiguities],
+            "air_rival": None if report.air_rival is None else report.air_rival.model_dump(),
+            "heldout": report.heldout.model_dump(),
+            "located": report.located.summary,
+            "seconds": report.seconds,
+        }
+        print(f"{pair.key}: {' '.join(report.headline) or report.statement}", flush=True)
+    lines = table(BASELINE_HEADER, rows, align="l" * len(BASELINE_HEADER))
+    write_text_atomic(out / "baseline_pairs.md", f"Model: {model.name}\n\n" + "\n".join(lines) + "\n")
+    write_text_atomic(out / "baseline_pairs.json", json.dumps(details, indent=1) + "\n")
+    return rows
+
+
 def figures(diagnosis: Diagnosis) -> dict[str, str]:
     """Aggregate plots only (binned means, histograms: no individual shot of the real data): name -> SVG."""
     rec = diagnosis.recordings
@@ -355,9 +592,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--venue-air", action="store_true", help="also diagnose each set of known air without it; venue_air.md"
     )
+    parser.add_argument(
+        "--baseline-pairs",
+        action="store_true",
+        help="instead, diagnose sets against others as their baseline session (ball types of the driver file's "
+        "trained lines, the trainable tour events); baseline_pairs.md (--only filters the pair keys)",
+    )
     args = parser.parse_args(argv)
     model: FlightModel = load_model(args.model)
     out = Path(args.out)
+    if args.baseline_pairs:
+        pairs = [p for p in baseline_pairs(shared_data_dir()) if not args.only or re.search(args.only, p.key)]
+        run_baseline_pairs(pairs, model, out)
+        return 0
     rows, details, air_rows = [], {}, []
     sets = real_sets(shared_data_dir())
     venue = {item.key + NO_AIR: venue_ratio(item.recordings) for item in sets}
