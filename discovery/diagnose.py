@@ -59,7 +59,7 @@ from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from golfflight.discovery.report import MATERIAL, ambiguity, effect_results, service_settings, statement
 from golfflight.discovery.schema import AirRival, Candidate, Heldout, Located, ModelInfo, Report, ScatterStat, Unlisted
 from golfflight.discovery.physical import ball_agrees, restatements
-from golfflight.discovery.reach import baseline_info, baseline_sentence
+from golfflight.discovery.reach import baseline_info, baseline_sentence, comparable
 from golfflight.discovery.venue_air import air_explanations, air_rival, air_sentence, with_air
 from golfflight.flight.wind import FAIRWAY_ROUGHNESS_M, STATION_HEIGHT_M, uniform_equivalent_factor
 from golfflight.shots.progress import progress_bar, progress_step
@@ -741,7 +741,7 @@ def diagnose(
     """Run the whole diagnosis of recordings against a model (its steps on standard error with `progress`); with
     what a `baseline` session taught (`discovery.form.learn_form`), against the model with that form: what changed."""
     if baseline is not None:
-        model = formed_model(model, baseline)
+        model, recordings = formed_model(model, baseline), comparable(recordings, baseline)
     return Diagnoser(
         recordings, model, noise, seed, with_correction, estimate_scatter, progress, baseline=baseline
     ).run()

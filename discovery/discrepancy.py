@@ -11,7 +11,7 @@ discrepancy the baseline showed: a new session's shots outside the baseline are 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from golfflight.discovery.recordings import OBSERVABLES
@@ -32,6 +32,8 @@ MAX_SD_POINTS = 300
 """The SD is read from the process conditioned on the first this many of them: a triangular solve per shot costs
 their square, and fewer points only widen the SD (a new session's 100,000 shots in seconds)."""
 CHUNK = 10_000
+CACHED = 4
+"""Launch sets whose discrepancy means are kept: a fit's shots, its held-out shots and the whole set."""
 """Shots whose kernel rows are built at once (a chunk of 10,000 against 1,000 points is 80 MB)."""
 
 
@@ -117,16 +119,25 @@ class Discrepancy:
     scale: np.ndarray
     processes: tuple[Process, ...]
     """One per observable, in OBSERVABLES order."""
+    recent: dict[bytes, np.ndarray] = field(default_factory=dict, compare=False, repr=False)
+    """The means of the last CACHED launch sets read, by their standardized values."""
 
     def standardized(self, launch: dict[str, np.ndarray]) -> np.ndarray:
         return (np.stack([launch[k] for k in INPUTS], axis=1) - self.centre) / self.scale
 
     def mean(self, launch: dict[str, np.ndarray]) -> np.ndarray:
-        """Mean [N,5] of the discrepancy at launches, read once for each distinct launch (a fit flies the same shots
-        under many parameter sets)."""
-        distinct, inverse = np.unique(self.standardized(launch), axis=0, return_inverse=True)
-        means = np.stack([process.mean(distinct) for process in self.processes], axis=1)
-        return means[inverse.reshape(-1)]
+        """Mean [N,5] of the discrepancy at launches, read once for each distinct launch and kept for the last
+        CACHED launch sets (a fit flies the same shots under many parameter sets, most of which leave the launch)."""
+        z = self.standardized(launch)
+        key = z.tobytes()
+        if key not in self.recent:
+            distinct, inverse = np.unique(z, axis=0, return_inverse=True)
+            means = np.stack([process.mean(distinct) for process in self.processes], axis=1)
+            self.recent[key] = means[inverse.reshape(-1)]
+            self.recent[key].flags.writeable = False
+            while len(self.recent) > CACHED:
+                self.recent.pop(next(iter(self.recent)))
+        return self.recent[key]
 
     def predict(self, launch: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """Mean and SD [N,5] of the discrepancy at launches."""

@@ -105,15 +105,6 @@ class FormedModel:
 
 def formed_flyer(flyer: Flyer, weights: np.ndarray) -> Flyer:
     """The same Flyer (step, step rule, air, card) with the form's weights applied to its coefficients."""
-    return Flyer(
-        FormedModel(flyer.model, np.asarray(weights, dtype=float)),
-        flyer.dt_s,
-        flyer.max_flight_time_s,
-        flyer.density_kg_m3,
-        flyer.kinematic_viscosity_m2_s,
-        flyer.rule,
-        flyer.card,
-        flyer.bundle_dir,
-    )
+    return flyer.replaced(model=FormedModel(flyer.model, np.asarray(weights, dtype=float)))
 
 

@@ -4,11 +4,14 @@ learned form is extrapolated), which baseline shots would cover them, and what t
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from golfflight.discovery.discrepancy import INPUTS
 from golfflight.discovery.form import LearnedForm
-from golfflight.discovery.recordings import OBSERVABLES, Recordings
+from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
 from golfflight.discovery.schema import BaselineInfo
+from golfflight.errors import InputError
 from scipy.spatial import cKDTree
 
 OUTSIDE_DISTANCE = 1.0
@@ -49,10 +52,31 @@ def needed_words(outside_launch: dict[str, list[float]], clubs: list[str]) -> st
     return f"Record baseline shots at {ranges}{which}, with the same launch monitor and ball."
 
 
+def _outcome_words(names: list[str]) -> str:
+    return ", ".join(LABELS[name].split(" (")[0] for name in names)
+
+
+def comparable(recordings: Recordings, form: LearnedForm) -> Recordings:
+    """The new recordings with only the outcomes the baseline recorded: the others have no baseline to differ from
+    (a form and discrepancy never learned for them would read the model's own form error as a change)."""
+    shared = [name for name in recordings.observed_names if name in form.informs]
+    if not shared:
+        new, old = _outcome_words(list(recordings.observed_names)), _outcome_words(list(form.informs)) or "nothing"
+        raise InputError(f"the baseline records none of the new session's outcomes ({new}; it records {old})")
+    keep = np.array([name in form.informs for name in OBSERVABLES])
+    return replace(recordings, observed=np.where(keep, recordings.observed, np.nan))
+
+
 def cannot_inform(form: LearnedForm, new_density: list[float]) -> list[str]:
     """What the baseline cannot teach about the new shots."""
     thinnest, densest = float(np.min(form.density_kg_m3)), float(np.max(form.density_kg_m3))
     notes = []
+    unrecorded = [name for name in OBSERVABLES if name not in form.informs]
+    if unrecorded:
+        notes.append(
+            f"the new shots' {_outcome_words(unrecorded)}: it records none of them (or on fewer than 10 shots), so "
+            "they are not compared"
+        )
     if densest < AIR_SPAN * thinnest:
         notes.append(
             f"how this ball and monitor respond to other air: the baseline flew at {thinnest:.3f}–{densest:.3f} kg/m³ "

@@ -141,6 +141,21 @@ class Flyer:
         self.density_kg_m3, self.kinematic_viscosity_m2_s = float(density_kg_m3), float(kinematic_viscosity_m2_s)
         self.max_steps = step_count(self.max_flight_time_s, self.dt_s)
 
+    def replaced(
+        self, model: ModelInAir | None = None, rule: StepRule | None = None, dt_s: float | None = None
+    ) -> Flyer:
+        """This Flyer with another model, step rule or step, the rest kept (discovery flies a learned form, or RK4)."""
+        return Flyer(
+            self.model if model is None else model,
+            self.dt_s if dt_s is None else dt_s,
+            self.max_flight_time_s,
+            self.density_kg_m3,
+            self.kinematic_viscosity_m2_s,
+            self.rule if rule is None else rule,
+            self.card,
+            self.bundle_dir,
+        )
+
     def in_air(self, kinematic_viscosity_m2_s: float | np.ndarray | None = None) -> CoefficientModel:
         """The model in air of this kinematic viscosity (a float, or one per ball); None: its nominal air."""
         viscosity = self.kinematic_viscosity_m2_s if kinematic_viscosity_m2_s is None else kinematic_viscosity_m2_s

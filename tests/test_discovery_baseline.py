@@ -3,13 +3,15 @@ a change named against it where the model's form alone would be confounded with 
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import diagnose, library_for
 from golfflight.discovery.discrepancy import fit_discrepancy
 from golfflight.discovery.effects import BALL, EFFECTS
-from golfflight.discovery.form import FORM, formed_model, learn_form
+from golfflight.discovery.form import FORM, RK4_STEP_S, accurately_flown, formed_model, learn_form
 from golfflight.discovery.form_terms import REYNOLDS_REF, SPIN_RATIO_REF, TERMS, log_multipliers
 from golfflight.discovery.model import load_model, reference
 from golfflight.discovery.noise import base_conditions
@@ -18,6 +20,8 @@ from golfflight.discovery.recordings import OBSERVABLES, from_shot_set
 from golfflight.discovery.reach import needed_words, outside_baseline
 from golfflight.discovery.schema import Report
 from golfflight.flight.constants import BALL_RADIUS_M
+from golfflight.flight.integrator import RUNGE_KUTTA_4
+from golfflight.errors import InputError
 from golfflight.shots.records import write_shots
 
 from golfflight.cli import main
@@ -148,3 +152,37 @@ def test_the_cli_diagnoses_against_a_baseline_and_refuses_a_tiny_one(tmp_path, c
     write_shots(tmp_path / "tiny.csv", home.shots.records[:10])
     assert main([*argv, "--baseline", str(tmp_path / "tiny.csv"), "--out", str(tmp_path / "x")]) == 2
     assert "--baseline" in capsys.readouterr().err
+
+
+def _apex_only(recordings):
+    keep = np.array([name == "apex_m" for name in OBSERVABLES])
+    return replace(recordings, observed=np.where(keep, recordings.observed, np.nan))
+
+
+def test_outcomes_the_baseline_never_recorded_are_not_compared(served):
+    """A baseline that records only the apex (as tour feeds do) teaches nothing about carry: a new session's carry,
+    side, time and landing angle are set aside and said so, not read as a change (the form's own carry error was
+    once named another ball), and a new session with nothing the baseline records is refused."""
+    clean = conceal({}, 150, seed=5, model=ferguson_world(), launch_seed=1)
+    baseline = learn_form(_apex_only(from_shot_set(clean.shots, source="apex feed")), served, seed=5)
+    assert baseline.informs == ("apex_m",)
+    new = from_shot_set(conceal({}, 150, seed=5, model=ferguson_world()).shots, source="same")
+    report = diagnose(new, served, seed=5, progress=False, baseline=baseline).report
+    assert not any(e.kind in ("venue", "monitor", "ball") for e in report.effects)
+    assert any("carry along the line" in note and "not compared" in note for note in report.baseline.cannot_inform)
+    carry_only = replace(new, observed=np.where(np.isin(OBSERVABLES, ["carry_y_m"]), new.observed, np.nan))
+    with pytest.raises(InputError, match="records none of the new session's outcomes"):
+        diagnose(carry_only, served, seed=5, progress=False, baseline=baseline)
+
+
+def test_discovery_flies_rk4_at_a_step_within_centimetres_of_a_fine_one(served):
+    """RK4 at RK4_STEP_S lands within 0.1 m and 0.1 deg of RK4 at 0.01 s (the card's forward Euler misses by metres):
+    the accuracy a baseline's form is learned at, at 2.5x fewer network calls than RK4 at the card's 0.1 s."""
+    base = base_conditions(from_shot_set(conceal({}, 120, seed=3).shots), served)
+    flown = accurately_flown(served)
+    assert flown.flyer.rule is RUNGE_KUTTA_4 and flown.flyer.dt_s == RK4_STEP_S
+    fine = replace(served, flyer=served.flyer.replaced(rule=RUNGE_KUTTA_4, dt_s=0.01)).simulate(base).outcomes()
+    coarse = flown.simulate(base).outcomes()
+    carry, angle = OBSERVABLES.index("carry_y_m"), OBSERVABLES.index("landing_angle_deg")
+    assert np.abs(coarse - fine)[:, [carry, angle]].max() < 0.1
+    assert np.abs(served.simulate(base).outcomes() - fine)[:, carry].max() > 0.5
