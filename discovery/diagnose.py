@@ -348,7 +348,7 @@ class Diagnoser:
             selection.scored,
             chosen,
         )
-        if selection.systematic and "varies_with_ball_speed" in selection.test:
+        if "varies_with_ball_speed" in selection.test:
             words += set_aside_sentence(selection.test["varies_with_ball_speed"])
         against = (
             None if self.baseline is None else baseline_info(self.baseline, recordings, self.as_is.base.density_kg_m3)

@@ -303,12 +303,24 @@ def likely_cause(report: Report) -> str:
             f"Most likely {explanation(report, report.effects, True)}.",
             f"Most likely {explanation(report, report.effects, False)}.",
         )
+    if _departs(report) and _set_aside(report):
+        return (
+            "No single cause is claimed: the best fit differs between slower and faster shots, as a difference in "
+            "the model's own form would."
+        )
     if _departs(report):
         return (
             "No single cause explains it on held-out shots: it changes between shots or sessions (shifting wind, "
             "mixed conditions or noisier readings than assumed)."
         )
     return "No cause is needed: no candidate explanation improves held-out shots clearly."
+
+
+def _set_aside(report: Report) -> str | None:
+    """The candidate set aside because its fit differs between slower and faster shots (the systematic test's
+    `varies_with_ball_speed`, 'NAME: slower half ...'), where nothing was claimed."""
+    text = report.systematic_test.get("varies_with_ball_speed")
+    return None if report.systematic or not isinstance(text, str) else text.split(":", 1)[0]
 
 
 def _rival_words(report: Report, name: str) -> str:
@@ -344,11 +356,17 @@ def runner_up(report: Report) -> str | None:
     """Sentence 3: the explanation the data cannot yet tell from the chosen one, else the closest one ruled out
     (for recordings the test finds structure in but nothing explains, the closest candidate)."""
     if not report.systematic:
-        tried = [c for c in report.candidates if c.effects]
+        tried = [c for c in report.candidates if c.effects and c.heldout_error < report.heldout.before_error]
         if not tried or not _departs(report):
             return None
         closest = min(tried, key=lambda c: c.score)
-        return f"Closest: {explanation(report, closest.effects, False)}, too small a gain on held-out shots to claim."
+        words = explanation(report, closest.effects, False)
+        if closest.name == _set_aside(report):
+            return _within(
+                f"Closest: {words}, set aside: slower and faster shots fit it differently.",
+                f"Closest, set aside as slower and faster shots fit it differently: {closest.name}.",
+            )
+        return f"Closest: {words}, too small a gain on held-out shots to claim."
     if report.ambiguities:
         item = report.ambiguities[0]
         return _within(

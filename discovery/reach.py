@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 from golfflight.discovery.discrepancy import INPUTS
 from golfflight.discovery.form import LearnedForm
-from golfflight.discovery.recordings import LABELS, OBSERVABLES, Recordings
+from golfflight.discovery.recordings import LABELS, OBSERVABLES, UNKNOWN_CLUB, Recordings
 from golfflight.discovery.schema import BaselineInfo
 from golfflight.errors import InputError
 from scipy.spatial import cKDTree
@@ -102,7 +102,7 @@ def baseline_info(form: LearnedForm, recordings: Recordings, new_density_kg_m3: 
     """The report's account of the baseline against the new recordings."""
     outside = outside_baseline(form, recordings.launch)
     outside_launch = {name: _span(recordings.launch[name][outside]) for name in INPUTS} if outside.any() else {}
-    clubs = sorted({str(c) for c in recordings.club[outside]})
+    clubs = sorted({str(c) for c in recordings.club[outside]} - {UNKNOWN_CLUB})
     new_density = _span(np.asarray(new_density_kg_m3, dtype=float))
     return BaselineInfo(
         source=form.source,

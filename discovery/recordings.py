@@ -13,6 +13,9 @@ from golfflight.shots.records import LAUNCH_COLUMNS, ShotSet, read_shots, read_t
 OBSERVABLES: tuple[str, ...] = ("carry_y_m", "carry_x_m", "apex_m", "flight_time_s", "landing_angle_deg")
 """Outcome columns compared with the model, in report order: carry along and across the line, apex, time, descent."""
 
+UNKNOWN_CLUB = "unknown"
+"""The club of a shot recorded without one."""
+
 LABELS = {
     "carry_y_m": "carry along the line (m)",
     "carry_x_m": "carry across the line (m, + right)",
@@ -127,7 +130,7 @@ def from_shot_set(shots: ShotSet, trajectories: dict[str, np.ndarray] | None = N
         {name: shots.column(name) for name in LAUNCH_COLUMNS},
         observed,
         session,
-        _text(shots.column("club"), "unknown"),
+        _text(shots.column("club"), UNKNOWN_CLUB),
         _shot_order(session, shots.column("timestamp")),
         shot_id,
         density,

@@ -16,8 +16,8 @@ from golfflight.discovery.form_terms import REYNOLDS_REF, SPIN_RATIO_REF, TERMS,
 from golfflight.discovery.model import load_model, reference
 from golfflight.discovery.noise import base_conditions
 from golfflight.discovery.prove import ferguson_world
-from golfflight.discovery.recordings import OBSERVABLES, from_shot_set
-from golfflight.discovery.reach import needed_words, outside_baseline
+from golfflight.discovery.recordings import OBSERVABLES, UNKNOWN_CLUB, from_shot_set
+from golfflight.discovery.reach import baseline_info, needed_words, outside_baseline
 from golfflight.discovery.schema import Report
 from golfflight.flight.constants import BALL_RADIUS_M
 from golfflight.flight.integrator import RUNGE_KUTTA_4
@@ -186,3 +186,15 @@ def test_discovery_flies_rk4_at_a_step_within_centimetres_of_a_fine_one(served):
     carry, angle = OBSERVABLES.index("carry_y_m"), OBSERVABLES.index("landing_angle_deg")
     assert np.abs(coarse - fine)[:, [carry, angle]].max() < 0.1
     assert np.abs(served.simulate(base).outcomes() - fine)[:, carry].max() > 0.5
+
+
+def test_a_session_without_clubs_is_not_told_to_record_the_unknown_club(ferguson_baseline):
+    new = from_shot_set(conceal({}, 40, seed=8).shots)
+    slow = replace(
+        new,
+        launch={**new.launch, "ball_speed_mps": np.full(len(new), 15.0)},
+        club=np.full(len(new), UNKNOWN_CLUB, dtype=object),
+    )
+    info = baseline_info(ferguson_baseline, slow, np.full(len(new), 1.225))
+    assert info.outside_shots == len(new) and info.outside_clubs == []
+    assert info.needed.startswith("Record baseline shots at ball speed 15–15 m/s, ") and UNKNOWN_CLUB not in info.needed

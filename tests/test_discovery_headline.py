@@ -259,6 +259,24 @@ def test_a_difference_nothing_explains_says_so_and_names_the_closest_candidate()
     assert headline(report)[2] == "Closest: a 4.2 m/s wind from 30°, too small a gain on held-out shots to claim."
 
 
+def test_a_candidate_that_removes_nothing_is_not_the_closest():
+    """A candidate fitted at its null (the ground 0.0 m below the tee) scores no better than the model as is: it is
+    not offered as the closest explanation."""
+    report = _report([], others=(_candidate([_effect("landing_elevation", height_m=(0.0, 0.4))], 4.2),))
+    assert len(headline(report)) == 2
+
+
+def test_a_candidate_set_aside_for_slower_and_faster_shots_says_why():
+    """The best fit, set aside because the slower and the faster half of the shots fit it differently (a form
+    difference), is not called too small a gain: the headline says why nothing is claimed."""
+    report = _report([], others=(_candidate([WIND], 1.1),))
+    halves = {"varies_with_ball_speed": "wind: slower half 4.1, 30, faster half 2.0, 31 (60% of its size apart)"}
+    lines = headline(report.model_copy(update={"systematic_test": halves}))
+    assert lines[1].startswith("No single cause is claimed: the best fit differs between slower and faster shots")
+    assert lines[2] == "Closest: a 4.2 m/s wind from 30°, set aside: slower and faster shots fit it differently."
+    assert all(word_count(line) <= MAX_WORDS for line in lines)
+
+
 @pytest.mark.parametrize(
     ("effect", "cause"),
     [
