@@ -154,7 +154,7 @@ class GSProMessage(_Lenient):
         degrees either way, as in GSPro) nor answered (the flight comes in yards and metres both); anything else is
         refused rather than ignored, as a connector sending it expects something that will not happen."""
         if value is not None and value.casefold() not in UNITS:
-            raise InputError(f"Units must be {' or '.join(UNITS.values())} (GSPro Open Connect's two), got {value!r}")
+            raise InputError(f"must be {' or '.join(UNITS.values())}, GSPro Open Connect's two, in any letter case")
         return value
 
     @field_validator("ShotNumber", mode="before")

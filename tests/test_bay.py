@@ -191,5 +191,5 @@ def test_a_connectors_shot_carries_its_flat_figures_and_unknown_units_are_refuse
         assert reply["Code"] == 200 and reply["Flight"]["flat"]["carry_m"] < reply["Flight"]["carry_m"]
         assert len(json.dumps(reply, separators=(",", ":"))) < 2048, "inside MLM2PRO-GSPro-Connector's recv(2048)"
         refused = http.post("/v1/gspro", json={**OPEN_CONNECT_SHOT, "Units": "furlongs"}).json()
-        assert refused["Code"] == 500 and "Units must be Yards or Meters" in refused["Message"]
+        assert refused["Code"] == 500 and "Units: must be Yards or Meters" in refused["Message"]
         assert http.post("/v1/gspro", json={**OPEN_CONNECT_SHOT, "Units": "Meters"}).json()["Code"] == 200
