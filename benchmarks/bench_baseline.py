@@ -1,13 +1,13 @@
 """`golfflight diagnose NEW --baseline BASELINE` at scale (issue 54): a large new session diagnosed against a baseline
 session of the same monitor and ball, each run in its own process; the diagnosis alone is timed (reading the two
 sets, `learn_form` and `diagnose`, no report files), split into learning the form and diagnosing, with the process's
-peak resident memory, its CPU time and the machine's load average while it ran, and what was named. Prints a table,
-writes its section of results.json (issue 54: 100,000 new shots against 10,000 baseline shots in at most 200 s and
+peak resident memory, its CPU time and the machine's load average while it ran, and what was named. Prints a table;
+--results FILE gets its section (issue 54: 100,000 new shots against 10,000 baseline shots in at most 200 s and
 1.5 GB).
 
 python benchmarks/bench_baseline.py [--pairs 100000:10000 ...] [--seed 7] [--truth reference|model]
                                     [--wind SPEED_MPS:FROM_DEG] [--blas-threads N ...] [--work DIR] [--profile]
-                                    [--no-write] [--append]
+                                    [--results FILE] [--append]
 
 The sets are `discovery.conceal`'s, generated once into --work (not timed): the baseline clean, in the truth world's
 calm ICAO air (`conceal({}, N, seed, launch_seed=1)`, other launches and noise than the new set's stream), the new set
@@ -39,7 +39,7 @@ import threading
 import time
 from pathlib import Path
 
-from common import REPO, RESULTS, write_results
+from common import REPO, add_results_flag, read_results, write_results
 
 TARGET = {"new_shots": 100_000, "baseline_shots": 10_000, "wall_s": 200.0, "peak_rss_mb": 1500.0}
 """Issue 54's target on the 2-core machine (the diagnosis: learning the form and diagnosing)."""
@@ -199,9 +199,9 @@ def named_words(row: dict) -> str:
     return " + ".join(parts)
 
 
-def earlier_rows() -> list[dict]:
-    """The measured rows results.json's section already holds (its target row left out)."""
-    data = json.loads(RESULTS.read_text()) if RESULTS.is_file() else {}
+def earlier_rows(path: Path | None) -> list[dict]:
+    """The measured rows the results file's section already holds (its target row left out)."""
+    data = read_results(path)
     return [r for r in data.get("diagnose_baseline", {}).get("rows", []) if r.get("name") != "target"]
 
 
@@ -233,8 +233,8 @@ def main() -> None:
     parser.add_argument("--blas-threads", type=int, nargs="+", help="OpenBLAS threads in the child, one run each")
     parser.add_argument("--work", help="folder for the sets (default: a temporary one)")
     parser.add_argument("--profile", action="store_true", help="run each child under cProfile")
-    parser.add_argument("--no-write", action="store_true", help="print the table only, leave results.json alone")
-    parser.add_argument("--append", action="store_true", help="keep the rows results.json already holds")
+    add_results_flag(parser)
+    parser.add_argument("--append", action="store_true", help="keep the rows the --results file already holds")
     parser.add_argument("--child", nargs=2, metavar=("NEW", "BASELINE"), help=argparse.SUPPRESS)
     parser.add_argument("--profile-to", help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -259,7 +259,7 @@ def main() -> None:
                 rows.append(row)
                 print(f"{pair}: {json.dumps(row)}", flush=True)
     print_rows(rows)
-    earlier = earlier_rows() if args.append and not args.no_write else []
+    earlier = earlier_rows(args.results) if args.append else []
     met_by = [
         f"{r['commit']}: {r['new_shots']:,} / {r['baseline_shots']:,} with {r['openblas_threads']} OpenBLAS threads"
         for r in [*earlier, *rows]
@@ -271,9 +271,9 @@ def main() -> None:
     ]
     met = bool(met_by)
     print(f"\ntarget {TARGET}: {'met by ' + '; '.join(met_by) if met else 'NOT met'}")
-    if not args.no_write and not args.profile:
+    if not args.profile:
         target = {"name": "target", **TARGET, "met": met, "met_by": met_by}
-        write_results("diagnose_baseline", [*earlier, *rows, target])
+        write_results("diagnose_baseline", [*earlier, *rows, target], args.results)
 
 
 if __name__ == "__main__":

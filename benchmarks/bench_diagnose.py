@@ -1,7 +1,7 @@
 """`golfflight diagnose` at scale: synthetic sets of N shots (the project's generator, `shots.synth`, against the
 served default model), each diagnosed in its own process as a user runs it; wall time, peak resident memory of that
-process, the time to its first progress line, how many shots the fits used and the verdict. Prints a table, writes
-its section of results.json (issue 32: 100,000 shots in at most 150 s and 1.5 GB, progress within 10 s).
+process, the time to its first progress line, how many shots the fits used and the verdict. Prints a table; --results
+FILE writes its section there (issue 32: 100,000 shots in at most 150 s and 1.5 GB, progress within 10 s).
 
 python benchmarks/bench_diagnose.py [--shots 1000 10000 100000] [--seed 7] [--data CSV] [--hidden EFFECTS] [--work DIR]
                                    [--uncertainty]
@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from common import REPO, write_results
+from common import REPO, add_results_flag, write_results
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import Diagnoser
 from golfflight.discovery.effects import EFFECTS
@@ -189,7 +189,7 @@ def main() -> None:
     parser.add_argument("--model", help="model bundle (default: the served default)")
     parser.add_argument("--work", help="folder for the sets and reports (default: a temporary one)")
     parser.add_argument("--uncertainty", action="store_true", help="also compare the ± on the largest set")
-    parser.add_argument("--no-write", action="store_true", help="print the table only, leave results.json alone")
+    add_results_flag(parser)
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="bench_diagnose_") as scratch:
         folder = Path(args.work or scratch)
@@ -210,9 +210,8 @@ def main() -> None:
         largest[k] is not None and largest[k] <= TARGET[k] for k in ("wall_s", "peak_rss_mb", "first_progress_s")
     )
     print(f"\ntarget {TARGET}: {'met' if met else 'NOT met'} by the {largest['shots']:,}-shot set")
-    if not args.no_write:
-        section = "diagnose" if not args.hidden else f"diagnose_hidden_{args.hidden}"
-        write_results(section, [*rows, {"name": "target", **TARGET, "met": met}, *ratios])
+    section = "diagnose" if not args.hidden else f"diagnose_hidden_{args.hidden}"
+    write_results(section, [*rows, {"name": "target", **TARGET, "met": met}, *ratios], args.results)
 
 
 if __name__ == "__main__":

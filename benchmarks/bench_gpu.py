@@ -4,7 +4,7 @@ phase, the ground phase where the engine puts it and on the other side: the devi
 with every shot flown to its part's last step, the landed shots never set aside), peak memory,
 carry parity with the ONNX Runtime engine on 10,000 mixed shots (float32 and float64 physics, float32
 compiled), the CPU's share of a sweep in microseconds a row (what caps a sweep however fast the device flies), and
-sweeps end to end through the command line. Writes the section `torch_engine_<cpu|cuda>` of benchmarks/results.json
+sweeps end to end through the command line. With --results FILE, writes the section `torch_engine_<cpu|cuda>` there
 (other sections are kept) and prints a table for docs/benchmarks.md. The flight's time runs from the launch states to
 the landings back in NumPy (the device's transfers included); around it are the batch's launch states and air before
 it, and the figures and the bounce and roll of the landings after it (`torch_engine.STAGES`); the CPU's share of a
@@ -12,7 +12,7 @@ sweep is all but the flight, the driver's work included.
 
 One command on a GPU machine (with the defaults estimated at 7-8 minutes on an H100, not yet run there: four engines
 at five batch sizes, two compilations, and seven sweeps of 4,194,304 rows, two of them by 2 and 4 processes sharing
-the GPU; each measurement is written to benchmarks/results.json as soon as it is made, so a run cut short keeps what
+the GPU; each measurement is written to that file as soon as it is made, so a run cut short keeps what
 it measured). `--engines` chooses the engines timed beside the eager one and `--sweep-timeout` stops a sweep that
 runs too long: scripts/gpu_session.sh runs the script in parts that fit the project's lent machines (15 minutes of
 device time a session, training's measurements included; their image lacks Ray). --ray-workers 1,2,4 also sweeps the
@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from common import REPO, write_results
+from common import REPO, add_results_flag, write_results
 from golfflight.flight.air import Air
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import load_flyer
@@ -338,6 +338,7 @@ def main() -> None:
     parser.add_argument("--sweep-timeout", type=float, default=300.0,
                         help="seconds an end-to-end sweep may run before it is stopped (default 300)")
     parser.add_argument("--share-rows", type=int, help="launches of the CPU-share sweeps (0: none; default: by device)")
+    add_results_flag(parser)
     args = parser.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
@@ -352,7 +353,7 @@ def main() -> None:
     def measured(name: str, value) -> None:
         """Keep a measurement in the section and write the section now (a run cut short keeps what it measured)."""
         section[name] = value
-        write_results(f"torch_engine_{kind}", [section])
+        write_results(f"torch_engine_{kind}", [section], args.results)
 
     measured("throughput", throughput(engines, batches, args.rounds))
     measured("parity", parity(bundle, args.device, args.parity_shots, engines))

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import onnx
 import onnxruntime as ort
-from common import SEVEN_IRON, write_results
+from common import SEVEN_IRON, add_results_flag, write_results
 from golfflight.flight.bundle_check import session_options
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine
@@ -83,6 +83,7 @@ def median_us(call, rounds: int = 9, calls: int = 5000) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", help="model bundle (default: the shipped one)")
+    add_results_flag(parser)
     args = parser.parse_args()
     bundle = model_dir(args.model)
     card, onnx_path = load_bundle(bundle)
@@ -109,7 +110,7 @@ def main() -> None:
     extra_nodes = rows[2]["nodes_after_ort"] - 1
     print(f"\nper extra node after the first: {(graph_us - floor_us) / extra_nodes:.2f} us; the rest of a step "
           f"(loop, buffers, landing checks): {rows[4]['p50'] - graph_us - rows[3]['p50']:.2f} us")
-    write_results("graph_overhead", rows)
+    write_results("graph_overhead", rows, args.results)
 
 
 if __name__ == "__main__":

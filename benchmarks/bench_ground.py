@@ -1,7 +1,7 @@
 """What the ground phase (bounce and roll to rest, flight.ground) adds to the engine: one shot and a batch of 1024,
 flight alone against flight plus ground, and the ground phase alone on a driver's landing, interleaved round by
 round. Times are CPU time per call (time.process_time), which a busy machine inflates far less than wall-clock time.
-Prints a table, writes results.json.
+Prints a table; --results FILE writes it there.
 
 python benchmarks/bench_ground.py [--model DIR] [--rounds 5]
 """
@@ -12,7 +12,16 @@ import argparse
 import statistics
 import time
 
-from common import DRIVER, SEVEN_IRON, median_of_rounds, mixed_launches, percentiles_ms, print_table, write_results
+from common import (
+    DRIVER,
+    SEVEN_IRON,
+    add_results_flag,
+    median_of_rounds,
+    mixed_launches,
+    percentiles_ms,
+    print_table,
+    write_results,
+)
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import RPM_TO_RADPS
 from golfflight.flight.engine import BATCH_THREADS, FlightEngine
@@ -40,6 +49,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", help="model bundle (default: the shipped one)")
     parser.add_argument("--rounds", type=int, default=5, help="interleaved rounds; the table shows their medians")
+    add_results_flag(parser)
     args = parser.parse_args()
     engine = FlightEngine(model_dir(args.model), BATCH_THREADS)
     launches = mixed_launches(1024)
@@ -81,7 +91,7 @@ def main() -> None:
     rows.append({"name": f"batch of 1024, per shot, level fairway, {rolled_us - alone_us:+.1f} us", "unit": "us",
                  "p50": rolled_us, "p99": None, "target": "(context)", "met": True})
     print_table(f"The ground phase's cost, CPU time, {args.rounds} interleaved rounds (medians of the rounds)", rows)
-    write_results("ground", rows)
+    write_results("ground", rows, args.results)
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 which needs no key to reach the Open Connect port, hold up the HTTP service?
 
 python benchmarks/bench_hostile.py [--flood-mb 20] [--hostile-s 10] [--quiet-s 5] [--connector-shots 20]
-                                   [--label after] [--tree DIR] [--no-write]
+                                   [--label after] [--tree DIR] [--results FILE]
 
 Starts `golfflight serve --port P --connect-port Q` in a subprocess, as a user would (of this checkout, or of
 --tree DIR: e.g. `git archive HEAD | tar -x -C DIR` for a before run while the checkout changes), waits for GET
@@ -20,7 +20,7 @@ trickling a byte a second, and connects again whenever one is closed; once it ho
 sends a shot --connector-shots times, 0.25 s apart, a new connection each time, and the time from its connect to its
 shot's reply is taken, with the reply's Code (200: it got in; 503: it was refused).
 
-Prints a table and writes the `hostile` section of results.json: rows carry --label (e.g. "before" / "after"), and
+Prints a table; --results FILE gets its `hostile` section: rows carry --label (e.g. "before" / "after"), and
 a run replaces only the rows of its own label, so the section can hold a before and an after run.
 """
 
@@ -40,7 +40,7 @@ from pathlib import Path
 
 import httpx
 import numpy as np
-from common import REPO, RESULTS, machine
+from common import REPO, add_results_flag, machine, read_results, save_results
 from server import HOST, RawHttp, free_port
 
 SHOT = {"ball_speed_mph": 150, "launch_angle_deg": 12, "spin_rpm": 3000}
@@ -435,15 +435,15 @@ def print_places(rows: list[dict]) -> None:
                   f"| {'met' if row['met'] else 'NOT met'} ||||||")
 
 
-def write_section(rows: list[dict], label: str) -> None:
-    """The `hostile` section of results.json: this run's rows in place of earlier rows of the same label; the
-    machine at each label's run is kept beside it."""
-    data = json.loads(RESULTS.read_text()) if RESULTS.is_file() else {}
+def write_section(rows: list[dict], label: str, path: Path | None) -> None:
+    """The `hostile` section of the results file named: this run's rows in place of earlier rows of the same label;
+    the machine at each label's run is kept beside it."""
+    data = read_results(path)
     section = data.get("hostile", {"machines": {}, "rows": []})
     section["rows"] = [row for row in section["rows"] if row.get("label") != label] + rows
     section["machines"][label] = machine()
     data["hostile"] = section
-    RESULTS.write_text(json.dumps(data, indent=2) + "\n")
+    save_results(path, data)
 
 
 def main() -> None:
@@ -454,13 +454,12 @@ def main() -> None:
     parser.add_argument("--connector-shots", type=int, default=20, help="connectors' shots in (d) and (e) each")
     parser.add_argument("--label", default="this tree", help="what is measured (rows of other labels are kept)")
     parser.add_argument("--tree", type=Path, default=REPO, help="the checkout whose service is measured")
-    parser.add_argument("--no-write", action="store_true", help="leave benchmarks/results.json as it is")
+    add_results_flag(parser)
     args = parser.parse_args()
     print(f"load average {os.getloadavg()}", flush=True)
     rows = run(args)
     print_rows(rows)
-    if not args.no_write:
-        write_section(rows, args.label)
+    write_section(rows, args.label, args.results)
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""HTTP speed over loopback: `golfflight serve` in a subprocess, a keep-alive httpx client. Table + results.json.
+"""HTTP speed over loopback: `golfflight serve` in a subprocess, a keep-alive httpx client. Table; --results FILE.
 
 python benchmarks/bench_http.py [--model DIR] [--rounds 5]
 """
@@ -10,7 +10,16 @@ import statistics
 import time
 
 import httpx
-from common import PAPER, SEVEN_IRON, median_of_rounds, mixed_launches, percentiles_ms, print_table, write_results
+from common import (
+    PAPER,
+    SEVEN_IRON,
+    add_results_flag,
+    median_of_rounds,
+    mixed_launches,
+    percentiles_ms,
+    print_table,
+    write_results,
+)
 from server import start
 
 SHOT = {
@@ -35,6 +44,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", help="model bundle (default: the shipped one)")
     parser.add_argument("--rounds", type=int, default=5)
+    add_results_flag(parser)
     args = parser.parse_args()
     server = start(1, args.model)
     batch = {"shots": [launch._asdict() for launch in mixed_launches(1024)]}
@@ -76,7 +86,7 @@ def main() -> None:
         "\nserver side (GET /v1/latency, whole window):"
         f" simulation {server_side['simulation']}, request {server_side['request']}"
     )
-    write_results("http", rows)
+    write_results("http", rows, args.results)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
-"""In-process speed of the engine: one shot, a batch of 1024, model load. Prints a table, writes results.json.
+"""In-process speed of the engine: one shot, a batch of 1024, model load. Prints a table; --results FILE writes it.
 
-python benchmarks/bench_inprocess.py [--model DIR] [--rounds 5]
+python benchmarks/bench_inprocess.py [--model DIR] [--rounds 5] [--shots 2000] [--results FILE]
 (Benchmark with OPENBLAS_CORETYPE and OPENBLAS_L2_SIZE unset where they are set: they slow NumPy.)
 """
 
@@ -14,6 +14,7 @@ from common import (
     DRIVER,
     PAPER,
     SEVEN_IRON,
+    add_results_flag,
     median_of_rounds,
     mixed_launches,
     percentiles_ms,
@@ -48,7 +49,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", help="model bundle (default: the shipped one)")
     parser.add_argument("--rounds", type=int, default=5, help="repeated rounds; the table shows their medians")
+    parser.add_argument("--shots", type=int, default=2000, help="single shots timed per round and club")
     parser.add_argument("--batch-threads", type=int, default=BATCH_THREADS, help="ORT threads of a batch step")
+    add_results_flag(parser)
     args = parser.parse_args()
     bundle = model_dir(args.model)
 
@@ -58,8 +61,8 @@ def main() -> None:
         engine = FlightEngine(bundle, args.batch_threads)
         loads.append(time.perf_counter() - started)
 
-    seven = median_of_rounds([time_single(engine, SEVEN_IRON, 2000) for _ in range(args.rounds)])
-    drive = median_of_rounds([time_single(engine, DRIVER, 2000) for _ in range(args.rounds)])
+    seven = median_of_rounds([time_single(engine, SEVEN_IRON, args.shots) for _ in range(args.rounds)])
+    drive = median_of_rounds([time_single(engine, DRIVER, args.shots) for _ in range(args.rounds)])
     launches = mixed_launches(1024)
     batch_rounds = [time_batch(engine, launches, 5) for _ in range(args.rounds)]
     per_shot_us = [statistics.median(r) / 1024 * 1e6 for r in batch_rounds]
@@ -105,7 +108,7 @@ def main() -> None:
     print_table(
         f"In process, {args.rounds} rounds (medians of the rounds' p50 and p99; batch p99 = slowest of 5 runs)", rows
     )
-    write_results("in_process", rows)
+    write_results("in_process", rows, args.results)
 
 
 if __name__ == "__main__":

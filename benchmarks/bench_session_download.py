@@ -1,13 +1,13 @@
 """Shots while clients download the session: does GET /v1/session.csv (the viewer's download button) hold up the bay?
 
 python benchmarks/bench_session_download.py [--shots 10000] [--seconds 10] [--downloaders 2] [--label after]
-                                            [--tree DIR] [--no-write]
+                                            [--tree DIR] [--results FILE]
 
 Starts `golfflight serve --connect-port Q` (of this checkout, or of --tree DIR for a before run), fills the session
 with --shots HTTP single shots shown on the viewer, then times, in two scenarios of --seconds each, HTTP single shots back to back (one
 keep-alive raw socket client) and a connector's Open Connect shots (one every 50 ms, each reply read before the
-next): (a) quiet; (b) while --downloaders processes each loop GET /v1/session.csv. Prints a table and writes the
-`session_download` section of results.json (rows carry --label; a run replaces only its own label's rows).
+next): (a) quiet; (b) while --downloaders processes each loop GET /v1/session.csv. Prints a table; --results FILE gets
+its `session_download` section (rows carry --label; a run replaces only its own label's rows).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import httpx
 import numpy as np
-from common import REPO, RESULTS, machine
+from common import REPO, add_results_flag, machine, read_results, save_results
 from server import HOST, RawHttp, start
 
 SHOT = {"ball_speed_mph": 150, "launch_angle_deg": 12, "spin_rpm": 3000}
@@ -150,15 +150,14 @@ def main() -> None:
     parser.add_argument("--downloaders", type=int, default=2)
     parser.add_argument("--label", default="after")
     parser.add_argument("--tree", type=Path, default=REPO)
-    parser.add_argument("--no-write", action="store_true")
+    add_results_flag(parser)
     args = parser.parse_args()
     rows = run(args)
     print_table(rows)
-    if not args.no_write:
-        data = json.loads(RESULTS.read_text()) if RESULTS.is_file() else {}
-        kept = [row for row in data.get("session_download", {}).get("rows", []) if row["label"] != args.label]
-        data["session_download"] = {"machine": machine(), "rows": kept + rows}
-        RESULTS.write_text(json.dumps(data, indent=2) + "\n")
+    data = read_results(args.results)
+    kept = [row for row in data.get("session_download", {}).get("rows", []) if row["label"] != args.label]
+    data["session_download"] = {"machine": machine(), "rows": kept + rows}
+    save_results(args.results, data)
 
 
 if __name__ == "__main__":

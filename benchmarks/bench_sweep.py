@@ -2,7 +2,7 @@
 (round by round, the order alternating), each as its own `golfflight sweep` process: shots per second end to end
 (process start to results written, Ray's start included), peak memory of the whole process tree (the sum of every
 process's RSS, sampled, Ray's raylet, GCS and workers included; and the sum of PSS, which counts shared pages once),
-and Ray's overhead (local shots/s over Ray's). Prints a table, writes results.json.
+and Ray's overhead (local shots/s over Ray's). Prints a table; --results FILE writes it.
 
 With --validation instead (section sweep_validation): a chunk's rows checked against the request model one row at a
 time (`contract.columns.check_cells` each row, as every sweep did before `sweep.rows`) against the columnar check
@@ -33,7 +33,7 @@ import numpy as np
 import psutil
 import pyarrow as pa
 import pyarrow.parquet as pq
-from common import REPO, mixed_launches, write_results
+from common import REPO, add_results_flag, mixed_launches, write_results
 
 ENGINES = ("local", "ray")
 PEAK_MB_TARGET = 2048
@@ -229,7 +229,7 @@ def validation_main(args: argparse.Namespace) -> None:
     if args.before:
         rows += whole_sweeps(Path(args.before).resolve(), args.grid_rows, args.rounds)
         print(f"whole sweep: {rows[-2]['ratio']:.2f}x shots/s, the rest {rows[-2]['rest_ratio']:.1f}x faster")
-    write_results("sweep_validation", rows)
+    write_results("sweep_validation", rows, args.results)
 
 
 def main() -> None:
@@ -240,6 +240,7 @@ def main() -> None:
     parser.add_argument("--validation", action="store_true", help="the row check's speed instead (module docstring)")
     parser.add_argument("--grid-rows", type=int, default=200_000, help="--validation: the whole torch sweep's grid")
     parser.add_argument("--before", help="--validation: a checkout of an earlier commit to sweep from, interleaved")
+    add_results_flag(parser)
     args = parser.parse_args()
     if args.validation:
         validation_main(args)
@@ -293,7 +294,7 @@ def main() -> None:
         rounds = ", ".join(f"{r:.2f}" for r in row["per_round"])
         print(f"| {row['name']} | | {row['ratio']:.2f}x ({rounds}) | | | | | | {row['target']} | "
               f"{'yes' if row['met'] else 'NO'} |")
-    write_results("sweep", [*rows, {"name": "runs", "runs": runs}])
+    write_results("sweep", [*rows, {"name": "runs", "runs": runs}], args.results)
 
 
 if __name__ == "__main__":

@@ -6,7 +6,7 @@ at least one kernel launch on a GPU, so their count times an operation's fixed c
 tensors) bounds an eager epoch there from below, however fast the device computes: what issue 33's target (an epoch
 10x faster than on 16 CPU cores) is up against, and what stacking seeds shares out. On a CPU `--jobs N` trains the
 seeds in N processes at once, each stacking its share (`train-real --stack-seeds --jobs N`): a many-core machine's
-way, and the baseline a GPU is to beat. Writes the section `train_epoch_<cpu|cuda>` of benchmarks/results.json (a row
+way, and the baseline a GPU is to beat. With --results FILE, writes the section `train_epoch_<cpu|cuda>` there (a row
 a device, process count, thread count, number of seeds and step; a rerun replaces its own) and prints them as a table
 for docs/benchmarks.md.
 
@@ -21,14 +21,13 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import json
 import tempfile
 import time
 from dataclasses import replace
 from pathlib import Path
 
 import torch
-from common import REPO, RESULTS, write_results
+from common import REPO, add_results_flag, read_results, write_results
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.devices import resolve_device
 from golfflight.model_export.joint import JointConfig, JointResult
@@ -117,6 +116,7 @@ def main() -> None:
     parser.add_argument("--count-ops", action=argparse.BooleanOptionalAction, default=True,
                         help="count an eager epoch's operations in a third epoch (default; --no-count-ops saves its "
                         "time: the counts do not depend on the device)")
+    add_results_flag(parser)
     args = parser.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
@@ -146,20 +146,20 @@ def main() -> None:
                       f"{'compiled' if compiled else 'eager'} | "
                       f"{row['epoch_s']:.1f} s | {row['seed_share_s']:.1f} s | {row['first_epoch_s']:.1f} s | {ops} | "
                       f"{floor} | {row['selection_loss']:.3f} m |", flush=True)
-                write_rows(f"train_epoch_{device.type}", rows)
+                write_rows(f"train_epoch_{device.type}", rows, args.results)
     print(f"\nan operation's fixed cost on {device}: {cost:.2f} µs")
 
 
-def write_rows(section: str, rows: list[dict]) -> None:
-    """The section of benchmarks/results.json with `rows` in it, in place of the rows that measured the same (written
+def write_rows(section: str, rows: list[dict], path: Path | None) -> None:
+    """The section of the results file with `rows` in it, in place of the rows that measured the same (written
     after each measurement: a run cut short keeps what it measured)."""
-    kept = json.loads(RESULTS.read_text()).get(section, {}).get("rows", []) if RESULTS.is_file() else []
+    kept = read_results(path).get(section, {}).get("rows", [])
     fresh = {_key(r) for r in rows}
-    write_results(section, [*(r for r in kept if "compiled" in r and _key(r) not in fresh), *rows])
+    write_results(section, [*(r for r in kept if "compiled" in r and _key(r) not in fresh), *rows], path)
 
 
 def _key(row: dict) -> tuple:
-    """What a row measured: a rerun of the same replaces it in results.json."""
+    """What a row measured: a rerun of the same replaces it in the results file."""
     return row["device"], row.get("jobs", 1), row["torch_threads"], row["runs"], row["compiled"]
 
 

@@ -11,7 +11,7 @@ start to file written).
 The in-process figures come from one worker process per checkout, both alive throughout, timing short blocks in turn
 (A B, then B A, ...), so that each block of one checkout has a block of the other beside it in time; the ratio of
 each pair is taken and the median of the pairs reported. The sweeps are whole processes, one of each checkout per
-round, the order alternating (ABBA), ratios per round. Prints a table; writes the `versus` section of results.json.
+round, the order alternating (ABBA), ratios per round. Prints a table; --results FILE gets its `versus` section.
 HTTP single shots and batches have their own A/B (`bench_wire.py --versus`).
 
 python benchmarks/bench_versus.py --before ../wt-before [--blocks 40] [--rounds 3] [--grid-rows 50000]
@@ -28,7 +28,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from common import REPO, write_results
+from common import REPO, add_results_flag, write_results
 
 WORKER = r"""
 import json, sys, time
@@ -223,6 +223,7 @@ def main() -> None:
     parser.add_argument("--blocks", type=int, default=40, help="in-process blocks of each checkout")
     parser.add_argument("--rounds", type=int, default=3, help="whole sweeps of each checkout")
     parser.add_argument("--grid-rows", type=int, default=50_000)
+    add_results_flag(parser)
     args = parser.parse_args()
     trees = {"before": Path(args.before).resolve(), "after": REPO}
     figures = interleaved(trees, args.blocks)
@@ -245,7 +246,7 @@ def main() -> None:
         rows.append({"name": name, "before": before, "after": after, "paired_ratio": ratio})
         shown = [f"{statistics.median(v):,.4g} ({min(v):,.4g}-{max(v):,.4g})" for v in (before, after)]
         print(f"| {name} | {shown[0]} | {shown[1]} | {ratio:.3f} |")
-    write_results("versus", rows)
+    write_results("versus", rows, args.results)
 
 
 if __name__ == "__main__":

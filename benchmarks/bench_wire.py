@@ -1,7 +1,7 @@
 """The wire's cost as a difference in one run: a 7-iron flown in process, over HTTP (keep-alive, from httpx and from a
 raw socket) and over GSPro Open Connect TCP, interleaved shot by shot, and a batch of 1,024 in process and over HTTP,
 interleaved run by run.
-Prints a table (overhead in ms beside the absolute figures, and the ratio), writes the `wire` section of results.json.
+Prints a table (overhead in ms beside the absolute figures, and the ratio), --results FILE gets its `wire` section.
 
 python benchmarks/bench_wire.py [--rounds 5] [--shots 500] [--batches 3]
 python benchmarks/bench_wire.py --versus ../wt25-before --versus-without uvloop httptools   # before/after A/B
@@ -29,7 +29,7 @@ from pathlib import Path
 
 import httpx
 import numpy as np
-from common import REPO, SEVEN_IRON, mixed_launches, write_results
+from common import REPO, SEVEN_IRON, add_results_flag, mixed_launches, write_results
 from golfflight.contract.flying import fly_request, fly_requests
 from golfflight.contract.requests import BatchRequest, ShotRequest
 from golfflight.flight.bundle_location import model_dir
@@ -146,7 +146,7 @@ def parse_args() -> argparse.Namespace:
     parser.add_argument("--versus", metavar="TREE", help="also serve this checkout's service, alternating with ours")
     parser.add_argument("--versus-without", nargs="*", default=[], metavar="MODULE",
                         help="modules hidden from the --versus server (as if not installed)")
-    parser.add_argument("--no-write", action="store_true", help="leave benchmarks/results.json as it is")
+    add_results_flag(parser)
     return parser.parse_args()
 
 
@@ -301,8 +301,7 @@ def main() -> None:
     if len(services) == 2:
         rows += paired_rows(*services, args.rounds)
     print_rows(rows, args)
-    if not args.no_write:
-        write_results("wire", rows)
+    write_results("wire", rows, args.results)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,9 @@
-"""Shared pieces of the benchmark scripts: the shots, percentiles, machine info, the table and results.json."""
+"""Shared pieces of the benchmark scripts: the shots, percentiles, machine info, the table, and the results file a
+run names (`--results FILE`; none named: printed only, nothing written)."""
 
 from __future__ import annotations
 
+import argparse
 import importlib.metadata
 import json
 import os
@@ -20,7 +22,8 @@ if str(REPO) not in sys.path:
 from golfflight.flight.engine import Launch
 from golfflight.shots.clubs import CLUBS
 
-RESULTS = REPO / "benchmarks" / "results.json"
+TRACKED_RESULTS = REPO / "benchmarks" / "results.json"
+"""The figures the docs quote, tracked in git: a run writes them only when it names this file (`--results`)."""
 
 SEVEN_IRON = Launch(55.0, 16.0, 0.0, 7100.0, 0.0)
 """The single shot timed: a tour-average 7-iron (the shipped model lands it after 6.2 s, 62 Euler steps)."""
@@ -94,11 +97,35 @@ def machine() -> dict:
     }
 
 
-def write_results(section: str, rows: list[dict]) -> None:
-    """Merge one script's rows into benchmarks/results.json (each script owns its section)."""
-    data = json.loads(RESULTS.read_text()) if RESULTS.is_file() else {}
+def add_results_flag(parser: argparse.ArgumentParser) -> None:
+    """`--results FILE`: where the run's section is merged; without it the run prints its table and writes nothing,
+    so the tracked figures (TRACKED_RESULTS) change only when a run names them on purpose."""
+    parser.add_argument(
+        "--results", type=Path, metavar="FILE",
+        help="merge this run's section into FILE (benchmarks/results.json: the tracked figures the docs quote); "
+        "default: print only, write nothing",
+    )
+
+
+def read_results(path: Path | None) -> dict:
+    """The sections a results file holds (none: no file named, or none there yet)."""
+    return json.loads(path.read_text()) if path is not None and path.is_file() else {}
+
+
+def save_results(path: Path | None, data: dict) -> None:
+    """Write every section to the results file named, or say that nothing was written when none is."""
+    if path is None:
+        print("results not written (--results FILE writes them)", flush=True)
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(data, indent=2) + "\n")
+
+
+def write_results(section: str, rows: list[dict], path: Path | None) -> None:
+    """Merge one script's rows into the results file named (each script owns its section); none named: nothing."""
+    data = read_results(path)
     data[section] = {"machine": machine(), "paper": PAPER, "rows": rows}
-    RESULTS.write_text(json.dumps(data, indent=2) + "\n")
+    save_results(path, data)
 
 
 def print_table(title: str, rows: list[dict]) -> None:

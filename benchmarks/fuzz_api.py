@@ -3,7 +3,8 @@ every check but one) plus raw malformed bodies, against `golfflight serve` on 12
 
 python benchmarks/fuzz_api.py [--examples 250] [--max-time 300] [--raw 2000] [--seed 1] [--workers 1]
 
-Prints the figures and writes the "fuzz" section of benchmarks/results.json (docs/reliability.md quotes them).
+Prints the figures and with --results FILE writes its "fuzz" section
+there (benchmarks/results.json: the tracked figures docs/reliability.md quotes).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from pathlib import Path
 
 import httpx
 import server as serving
-from common import REPO, machine
+from common import add_results_flag, machine, read_results, save_results
 
 EXCLUDED_CHECKS = ["positive_data_acceptance"]
 """Two cross-field rules cannot be written in JSON Schema (back and side spin together within 15,000 rpm; a GSPro
@@ -91,6 +92,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--model", help="model bundle (default: the shipped one)")
+    add_results_flag(parser)
     args = parser.parse_args()
     if not 0 < args.max_time <= 3600 or not 0 <= args.raw <= 100_000:
         parser.error("--max-time must be 1..3600 s and --raw 0..100000: the campaign is bounded")
@@ -124,10 +126,9 @@ def main() -> None:
         "shutdown": {"exit_code": code, "seconds": round(seconds, 2)},
     }
     print(json.dumps({k: v for k, v in result.items() if k not in ("machine",)}, indent=1)[:6000])
-    results = REPO / "benchmarks" / "results.json"
-    data = json.loads(results.read_text()) if results.is_file() else {}
+    data = read_results(args.results)
     data["fuzz"] = result
-    results.write_text(json.dumps(data, indent=2) + "\n")
+    save_results(args.results, data)
     sys.exit(0 if not report["failures"] and not raw["problems"] and raw["server_fine_afterwards"] else 1)
 
 

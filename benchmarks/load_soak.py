@@ -6,8 +6,8 @@ Three phases, each bounded in time: (1) saturation, every client sending back to
 machine sustains; (2) the measured runs, an open-loop schedule at each --load fraction of that rate (or each
 --rate), latency counted from each request's scheduled time (so queueing shows); memory of the supervisor and workers is taken
 before and after, and sampled through the run; (3) graceful shutdown: batches in flight when SIGTERM arrives must
-all complete. Prints the figures and writes the --section ("load" by default; "soak" for a long run) of
-benchmarks/results.json.
+all complete. Prints the figures and, with --results FILE, writes the --section ("load" by default; "soak" for a long
+run) there (benchmarks/results.json: the tracked figures).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 import server as serving
-from common import REPO, machine, mixed_launches
+from common import add_results_flag, machine, mixed_launches, read_results, save_results
 
 MAX_DURATION_S = 3600
 """Longest measured run the script accepts (a soak); every loop below stops by itself."""
@@ -177,7 +177,8 @@ def main() -> None:
     parser.add_argument("--batch-size", type=int, default=100)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--model", help="model bundle (default: the shipped one)")
-    parser.add_argument("--section", default="load", help="section of benchmarks/results.json to write")
+    parser.add_argument("--section", default="load", help="section of the --results file to write")
+    add_results_flag(parser)
     args = parser.parse_args()
     if not 0 < args.duration <= MAX_DURATION_S or not 0 < args.saturation <= 600 or not 0 < args.clients <= 512:
         parser.error(f"--duration 0..{MAX_DURATION_S} s, --saturation 0..600 s, --clients 1..512: the test is bounded")
@@ -222,10 +223,9 @@ def main() -> None:
         },
     }
     print(json.dumps(result, indent=1))
-    results = REPO / "benchmarks" / "results.json"
-    data = json.loads(results.read_text()) if results.is_file() else {}
+    data = read_results(args.results)
     data[args.section] = {"machine": machine(), **result}
-    results.write_text(json.dumps(data, indent=2) + "\n")
+    save_results(args.results, data)
     ok = saturated["errors"] == 0 and all(run["errors"] == 0 for run in measured) and shutdown["clean"]
     sys.exit(0 if ok else 1)
 

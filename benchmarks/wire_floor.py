@@ -7,7 +7,7 @@ Two servers in processes of their own, each spending `--work-us` of busy CPU per
 1 kB body: an asyncio Protocol on uvloop that writes back what it got (Open Connect's shape), and a bare ASGI app on
 uvicorn with uvloop and httptools (`golfflight serve`'s choice) answering a POST. Raw keep-alive socket clients (for
 HTTP `server.RawHttp`, as in `bench_wire.py`) time round trips; the figure is the round trip minus the work. Prints
-a table and writes the `wire_floor` section of results.json.
+a table and --results FILE gets its `wire_floor` section.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import subprocess
 import sys
 import time
 
-from common import SEVEN_IRON, write_results
+from common import SEVEN_IRON, add_results_flag, write_results
 
 ANSWER = json.dumps({f"figure_{i}": 123.456789 for i in range(48)}).encode()
 BODY = json.dumps({"ball_speed_mps": SEVEN_IRON.ball_speed_mps, "launch_angle_deg": SEVEN_IRON.launch_angle_deg,
@@ -124,6 +124,7 @@ def main() -> None:
     parser.add_argument("--requests", type=int, default=1500)
     parser.add_argument("--work-us", type=float, help="busy CPU per request (default: the in-process 7-iron's p50)")
     parser.add_argument("--serve", nargs=3, metavar=("KIND", "PORT", "WORK_S"), help=argparse.SUPPRESS)
+    add_results_flag(parser)
     args = parser.parse_args()
     if args.serve:
         kind, port, work = args.serve
@@ -165,7 +166,7 @@ def main() -> None:
     print("|---|---:|---|")
     for row in rows:
         print(f"| {row['name']} | {row['p50']:.3f} ms | {', '.join(f'{r:.3f}' for r in row['per_round_ms'])} |")
-    write_results("wire_floor", rows)
+    write_results("wire_floor", rows, args.results)
 
 
 if __name__ == "__main__":

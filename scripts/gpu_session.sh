@@ -48,11 +48,12 @@ on_device() {
     python3 -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name())"
 }
 
-step() {  # step NAME SECONDS COMMAND...: run it under a time limit, its output in $OUT/NAME.log, the results copied
+step() {  # step NAME SECONDS COMMAND...: run it under a time limit, its output in $OUT/NAME.log, its rows merged into
+    # the copy's benchmarks/results.json (--results: the scripts write nowhere unless told), then copied out
     local name=$1 limit=$2
     shift 2
     echo "== $* (at most ${limit} s)"
-    timeout "$limit" "$@" 2>&1 | tee "$OUT/$name.log"
+    timeout "$limit" "$@" --results benchmarks/results.json 2>&1 | tee "$OUT/$name.log"
     cp benchmarks/results.json "$OUT/results.json"
 }
 
