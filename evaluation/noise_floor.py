@@ -18,7 +18,7 @@ from golfflight.evaluation.validation import Errors, Prediction, ValidationShots
 from golfflight.flight.air import Air
 from golfflight.flight.physics import initial_state
 from golfflight.flight.wind import CALM, Wind
-from golfflight.shots.records import ShotSet
+from golfflight.shots.records import CSV_ENCODING, ShotSet
 from golfflight.shots.reference_world import fly_reference
 from golfflight.shots.synth import MeasurementNoise, sessions_path
 
@@ -35,7 +35,7 @@ class SessionTruth(NamedTuple):
 
 def read_session_truth(path: str | os.PathLike) -> dict[str, SessionTruth]:
     """The hidden air and wind of every session of a synthetic file's companion NAME.sessions.csv."""
-    with open(path, newline="") as handle:
+    with open(path, newline="", encoding=CSV_ENCODING) as handle:
         return {
             row["session"]: SessionTruth(*(float(row[f]) for f in SessionTruth._fields))
             for row in csv.DictReader(handle)

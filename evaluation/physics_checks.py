@@ -37,6 +37,7 @@ from golfflight.flight.constants import BALL_RADIUS_M
 from golfflight.flight.physics import spin_ratio
 from golfflight.shots.clubs import CLUBS, ClubLaunch, straight_launches
 from golfflight.shots.markdown import table
+from golfflight.shots.records import CSV_ENCODING
 
 COMMAND = "physics-check"
 LITERATURE_DIR = Path("literature")
@@ -137,7 +138,7 @@ def is_fit(source: str, method: str) -> bool:
 
 def _rows(path: str | os.PathLike, columns: tuple[str, ...]) -> list[dict[str, str]]:
     """The rows of a CSV table that must have these columns (ValueError naming the file and the missing ones)."""
-    with Path(path).open(newline="") as handle:
+    with Path(path).open(newline="", encoding=CSV_ENCODING) as handle:
         reader = csv.DictReader(handle)
         missing = [c for c in columns if c not in (reader.fieldnames or [])]
         if missing:

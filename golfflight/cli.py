@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 import csv
+import os
+import select
 import sys
 
 import golfflight
@@ -37,7 +39,18 @@ Our other failures (an output that cannot be written, a shot that cannot land) a
 anything else is a bug and keeps its traceback."""
 
 
-def main(argv: list[str] | None = None) -> int:
+def stdout_reader_gone() -> bool:
+    """Whether standard output is a pipe whose reader has closed it (`golfflight simulate s.csv | head` once `head`
+    has its lines): the poll of its write end reports an error."""
+    try:
+        poll = select.poll()
+        poll.register(sys.stdout.fileno(), select.POLLOUT)
+        return any(events & select.POLLERR for _, events in poll.poll(0))
+    except (AttributeError, OSError, ValueError):  # no poll on this platform, or no file behind standard output
+        return False
+
+
+def _dispatch(argv: list[str] | None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.run(args) or 0
@@ -47,6 +60,22 @@ def main(argv: list[str] | None = None) -> int:
     except GolfflightError as error:
         print(f"golfflight {args.command}: error: {error}", file=sys.stderr)
         return 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run one command (its help included) and flush what it printed. A reader that closes standard output early
+    ends the command quietly with status 0, as `head` expects of what it reads, instead of a BrokenPipeError
+    traceback; any other broken pipe keeps its traceback."""
+    try:
+        try:
+            return _dispatch(argv)
+        finally:
+            sys.stdout.flush()
+    except BrokenPipeError:
+        if not stdout_reader_gone():
+            raise
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # the interpreter's last flush goes nowhere
+        return 0
 
 
 if __name__ == "__main__":

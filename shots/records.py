@@ -98,6 +98,10 @@ COLUMNS: tuple[str, ...] = tuple(ShotRecord.model_fields)
 REQUIRED_COLUMNS: tuple[str, ...] = tuple(name for name, f in ShotRecord.model_fields.items() if f.is_required())
 NUMERIC_COLUMNS: tuple[str, ...] = tuple(RANGES)
 LAUNCH_COLUMNS: tuple[str, ...] = REQUIRED_COLUMNS
+CSV_ENCODING = "utf-8-sig"
+"""How every CSV golfflight reads is decoded: UTF-8, a byte-order mark at the start passed over (a spreadsheet's
+"CSV UTF-8" writes one; read as plain UTF-8 it glues itself to the first column's name)."""
+
 OUTCOME_COLUMNS = ("carry_x_m", "carry_y_m", "apex_m", "flight_time_s", "landing_angle_deg")
 AIR_COLUMNS = ("temperature_c", "altitude_m", "pressure_hpa", "humidity_pct")
 TRAJECTORY_COLUMNS = ("shot_id", "t_s", "x_m", "y_m", "z_m")
@@ -202,7 +206,7 @@ def read_shots(path: str | os.PathLike, skip_bad_rows: bool = False) -> ShotSet:
 
 
 def _read_shots(path: Path, skip_bad_rows: bool) -> ShotSet:
-    with path.open(newline="") as handle:
+    with path.open(newline="", encoding=CSV_ENCODING) as handle:
         reader = csv.DictReader(handle)
         header = reader.fieldnames or []
         missing = [c for c in REQUIRED_COLUMNS if c not in header]
@@ -293,7 +297,7 @@ def read_trajectories(path: str | os.PathLike) -> dict[str, np.ndarray]:
 
 def _read_trajectories(path: Path) -> dict[str, np.ndarray]:
     grouped: dict[str, list[list[float]]] = {}
-    with path.open(newline="") as handle:
+    with path.open(newline="", encoding=CSV_ENCODING) as handle:
         reader = csv.DictReader(handle)
         if list(reader.fieldnames or []) != list(TRAJECTORY_COLUMNS):
             raise RecordError(f"{path} line 1 (header): expected columns {list(TRAJECTORY_COLUMNS)}, got {reader.fieldnames}")

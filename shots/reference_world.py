@@ -28,6 +28,7 @@ from golfflight.flight.reference_aero import (
 )
 from golfflight.flight.wind import CALM, Wind
 from golfflight.shots.paths import shared_data_dir
+from golfflight.shots.records import CSV_ENCODING
 from pydantic import BaseModel, ConfigDict
 
 CALIBRATION_AIR = Air.from_conditions(temperature_c=25.0, altitude_m=0.0, humidity_pct=50.0)
@@ -107,7 +108,7 @@ def default_tour_averages_path() -> Path:
 def read_tour_averages(path: str | os.PathLike) -> list[ClubAverage]:
     """Read a TrackMan tour-averages CSV (one row per club) into validated rows, in file order."""
     path = Path(path)
-    with path.open(newline="") as handle:
+    with path.open(newline="", encoding=CSV_ENCODING) as handle:
         rows = list(csv.DictReader(handle))
     if not rows:
         raise InputError(f"{path}: no rows")

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from golfflight.contract.columns import columns_message
 from golfflight.errors import InputError
-from golfflight.shots.records import reading
+from golfflight.shots.records import CSV_ENCODING, reading
 from golfflight.sweep.grid import Grid
 
 READ_BUFFER_BYTES = 1 << 20
@@ -104,7 +104,7 @@ class CsvSource:
 
     @classmethod
     def open(cls, path: Path, chunk_rows: int) -> CsvSource:
-        with reading(path), open(path, newline="") as handle:
+        with reading(path), open(path, newline="", encoding=CSV_ENCODING) as handle:
             header = next(csv.reader(handle), [])
         refused = columns_message(str(path), header)
         if refused:

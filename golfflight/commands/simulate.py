@@ -53,7 +53,7 @@ from golfflight.contract.columns import (
 from golfflight.contract.inputs import conditions_of
 from golfflight.contract.requests import ShotRequest
 from golfflight.errors import InputError
-from golfflight.shots.records import reading
+from golfflight.shots.records import CSV_ENCODING, reading
 
 ECHOED_CONDITIONS = (*WIND_COLUMNS, *GROUND_COLUMNS)
 """The condition columns echoed as read (the air's come with `flown_air`)."""
@@ -91,7 +91,7 @@ def shots_from_csv(path: Path) -> Input:
     """The shots of a launches CSV, its header checked first (`columns_message`): a missing launch column refuses
     the file in one line instead of one "Field required" a row."""
     read = Input()
-    with reading(path), open(path, newline="") as handle:
+    with reading(path), open(path, newline="", encoding=CSV_ENCODING) as handle:
         reader = csv.DictReader(handle)
         refused = columns_message(str(path), list(reader.fieldnames or []), also=frozenset({PUTT}))
         if refused:
@@ -158,7 +158,7 @@ def read_input(name: str) -> tuple[Input, bool]:
     if path.suffix.lower() == ".csv":
         return shots_from_csv(path), True
     with reading(path):
-        return shots_from_json(path.read_text(), str(path)), False
+        return shots_from_json(path.read_text(encoding=CSV_ENCODING), str(path)), False
 
 
 def refuse_or_skip(name: str, problems: list[str], flyable: int, rows_read: int, skip_bad_rows: bool) -> None:
