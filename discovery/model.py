@@ -15,6 +15,7 @@ import os
 from dataclasses import dataclass, field
 from typing import Literal
 
+from golfflight.discovery.choices import REFERENCE
 from golfflight.discovery.discrepancy import Discrepancy
 from golfflight.discovery.recordings import OBSERVABLES
 from golfflight.discovery.simulator import Correction, Outcomes, Setup, setup_flight, simulate_setup
@@ -24,9 +25,6 @@ from golfflight.flight.integrator import RUNGE_KUTTA_4
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics, ReferenceParameters
 from golfflight.flight.wind import Wind
-
-REFERENCE = "reference"
-"""`--model reference` diagnoses against the reference world instead of a bundle."""
 
 MIN_T_MAX_S = 15.0
 """Flights are integrated for at least this long, so a shot the effects lengthen still lands."""

@@ -20,9 +20,9 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
+from golfflight.discovery.choices import CAMPAIGNS, CLEAN_SETS, TRUTHS, Campaign, Truth
 from golfflight.discovery.conceal import NOMINAL_AIR, NOMINAL_CONTEXT, OUTSIDE_EFFECT, conceal
 from golfflight.discovery.diagnose import diagnose
 from golfflight.discovery.effects import AIR_VARIANTS, BALL, DENSITY_ONLY, EFFECTS, LIBRARY, Draw, equivalent_altitude_m
@@ -56,15 +56,6 @@ LOG_WIND = "wind, log profile"
 its uniform-equivalent speed (the stated speed x the profile's mean factor along the flights), and the service
 settings must give back the stated 10 m speed."""
 
-CLEAN_SETS = 40
-"""Clean sets per campaign, whatever the seeds per case: false alarms are counted on at least this many."""
-
-Truth = Literal["model", "reference", "ferguson", "density-only"]
-TRUTHS: tuple[Truth, ...] = ("model", "reference", "ferguson", "density-only")
-"""The worlds effects are hidden in: the diagnosed model's own flights, and those that differ from it in form (the
-model-form campaign): the reference world, Ferguson 2022's closed-form coefficients, and the model itself in venue
-air that scales density only (recorded, so the model flies it with the Reynolds change real air has)."""
-
 VENUE_RATIOS = (0.75, 0.95)
 """The density-only world's venue air, as a share of ICAO density (about 500 to 2,600 m)."""
 PAIRS = (
@@ -77,9 +68,6 @@ PAIRS = (
 )
 """The two-effect cases of the `pairs` campaign: each library family beside another, so that the step from a single
 to a pair is measured on its own (issue 41: pairs had regressed after the triple step)."""
-
-Campaign = Literal["library", "pairs", "triples", "baseline"]
-CAMPAIGNS: tuple[Campaign, ...] = ("library", "pairs", "triples", "baseline")
 
 HIGH_VENUE = "1,900 m air, density only"
 """The baseline campaign's fixed case: a venue at about 1,900 m (0.776 x ICAO) flown as density alone, against a

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import importlib
 import os
 import select
 import sys
@@ -23,13 +24,28 @@ from golfflight.commands import COMMANDS
 from golfflight.errors import GolfflightError, InputError
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The command line: every command with its options, or with `only` (a command's name, or "" for none) that
+    command's alone, the others by name and one-line help, so that their modules (and what they import) are not
+    loaded for a command that does not need them."""
     parser = argparse.ArgumentParser(prog="golfflight", description="Golf ball flight engine (Phys-NN+).")
     parser.add_argument("--version", action="version", version=f"golfflight {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True)
-    for command in COMMANDS:
-        command.register(subparsers)
+    full = {c.module for name, c in COMMANDS.items() if only is None or name == only}
+    for name, command in COMMANDS.items():
+        if command.module in full:
+            importlib.import_module(f"golfflight.commands.{command.module}").register(subparsers)
+            full.discard(command.module)  # a module registers all of its commands at once
+        elif name not in subparsers.choices:
+            subparsers.add_parser(name, help=command.summary)
     return parser
+
+
+def command_named(argv: list[str]) -> str:
+    """The command an argument list runs ("" when it names none: `golfflight --help`, a typo), read as argparse
+    reads it: the first argument that is not an option."""
+    first = next((arg for arg in argv if not arg.startswith("-")), "")
+    return first if first in COMMANDS else ""
 
 
 USER_ERRORS = (InputError, FileNotFoundError, IsADirectoryError, NotADirectoryError, PermissionError, csv.Error)
@@ -51,7 +67,8 @@ def stdout_reader_gone() -> bool:
 
 
 def _dispatch(argv: list[str] | None) -> int:
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else argv
+    args = build_parser(command_named(argv)).parse_args(argv)
     try:
         return args.run(args) or 0
     except USER_ERRORS as error:

@@ -40,6 +40,7 @@ import numpy as np
 from golfflight.flight.air import Air
 from golfflight.flight.constants import YARD_M
 from golfflight.flight.physics import initial_state
+from golfflight.model_export.real_sources import DEFAULT_SOURCES, SOURCES
 from golfflight.shots.heldout import check_training_rows, shot_round
 from golfflight.shots.pbp import load_pbp, recorded_apex
 from golfflight.shots.records import ShotRecord, trajectories_path, write_shots, write_trajectories
@@ -277,20 +278,11 @@ def synthetic(n_shots: int = SYNTHETIC_SHOTS, seed: int = SYNTHETIC_SEED) -> Sou
     return SourceData("synthetic", "synthetic", _tag(records, "synthetic", groups, val), {}, report)
 
 
-BUILDERS: dict[str, Callable[[Path], SourceData]] = {
-    "trackman-outdoor": trackman_outdoor,
-    "sentry-2022": sentry,
-    "players-2020": players,
-    "trackman-model": trackman_model,
-    "tour-championship-2020": tour_championship,
-    "pga-2023-table": pga_table,
-    "synthetic": lambda root: synthetic(),
-}
-"""Every source, by name, in the order the merged file lists them."""
+BUILDERS: dict[str, Callable[[Path], SourceData]] = dict(zip(SOURCES, (
+    trackman_outdoor, sentry, players, trackman_model, tour_championship, pga_table, lambda root: synthetic(),
+), strict=True))
+"""Every source, by name (`real_sources.SOURCES`), in the order the merged file lists them."""
 
-DEFAULT_SOURCES = ("trackman-outdoor", "sentry-2022", "players-2020", "trackman-model", "tour-championship-2020",
-                   "pga-2023-table", "synthetic")
-"""What the shipped model is trained on."""
 
 
 def build(root: str | os.PathLike, out: str | os.PathLike, names: tuple[str, ...] = tuple(BUILDERS)) -> list[SourceData]:

@@ -7,10 +7,12 @@ Launches only: the table's carries, heights and land angles are targets elsewher
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import NamedTuple, Protocol
+from typing import TYPE_CHECKING, NamedTuple, Protocol
 
-import numpy as np
 from golfflight.errors import InputError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class HasLaunch(Protocol):
@@ -26,7 +28,9 @@ class HasLaunch(Protocol):
 
 def straight_launches(clubs: Sequence[HasLaunch]) -> dict[str, np.ndarray]:
     """The canonical launch columns of each club's mean launch, straight: launch direction and spin axis 0 (the
-    tables publish neither)."""
+    tables publish neither). NumPy is imported here, not with the table: `golfflight fly --help` lists the clubs."""
+    import numpy as np
+
     n = len(clubs)
     return {
         "ball_speed_mps": np.array([c.ball_speed_mps for c in clubs], dtype=float),

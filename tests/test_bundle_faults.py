@@ -174,7 +174,7 @@ def test_the_service_reports_a_broken_bundle_on_healthz_and_flies_nothing(tmp_pa
 
 
 RUNTIME = ["service", "weights_schema", "shots", "golfflight/cli.py", "golfflight/commands/serve.py",
-           "golfflight/commands/simulate.py", "golfflight/commands/fly.py"]
+           "golfflight/commands/simulate.py", "golfflight/commands/simulate_io.py", "golfflight/commands/fly.py"]
 UNPICKLERS = {"pickle", "cPickle", "dill", "joblib", "cloudpickle", "shelve", "marshal", "torch"}
 
 

@@ -75,7 +75,7 @@ def test_one_table_answers_each_kind_for_http_and_open_connect(error, http, code
 def _main_raising(monkeypatch, error: BaseException) -> int:
     """`golfflight boom` with a command whose run raises `error`."""
 
-    def parser() -> argparse.ArgumentParser:
+    def parser(only: str | None = None) -> argparse.ArgumentParser:
         built = argparse.ArgumentParser(prog="golfflight")
         command = built.add_subparsers(dest="command", required=True).add_parser("boom")
         command.set_defaults(run=lambda args: (_ for _ in ()).throw(error))

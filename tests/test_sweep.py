@@ -163,7 +163,7 @@ def test_the_column_path_gives_fly_requests_numbers_bit_for_bit():
     object a shot, as simulate and the HTTP batch route) fly the same batch: every number equal, not just close,
     each column present exactly where the shot's flat row has it, the same errors (a ground the ball never reaches
     fails its shot alone), and the air density each flew in is the one simulate echoes."""
-    from golfflight.commands.simulate import flown_air
+    from golfflight.commands.simulate_io import flown_air
     from golfflight.contract.columns import AIR_DENSITY, cell_value, check, flat_row, request_of_cells
     from golfflight.contract.flying import fly_requests
     from golfflight.flight.bundle_location import model_dir

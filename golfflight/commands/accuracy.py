@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from golfflight.commands import COMMANDS
 from golfflight.errors import InputError
 from golfflight.flight.bundle_location import CHECKOUT_MODEL
 
@@ -16,8 +17,7 @@ DEFAULT_SYNTHETIC = CHECKOUT_MODEL.parent / "synthetic"
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "accuracy",
-        help="compare the real-data model, the synthetic model and Ferguson 2022 on the held-out real data and "
-        "write docs/accuracy.md",
+        help=COMMANDS["accuracy"].summary,
         description="Fly three models through the runtime path on the shared real data (read by path, never copied): "
         "the held-out TrackMan drivers (lines 2943 on), the TOUR Championship 2020 and the PGA 2023 averages; the "
         "paper's figures and slow shots for context; the Sentry 2022 trajectories with each shot's fitted wind; "

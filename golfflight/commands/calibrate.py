@@ -7,23 +7,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from golfflight.flight.reference_aero import CALIBRATED
-from golfflight.model_export.reference_targets import FITTED_AIR_FACTORS, calibration_cells
-from golfflight.shots.calibrate_reference import (
-    evaluate,
-    evaluate_clubs,
-    evaluate_clubs_ferguson,
-    fit_reference,
-    parameters_literal,
-    render_markdown,
-    with_air_factors,
-)
-from golfflight.shots.markdown import write_generated_section
-from golfflight.shots.paths import shared_data_dir
-from golfflight.shots.progress import progress_step
-from golfflight.shots.reference_checks import render_checks_markdown
-from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
-from golfflight.shots.source_air import PGA_2023_TABLE, UNKNOWN_AIR_SOURCES
+from golfflight.commands import COMMANDS
 
 COMMAND = "calibrate-reference"
 
@@ -31,7 +15,7 @@ COMMAND = "calibrate-reference"
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         COMMAND,
-        help="render the reference world's calibration tables (or refit it with --fit)",
+        help=COMMANDS[COMMAND].summary,
         description="Fly the calibration cells (the training split of every trainable real source in its own air, "
         "TrackMan's normalized 7-iron set and the PGA 2023 table's training clubs) through the reference world and "
         "compare with the recordings. Without --fit the committed CALIBRATED parameters and air factors are used; "
@@ -46,6 +30,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from golfflight.flight.reference_aero import CALIBRATED
+    from golfflight.model_export.reference_targets import FITTED_AIR_FACTORS, calibration_cells
+    from golfflight.shots.calibrate_reference import (
+        evaluate,
+        evaluate_clubs,
+        evaluate_clubs_ferguson,
+        fit_reference,
+        parameters_literal,
+        render_markdown,
+        with_air_factors,
+    )
+    from golfflight.shots.markdown import write_generated_section
+    from golfflight.shots.paths import shared_data_dir
+    from golfflight.shots.progress import progress_step
+    from golfflight.shots.reference_checks import render_checks_markdown
+    from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, read_tour_averages
+    from golfflight.shots.source_air import PGA_2023_TABLE, UNKNOWN_AIR_SOURCES
+
     root = args.data or shared_data_dir()
     shown = not args.quiet
     progress_step(f"reading the calibration cells under {root}...", shown)

@@ -4,20 +4,20 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import TYPE_CHECKING
 
+from golfflight.commands import COMMANDS
 from golfflight.errors import InputError
-from golfflight.shots.garmin import load_garmin
-from golfflight.shots.pbp import load_pbp
-from golfflight.shots.records import trajectories_path, write_shots, write_trajectories
-from golfflight.shots.tourcast import load_tourcast
-from golfflight.shots.trackman import Conversion, load_trackman
+
+if TYPE_CHECKING:
+    from golfflight.shots.trackman import Conversion
 
 SKIP_HELP = "leave out malformed rows (each listed in the report) instead of refusing the file"
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
-        "convert", help="convert a real export (TrackMan, TOURCAST, PGA TOUR pbp, Garmin) to canonical CSV"
+        "convert", help=COMMANDS["convert"].summary
     )
     formats = parser.add_subparsers(dest="format", required=True)
 
@@ -63,6 +63,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _write(conversion: Conversion, out: str) -> int:
+    from golfflight.shots.records import trajectories_path, write_shots, write_trajectories
+
     print(conversion.report.summary())
     if not conversion.records:
         print(f"golfflight convert: no shot kept, {out} not written", file=sys.stderr)
@@ -77,6 +79,8 @@ def _write(conversion: Conversion, out: str) -> int:
 
 
 def run_trackman(args: argparse.Namespace) -> int:
+    from golfflight.shots.trackman import load_trackman
+
     fraction = None if args.all_flights else args.min_tracked_fraction
     if fraction is not None and not 0 < fraction <= 1:
         raise InputError(f"--min-tracked-fraction must be in (0, 1], got {fraction}")
@@ -86,6 +90,8 @@ def run_trackman(args: argparse.Namespace) -> int:
 
 
 def run_tourcast(args: argparse.Namespace) -> int:
+    from golfflight.shots.tourcast import load_tourcast
+
     if args.sample_interval <= 0:
         raise InputError(f"--sample-interval must be positive, got {args.sample_interval}")
     conversion = load_tourcast(args.source, args.pbp, estimate_spin=args.estimate_spin,
@@ -94,9 +100,13 @@ def run_tourcast(args: argparse.Namespace) -> int:
 
 
 def run_pbp(args: argparse.Namespace) -> int:
+    from golfflight.shots.pbp import load_pbp
+
     return _write(load_pbp(args.source, apex=args.apex, skip_bad_rows=args.skip_bad_rows), args.out)
 
 
 def run_garmin(args: argparse.Namespace) -> int:
+    from golfflight.shots.garmin import load_garmin
+
     conversion = load_garmin(args.source, air=args.air, session=args.session, skip_bad_rows=args.skip_bad_rows)
     return _write(conversion, args.out)

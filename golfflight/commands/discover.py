@@ -6,14 +6,8 @@ import argparse
 import re
 from pathlib import Path
 
-from golfflight.discovery.diagnose import diagnose
-from golfflight.discovery.form import learn_form
-from golfflight.discovery.html import PLOTS_MISSING, plots_available
-from golfflight.discovery.model import REFERENCE, load_model
-from golfflight.discovery.outputs import write_diagnosis
-from golfflight.discovery.own_error import measure_own_error, write_own_error
-from golfflight.discovery.prove import CAMPAIGNS, CLEAN_SETS, TRUTHS, cases, command, prove, read_runs, write_tables
-from golfflight.discovery.recordings import read_recordings
+from golfflight.commands import COMMANDS
+from golfflight.discovery.choices import CAMPAIGNS, CLEAN_SETS, REFERENCE, TRUTHS
 from golfflight.errors import InputError
 from golfflight.shots.progress import print_line, progress_step
 
@@ -23,7 +17,7 @@ MIN_BASELINE_SHOTS = 30
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser("diagnose", help="locate and explain a mismatch between recordings and the model")
+    parser = subparsers.add_parser("diagnose", help=COMMANDS["diagnose"].summary)
     parser.add_argument("recordings", help="canonical shot CSV (a NAME.trajectories.csv beside it is used)")
     parser.add_argument(
         "--model",
@@ -55,7 +49,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--quiet", action="store_true", help=QUIET_HELP)
     parser.set_defaults(run=run_diagnose)
 
-    prove = subparsers.add_parser("prove", help="hide effects in synthetic recordings, diagnose them blind, score")
+    prove = subparsers.add_parser("prove", help=COMMANDS["prove"].summary)
     prove.add_argument(
         "--model", help=f"a bundle (default: the served default) or '{REFERENCE}' (the method alone)"
     )
@@ -93,7 +87,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     prove.set_defaults(run=run_prove)
 
     own = subparsers.add_parser(
-        "own-error", help="measure a reference-trained bundle's own error against its teacher, for its card"
+        "own-error", help=COMMANDS["own-error"].summary
     )
     own.add_argument("bundle", help="model bundle directory")
     own.add_argument("--shots", type=int, default=2000, help="clean calm launches to fly")
@@ -102,6 +96,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run_diagnose(args: argparse.Namespace) -> int:
+    from golfflight.discovery.diagnose import diagnose
+    from golfflight.discovery.form import learn_form
+    from golfflight.discovery.html import PLOTS_MISSING, plots_available
+    from golfflight.discovery.model import load_model
+    from golfflight.discovery.outputs import write_diagnosis
+    from golfflight.discovery.recordings import read_recordings
+
     recordings = read_recordings(args.recordings)
     if len(recordings) < 3:
         raise InputError(f"{args.recordings}: {len(recordings)} shots with an observed outcome; at least 3 are needed")
@@ -134,6 +135,9 @@ def run_diagnose(args: argparse.Namespace) -> int:
 
 
 def run_prove(args: argparse.Namespace) -> int:
+    from golfflight.discovery.model import load_model
+    from golfflight.discovery.prove import cases, command, prove, read_runs, write_tables
+
     if args.cases is not None:
         try:
             re.compile(args.cases)
@@ -168,6 +172,8 @@ def run_prove(args: argparse.Namespace) -> int:
 
 
 def run_own_error(args: argparse.Namespace) -> int:
+    from golfflight.discovery.own_error import measure_own_error, write_own_error
+
     own = measure_own_error(args.bundle, args.shots)
     print(own.model_dump_json(indent=2))
     if args.write:

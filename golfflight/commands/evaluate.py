@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import argparse
 
+from golfflight.commands import COMMANDS
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "evaluate",
-        help="Table 1 of trained runs on the validation split, with the noise floor and Figures 6-7",
+        help=COMMANDS["evaluate"].summary,
         description="Evaluate each run's best checkpoint on the file's validation shots, compute the reference "
         "world's noise floor, write the table into OUT/training.md (generated section) and the figures into "
         "OUT/figures/.",

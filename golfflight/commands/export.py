@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import argparse
 
+from golfflight.commands import COMMANDS
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser("export", help="export a trained physics variant as an ONNX model bundle")
+    parser = subparsers.add_parser("export", help=COMMANDS["export"].summary)
     parser.add_argument("--checkpoint", required=True, help="checkpoint file, or a run directory (its best.pt)")
     parser.add_argument("--out", required=True, help="bundle directory to write")
     parser.set_defaults(run=run)

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import argparse
 
+from golfflight.commands import COMMANDS
 from golfflight.commands.train import COMPILE_HELP
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "finetune",
-        help="fine-tune a model bundle or training run on your own shots and export a new bundle",
+        help=COMMANDS["finetune"].summary,
         description="Start from the trained weights, train on the file's 'train' rows (or, without a split column, "
         "all but the most recent --val-fraction of the shots), keep the epoch with the lowest validation landing "
         "error, and export it to OUT if it beats the starting model there. The training run stays in a subdirectory "

@@ -15,6 +15,7 @@ import re
 
 from pydantic import ValidationError
 
+from golfflight.commands import COMMANDS
 from golfflight.contract.figures import FIGURES, Figure
 from golfflight.errors import InputError
 from golfflight.flight.constants import MPH_TO_MPS
@@ -50,7 +51,7 @@ DECIMALS = {"m": 1, "s": 2, "deg": 1, "m/s": 1, "rpm": 0}
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "fly",
-        help="fly one shot (a club's typical launch or your own) through the served model, or the reference world",
+        help=COMMANDS["fly"].summary,
         description="One shot through the model `golfflight serve` flies (or, with --reference, the reference world); "
         "each launch value left out takes the club's tour-average launch. Values are checked against the API's "
         "ranges (flight/limits.py).",

@@ -8,11 +8,13 @@ import argparse
 import json
 from pathlib import Path
 
+from golfflight.commands import COMMANDS
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "ground-fit",
-        help="fit the fairway's bounce and roll on PGA TOUR rest positions and write docs/ground.md",
+        help=COMMANDS["ground-fit"].summary,
         description="Fly every radar tee shot that came to rest on the fairway (THE PLAYERS 2020, TOUR Championship "
         "2020 pbp files of the shared data, read in place) through the model to its rest elevation, bounce and roll "
         "it on the fairway; fit the fairway on THE PLAYERS, check on the TOUR Championship against carry plus a "

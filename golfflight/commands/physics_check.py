@@ -6,12 +6,13 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from golfflight.commands import COMMANDS
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "physics-check",
-        help="check a model's C_D, C_L and spin decay along each club's flight against the literature and write "
-        "docs/physics_checks.md",
+        help=COMMANDS["physics-check"].summary,
         description="Fly every club of shots.clubs.CLUBS through the bundle's runtime path in ICAO standard air, "
         "compare the C_D and C_L it meets with the band the measured literature points span near each (Re, S), "
         "and the spin it loses after 1, 3 and 5 s with TrackMan's measurements (the shared data's literature "

@@ -23,6 +23,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from golfflight.commands import COMMANDS
 from golfflight.errors import InputError
 
 if TYPE_CHECKING:
@@ -34,7 +35,7 @@ GRACEFUL_SHUTDOWN_S = 30
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
-        "serve", help="serve flights over HTTP (OpenAPI docs at /docs) and, with --connect-port, GSPro Open Connect"
+        "serve", help=COMMANDS["serve"].summary
     )
     parser.add_argument("--host", default="127.0.0.1", help="interface to listen on (0.0.0.0 for every one)")
     parser.add_argument("--port", type=int, default=8000)

@@ -22,6 +22,7 @@ import importlib
 import os
 import sys
 
+from golfflight.commands import COMMANDS
 from golfflight.errors import InputError
 
 EXTRAS = {"sweep": ("pyarrow", "tqdm"), "ray": ("ray.data",), "train": ("torch",)}
@@ -39,7 +40,7 @@ million); a CPU 65,536. The engine splits a batch further where the device's mem
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "sweep",
-        help="fly a file or grid of launches into a Parquet file (local, Ray or torch)",
+        help=COMMANDS["sweep"].summary,
         description="Fly every row of a launches file (CSV or Parquet, simulate's columns) or of a grid into one Parquet "
         "file, the numbers simulate gives: on local processes (ONNX Runtime), Ray Data actors, or the model rebuilt in "
         "torch (--engine torch, on --device cpu or cuda). On a Ray cluster with GPUs, --engine ray --device cuda "

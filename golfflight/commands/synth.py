@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import argparse
 
+from golfflight.commands import COMMANDS
 from golfflight.errors import InputError
 from golfflight.shots.progress import progress_step
-from golfflight.shots.synth import SynthConfig, generate, sessions_path, write_synthetic
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser("synth", help="generate synthetic sessions flown through the reference world")
+    parser = subparsers.add_parser("synth", help=COMMANDS["synth"].summary)
     parser.add_argument("--shots", type=int, default=90_000, help="number of shots to draw (before the paper's filters)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", required=True, help="canonical CSV to write (the hidden truth goes beside it)")
@@ -22,6 +22,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from golfflight.shots.synth import SynthConfig, generate, sessions_path, write_synthetic
+
     if args.shots < 1:
         raise InputError(f"--shots must be at least 1, got {args.shots}")
     config = SynthConfig(n_shots=args.shots, seed=args.seed, robot_share=args.robot_share,

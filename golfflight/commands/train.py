@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from golfflight.commands import COMMANDS
 from golfflight.model_export import DEFAULT_HIDDEN, VARIANTS
 
 COMPILE_HELP = ("fuse each Euler step's kernels, forward and backward, with torch.compile (compiled once a run, in "
@@ -24,7 +25,7 @@ def _hidden(text: str) -> tuple[int, ...]:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser("train", help="train a Phys-NN variant or a baseline on shot records")
+    parser = subparsers.add_parser("train", help=COMMANDS["train"].summary)
     parser.add_argument("--data", required=True, help="canonical shot CSV with a split column (train/val)")
     parser.add_argument("--variant", default="phys-nn+", choices=VARIANTS, help="model variant (default phys-nn+)")
     parser.add_argument("--epochs", type=int, default=50, help="total epochs (with --resume: up to this many)")

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import argparse
 
+from golfflight.commands import COMMANDS
 from golfflight.commands.train import COMPILE_HELP
+from golfflight.model_export.real_sources import DEFAULT_SOURCES, SOURCES
 from golfflight.shots.paths import shared_data_dir
 
 
@@ -18,11 +20,9 @@ def _seeds(text: str) -> tuple[int, ...]:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from golfflight.model_export.real_data import BUILDERS, DEFAULT_SOURCES
-
     parser = subparsers.add_parser(
         "train-real",
-        help="train on the real flights of the shared data (held-out sets never read), export the run with the lowest validation felt error (carry MAE + |bias| per source)",
+        help=COMMANDS["train-real"].summary,
         description="Build WORK/real_flights.csv from every usable real source (docs/training_real.md), fine-tune "
         "the --init bundle on it jointly with a wind per conditions group, an air factor per air group and a scale "
         "per ball type, once per seed, average the seeds' weights into a soup, and export the run (a seed or the "
@@ -33,7 +33,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--init", default="models/synthetic", help="bundle to start from (default models/synthetic)")
     parser.add_argument("--data-root", default=None, help="shared data folder (default ../shared/data)")
     parser.add_argument("--sources", default=",".join(DEFAULT_SOURCES),
-                        help=f"comma-separated subset of {list(BUILDERS)} (default: {','.join(DEFAULT_SOURCES)})")
+                        help=f"comma-separated subset of {list(SOURCES)} (default: {','.join(DEFAULT_SOURCES)})")
     parser.add_argument("--epochs", type=int, default=14)
     parser.add_argument("--seeds", type=_seeds, default=(0, 1, 2))
     parser.add_argument("--lr", type=float, default=1e-3, help="Adam learning rate of the network")
