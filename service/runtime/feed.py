@@ -61,6 +61,7 @@ class Entry:
     player: Player | None = None
     putt: bool = False
     club_data: dict | None = None
+    session_shot: int | None = None
     frame: str | None = None
 
     def rendered(self, frame: str) -> str:
@@ -147,7 +148,9 @@ class ShotFeed:
         """A shot flown: its request as flown, its result (trajectory and normalized flight left out: the states
         are the path) and the states it was read from; `details` are Entry's shot_number, player, putt, club_data."""
         result = result.model_copy(update={"trajectory": None, "normalized": None})
-        entry = Entry(self._next_id, source, time.time(), request, result, states, flight_time_s, **details)
+        session = self.sessions.current
+        entry = Entry(self._next_id, source, time.time(), request, result, states, flight_time_s, **details,
+                      session_shot=session.dropped + len(session.shots) + 1)
         self._next_id += 1
         self._history.append(entry)
         self.sessions.add(SessionShot(entry.id, entry.received_unix_s, source, entry.shot_number, entry.player,

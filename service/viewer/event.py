@@ -42,6 +42,8 @@ class ShotEvent(BaseModel):
     source: Source
     received_unix_s: float = Field(description="when the shot arrived, seconds since 1970 (UTC)")
     shot_number: int | None = Field(None, description="the connector's ShotNumber (GSPro Open Connect)")
+    session_shot: int | None = Field(None, ge=1, description="the shot's number in its session, from 1: what the "
+                                     "screens number it (`id` runs on across sessions)")
     launch: LaunchNumbers
     flight: ShotResult = Field(description="the flight result the client got back (a /v1/shots result), its "
                                "trajectory the states it was computed from, through the bounces and roll to rest")

@@ -49,6 +49,7 @@ def render(entry: Entry) -> str:
         source=entry.source,
         received_unix_s=entry.received_unix_s,
         shot_number=entry.shot_number,
+        session_shot=entry.session_shot,
         launch=LaunchNumbers(**launch_of(request)._asdict()),
         flight=entry.result.model_copy(update={"trajectory": trajectory, "normalized": None}),
         player=entry.player,

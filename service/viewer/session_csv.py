@@ -19,7 +19,7 @@ import time
 from collections.abc import AsyncIterator, Sequence
 from datetime import UTC, datetime
 
-from golfflight.contract.columns import PUTT, condition_cells, flat_row
+from golfflight.contract.columns import PUTT, condition_cells, flat_row, result_columns
 from golfflight.contract.inputs import launch_of
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.runtime.sessions import SessionShot
@@ -34,6 +34,13 @@ SLICE_S = 0.002
 download in progress."""
 
 LAUNCH_COLUMNS = ("ball_speed_mps", "launch_angle_deg", "launch_direction_deg", "spin_rpm", "spin_axis_deg")
+
+
+EMPTY_SESSION_COLUMNS = (*SHOT_COLUMNS, *LAUNCH_COLUMNS,
+                         *(c for c in result_columns(normalized=False, flat=False) if c != "error"))
+"""An empty session's header: the columns every shot's row has (who, its launch, its flight; 38), so that its CSV
+opens with the columns a session of shots in the default bay has (it had the first 8 only). A row adds the
+conditions it flew in and a flat flight where the ground lies off the tee's height."""
 
 
 def request_cells(request: ShotRequest) -> dict:
@@ -60,7 +67,7 @@ async def session_csv_slices(shots: Sequence[SessionShot], slice_s: float = SLIC
     `slice_s` with a turn of the event loop between two: the rows first (their columns, in the order they first
     appear, are known only once all are made), then the text."""
     rows: list[dict] = []
-    columns = dict.fromkeys(SHOT_COLUMNS)
+    columns = dict.fromkeys(SHOT_COLUMNS if shots else EMPTY_SESSION_COLUMNS)
     deadline = time.perf_counter() + slice_s
     for shot in shots:
         rows.append(_row(shot, player))

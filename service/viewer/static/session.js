@@ -114,10 +114,11 @@ function showSummary(rows, colour) {
     line.dataset.club = row.club || "";
     if (row.putts) line.dataset.putts = "1";
     const shape = row.putts ? row.rest : row.landing;
+    const flew = !row.putts;  // putts roll from the start: their total is the roll; no carry, apex or landing
     const cells = [
-      summaryClubName(row), String(row.shots), spreadText(row.carry),
-      row.carry_gap_m === undefined ? "—" : fixed(metres(row.carry_gap_m)),
-      spreadText(row.total), spreadText(row.apex), spreadText(row.lateral, true),
+      summaryClubName(row), String(row.shots), flew ? spreadText(row.carry) : "—",
+      row.carry_gap_m === undefined || row.carry_gap_m === null ? "—" : fixed(metres(row.carry_gap_m)),
+      spreadText(row.total), flew ? spreadText(row.apex) : "—", flew ? spreadText(row.lateral, true) : "—",
       shape ? `${fixed(metres(2 * shape.semi_major_m))} × ${fixed(metres(2 * shape.semi_minor_m))}` : "—",
     ];
     for (const text of cells) {
@@ -132,6 +133,10 @@ function showSummary(rows, colour) {
   const head = document.querySelectorAll("#summary th");
   for (const [index, name] of [[2, "carry"], [3, "gap"], [4, "total"], [5, "apex"], [6, "lateral"], [7, "95 % ellipse"]]) {
     head[index].textContent = `${name} (${unit})`;
+  }
+  // each cell carries its column's name: on a phone the rows stack, one club a card, each number under its name
+  for (const line of body.rows) {
+    [...line.cells].forEach((cell, index) => { cell.dataset.label = head[index].textContent; });
   }
   document.getElementById("summary").hidden = rows.length === 0;
 }

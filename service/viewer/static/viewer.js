@@ -294,6 +294,19 @@ function el(parent, name, attrs = {}, text) {
 
 function latest() { return state.shots.length ? state.shots[state.shots.length - 1] : null; }
 
+/** The newest shot that flew (a putt rolls from the start: it has no apex to read heights at), or null. */
+function latestFlight() {
+  for (let i = state.shots.length - 1; i >= 0; i--) {
+    const shot = state.shots[i];
+    if (!shot.event.putt && shot.event.flight.trajectory.length) return shot;
+  }
+  return null;
+}
+
+/** A shot's number on the screens: its number in its session (#1 for the session's first), or, from a service
+ * that does not send one, its event id. */
+function shotNumber(shot) { return shot.event.session_shot ?? shot.event.id; }
+
 /** The trajectory of a shot up to the playback time (all of it for every shot but the one playing). */
 function shown(shot) {
   const points = shot.event.flight.trajectory;
@@ -618,8 +631,8 @@ function fitBehindCamera(W, H) {
  * once it has flown) reads off them; labelled at the left edge under a caption saying how far out that plane is:
  * [{text, line_y, box}]. */
 function drawBehindHeights(svg, project, W, H, kept) {
-  const newest = latest();
-  if (!newest || !newest.event.flight.trajectory.length) return [];
+  const newest = latestFlight();
+  if (!newest) return [];
   let apex = newest.event.flight.trajectory[0], high = 0;
   for (const p of newest.event.flight.trajectory) if (p.z_m > apex.z_m) apex = p;
   for (const shot of state.shots) for (const p of shot.event.flight.trajectory) high = Math.max(high, p.z_m);
@@ -867,6 +880,7 @@ function showClubData(clubData) {
     dt.textContent = name;
     const dd = document.createElement("dd");
     dd.id = `club-${field}`;
+    dd.title = `${name}: ${value}`;  // a long value is cut with an ellipsis on the tile; the whole of it on hover
     tile.append(dt, dd);
     list.appendChild(tile);
     if (typeof value !== "number") {
@@ -887,7 +901,7 @@ function showClubData(clubData) {
 function showNumbers(shot) {
   const source = document.getElementById("last-source");
   source.textContent = shot
-    ? `#${shot.event.id} · ${SOURCES[shot.event.source]}${shot.event.shot_number ? " shot " + shot.event.shot_number : ""}`
+    ? `#${shotNumber(shot)} · ${SOURCES[shot.event.source]}${shot.event.shot_number ? " shot " + shot.event.shot_number : ""}`
       + (shot.club ? ` · ${clubName(shot.club)}` : "") + (shot.event.putt ? " putt" : "")
     : "";
   showClubData(shot ? shot.event.club_data : null);
@@ -902,14 +916,15 @@ function showNumbers(shot) {
   setNumber("n-back-spin", rpm(spin.back), "rpm");
   const [sideSpin, spinHand] = side(spin.side, 0);
   setNumber("n-side-spin", sideSpin, "rpm", spinHand);
-  setNumber("n-carry", fixed(distance(flight, "carry")), unit);
+  const flew = !shot.event.putt;  // a putt rolls from the start: no carry, apex, landing or hang time
+  setNumber("n-carry", flew ? fixed(distance(flight, "carry")) : "—", unit);
   setNumber("n-total", fixed(distance(flight, "total")), unit);
   setNumber("n-roll", fixed(distance(flight, "roll")), unit);
-  setNumber("n-apex", fixed(distance(flight, "apex")), unit);
-  setNumber("n-landing-angle", fixed(flight.landing_angle_deg), "°");
-  const [lateral, lateralHand] = side(distance(flight, "lateral"));
+  setNumber("n-apex", flew ? fixed(distance(flight, "apex")) : "—", unit);
+  setNumber("n-landing-angle", flew ? fixed(flight.landing_angle_deg) : "—", "°");
+  const [lateral, lateralHand] = flew ? side(distance(flight, "lateral")) : ["—", ""];
   setNumber("n-lateral", lateral, unit, lateralHand);
-  setNumber("n-flight-time", fixed(flight.flight_time_s), "s");
+  setNumber("n-flight-time", flew ? fixed(flight.flight_time_s) : "—", "s");
 }
 
 /** The club cell: the GSPro code (its name on hover), "putt" after a putter's, "—" for a shot without a player. */
@@ -935,11 +950,13 @@ function showTable() {
     row.dataset.shot = shot.event.id;
     row.dataset.club = shot.club;
     if (shot.event.putt) row.dataset.putt = "1";
+    const flew = !shot.event.putt;  // a putt: its roll in `total`, no carry, apex, landing or lateral at landing
     const cells = [
-      shot.event.id, SOURCES[shot.event.source], null,
+      String(shotNumber(shot)), SOURCES[shot.event.source], null,
       speedText(launch.ball_speed_mps), `${fixed(launch.launch_angle_deg)}°`, rpm(launch.spin_rpm),
-      fixed(distance(flight, "carry")), fixed(distance(flight, "total")), fixed(distance(flight, "apex")),
-      `${fixed(flight.landing_angle_deg)}°`, side(distance(flight, "lateral")).join(" ").trim(),
+      flew ? fixed(distance(flight, "carry")) : "—", fixed(distance(flight, "total")),
+      flew ? fixed(distance(flight, "apex")) : "—", flew ? `${fixed(flight.landing_angle_deg)}°` : "—",
+      flew ? side(distance(flight, "lateral")).join(" ").trim() : "—",
     ];
     for (const text of cells) {
       if (text === null) {
