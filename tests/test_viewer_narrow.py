@@ -19,7 +19,6 @@ from test_viewer_bay import PUTT_BALL, WITH_BROWSER, live_viewer
 DRIVE_BALL = {"Speed": 150.0, "VLA": 12.0, "HLA": 1.0, "TotalSpin": 2900.0, "SpinAxis": 4.0}
 LONG_TEXT = "Tour Edge Exotics C723 driver, 9.5 stiff"
 """A connector's text value of 40 characters, the most a ClubData text keeps (`contract.gspro.MAX_CLUB_TEXT`)."""
-assert len(LONG_TEXT) == 40
 
 
 def drive(number: int) -> dict:
@@ -29,8 +28,9 @@ def drive(number: int) -> dict:
 SUMMARY = """() => {
   const box = document.querySelector('.summary-box'), b = box.getBoundingClientRect();
   const shown = (e) => getComputedStyle(e).display !== 'none' && e.getBoundingClientRect().width > 0;
+  const heads = [...document.querySelectorAll('#summary th')];
   return {box: [b.left, b.right], overflow: box.scrollWidth - box.clientWidth,
-    heads: [...document.querySelectorAll('#summary th')].filter(shown).map(h => h.textContent),
+    names: heads.map(h => h.textContent), heads: heads.filter(shown).map(h => h.textContent),
     rows: [...document.querySelectorAll('#summary tbody tr')].map(r => ({club: r.dataset.club, putts: r.dataset.putts,
       cells: [...r.cells].map(c => {
         const cb = c.getBoundingClientRect();
@@ -38,8 +38,8 @@ SUMMARY = """() => {
                 px: parseFloat(getComputedStyle(c).fontSize), cut: c.scrollWidth > c.clientWidth + 1};
       })}))};
 }"""
-"""The summary's box across and whether it scrolls sideways, the headers shown, and each row's cells: text, the label
-drawn before it (a stacked row's column name), box across, font size and whether its text is cut."""
+"""The summary's box across and how far it scrolls sideways, its column names and the headers shown, and each row's
+cells: text, the label drawn before it (a stacked row's column name), box across, font size and whether it is cut."""
 
 
 def _session_rows(page, shots: int) -> None:
@@ -56,14 +56,10 @@ def _summary_is_read_whole(page, width: int) -> None:
         for index, cell in enumerate(row["cells"]):
             x0, x1 = cell["box"]
             assert left - 0.5 <= x0 and x1 <= right + 0.5 and not cell["cut"] and cell["px"] >= 10, (row, cell)
-            if width == 400 and index:  # stacked: each number under its column's name, with the unit
-                assert cell["label"].strip('"') == summary["heads"][index] if summary["heads"] else cell["label"]
-    if width == 400:
-        assert summary["heads"] == [] and all(c["label"] not in ("none", "") for r in summary["rows"]
-                                              for c in r["cells"][1:])
-        assert '"carry (yd)"' in [c["label"] for c in summary["rows"][0]["cells"]]
-    else:
-        assert len(summary["heads"]) == 8 and summary["heads"][2] == "carry (yd)"
+            if width == 400 and index:  # stacked: each figure under its column's name, with the unit
+                assert cell["label"] == f'"{summary["names"][index]}"', (row, cell)
+    assert summary["names"][2] == "carry (yd)"
+    assert summary["heads"] == ([] if width == 400 else summary["names"]) and len(summary["names"]) == 8
     putts = next(r for r in summary["rows"] if r["putts"] == "1")
     by_name = dict(zip(("club", "shots", "carry", "gap", "total", "apex", "lateral"), putts["cells"], strict=False))
     assert [by_name[k]["text"] for k in ("carry", "apex", "lateral")] == ["—"] * 3, putts
@@ -98,7 +94,7 @@ def _a_long_club_data_value_stays_in_its_tile(page, http) -> None:
               section: box(document.querySelector('section.numbers')), cut: dd.scrollWidth > dd.clientWidth,
               overflow: getComputedStyle(dd).textOverflow};
     }""")
-    assert tile["value"] == LONG_TEXT and LONG_TEXT in tile["title"]
+    assert len(LONG_TEXT) == 40 and tile["value"] == LONG_TEXT and LONG_TEXT in tile["title"]
     assert tile["tile"][0] - 0.5 <= tile["dd"][0] and tile["dd"][1] <= tile["tile"][1] + 0.5, tile
     assert tile["tile"][1] <= tile["section"][1] + 0.5, tile
     assert not tile["cut"] or tile["overflow"] == "ellipsis", tile
