@@ -102,8 +102,8 @@ def add_results_flag(parser: argparse.ArgumentParser) -> None:
     so the tracked figures (TRACKED_RESULTS) change only when a run names them on purpose."""
     parser.add_argument(
         "--results", type=Path, metavar="FILE",
-        help="merge this run's section into FILE (benchmarks/results.json: the tracked figures the docs quote); "
-        "default: print only, write nothing",
+        help=f"merge this run's section into FILE ({TRACKED_RESULTS.relative_to(REPO)}: the tracked figures the docs "
+        "quote); default: print only, write nothing",
     )
 
 
