@@ -11,6 +11,16 @@ from golfflight.contract.requests import RANGES
 from golfflight.errors import FlightError, GolfflightError, InputError, ServiceError
 from golfflight.flight.limits import Range, limit_text
 
+NOT_JSON = "the body is not JSON text in UTF-8 (or UTF-16 or UTF-32, which are read too)"
+"""The refusal of a body that cannot even be decoded (FastAPI's bare 400, said as a 422 like every other refusal)."""
+NESTED_TOO_DEEPLY = ("the body is not valid JSON: nested too deeply to read (a request nests its objects and "
+                     "lists four levels deep at most)")
+"""The refusal of a body whose nesting exhausted Python's JSON parser (about a thousand levels)."""
+
+LISTED_ERRORS = 20
+"""Most problems one 422 lists; a last entry counts the rest. A 20 KB batch of 10,000 wrong shots listed every one
+(2.8 MB, issue 55); a batch's problems are mostly one mistake repeated, and 20 entries are about 8 KB."""
+
 QUOTED_CHARS = 40
 """Most characters of a value (or a field name) a refusal quotes; a longer one is cut, "…" in place of the rest, so
 that a refusal never echoes a whole body."""
@@ -119,6 +129,19 @@ def answer_to(error: BaseException) -> Answer:
     return UNEXPECTED
 
 
+class Refused(InputError):
+    """A request refused with these 422 details (`listed_errors`), found where the request was read (the batch
+    process reads a batch's body off the event loop)."""
+
+    def __init__(self, details: list[dict]):
+        super().__init__(details[0]["message"])
+        self.details = details
+
+    def __reduce__(self):
+        """Pickled with its details (the batch process sends a refusal back to its server)."""
+        return Refused, (self.details,)
+
+
 def body_detail(message: str, kind: str) -> dict:
     """A 422/413 detail about the body as a whole (not one field), shaped like `describe_error`'s."""
     return {"loc": ["body"], "msg": message, "type": kind, "field": "body", "message": message}
@@ -137,3 +160,14 @@ def not_json(reason: str, text: str, position: int) -> str:
 def describe_errors(errors, ranges: dict[str, Range] = RANGES) -> list[dict]:
     """422 details naming the field, the value and the allowed range (see `describe_error`)."""
     return [describe_error(error, ranges) for error in errors]
+
+
+def listed_errors(errors: list[dict], ranges: dict[str, Range] = RANGES) -> list[dict]:
+    """422 details of the first LISTED_ERRORS problems (`describe_error`), then one entry, type `more_errors`, that
+    counts the rest (its `omitted`), so that a refusal stays small however many problems a body has."""
+    listed = [describe_error(error, ranges) for error in errors[:LISTED_ERRORS]]
+    omitted = len(errors) - len(listed)
+    if omitted > 0:
+        message = f"{omitted:,} more problems not listed (the first {LISTED_ERRORS} of {len(errors):,} are)"
+        listed.append({**body_detail(message, "more_errors"), "omitted": omitted})
+    return listed

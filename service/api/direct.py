@@ -8,27 +8,34 @@ FastAPI's handler answers it (`errors.failure_response`).
 Per single shot, FastAPI's request handling (body reading, a `json.loads`, the dependency solver) and the layers
 around a route (exception middleware, exit stacks, the router) cost about as much as all of the service's other
 work beside the flight (`docs/benchmarks.md`, issue 25). A route opts in by its class (`DirectRoute`);
-`DirectLanes` is the innermost of the app's middleware and serves those routes' direct requests.
+`DirectLanes` is the innermost of the app's middleware and serves those routes' direct requests. A `RawBodyRoute`
+(the batch route) hands its body over unparsed: its endpoint has it read and validated off the event loop.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
+from email.message import Message
 from typing import Any
+from urllib.parse import parse_qsl
 
 from fastapi.routing import APIRoute
+from golfflight.contract.refusals import listed_errors
 from golfflight.errors import GolfflightError
 from golfflight.service.api.errors import failure_response
 from golfflight.service.api.request_body import read_body, replay
-from pydantic import BaseModel, ValidationError
+from pydantic import BaseModel, TypeAdapter, ValidationError
 from starlette.requests import Request
-from starlette.responses import Response
+from starlette.responses import JSONResponse, Response
 
 FLAG_SPELLINGS = {b"true": True, b"false": False, b"1": True, b"0": False}
 """Spellings of a boolean query flag taken on the direct path; any other spelling goes through FastAPI's own
 reading of it (which takes more and refuses the rest with a 422)."""
 
 JSON = b"application/json"
+
+FLAG = TypeAdapter(bool)
+"""A query flag read as FastAPI reads one (lax: true/false, 1/0, yes/no, on/off, t/f, y/n, any case)."""
 
 
 class DirectRoute(APIRoute):
@@ -67,11 +74,38 @@ class DirectRoute(APIRoute):
             model = self.body_model.model_validate_json(body)
         except ValidationError:
             return None  # FastAPI reads it again and refuses it in its own words
+        return await self._answer(request, model, flags)
+
+    async def _answer(self, request: Request, model: BaseModel | None, flags: dict[str, bool]) -> Response:
         body_name, request_name = self._names
         response = await self.endpoint(**{body_name: model, request_name: request}, **flags)
         if not isinstance(response, Response):
             raise TypeError(f"{self.path}: a DirectRoute endpoint returns a Response, not {type(response)}")
         return response
+
+
+class RawBodyRoute(DirectRoute):
+    """A DirectRoute whose endpoint reads and validates the raw body itself, elsewhere (`Request.body()`: a batch,
+    in the batch process, off the event loop; issue 55). Its direct path takes every non-empty body FastAPI would
+    read as JSON, unparsed (the body model None), with its flags read as FastAPI reads them, so that FastAPI's path,
+    which parses and validates on the event loop, answers only a body refused unread (none, another content type)."""
+
+    async def direct(self, request: Request, body: bytes) -> Response | None:
+        """The endpoint's response to any JSON body; a 422 for a flag FastAPI would refuse; None (FastAPI's path)
+        for no body or a body FastAPI would not read as JSON."""
+        if not body or not _read_as_json(request.headers.get("content-type")):
+            return None
+        flags = {name: default for name, default in self._flags.values()}
+        problems = []
+        for key, value in parse_qsl(request.scope["query_string"].decode("latin-1"), keep_blank_values=True):
+            if key.encode() in self._flags:
+                try:
+                    flags[self._flags[key.encode()][0]] = FLAG.validate_python(value)
+                except ValidationError as error:
+                    problems += [{**problem, "loc": ("query", key)} for problem in error.errors(include_url=False)]
+        if problems:
+            return JSONResponse({"detail": listed_errors(problems)}, 422)
+        return await self._answer(request, None, flags)
 
 
 class DirectLanes:
@@ -98,6 +132,17 @@ class DirectLanes:
             await response(scope, receive, send)
             return
         await self.app(scope, replay(messages, receive), send)
+
+
+def _read_as_json(content_type: str | None) -> bool:
+    """Whether FastAPI reads a body sent with this content type as JSON: application/json or application/*+json,
+    with any parameters."""
+    if not content_type:
+        return False
+    message = Message()
+    message["content-type"] = content_type
+    subtype = message.get_content_subtype()
+    return message.get_content_maintype() == "application" and (subtype == "json" or subtype.endswith("+json"))
 
 
 def _content_type(headers: list[tuple[bytes, bytes]]) -> bytes | None:

@@ -2,7 +2,8 @@
 in Open Connect's own form (Code 500, a Message); a body that is not valid JSON is refused saying where and what the
 decoder expected (FastAPI's own detail is its character position as the field: `"1: JSON decode error"`); a body
 sent without a JSON content type gets 415 saying so (FastAPI hands a model the raw bytes then, which read as "Input
-should be a valid dictionary"); a route called before the model is ready gets 503."""
+should be a valid dictionary"); a route called before the model is ready gets 503. A 422 lists at most
+`contract.refusals.LISTED_ERRORS` problems and counts the rest."""
 
 from __future__ import annotations
 
@@ -11,17 +12,20 @@ from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
 from golfflight.contract.gspro import GSProReply, invalid_message, shot_number_of
-from golfflight.contract.refusals import answer_to, body_detail, describe_errors, not_json
+from golfflight.contract.refusals import (
+    NESTED_TOO_DEEPLY,
+    NOT_JSON,
+    Refused,
+    answer_to,
+    body_detail,
+    listed_errors,
+    not_json,
+)
 from golfflight.contract.requests import RANGES
 from golfflight.errors import GolfflightError
 from golfflight.service.api.paths import GSPRO_PATH
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-NOT_JSON = "the body is not JSON text in UTF-8 (or UTF-16 or UTF-32, which are read too)"
-"""FastAPI's 400 for a body it cannot even decode, said as a 422 like every other refusal of a body."""
-NESTED_TOO_DEEPLY = ("the body is not valid JSON: nested too deeply to read (a request nests its objects and "
-                     "lists four levels deep at most)")
-"""FastAPI's 400 for a body whose nesting exhausted Python's JSON parser (about a thousand levels)."""
 JSON_CONTENT_TYPE = "the body must be JSON: send content-type: application/json"
 """The refusal (415) of a body sent without a JSON content type, followed by what was sent."""
 
@@ -61,7 +65,7 @@ async def invalid_request(request: Request, error: RequestValidationError) -> JS
         return JSONResponse({"detail": [body_detail(unread, "content_type")]}, 415)
     if broken:
         return JSONResponse({"detail": [body_detail(broken, "json_invalid")]}, 422)
-    return JSONResponse({"detail": describe_errors(error.errors(), RANGES)}, 422)
+    return JSONResponse({"detail": listed_errors(error.errors(), RANGES)}, 422)
 
 
 async def http_error(request: Request, error: StarletteHTTPException) -> Response:
@@ -81,6 +85,8 @@ def failure_response(path: str, error: GolfflightError) -> JSONResponse:
         return _gspro_error(str(error), answer.http_status, code=answer.open_connect_code)
     if answer.http_status >= 500:
         return JSONResponse({"detail": str(error)}, answer.http_status)
+    if isinstance(error, Refused):
+        return JSONResponse({"detail": error.details}, answer.http_status)
     return JSONResponse({"detail": [body_detail(str(error), answer.kind)]}, answer.http_status)
 
 

@@ -1,17 +1,21 @@
 """What the batch child process of each server process runs (`service.runtime.batch_process` starts and feeds it):
-load the bundle at a lower CPU priority, then fly each validated batch request body it is sent and encode its
-result; end as soon as its server has gone. It imports the shot contract and the engine only, never the HTTP
-package."""
+load the bundle at a lower CPU priority, then read, validate and fly each raw batch request body it is sent and
+encode its result, or its refusal (off the server's event loop: issue 55); end as soon as its server has gone. It
+imports the shot contract and the engine only, never the HTTP package."""
 
 from __future__ import annotations
 
-import json
 import os
 import signal
 import time
 
+from typing import NamedTuple
+
+from golfflight.contract.batch_body import read_batch
+from golfflight.contract.bay import BayConditions, in_bay
 from golfflight.contract.flying import fly_requests
-from golfflight.contract.requests import BatchRequest
+from golfflight.contract.refusals import Refused
+from golfflight.contract.requests import ShotRequest
 from golfflight.contract.results import BatchResult, ShotResult
 from golfflight.flight.engine import EulerStates, FlightEngine
 from golfflight.service.runtime.parent_watch import exit_with_parent
@@ -20,8 +24,19 @@ BATCH_NICE = 19
 """How much lower the batch process's CPU priority is (Linux nice increment): a single shot waiting for a core
 gets it first, a batch still gets the cores nobody else wants."""
 
-Shown = dict[int, tuple[ShotResult, EulerStates, float]]
-"""The shots of a batch its screens show, by index: result, the states it was read from, and its landing time."""
+Shown = dict[int, tuple[ShotRequest, ShotResult, EulerStates, float]]
+"""The shots of a batch its screens show, by index: the shot as flown (the bay's conditions filled in), its result,
+the states it was read from, and its landing time."""
+
+
+class Flown(NamedTuple):
+    """A batch flown: the JSON response body, the seconds its simulation took, its number of shots, and the shots
+    its screens show (`Shown`)."""
+
+    body: bytes
+    seconds: float
+    shots: int
+    shown: Shown
 
 _engine: FlightEngine | None = None
 
@@ -44,22 +59,19 @@ def ready() -> tuple[str, int]:
     return _engine.sha256, os.getpid()
 
 
-def parse_batch(body: bytes) -> BatchRequest:
-    """A batch body as the HTTP app read it: pydantic's own JSON reader first, then Python's, which also takes a
-    UTF-8 byte order mark, UTF-16 and UTF-32 as the app's does: the child accepts exactly what the app accepted."""
-    try:
-        return BatchRequest.model_validate_json(body)
-    except ValueError:
-        return BatchRequest.model_validate(json.loads(body))
-
-
-def fly_and_encode(body: bytes, shown: int = 0) -> tuple[bytes, float, Shown]:
-    """The JSON response body for a valid batch request body, the seconds its simulation took, and the last
-    `shown` shots that flew with the states they were read from (for the bay's screens)."""
+def fly_and_encode(body: bytes, shown: int = 0, bay: BayConditions | None = None) -> Flown | Refused:
+    """A raw batch request body flown (`Flown`), the `bay`'s conditions filled in where a shot gives none, the last
+    `shown` shots kept with their states; or its refusal, the 422 details the HTTP app would give (`read_batch`),
+    returned rather than raised so that it crosses back to the server whole."""
     assert _engine is not None
-    shots = parse_batch(body).shots
+    try:
+        shots = read_batch(body).shots
+    except Refused as refused:
+        return refused
+    if bay is not None:
+        shots = [in_bay(shot, bay) for shot in shots]
     started = time.perf_counter()
     results, flights = fly_requests(_engine, shots, shown)
     seconds = time.perf_counter() - started
-    kept = {i: (results[i], flight.states, flight.flight_time_s) for i, flight in flights.items()}
-    return BatchResult(results=results).model_dump_json(exclude_none=True).encode(), seconds, kept
+    kept = {i: (shots[i], results[i], flight.states, flight.flight_time_s) for i, flight in flights.items()}
+    return Flown(BatchResult(results=results).model_dump_json(exclude_none=True).encode(), seconds, len(shots), kept)

@@ -3,9 +3,10 @@
 With batches on a thread, a batch of 100 shared the GIL and the cores with the event loop, and single shots queued
 behind it: p99 65 ms against 9.4 ms without batches (docs/reliability.md). A child process has its own GIL, and its
 nice value lets the kernel run a waiting single shot first. The child (`service.runtime.batch_child`, no HTTP code)
-loads and verifies the bundle itself. It gets the request body the server has already validated and parses it
-again: bytes cross the process boundary for free, while pickling 100 parsed shots held the server's GIL for over a
-millisecond. Only the few shots a screen shows come back as objects, with their states.
+loads and verifies the bundle itself. It gets the raw request body and reads and validates it itself: bytes cross
+the process boundary for free, while pickling 100 parsed shots held the server's GIL for over a millisecond, and
+validating 10,000 invalid shots on the server's event loop held every other client for hundreds of milliseconds
+(issue 55). Only the few shots a screen shows come back as objects, with their states, or a refusal's details.
 
 A child that dies (killed, out of memory) is replaced at once, not at the next batch: a watcher thread waits on
 the child's process, starts another and loads the model in it while single shots keep flying, and `problem` says
@@ -25,6 +26,8 @@ from multiprocessing.connection import wait
 from multiprocessing.process import BaseProcess
 from pathlib import Path
 
+from golfflight.contract.bay import BayConditions
+from golfflight.contract.refusals import Refused
 from golfflight.errors import ServiceError
 from golfflight.service.runtime import batch_child
 
@@ -76,17 +79,19 @@ class BatchProcess:
         """GET /healthz's figures: how many times the child died and was restarted since the server started."""
         return {"restarts": self.restarts}
 
-    async def submit(self, body: bytes, shown: int = 0) -> tuple[bytes, float, batch_child.Shown]:
-        """The encoded BatchResult of a validated BatchRequest body, the simulation seconds, and the last `shown`
-        shots with their states (`batch_child.fly_and_encode`). A child found dead before the watcher has
-        replaced it is replaced before the batch is sent; one that dies under this batch is replaced for the next
-        and this one raises BatchProcessDied."""
+    async def submit(
+        self, body: bytes, shown: int = 0, bay: BayConditions | None = None
+    ) -> batch_child.Flown | Refused:
+        """A raw batch request body flown in the child (`batch_child.fly_and_encode`: the `bay`'s conditions filled
+        in, the last `shown` shots kept), or its refusal. A child found dead before the watcher has replaced it is
+        replaced before the batch is sent; one that dies under this batch is replaced for the next and this one
+        raises BatchProcessDied."""
         pool = self._pool
         try:
-            future = pool.submit(batch_child.fly_and_encode, body, shown)
+            future = pool.submit(batch_child.fly_and_encode, body, shown, bay)
         except BrokenProcessPool:
             pool = self._replace(pool)
-            future = pool.submit(batch_child.fly_and_encode, body, shown)
+            future = pool.submit(batch_child.fly_and_encode, body, shown, bay)
         try:
             return await asyncio.wrap_future(future)
         except BrokenProcessPool:

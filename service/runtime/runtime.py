@@ -19,7 +19,8 @@ from typing import Callable, Literal
 from golfflight.contract.bay import CONDITION_FIELDS, PUTTER, BayConditions, Player, in_bay
 from golfflight.contract.flying import fly_request
 from golfflight.contract.gspro import GSProMessage, GSProReply, failed_reply, shot_reply, shot_request
-from golfflight.contract.requests import BatchRequest, ShotRequest
+from golfflight.contract.refusals import Refused
+from golfflight.contract.requests import ShotRequest
 from golfflight.contract.results import ShotResult
 from golfflight.contract.session import SessionList, SessionSummary
 from golfflight.errors import GolfflightError, ServiceError
@@ -165,23 +166,22 @@ class BayRuntime:
             return failed_reply(message, error)
         return shot_reply(message, flown.result)
 
-    async def fly_batch(self, request: BatchRequest, body: bytes, show: bool) -> bytes:
-        """A validated batch's encoded BatchResult, flown in the batch process (the bay's conditions filled in
-        where a shot gives none); with `show`, its last shots go to the screens with the states they came from.
-        BatchProcessDied when the batch process died under it."""
+    async def fly_batch(self, body: bytes, show: bool) -> bytes:
+        """A raw batch request body's encoded BatchResult, read, validated and flown in the batch process (the bay's
+        conditions filled in where a shot gives none); with `show`, its last shots go to the screens with the states
+        they came from. Refused with its 422 details when the body is invalid; BatchProcessDied when the batch
+        process died under it."""
         self._ready_engine()
         bay = self._bay.conditions
-        if any(getattr(bay, name) is not None for name in CONDITION_FIELDS):
-            request = BatchRequest.model_construct(shots=[in_bay(shot, bay) for shot in request.shots])
-            body = request.model_dump_json(exclude_none=True).encode()
-        shown = self._feed.history if show else 0
-        encoded, seconds, kept = await self._batches.submit(body, shown)
-        self._record_simulation("batch", seconds)
-        self._metrics.batch_shots.observe(len(request.shots))
-        for index, (result, states, flight_time_s) in sorted(kept.items()):
-            self._feed.publish("batch", request.shots[index], result, states, flight_time_s)
-        return encoded
-
+        filled = bay if any(getattr(bay, name) is not None for name in CONDITION_FIELDS) else None
+        answer = await self._batches.submit(body, self._feed.history if show else 0, filled)
+        if isinstance(answer, Refused):
+            raise answer
+        self._record_simulation("batch", answer.seconds)
+        self._metrics.batch_shots.observe(answer.shots)
+        for _, (shot, result, states, flight_time_s) in sorted(answer.shown.items()):
+            self._feed.publish("batch", shot, result, states, flight_time_s)
+        return answer.body
 
     def latency(self) -> dict:
         """GET /v1/latency: the rolling p50/p95/p99 of simulation time and of whole requests, and PROBE_SHOT flown

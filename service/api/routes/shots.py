@@ -1,5 +1,6 @@
 """POST /v1/shots (inline: one shot takes well under a millisecond, less than a hop to a thread would cost) and
-POST /v1/shots/batch (in the batch process, at a lower CPU priority: `service.runtime.batch_process`). A shot without
+POST /v1/shots/batch (read, validated and flown in the batch process, at a lower CPU priority, off the event loop:
+`service.runtime.batch_process`). A shot without
 air, wind or ground of its own flies in the bay's (`service.runtime.bay`)."""
 
 from __future__ import annotations
@@ -8,7 +9,7 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import Response
 from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, BatchRequest, ShotRequest
 from golfflight.contract.results import BatchResult, ShotResult
-from golfflight.service.api.direct import DirectRoute
+from golfflight.service.api.direct import DirectRoute, RawBodyRoute
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
 from golfflight.service.runtime import runtime_of
 
@@ -34,8 +35,18 @@ async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer)
     return json_response(runtime_of(http).fly(request, "http", show=viewer).result)
 
 
-@router.post(
+async def batch(request: BatchRequest, http: Request, viewer: bool = ShowOnViewer) -> Response:
+    """The batch process reads, validates and flies the raw body (the bay's conditions filled in where a shot gives
+    none) or refuses it; `request` gives FastAPI the schema and is None on the direct path (`RawBodyRoute`)."""
+    body = await runtime_of(http).fly_batch(await http.body(), show=viewer)
+    return Response(body, media_type="application/json")
+
+
+router.add_api_route(
     "/batch",
+    batch,
+    methods=["POST"],
+    route_class_override=RawBodyRoute,
     response_model=BatchResult,
     response_model_exclude_none=True,
     responses=ERROR_RESPONSES,
@@ -43,8 +54,3 @@ async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer)
     f"{MAX_BATCH_TRAJECTORIES} of them with a trajectory); results come back in order and a shot that cannot "
     "land gets an error entry of its own.",
 )
-async def batch(request: BatchRequest, http: Request, viewer: bool = ShowOnViewer) -> Response:
-    """`request` is valid (a 422 otherwise); the batch process flies its raw body, or the shots with the bay's
-    conditions filled in when the bay has any."""
-    body = await runtime_of(http).fly_batch(request, await http.body(), show=viewer)
-    return Response(body, media_type="application/json")
