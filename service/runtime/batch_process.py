@@ -8,6 +8,9 @@ the process boundary for free, while pickling 100 parsed shots held the server's
 validating 10,000 invalid shots on the server's event loop held every other client for hundreds of milliseconds
 (issue 55). Only the few shots a screen shows come back as objects, with their states, or a refusal's details.
 
+Batches go to the child one at a time, the rest waiting here: a child that dies fails only the batch it was flying,
+and the batches queued behind it go to its replacement (with several in the pool, a dead child failed them all).
+
 A child that dies (killed, out of memory) is replaced at once, not at the next batch: a watcher thread waits on
 the child's process, starts another and loads the model in it while single shots keep flying, and `problem` says
 so until it is ready (GET /healthz: "degraded"). The child ends by itself when its server dies
@@ -56,6 +59,7 @@ class BatchProcess:
         self._sha256: str | None = None
         self._stopping = False
         self._lock = threading.Lock()
+        self._one_at_a_time = asyncio.Lock()
         self._pool = self._new_pool()
 
     def _new_pool(self) -> ProcessPoolExecutor:
@@ -83,20 +87,21 @@ class BatchProcess:
         self, body: bytes, shown: int = 0, bay: BayConditions | None = None
     ) -> batch_child.Flown | Refused:
         """A raw batch request body flown in the child (`batch_child.fly_and_encode`: the `bay`'s conditions filled
-        in, the last `shown` shots kept), or its refusal. A child found dead before the watcher has replaced it is
-        replaced before the batch is sent; one that dies under this batch is replaced for the next and this one
-        raises BatchProcessDied."""
-        pool = self._pool
-        try:
-            future = pool.submit(batch_child.fly_and_encode, body, shown, bay)
-        except BrokenProcessPool:
-            pool = self._replace(pool)
-            future = pool.submit(batch_child.fly_and_encode, body, shown, bay)
-        try:
-            return await asyncio.wrap_future(future)
-        except BrokenProcessPool:
-            self._replace(pool)
-            raise BatchProcessDied(BATCH_PROCESS_DIED) from None
+        in, the last `shown` shots kept), or its refusal, once the batches sent before it are done. A child found
+        dead before the watcher has replaced it is replaced before the batch is sent; one that dies under this batch
+        is replaced for the batches waiting behind it, and this one raises BatchProcessDied."""
+        async with self._one_at_a_time:
+            pool = self._pool
+            try:
+                future = pool.submit(batch_child.fly_and_encode, body, shown, bay)
+            except BrokenProcessPool:
+                pool = self._replace(pool)
+                future = pool.submit(batch_child.fly_and_encode, body, shown, bay)
+            try:
+                return await asyncio.wrap_future(future)
+            except BrokenProcessPool:
+                self._replace(pool)
+                raise BatchProcessDied(BATCH_PROCESS_DIED) from None
 
     def _keep_alive(self, pool: ProcessPoolExecutor, process: BaseProcess | None) -> None:
         """Thread: each time the child dies while the server runs, start another at once and load the model in
