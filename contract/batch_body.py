@@ -8,7 +8,7 @@ import json
 from golfflight.contract.refusals import (
     NESTED_TOO_DEEPLY,
     NOT_JSON,
-    Refused,
+    RequestRefused,
     body_detail,
     listed_errors,
     not_json,
@@ -18,7 +18,7 @@ from pydantic import ValidationError
 
 
 def read_batch(body: bytes) -> BatchRequest:
-    """The BatchRequest a non-empty body holds; Refused with the 422 details FastAPI's path gives the same body
+    """The BatchRequest a non-empty body holds; RequestRefused with the 422 details FastAPI's path gives the same body
     (`json.loads`, then the model, each problem's `loc` starting with "body", at most LISTED_ERRORS listed).
     pydantic's own JSON reader goes first: it is the fast path for a valid body."""
     try:
@@ -28,13 +28,13 @@ def read_batch(body: bytes) -> BatchRequest:
     try:
         data = json.loads(body)
     except json.JSONDecodeError as error:
-        raise Refused([body_detail(not_json(error.msg, error.doc, error.pos), "json_invalid")]) from None
+        raise RequestRefused([body_detail(not_json(error.msg, error.doc, error.pos), "json_invalid")]) from None
     except RecursionError:
-        raise Refused([body_detail(NESTED_TOO_DEEPLY, "json_invalid")]) from None
+        raise RequestRefused([body_detail(NESTED_TOO_DEEPLY, "json_invalid")]) from None
     except ValueError:  # not UTF-8, UTF-16 or UTF-32 text
-        raise Refused([body_detail(NOT_JSON, "json_invalid")]) from None
+        raise RequestRefused([body_detail(NOT_JSON, "json_invalid")]) from None
     try:
         return BatchRequest.model_validate(data)
     except ValidationError as error:
         problems = [{**problem, "loc": ("body", *problem["loc"])} for problem in error.errors(include_url=False)]
-        raise Refused(listed_errors(problems)) from None
+        raise RequestRefused(listed_errors(problems)) from None

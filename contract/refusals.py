@@ -129,7 +129,7 @@ def answer_to(error: BaseException) -> Answer:
     return UNEXPECTED
 
 
-class Refused(InputError):
+class RequestRefused(InputError):
     """A request refused with these 422 details (`listed_errors`), found where the request was read (the batch
     process reads a batch's body off the event loop)."""
 
@@ -139,7 +139,7 @@ class Refused(InputError):
 
     def __reduce__(self):
         """Pickled with its details (the batch process sends a refusal back to its server)."""
-        return Refused, (self.details,)
+        return RequestRefused, (self.details,)
 
 
 def body_detail(message: str, kind: str) -> dict:

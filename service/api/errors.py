@@ -15,7 +15,7 @@ from golfflight.contract.gspro import GSProReply, invalid_message, shot_number_o
 from golfflight.contract.refusals import (
     NESTED_TOO_DEEPLY,
     NOT_JSON,
-    Refused,
+    RequestRefused,
     answer_to,
     body_detail,
     listed_errors,
@@ -85,7 +85,7 @@ def failure_response(path: str, error: GolfflightError) -> JSONResponse:
         return _gspro_error(str(error), answer.http_status, code=answer.open_connect_code)
     if answer.http_status >= 500:
         return JSONResponse({"detail": str(error)}, answer.http_status)
-    if isinstance(error, Refused):
+    if isinstance(error, RequestRefused):
         return JSONResponse({"detail": error.details}, answer.http_status)
     return JSONResponse({"detail": [body_detail(str(error), answer.kind)]}, answer.http_status)
 

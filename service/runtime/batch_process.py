@@ -30,7 +30,7 @@ from multiprocessing.process import BaseProcess
 from pathlib import Path
 
 from golfflight.contract.bay import BayConditions
-from golfflight.contract.refusals import Refused
+from golfflight.contract.refusals import RequestRefused
 from golfflight.errors import ServiceError
 from golfflight.service.runtime import batch_child
 
@@ -85,16 +85,16 @@ class BatchProcess:
 
     async def submit(
         self, body: bytes, shown: int = 0, bay: BayConditions | None = None
-    ) -> batch_child.Flown | Refused:
+    ) -> batch_child.FlownBatch | RequestRefused:
         """A raw batch request body flown in the child (`batch_child.fly_and_encode`: the `bay`'s conditions filled
         in, the last `shown` shots kept), or its refusal, once the batches sent before it are done. A child found
-        dead before the watcher has replaced it is replaced before the batch is sent; one that dies under this batch
-        is replaced for the batches waiting behind it, and this one raises BatchProcessDied."""
+        dead (or its pool just replaced by the watcher) before the batch is sent is replaced first; one that dies
+        under this batch is replaced for the batches waiting behind it, and this one raises BatchProcessDied."""
         async with self._one_at_a_time:
             pool = self._pool
             try:
                 future = pool.submit(batch_child.fly_and_encode, body, shown, bay)
-            except BrokenProcessPool:
+            except (BrokenProcessPool, RuntimeError):  # RuntimeError: the watcher has just shut it down, replaced
                 pool = self._replace(pool)
                 future = pool.submit(batch_child.fly_and_encode, body, shown, bay)
             try:

@@ -19,7 +19,7 @@ from typing import Callable, Literal
 from golfflight.contract.bay import CONDITION_FIELDS, PUTTER, BayConditions, Player, in_bay
 from golfflight.contract.flying import fly_request
 from golfflight.contract.gspro import GSProMessage, GSProReply, failed_reply, shot_reply, shot_request
-from golfflight.contract.refusals import Refused
+from golfflight.contract.refusals import RequestRefused
 from golfflight.contract.requests import ShotRequest
 from golfflight.contract.results import ShotResult
 from golfflight.contract.session import SessionList, SessionSummary
@@ -169,13 +169,13 @@ class BayRuntime:
     async def fly_batch(self, body: bytes, show: bool) -> bytes:
         """A raw batch request body's encoded BatchResult, read, validated and flown in the batch process (the bay's
         conditions filled in where a shot gives none); with `show`, its last shots go to the screens with the states
-        they came from. Refused with its 422 details when the body is invalid; BatchProcessDied when the batch
-        process died under it."""
+        they came from. RequestRefused with its 422 details when the body is invalid or asks for too many trajectory
+        points; BatchProcessDied when the batch process died under it."""
         self._ready_engine()
         bay = self._bay.conditions
         filled = bay if any(getattr(bay, name) is not None for name in CONDITION_FIELDS) else None
         answer = await self._batches.submit(body, self._feed.history if show else 0, filled)
-        if isinstance(answer, Refused):
+        if isinstance(answer, RequestRefused):
             raise answer
         self._record_simulation("batch", answer.seconds)
         self._metrics.batch_shots.observe(answer.shots)
