@@ -19,6 +19,7 @@ from golfflight.contract.results import (
     TrajectoryPoint,
 )
 from golfflight.contract.trajectory import resample
+from golfflight.contract.trajectory_size import refuse_long_trajectories
 from golfflight.errors import FlightError
 from golfflight.flight.conditions import Conditions
 from golfflight.flight.engine import BatchFlights, FlightEngine, Launch, ShotFlight
@@ -97,6 +98,8 @@ def fly_request(
     if reference is not None:
         normalized = engine.fly(launch, Conditions(air_of(reference), CALM), shot.trajectory is not None, ground)
     flat_flight = engine.fly(launch, conditions_of(shot)) if flat and lands_off_the_flat(shot) else None
+    if shot.trajectory is not None:
+        refuse_long_trajectories([(shot.trajectory, own.states) for own in (flight, normalized) if own is not None])
     return result_of(shot, flight, normalized, flat_flight), flight
 
 
@@ -139,6 +142,10 @@ def _fly_group(
     replays, flats = batch.replays.tolist(), batch.flats.tolist()
     replayed = dict(zip(replays, flights[len(shots) : len(shots) + len(replays)], strict=True))
     flat = dict(zip(flats, flights[len(shots) + len(replays) :], strict=True))
+    refuse_long_trajectories([
+        (shot.trajectory, own.states) for i, shot in enumerate(shots) if shot.trajectory is not None
+        for own in (flights[i], replayed.get(i)) if isinstance(own, ShotFlight)
+    ])
     results: list[ShotResult | ShotFailure] = []
     for i, shot in enumerate(shots):
         own = (flights[i], replayed.get(i), flat.get(i))

@@ -14,7 +14,7 @@ from typing import NamedTuple
 from golfflight.contract.batch_body import read_batch
 from golfflight.contract.bay import BayConditions, in_bay
 from golfflight.contract.flying import fly_requests
-from golfflight.contract.refusals import Refused
+from golfflight.contract.refusals import RequestRefused
 from golfflight.contract.requests import ShotRequest
 from golfflight.contract.results import BatchResult, ShotResult
 from golfflight.flight.engine import EulerStates, FlightEngine
@@ -29,7 +29,7 @@ Shown = dict[int, tuple[ShotRequest, ShotResult, EulerStates, float]]
 the states it was read from, and its landing time."""
 
 
-class Flown(NamedTuple):
+class FlownBatch(NamedTuple):
     """A batch flown: the JSON response body, the seconds its simulation took, its number of shots, and the shots
     its screens show (`Shown`)."""
 
@@ -59,19 +59,20 @@ def ready() -> tuple[str, int]:
     return _engine.sha256, os.getpid()
 
 
-def fly_and_encode(body: bytes, shown: int = 0, bay: BayConditions | None = None) -> Flown | Refused:
-    """A raw batch request body flown (`Flown`), the `bay`'s conditions filled in where a shot gives none, the last
-    `shown` shots kept with their states; or its refusal, the 422 details the HTTP app would give (`read_batch`),
-    returned rather than raised so that it crosses back to the server whole."""
+def fly_and_encode(body: bytes, shown: int = 0, bay: BayConditions | None = None) -> FlownBatch | RequestRefused:
+    """A raw batch request body flown (`FlownBatch`), the `bay`'s conditions filled in where a shot gives none, the
+    last `shown` shots kept with their states; or its refusal, the 422 details the HTTP app would give (`read_batch`,
+    `contract.trajectory_size`), returned rather than raised so that it crosses back to the server whole."""
     assert _engine is not None
     try:
         shots = read_batch(body).shots
-    except Refused as refused:
+        if bay is not None:
+            shots = [in_bay(shot, bay) for shot in shots]
+        started = time.perf_counter()
+        results, flights = fly_requests(_engine, shots, shown)
+    except RequestRefused as refused:  # the body, or the trajectory points it asks for (`contract.trajectory_size`)
         return refused
-    if bay is not None:
-        shots = [in_bay(shot, bay) for shot in shots]
-    started = time.perf_counter()
-    results, flights = fly_requests(_engine, shots, shown)
     seconds = time.perf_counter() - started
     kept = {i: (shots[i], results[i], flight.states, flight.flight_time_s) for i, flight in flights.items()}
-    return Flown(BatchResult(results=results).model_dump_json(exclude_none=True).encode(), seconds, len(shots), kept)
+    encoded = BatchResult(results=results).model_dump_json(exclude_none=True).encode()
+    return FlownBatch(encoded, seconds, len(shots), kept)
