@@ -3,8 +3,11 @@
 Starts `golfflight serve --workers 1` on a free loopback port, as the container does, and measures with psutil the
 server process and its batch child (which flies batches at a lower priority): resident memory (RSS) after startup,
 after a warm-up of single shots and batches and a burst of the largest batches, and the peak sampled every 20 ms
-throughout; CPU seconds per single shot and per batched shot, each over its own phase. Prints JSON (docs/service.md,
-"On Kubernetes", quotes it). Run it with the Python of a runtime-only install (`pip install .` and psutil in a fresh
+throughout; CPU seconds per single shot and per batched shot, each over its own phase. Then the worst request the
+API accepts, for memory (`worst_batch`: 10,000 shots, each with its own air and wind, a normalized replay and a
+flat flight, the last 100 with trajectories that come to just under MAX_TRAJECTORY_SAMPLES points, shown on the
+viewer), BURST of them at once beside single shots at 1 kHz, with its own peak (issue 55, item 4). Prints JSON
+(docs/service.md, "On Kubernetes", and docs/reliability.md quote it). Run it with the Python of a runtime-only install (`pip install .` and psutil in a fresh
 virtual environment) from outside the checkout, so that what is measured is what the serving image runs.
 
     python3 scripts/serving_footprint.py [--shots 500] [--batches 10] [--batch-size 1000]
@@ -24,7 +27,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import httpx
 import psutil
-from golfflight.contract.requests import MAX_BATCH_TRAJECTORIES
+from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES
+from golfflight.contract.trajectory_size import MAX_TRAJECTORY_SAMPLES
 
 SHOT = {"ball_speed_mph": 171.0, "launch_angle_deg": 10.4, "back_spin_rpm": 2545.0, "side_spin_rpm": -300.0}
 LARGEST_BATCH = 10_000
@@ -71,6 +75,68 @@ class PeakSampler(threading.Thread):
             self.peak = {role: max(self.peak[role], now[role]) for role in self.peak}
 
 
+FULL_SHOT = SHOT | {
+    "normalized": True,
+    "air": {"temperature_c": 31.5, "altitude_m": 1600.0, "humidity_pct": 40.0},
+    "wind": {"speed_mps": 6.5, "from_deg": 210.0, "profile": "log"},
+    "ground": {"surface": "fairway", "elevation_m": -4.5, "slope_deg": 2.0, "slope_dir_deg": 45.0},
+}
+"""A shot that asks for everything a flight can cost: its own air and wind, a normalized replay, a flat flight."""
+
+
+def worst_batch(http: httpx.Client) -> dict:
+    """The batch the API accepts that costs the most memory: MAX_BATCH_SHOTS FULL_SHOTs, the last
+    MAX_BATCH_TRAJECTORIES with a trajectory at the highest rate whose points (both flights of each) stay within
+    MAX_TRAJECTORY_SAMPLES, found from the points those shots get at 1 Hz (about one a second of flight and roll)."""
+    traced = [FULL_SHOT | {"trajectory": {"rate_hz": 1}}] * MAX_BATCH_TRAJECTORIES
+    answer = http.post("/v1/shots/batch", json={"shots": traced})
+    answer.raise_for_status()
+    flights = [r for result in answer.json()["results"] for r in (result, result["normalized"])]
+    seconds = sum(flight["trajectory"][-1]["t_s"] for flight in flights)
+    rate = min(1000, int((MAX_TRAJECTORY_SAMPLES - 3 * len(flights)) / seconds))
+    plain = [FULL_SHOT] * (MAX_BATCH_SHOTS - MAX_BATCH_TRAJECTORIES)
+    return {"shots": plain + [FULL_SHOT | {"trajectory": {"rate_hz": rate}}] * MAX_BATCH_TRAJECTORIES}
+
+
+def worst_burst(http: httpx.Client, processes: dict[str, psutil.Process]) -> dict:
+    """BURST worst batches at once (shown on the viewer) beside BURST single shots at 1 kHz with a normalized
+    replay: the peak RSS while they are answered, and what was sent."""
+    batch = worst_batch(http)
+    body = json.dumps(batch).encode()  # under the 8 MiB body limit: a 413 otherwise, and the run stops
+    single = FULL_SHOT | {"trajectory": {"rate_hz": 1000}}
+    sampler = PeakSampler(processes)
+    sampler.start()
+    url = http.base_url.join("/v1/shots/batch?viewer=true")
+    headers = {"content-type": "application/json"}
+    with ThreadPoolExecutor(2 * BURST) as pool:
+        batches = [pool.submit(httpx.post, url, content=body, headers=headers, timeout=600) for _ in range(BURST)]
+        singles = [pool.submit(http.post, "/v1/shots", json=single) for _ in range(BURST)]
+        answers = [future.result() for future in batches + singles]
+    sampler.stopped.set()
+    sampler.join()
+    assert all(answer.status_code == 200 for answer in answers), [a.text[:200] for a in answers if a.is_error]
+    points = sum(len(r["trajectory"]) + len(r["normalized"]["trajectory"])
+                 for r in answers[0].json()["results"] if "trajectory" in r)
+    return {"batch": {"shots": len(batch["shots"]), "body_bytes": len(body),
+                      "trajectory_rate_hz": batch["shots"][-1]["trajectory"]["rate_hz"], "trajectory_points": points,
+                      "answer_bytes": len(answers[0].content)},
+            "at_once": f"{BURST} such batches and {BURST} single shots at 1 kHz with a normalized replay",
+            "peak_rss_mib": sampler.peak}
+
+
+def wait_ready(http: httpx.Client, server: subprocess.Popen) -> None:
+    """Return once the server answers GET /healthz with 200 (two minutes at most)."""
+    deadline = time.monotonic() + 120
+    while True:
+        try:
+            if http.get("/healthz").status_code == 200:
+                return
+        except httpx.TransportError:
+            pass
+        assert time.monotonic() < deadline and server.poll() is None, "the server did not become ready"
+        time.sleep(0.1)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--shots", type=int, default=500, help="single shots in the warm-up")
@@ -84,15 +150,7 @@ def main() -> None:
     server = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=120) as http:
-            deadline = time.monotonic() + 120
-            while True:
-                try:
-                    if http.get("/healthz").status_code == 200:
-                        break
-                except httpx.TransportError:
-                    pass
-                assert time.monotonic() < deadline and server.poll() is None, "the server did not become ready"
-                time.sleep(0.1)
+            wait_ready(http, server)
             processes = tree(psutil.Process(server.pid))
             started = rss_mib(processes)
             sampler = PeakSampler(processes)
@@ -121,6 +179,7 @@ def main() -> None:
             warm = rss_mib(processes)
             sampler.stopped.set()
             sampler.join()
+            worst = worst_burst(http, processes)
     finally:
         server.terminate()
         server.wait(timeout=60)
@@ -132,6 +191,7 @@ def main() -> None:
                 "cpus": os.cpu_count(),
                 "load_average_before": [round(x, 2) for x in load_before],
                 "rss_mib": {"after_startup": started, "after_warm_up": warm, "peak": sampler.peak},
+                "worst_request": worst,
                 "single_shots": {
                     "shots": args.shots,
                     "shots_per_s": round(args.shots / single_wall, 1),
