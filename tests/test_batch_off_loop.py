@@ -80,7 +80,7 @@ def test_a_killed_batch_process_fails_only_the_batch_it_was_flying(server):
     four fly on the restarted child (before, all five got 503)."""
     process, http = server
     child = _batch_process(process)
-    long = {"shots": [{**SEVEN_IRON, "normalized": True}] * 10_000}
+    long = {"shots": [{**SEVEN_IRON, "normalized": True, "ground": {"elevation_m": -3.0}}] * 10_000}  # 3 flights each
     small = {"shots": [SEVEN_IRON] * 3}
     expected = http.post("/v1/shots/batch", json=small).json()
     url = http.base_url.join("/v1/shots/batch")
