@@ -14,7 +14,7 @@ from golfflight.flight.engine import EulerStates
 MAX_TRAJECTORY_SAMPLES = 300_000
 """Most trajectory points one request may get back, over all its shots and their normalized replays: a single shot
 at the top rate, 1,000 Hz, with its normalized replay over the longest flight and roll there can be (2 x 140 s,
-280,002 points), or 100 shots at 60 Hz over 50 s each. Each point costs about 0.5 KB while its answer is built."""
+280,002 points), or 100 shots at 60 Hz over 50 s each. Each point costs about 0.6 KB while its answer is built."""
 
 
 def sample_count(states: EulerStates, trajectory: TrajectoryRequest) -> int:
@@ -24,7 +24,8 @@ def sample_count(states: EulerStates, trajectory: TrajectoryRequest) -> int:
         return len(states.times_s)
     duration_s = float(states.times_s[-1])
     on_grid = math.floor(duration_s * trajectory.rate_hz + 1e-9) + 1
-    return on_grid + ((on_grid - 1) / trajectory.rate_hz < duration_s - 1e-9)
+    ends_off_grid = (on_grid - 1) / trajectory.rate_hz < duration_s - 1e-9  # the last state's time is added
+    return on_grid + int(ends_off_grid)
 
 
 def refuse_long_trajectories(traced: list[tuple[TrajectoryRequest, EulerStates]]) -> None:

@@ -3,12 +3,13 @@
 Starts `golfflight serve --workers 1` on a free loopback port, as the container does, and measures with psutil the
 server process and its batch child (which flies batches at a lower priority): resident memory (RSS) after startup,
 after a warm-up of single shots and batches and a burst of the largest batches, and the peak sampled every 20 ms
-throughout; CPU seconds per single shot and per batched shot, each over its own phase. Then the worst request the
-API accepts, for memory (`worst_batch`: 10,000 shots, each with its own air and wind, a normalized replay and a
-flat flight, the last 100 with trajectories that come to just under MAX_TRAJECTORY_SAMPLES points, shown on the
-viewer), BURST of them at once beside single shots at 1 kHz, with its own peak (issue 55, item 4). Prints JSON
-(docs/service.md, "On Kubernetes", and docs/reliability.md quote it). Run it with the Python of a runtime-only install (`pip install .` and psutil in a fresh
-virtual environment) from outside the checkout, so that what is measured is what the serving image runs.
+throughout; CPU seconds per single shot and per batched shot, each over its own phase. Then the worst request the API
+accepts, for memory (`worst_batch`: 10,000 shots, each with its own air and wind, a normalized replay and a flat
+flight, the last 100 with trajectories that come to just under MAX_TRAJECTORY_SAMPLES points, shown on the viewer),
+BURST of them at once beside single shots at 1 kHz, with its own peak (issue 55, item 4). Prints JSON
+(docs/service.md, "On Kubernetes", and docs/reliability.md quote it). Run it with the Python of a runtime-only
+install (`pip install .` and psutil in a fresh virtual environment) from outside the checkout, so that what is
+measured is what the serving image runs.
 
     python3 scripts/serving_footprint.py [--shots 500] [--batches 10] [--batch-size 1000]
 """

@@ -8,7 +8,6 @@ from __future__ import annotations
 import os
 import signal
 import time
-
 from typing import NamedTuple
 
 from golfflight.contract.batch_body import read_batch
@@ -65,7 +64,7 @@ def ready() -> tuple[str, int]:
 
 def _for_screens(result: ShotResult) -> ShotResult:
     """A shown shot's result as the screens keep it (`feed.ShotFeed.publish`): no trajectory or normalized flight,
-    which would cross to the server for nothing (50 shown shots with trajectories: 150,000 points, 200 MiB there)."""
+    which would cross to the server for nothing (50 shown shots with trajectories: 150,000 points, 125 MiB of the server's peak)."""
     return result.model_copy(update={"trajectory": None, "normalized": None})
 
 
@@ -90,7 +89,7 @@ def fly_and_encode(body: bytes, shown: int = 0, bay: BayConditions | None = None
 
 def encode_results(results: list) -> bytes:
     """The BatchResult JSON of `results`, encoded ENCODED_AT_ONCE at a time, each slice's objects let go once
-    encoded (the list is emptied): the answer's text grows as its objects go, where encoding all at once held both
+    encoded (its entries set to None): the answer's text grows as its objects go, where encoding all at once held both
     (about 90 MiB more for 10,000 shots with 300,000 trajectory points)."""
     pieces = []
     for start in range(0, len(results), ENCODED_AT_ONCE):

@@ -1,7 +1,7 @@
 """POST /v1/shots (inline: one shot takes well under a millisecond, less than a hop to a thread would cost) and
 POST /v1/shots/batch (read, validated and flown in the batch process, at a lower CPU priority, off the event loop:
-`service.runtime.batch_process`). A shot without
-air, wind or ground of its own flies in the bay's (`service.runtime.bay`)."""
+`service.runtime.batch_process`). A shot without air, wind or ground of its own flies in the bay's
+(`service.runtime.bay`)."""
 
 from __future__ import annotations
 
