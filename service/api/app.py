@@ -5,8 +5,9 @@ on `app.state.runtime`, reached through `service.runtime.runtime_of`).
 Single shots simulate inline in `async def` routes. Batches fly in the runtime's child process at a lower CPU
 priority, so a fitting studio's thousands of shots neither hold the GIL nor take a core from a simulator bay's single
 shots; more concurrency comes from `golfflight serve --workers N` (one process, one runtime each). In front of the
-routes: a body-size limit, the optional API key ($GOLFFLIGHT_API_KEY) and CORS only for configured origins
-($GOLFFLIGHT_CORS_ORIGINS); inside those, a valid simulation request goes straight to its endpoint
+routes: CORS only for configured origins ($GOLFFLIGHT_CORS_ORIGINS), the optional API key ($GOLFFLIGHT_API_KEY; without
+one, the Host and cross-site checks of `guards.HostCheck`), then a body-size limit, so that no body is read before the
+key is checked; inside those, a valid simulation request goes straight to its endpoint
 (`service.api.direct`); every refusal is a 4xx whose body names the field, the value and the allowed range
 (`service.api.errors`). GET/PUT/PATCH /v1/bay hold the bay's conditions and player. /docs loads its script and style
 from an installed package, not a CDN (`routes.docs`; ReDoc is off). The outermost middleware counts and times every
@@ -60,10 +61,11 @@ def http_app(
     routers = (shots.router, gspro.router, bay_routes.router, status.router, metrics.router, *more_routers,
                docs.router)
     app.add_middleware(DirectLanes, routes=[route for router in routers for route in router.routes])  # innermost
+    app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # inside the key: no body is read before the key is checked
     if api_key:
         app.add_middleware(ApiKey, key=api_key, open_paths=open_paths)
     else:
-        app.add_middleware(HostCheck, allowed=frozenset(allowed_hosts))
+        app.add_middleware(HostCheck, allowed=frozenset(allowed_hosts), origins=frozenset(cors_origins))
     if cors_origins:
         app.add_middleware(
             CORSMiddleware,
@@ -71,7 +73,6 @@ def http_app(
             allow_methods=["GET", "POST", "PUT", "PATCH"],
             allow_headers=["content-type", "x-api-key", "authorization"],
         )
-    app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)
     errors.install(app)
     for router in routers:
         app.include_router(router)
