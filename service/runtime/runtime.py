@@ -226,6 +226,10 @@ class BayRuntime:
         """The bay's conditions and player now."""
         return self._bay.conditions
 
+    def bay_file(self) -> Path | None:
+        """The bay file (None: the bay is in memory only)."""
+        return self._bay.path
+
     def set_bay(self, conditions: BayConditions) -> BayConditions:
         """Replace the bay's conditions (kept in its file, if it has one); BayFileError when the file cannot be
         written."""
