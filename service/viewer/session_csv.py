@@ -6,7 +6,11 @@ in a spreadsheet. Who hit it, when and from where ride along in columns simulate
 
 The download is built on the event loop in slices of at most SLICE_S, each followed by a turn of the loop, over a
 snapshot of the session taken when it is asked for: 10,000 shots take 1 to 3 s of pure Python, which in one piece
-held every shot (HTTP and Open Connect) for that long. A thread would not help: it holds the GIL for the
+held every shot (HTTP and Open Connect) for that long. Every download in progress shares one turn (a lock): 50 at
+once took 50 slices per turn of the loop, and single shots waited 376 ms (issue 55). Its rows are made twice, once
+for the columns and once for the text, which is handed on piece by piece: a download whose client reads nothing
+holds one piece and the snapshot's references, where the whole session's rows (14 MiB for 10,000 shots) stayed
+in memory until the client left. A thread would not help: it holds the GIL for the
 interpreter's switch interval (5 ms) each time the loop's flight lets go of it for an ONNX Runtime call, hundreds of
 times per shot."""
 
@@ -16,7 +20,7 @@ import asyncio
 import csv
 import io
 import time
-from collections.abc import AsyncIterator, Sequence
+from collections.abc import AsyncIterator, Callable, Sequence
 from datetime import UTC, datetime
 
 from golfflight.contract.columns import PUTT, condition_cells, flat_row, result_columns
@@ -61,29 +65,46 @@ def _row(shot: SessionShot, player: str | None) -> dict:
     return {**own, **request_cells(shot.request), **flat_row(shot.result.model_dump(exclude_none=True))}
 
 
-async def session_csv_slices(shots: Sequence[SessionShot], slice_s: float = SLICE_S,
-                             player: str | None = None) -> AsyncIterator[str]:
+async def session_csv_slices(shots: Sequence[SessionShot], slice_s: float = SLICE_S, player: str | None = None,
+                             turns: asyncio.Lock | None = None) -> AsyncIterator[str]:
     """The shots (of a session played by `player`) as CSV text, one row each, in pieces, each made in at most about
-    `slice_s` with a turn of the event loop between two: the rows first (their columns, in the order they first
-    appear, are known only once all are made), then the text."""
-    rows: list[dict] = []
+    `slice_s` while holding `turns` (shared by every download of the service) with a turn of the event loop between
+    two: the columns first (in the order they first appear, known only once every row was made), then the text,
+    each piece handed on as it is made, so a download holds one piece, never the whole session."""
+    turns = turns if turns is not None else asyncio.Lock()
     columns = dict.fromkeys(SHOT_COLUMNS if shots else EMPTY_SESSION_COLUMNS)
-    deadline = time.perf_counter() + slice_s
-    for shot in shots:
-        rows.append(_row(shot, player))
-        columns.update(dict.fromkeys(rows[-1]))
-        if time.perf_counter() >= deadline:
-            await asyncio.sleep(0)
-            deadline = time.perf_counter() + slice_s
+    async for _ in _in_turns(shots, lambda shot: columns.update(dict.fromkeys(_row(shot, player))), slice_s, turns):
+        pass
     out = io.StringIO()
     writer = csv.DictWriter(out, list(columns), restval="", lineterminator="\n")
     writer.writeheader()
-    for row in rows:
-        writer.writerow(row)
-        if time.perf_counter() >= deadline:
-            yield out.getvalue()
-            out.seek(0)
-            out.truncate()
-            await asyncio.sleep(0)
+    async for _ in _in_turns(shots, lambda shot: writer.writerow(_row(shot, player)), slice_s, turns):
+        yield _taken(out)
+    rest = _taken(out)
+    if rest:
+        yield rest
+
+
+async def _in_turns(shots: Sequence[SessionShot], each: Callable[[SessionShot], object], slice_s: float,
+                    turns: asyncio.Lock) -> AsyncIterator[None]:
+    """`each` of the shots in turns of at most about `slice_s`, each holding `turns` and followed by a turn of the
+    event loop; yields after each (`turns` released): downloads in progress together take one slice per turn."""
+    position = 0
+    while position < len(shots):
+        async with turns:
             deadline = time.perf_counter() + slice_s
-    yield out.getvalue()
+            while position < len(shots):
+                each(shots[position])
+                position += 1
+                if time.perf_counter() >= deadline:
+                    break
+        await asyncio.sleep(0)
+        yield
+
+
+def _taken(out: io.StringIO) -> str:
+    """The text written to `out` so far, `out` emptied."""
+    text = out.getvalue()
+    out.seek(0)
+    out.truncate()
+    return text

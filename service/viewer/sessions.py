@@ -6,6 +6,9 @@ Sessions and their bounds are the runtime's (`service.runtime.sessions`); the mo
 
 from __future__ import annotations
 
+import asyncio
+from collections.abc import AsyncIterator
+
 from fastapi import APIRouter, Query, Request
 from fastapi.responses import JSONResponse, Response, StreamingResponse
 from golfflight.contract.session import NewSession, SessionInfo, SessionList, SessionSummary
@@ -77,5 +80,21 @@ async def session_csv(request: Request, session: int | None = SessionId) -> Resp
     snapshot = list(found.shots)
     name = f"golfflight-session-{found.id}.csv"
     headers = {"content-disposition": f'attachment; filename="{name}"', "cache-control": "no-store"}
-    return StreamingResponse(session_csv_slices(snapshot, player=found.player), media_type="text/csv; charset=utf-8",
-                             headers=headers)
+    text = _until_gone(request, session_csv_slices(snapshot, player=found.player, turns=_csv_turns(request)))
+    return StreamingResponse(text, media_type="text/csv; charset=utf-8", headers=headers)
+
+
+def _csv_turns(request: Request) -> asyncio.Lock:
+    """The one lock every download of the service's CSV takes turns by (`session_csv_slices`)."""
+    state = request.app.state
+    if not hasattr(state, "csv_turns"):
+        state.csv_turns = asyncio.Lock()
+    return state.csv_turns
+
+
+async def _until_gone(request: Request, pieces: AsyncIterator[str]) -> AsyncIterator[str]:
+    """`pieces` until the client has gone (uvicorn drops what is sent after): no CSV is made for nobody."""
+    async for piece in pieces:
+        if await request.is_disconnected():
+            return
+        yield piece
