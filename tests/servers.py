@@ -1,15 +1,21 @@
 """A real uvicorn server on 127.0.0.1 in a thread for tests that need one (the service as clients see it), on the
-event loop and HTTP parser `golfflight serve` picks (`fast_io`)."""
+event loop and HTTP parser `golfflight serve` picks (`fast_io`); a real `golfflight serve` process for tests that
+measure its memory."""
 
 from __future__ import annotations
 
+import os
 import socket
+import subprocess
+import sys
 import threading
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
+from pathlib import Path
 
 import httpx
+import psutil
 import uvicorn
 
 from golfflight.commands.serve import fast_io
@@ -66,3 +72,36 @@ def shot(http: httpx.Client, **body) -> dict:
     response = http.post("/v1/shots", json=body)
     assert response.status_code == 200, response.text
     return response.json()
+
+
+@contextmanager
+def serve_process(log: Path, env: dict[str, str] | None = None) -> Iterator[tuple[psutil.Process, httpx.Client]]:
+    """(server process, keep-alive client) of a real `golfflight serve` on a free loopback port (its output in
+    `log`; none of this environment's GOLFFLIGHT_* settings, `env`'s instead), once /healthz answers 200; it and its children (the batch process) are killed at the end."""
+    port = free_port()
+    command = [sys.executable, "-m", "golfflight", "serve", "--port", str(port)]
+    inherited = {key: value for key, value in os.environ.items() if not key.startswith("GOLFFLIGHT_")}
+    with open(log, "w") as output:
+        popen = subprocess.Popen(command, env={**inherited, **(env or {})}, stdout=output, stderr=subprocess.STDOUT)
+    server = psutil.Process(popen.pid)
+    try:
+        with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=60) as http:
+            deadline = time.monotonic() + 90
+            while not _ready(http):
+                assert time.monotonic() < deadline and popen.poll() is None, log.read_text()
+                time.sleep(0.05)
+            yield server, http
+    finally:
+        children = server.children(recursive=True) if popen.poll() is None else []
+        popen.kill()
+        popen.wait(30)
+        for child in children:
+            with suppress(psutil.NoSuchProcess):
+                child.kill()
+
+
+def _ready(http: httpx.Client) -> bool:
+    try:
+        return http.get("/healthz").status_code == 200
+    except httpx.TransportError:
+        return False
