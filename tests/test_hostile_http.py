@@ -6,6 +6,9 @@ read (item 7); /healthz names no directory and malformed requests write one log 
 
 from __future__ import annotations
 
+import asyncio
+import csv
+import io
 import json
 import logging
 import socket
@@ -19,9 +22,14 @@ import browser
 import httpx
 import psutil
 import pytest
+from golfflight.contract.flying import fly_request
+from golfflight.contract.requests import ShotRequest
 from golfflight.service.api.http_protocol import MAX_HEAD_BYTES, DeadlineHttpProtocol
 from golfflight.service.app import create_app
+from golfflight.service.runtime.feed import ShotFeed
 from golfflight.service.settings import ServiceSettings
+from golfflight.service.viewer.loop_turns import LoopTurns
+from golfflight.service.viewer.session_csv import session_csv_slices
 from servers import free_port, running, serve_process
 
 SHOT = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}
@@ -167,6 +175,45 @@ def test_session_downloads_nobody_reads_hold_no_sessions_rows_in_a_real_server(s
         for sock in sockets:
             sock.close()
     assert grown < 24, f"4 unread downloads of 10,000 shots grew the server by {grown:.0f} MiB"
+
+
+async def _downloads_and_turns(shots: list, downloads: int) -> tuple[list[str], int, int]:
+    """`downloads` CSVs of `shots` made at once on one LoopTurns, as the service makes them: (their texts, the
+    slices they took, the turns another task got meanwhile)."""
+    turns, slices, done = 0, 0, False
+
+    async def other_task():
+        nonlocal turns
+        while not done:
+            turns += 1
+            await asyncio.sleep(0)
+
+    async def download() -> str:
+        nonlocal slices
+        pieces = []
+        async for piece in session_csv_slices(shots, 0.0005, turns=shared):
+            slices += 1
+            pieces.append(piece)
+        return "".join(pieces)
+
+    shared = LoopTurns()
+    ticker = asyncio.create_task(other_task())
+    texts = await asyncio.gather(*[download() for _ in range(downloads)])
+    done = True
+    await ticker
+    return texts, slices, turns
+
+
+def test_downloads_made_at_once_take_one_slice_per_turn_of_the_loop_over_them_all(engine):
+    """Ten at once: the loop turns at least once per slice of any of them (a shot waits one slice, not ten)."""
+    request = ShotRequest(ball_speed_mps=60.0, launch_angle_deg=14.0, spin_rpm=5000.0)
+    result, flight = fly_request(engine, request, keep_states=True)
+    feed = ShotFeed()
+    for _ in range(500):
+        feed.publish("http", request, result, flight.states, flight.flight_time_s)
+    texts, slices, turns = asyncio.run(_downloads_and_turns(list(feed.session), 10))
+    assert all(text == texts[0] for text in texts) and len(list(csv.DictReader(io.StringIO(texts[0])))) == 500
+    assert slices >= 20 and turns >= slices, f"{slices} slices in {turns} turns of the loop"
 
 
 class _OtherSite(BaseHTTPRequestHandler):

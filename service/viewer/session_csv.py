@@ -6,8 +6,9 @@ in a spreadsheet. Who hit it, when and from where ride along in columns simulate
 
 The download is built on the event loop in slices of at most SLICE_S, each followed by a turn of the loop, over a
 snapshot of the session taken when it is asked for: 10,000 shots take 1 to 3 s of pure Python, which in one piece
-held every shot (HTTP and Open Connect) for that long. Every download in progress shares one turn (a lock): 50 at
-once took 50 slices per turn of the loop, and single shots waited 376 ms (issue 55). Its rows are made twice, once
+held every shot (HTTP and Open Connect) for that long. Every download in progress takes its slices from one
+`LoopTurns`, one slice per turn of the loop over them all: 50 at once took 50 slices per turn, and single shots
+waited 376 ms (issue 55). Its rows are made twice, once
 for the columns and once for the text, which is handed on piece by piece: a download whose client reads nothing
 holds one piece and the snapshot's references, where the whole session's rows (14 MiB for 10,000 shots) stayed
 in memory until the client left. A thread would not help: it holds the GIL for the
@@ -16,7 +17,6 @@ times per shot."""
 
 from __future__ import annotations
 
-import asyncio
 import csv
 import io
 import time
@@ -27,6 +27,7 @@ from golfflight.contract.columns import PUTT, condition_cells, flat_row, result_
 from golfflight.contract.inputs import launch_of
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.runtime.sessions import SessionShot
+from golfflight.service.viewer.loop_turns import LoopTurns
 
 SHOT_COLUMNS = ("shot_id", "timestamp", "session", "player", "source", "club", "shot_number", PUTT)
 """Who, when and where from: `session` is the session's id, `player` its player's name, `source` where the shot came
@@ -66,15 +67,15 @@ def _row(shot: SessionShot, player: str | None) -> dict:
 
 
 async def session_csv_slices(shots: Sequence[SessionShot], slice_s: float = SLICE_S, player: str | None = None,
-                             turns: asyncio.Lock | None = None) -> AsyncIterator[str]:
+                             turns: LoopTurns | None = None) -> AsyncIterator[str]:
     """The shots (of a session played by `player`) as CSV text, one row each, in pieces, each made in at most about
-    `slice_s` while holding `turns` (shared by every download of the service) with a turn of the event loop between
-    two: the columns first (in the order they first appear, known only once every row was made), then the text,
-    each piece handed on as it is made, so a download holds one piece, never the whole session."""
-    turns = turns if turns is not None else asyncio.Lock()
+    `slice_s` at a turn of the event loop that `turns` (shared by every download of the service) gives: the columns
+    first (in the order they first appear, known only once every row was made; an empty piece after each turn), then
+    the text, each piece handed on as it is made, so a download holds one piece, never the whole session."""
+    turns = turns if turns is not None else LoopTurns()
     columns = dict.fromkeys(SHOT_COLUMNS if shots else EMPTY_SESSION_COLUMNS)
     async for _ in _in_turns(shots, lambda shot: columns.update(dict.fromkeys(_row(shot, player))), slice_s, turns):
-        pass
+        yield ""  # no text yet: a turn at which the caller may stop, its client gone
     out = io.StringIO()
     writer = csv.DictWriter(out, list(columns), restval="", lineterminator="\n")
     writer.writeheader()
@@ -86,19 +87,17 @@ async def session_csv_slices(shots: Sequence[SessionShot], slice_s: float = SLIC
 
 
 async def _in_turns(shots: Sequence[SessionShot], each: Callable[[SessionShot], object], slice_s: float,
-                    turns: asyncio.Lock) -> AsyncIterator[None]:
-    """`each` of the shots in turns of at most about `slice_s`, each holding `turns` and followed by a turn of the
-    event loop; yields after each (`turns` released): downloads in progress together take one slice per turn."""
+                    turns: LoopTurns) -> AsyncIterator[None]:
+    """`each` of the shots, at most about `slice_s` of them at each turn `turns` gives; yields after each."""
     position = 0
     while position < len(shots):
-        async with turns:
-            deadline = time.perf_counter() + slice_s
-            while position < len(shots):
-                each(shots[position])
-                position += 1
-                if time.perf_counter() >= deadline:
-                    break
-        await asyncio.sleep(0)
+        await turns.turn()
+        deadline = time.perf_counter() + slice_s
+        while position < len(shots):
+            each(shots[position])
+            position += 1
+            if time.perf_counter() >= deadline:
+                break
         yield
 
 

@@ -6,7 +6,6 @@ Sessions and their bounds are the runtime's (`service.runtime.sessions`); the mo
 
 from __future__ import annotations
 
-import asyncio
 from collections.abc import AsyncIterator
 
 from fastapi import APIRouter, Query, Request
@@ -14,6 +13,7 @@ from fastapi.responses import JSONResponse, Response, StreamingResponse
 from golfflight.contract.session import NewSession, SessionInfo, SessionList, SessionSummary
 from golfflight.service.runtime import runtime_of
 from golfflight.service.runtime.sessions import Session
+from golfflight.service.viewer.loop_turns import LoopTurns
 from golfflight.service.viewer.session_csv import session_csv_slices
 
 SESSIONS_PATH = "/v1/sessions"
@@ -84,17 +84,19 @@ async def session_csv(request: Request, session: int | None = SessionId) -> Resp
     return StreamingResponse(text, media_type="text/csv; charset=utf-8", headers=headers)
 
 
-def _csv_turns(request: Request) -> asyncio.Lock:
-    """The one lock every download of the service's CSV takes turns by (`session_csv_slices`)."""
+def _csv_turns(request: Request) -> LoopTurns:
+    """The turns every download of the service's CSV shares (`session_csv_slices`)."""
     state = request.app.state
     if not hasattr(state, "csv_turns"):
-        state.csv_turns = asyncio.Lock()
+        state.csv_turns = LoopTurns()
     return state.csv_turns
 
 
 async def _until_gone(request: Request, pieces: AsyncIterator[str]) -> AsyncIterator[str]:
-    """`pieces` until the client has gone (uvicorn drops what is sent after): no CSV is made for nobody."""
+    """The text of `pieces` until the client has gone (uvicorn drops what is sent after): no CSV is made for
+    nobody."""
     async for piece in pieces:
         if await request.is_disconnected():
             return
-        yield piece
+        if piece:
+            yield piece
