@@ -6,14 +6,13 @@ in a spreadsheet. Who hit it, when and from where ride along in columns simulate
 
 The download is built on the event loop in slices of at most SLICE_S, each followed by a turn of the loop, over a
 snapshot of the session taken when it is asked for: 10,000 shots take 1 to 3 s of pure Python, which in one piece
-held every shot (HTTP and Open Connect) for that long. Every download in progress takes its slices from one
-`LoopTurns`, one slice per turn of the loop over them all: 50 at once took 50 slices per turn, and single shots
-waited 376 ms (issue 55). Its rows are made twice, once
-for the columns and once for the text, which is handed on piece by piece: a download whose client reads nothing
-holds one piece and the snapshot's references, where the whole session's rows (14 MiB for 10,000 shots) stayed
-in memory until the client left. A thread would not help: it holds the GIL for the
+held every shot (HTTP and Open Connect) for that long. A thread would not help: it holds the GIL for the
 interpreter's switch interval (5 ms) each time the loop's flight lets go of it for an ONNX Runtime call, hundreds of
-times per shot."""
+times per shot. Every download in progress takes its slices from one `LoopTurns`, one slice per turn of the loop
+over them all: 50 at once had taken 50 slices per turn, and single shots waited 376 ms (issue 55). Its rows are
+made twice, once for the columns and once for the text, which is handed on piece by piece: a download whose client
+reads nothing holds one piece and the snapshot's references, where the whole session's rows (13 MiB for 10,000
+shots) stayed in memory until the client left."""
 
 from __future__ import annotations
 
@@ -35,8 +34,8 @@ in (http, batch, gspro-http, open-connect), `club` the GSPro club code of the ba
 `putt` 1 for a putt."""
 
 SLICE_S = 0.002
-"""Longest the download works at once before it lets the loop answer shots: a shot waits at most this much per
-download in progress."""
+"""Longest the downloads work at once before they let the loop answer shots: a shot waits about this much per turn
+of the loop it needs, however many downloads are in progress (`LoopTurns`)."""
 
 LAUNCH_COLUMNS = ("ball_speed_mps", "launch_angle_deg", "launch_direction_deg", "spin_rpm", "spin_axis_deg")
 
