@@ -75,14 +75,15 @@ def shot(http: httpx.Client, **body) -> dict:
 
 
 @contextmanager
-def serve_process(log: Path, env: dict[str, str] | None = None) -> Iterator[tuple[psutil.Process, httpx.Client]]:
+def serve_process(log: Path) -> Iterator[tuple[psutil.Process, httpx.Client]]:
     """(server process, keep-alive client) of a real `golfflight serve` on a free loopback port (its output in
-    `log`; none of this environment's GOLFFLIGHT_* settings, `env`'s instead), once /healthz answers 200; it and its children (the batch process) are killed at the end."""
+    `log`; none of this environment's GOLFFLIGHT_* settings), once /healthz answers 200; it and its children (the
+    batch process) are killed at the end."""
     port = free_port()
     command = [sys.executable, "-m", "golfflight", "serve", "--port", str(port)]
     inherited = {key: value for key, value in os.environ.items() if not key.startswith("GOLFFLIGHT_")}
     with open(log, "w") as output:
-        popen = subprocess.Popen(command, env={**inherited, **(env or {})}, stdout=output, stderr=subprocess.STDOUT)
+        popen = subprocess.Popen(command, env=inherited, stdout=output, stderr=subprocess.STDOUT)
     server = psutil.Process(popen.pid)
     try:
         with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=60) as http:

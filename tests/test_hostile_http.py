@@ -56,7 +56,7 @@ def served(tmp_path_factory) -> Iterator[tuple[psutil.Process, int]]:
 
 
 def _answer(port: int, request: bytes) -> bytes:
-    """What the server sends for `request` until it closes the connection (b"" on a reset)."""
+    """What the server sends for `request` until it closes the connection (or resets it)."""
     with socket.create_connection(("127.0.0.1", port), timeout=20) as sock:
         sock.sendall(request)
         received = b""
