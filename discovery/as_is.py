@@ -81,7 +81,7 @@ def as_is(
     predicted = predicted + offset
     residual = recordings.observed - predicted
     wild = outlier_mask(residual)
-    use = np.isfinite(recordings.observed) & ~wild
+    use = np.isfinite(residual) & np.isfinite(expected.sigma) & ~wild  # a shot the model does not land has none
     own_rng = np.random.default_rng([seed, 1])  # its own stream: the fits' draws stay as they were
     scatter = recording_scatter(recordings, np.where(use, residual / expected.sigma, np.nan), own_rng)
     if estimate_scatter:

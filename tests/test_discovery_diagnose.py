@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
+from golfflight.discovery.as_is import as_is
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import diagnose
 from golfflight.discovery.model import reference
+from golfflight.discovery.noise import RADAR_NOISE
 from golfflight.discovery.recordings import from_shot_set
 from golfflight.discovery.schema import SCHEMA_PATH, Report, schema_text
+from golfflight.flight.flyer import Flyer
 from golfflight.shots.paths import REPO_ROOT
 from golfflight.shots.records import ShotSet, trajectories_path, write_shots, write_trajectories
 
@@ -190,3 +194,19 @@ def test_a_pair_gains_no_third_effect():
     assert {e.name for e in report.effects} == set(hidden)
     assert "best_triple" in report.systematic_test, "triples were fitted and turned down"
     assert len([c for c in report.candidates if c.name.count("+") == 2]) >= 1
+
+
+def test_shots_the_model_does_not_land_are_left_out_not_read_as_nan():
+    """A shot the model does not land (here a Flyer that stops at 4 s) has no prediction: it is left out of the
+    comparison, and every statistic of the others stays finite (a learned form once flew two wedges to NaN and the
+    report read 'carry at nanx its expected error' and found no structure)."""
+    model = reference()
+    f = model.flyer
+    short = replace(model, flyer=Flyer(f.model, f.dt_s, 4.0, f.density_kg_m3, f.kinematic_viscosity_m2_s, f.rule))
+    recordings = from_shot_set(conceal({}, 80, seed=2).shots)
+    result = as_is(recordings, short, RADAR_NOISE, 0, estimate_scatter=True)
+    unflown = ~np.isfinite(result.predicted).all(axis=1)
+    assert 0 < unflown.sum() < len(recordings) and not result.use[unflown].any()
+    report = diagnose(recordings, short, progress=False).report
+    assert all(np.isfinite(o.rms_ratio) for o in report.located.observables)
+    assert "nan" not in report.statement
