@@ -1,5 +1,5 @@
 """Open Connect's places (issue 42): sockets held idle, or trickling bytes that make no message, give their place to
-a new connector when every place is taken; a connector that has sent a valid message keeps its place against a flood
+a new connector when every place is taken (all but the WAITING_KEPT that connected first: issue 55); a connector that has sent a valid message keeps its place against a flood
 of new connections. Real TCP sockets on loopback against a real server (`Served`, as in the limits' tests), and the
 whole service for /healthz."""
 
@@ -12,7 +12,7 @@ import time
 import pytest
 from golfflight.service.app import create_app
 from golfflight.service.settings import ServiceSettings
-from golfflight.service.open_connect.limits import MAX_CONNECTIONS, ConnectorLimits
+from golfflight.service.open_connect.limits import MAX_CONNECTIONS, WAITING_KEPT, ConnectorLimits
 
 from tests.servers import free_port, running
 from tests.test_open_connect import HEARTBEAT, encoded, shot
@@ -60,7 +60,7 @@ def test_a_connector_gets_in_past_sixteen_sockets_held_idle(served):
     idle = held(served, MAX_CONNECTIONS)
     reply, seconds = new_connector_shot(served.port, 7)
     assert reply["Code"] == 200 and reply["ShotNumber"] == 7 and seconds < 1.0, (reply, seconds)
-    data, _ = until_closed(idle[0], timeout_s=5)  # the oldest idle socket gave its place, saying why
+    data, _ = until_closed(idle[WAITING_KEPT], timeout_s=5)  # the oldest past those kept gave its place, saying why
     assert "sent no valid message since it connected" in refusal(data, EVICTED)["Message"]
     health = served.call(served.server.health)
     assert health["max_connections"] == MAX_CONNECTIONS and health["refused"] == 0 and health["evicted"] == 1
@@ -102,7 +102,7 @@ def test_a_connector_gets_in_past_sixteen_sockets_trickling_a_byte_a_second(serv
             time.sleep(0.1)
         reply, seconds = new_connector_shot(served.port, 8)
         assert reply["Code"] == 200 and reply["ShotNumber"] == 8 and seconds < 1.0, (reply, seconds)
-        refusal(until_closed(trickling[0], timeout_s=5)[0], EVICTED)
+        refusal(until_closed(trickling[WAITING_KEPT], timeout_s=5)[0], EVICTED)
     finally:
         trickle.close()
         close_all(trickling)

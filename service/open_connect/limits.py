@@ -26,17 +26,30 @@ from golfflight.service.open_connect.framing import MAX_MESSAGE_BYTES
 MAX_CONNECTIONS = 16
 """Connectors connected at once. A bay has one launch monitor and one connector; 16 leaves room for several bays on
 one service and for a connector's reconnect overlapping its old connection. One more takes the place of the
-connection that has gone longest without a valid message (`server.OpenConnectServer.admit`), which gets Code 503 and
-a close; only when every place is PROTECTED_S-fresh is the new one refused instead (Code 503, closed)."""
+connection that gives way first (`server.OpenConnectServer.admit`: WAITING_KEPT and PROTECTED_S say which), which
+gets Code 503 and a close; only when every place is PROTECTED_S-fresh is the new one refused instead (Code 503,
+closed)."""
+
+WAITING_KEPT = 4
+"""Connections with no valid message yet that keep their places against new connections: the WAITING_KEPT that
+connected first. A real connector connects when it starts and sends nothing until the golfer hits (minutes), and
+nothing on the wire tells it from a socket held idle; what does is that it stays, while a flood's sockets come and
+go. So a connector that connected before a flood keeps its place however long it waits, while the other silent
+connections (the newer ones) give way, the oldest of them first: a connector that connects during a flood of
+sockets that never send a valid message still gets MAX_CONNECTIONS - WAITING_KEPT - 1 = 11 newer connections' time
+to send its first message, after which its place is kept as any playing connector's. Four covers a bay's connector,
+its reconnect overlapping the old connection, and a second program on the bay; more would let sockets held idle
+before anyone connects shrink what newcomers share (16 - 4 = 12 places), fewer would drop a waiting connector."""
 
 PROTECTED_S = 60.0
 """How long a valid message (a shot, a heartbeat, any message that validates) keeps its connection's place against
 new connections once all MAX_CONNECTIONS are taken. Nothing is closed for being quiet while a place is free: a golfer
 may not hit for minutes and some connectors send no heartbeat, so any idle timeout would drop real connectors. Under
 pressure, a connection that never sent a valid message (an idle socket, one trickling bytes that never make a
-message, a new connection that has sent nothing yet) gives way first, the oldest first; then one quiet longer than
-this, the quietest first. A minute covers a connector's heartbeats (every few seconds) and a golfer's shots, so a
-flood of new connections cannot push out a bay that is playing."""
+message, a new connection that has sent nothing yet) gives way first: those past the WAITING_KEPT that connected
+first, the oldest of them first; then those WAITING_KEPT, the newest first; then one quiet longer than this, the
+quietest first. A minute covers a connector's heartbeats (every few seconds) and a golfer's shots, so a flood of new
+connections cannot push out a bay that is playing."""
 
 MESSAGES_PER_S = 200.0
 """Messages (objects, and refused pieces of input) a connection may send a second on average: a token bucket
@@ -104,6 +117,7 @@ class ConnectorLimits:
     linger_s: float = LINGER_S
     linger_bytes: int = LINGER_BYTES
     protected_s: float = PROTECTED_S
+    waiting_kept: int = WAITING_KEPT
 
     def too_many_connections(self) -> str:
         return (f"{self.max_connections} connectors are connected to this golfflight already (the most it takes at "

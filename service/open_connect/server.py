@@ -29,13 +29,14 @@ The turns also keep `answer` on the loop the rest of the service runs on, so it 
 
 Places: MAX_CONNECTIONS connections are served at once, and nothing is closed for being quiet (a golfer may not hit
 for minutes; some connectors send no heartbeat). A new connection when every place is taken is admitted on
-probation: it takes the place of the connection that gives way first (`Connection.gives_way`: never a valid message,
-the oldest first; then the quietest), which gets Code 503 saying why and a close; a connection with a valid message
-in the last `limits.PROTECTED_S` never gives way, and when all are so, the new one is refused instead. So sixteen
-sockets held idle, or trickling bytes that make no message, lose their places to the next connector, while a flood of
-new connections pushes out only its own (they never send a message) and never a connector that is playing. A program
-that sends valid messages on sixteen sockets looks like sixteen connectors: with no authentication, nothing tells
-them apart.
+probation: it takes the place of the connection that gives way first (`OpenConnectServer._giving_way`: of those that
+never sent a valid message, the oldest past the `limits.WAITING_KEPT` that connected first, then those kept, the
+newest first; then the quietest), which gets Code 503 saying why and a close; a connection with a valid message in
+the last `limits.PROTECTED_S` never gives way, and when all are so, the new one is refused instead. So sixteen
+sockets held idle, or trickling bytes that make no message, lose their places to the next connector; a flood of new
+connections pushes out only its own (they never send a message), never a connector that is playing nor one that
+connected before it and waits for its golfer. A program that sends valid messages on sixteen sockets looks like
+sixteen connectors: with no authentication, nothing tells them apart.
 """
 
 from __future__ import annotations
@@ -210,14 +211,26 @@ class OpenConnectServer:
             self.connections.discard(leaving)
             return True
         now = time.monotonic()
-        exposed = [connection for connection in self.connections if not connection.protected(now)]
-        if not exposed:
+        quitting = self._giving_way(now)
+        if quitting is None:
             return False
-        quitting = min(exposed, key=Connection.gives_way)
         self.events.warning("a connection closed to make room for a new one")
         self.evicted_total += 1
         quitting.refuse(self.limits.evicted(now - quitting.last_heard, quitting.last_message is not None))
         return True
+
+    def _giving_way(self, now: float) -> Connection | None:
+        """The connection that gives its place to a new one: of those with no valid message yet, the oldest past the
+        `limits.WAITING_KEPT` that connected first, else the newest of those; else the quietest unprotected one that
+        sent one; None when every connection is protected."""
+        waiting = sorted((c for c in self.connections if c.last_message is None), key=lambda c: c.admitted)
+        kept, newer = waiting[: self.limits.waiting_kept], waiting[self.limits.waiting_kept :]
+        if newer:
+            return newer[0]
+        if kept:
+            return kept[-1]
+        exposed = [c for c in self.connections if not c.protected(now)]
+        return min(exposed, key=lambda c: c.last_message, default=None)
 
     def busy(self) -> bool:
         """Whether some connection waits for its turn (then a new arrival waits too, behind it)."""
@@ -288,11 +301,6 @@ class Connection(asyncio.Protocol):
     def protected(self, now: float) -> bool:
         """Whether its place is kept against new connections: a valid message in the last PROTECTED_S."""
         return self.last_message is not None and now - self.last_message < self.limits.protected_s
-
-    def gives_way(self) -> tuple[bool, float]:
-        """Its order in giving its place to a new connection, lowest first: a connection that never sent a valid
-        message (the oldest first) before one that did (the quietest first)."""
-        return self.last_message is not None, self.last_heard
 
     def connection_made(self, transport: asyncio.Transport) -> None:
         self.transport = transport

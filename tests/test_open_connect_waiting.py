@@ -1,0 +1,84 @@
+"""Open Connect's places for a connector that connects and waits (issue 55, item 2): a real connector connects when
+it starts and sends nothing until the golfer hits. Under a flood of sockets that never send a valid message,
+connecting again whenever closed (a program in a process of its own), the connector that connected first keeps its
+place however long it waits, and a connector that connects during the flood and sends its shot at once still gets
+in. Real TCP sockets on loopback against a real `OpenConnectServer` (`Served`)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+
+from golfflight.service.open_connect.limits import MAX_CONNECTIONS, WAITING_KEPT
+
+from tests.test_open_connect_idle import EVICTED, close_all, held, new_connector_shot, played
+from tests.test_open_connect_limits import Served, refusal, served, until_closed  # noqa: F401 (served: a fixture)
+
+FLOOD_SOCKETS = 20
+"""The flood's sockets: more than the places, so that it always has one waiting to take a place."""
+
+FLOOD = """
+import select, socket, sys
+port, count = int(sys.argv[1]), int(sys.argv[2])
+opened = lambda: socket.create_connection(("127.0.0.1", port))
+sockets = [opened() for _ in range(count)]
+print("connected", flush=True)
+while True:
+    readable, _, _ = select.select(sockets, [], [], 0.05)
+    for sock in readable:
+        try:
+            data = sock.recv(65536)
+        except OSError:
+            data = b""
+        if not data:
+            sock.close()
+            sockets[sockets.index(sock)] = opened()
+"""
+"""Holds `count` sockets to the port, sending nothing, and connects again as soon as one is closed (it reads only
+to see the close)."""
+
+
+def flooding(port: int) -> subprocess.Popen:
+    """The flood's process, once all its sockets are connected."""
+    flood = subprocess.Popen([sys.executable, "-c", FLOOD, str(port), str(FLOOD_SOCKETS)], stdout=subprocess.PIPE)
+    assert flood.stdout.readline() == b"connected\n"
+    return flood
+
+
+def evicted_past(served: Served, count: int) -> None:
+    """Wait until `count` more connections than now have given their places (the flood churning)."""
+    goal = served.call(served.server.health)["evicted"] + count
+    deadline = time.monotonic() + 20
+    while served.call(served.server.health)["evicted"] < goal:
+        assert time.monotonic() < deadline, served.call(served.server.health)
+        time.sleep(0.02)
+
+
+def test_a_connector_that_connected_first_keeps_its_place_while_it_waits_through_a_flood(served):
+    (waiting,) = held(served, 1)
+    flood = flooding(served.port)
+    try:
+        evicted_past(served, 4 * MAX_CONNECTIONS)  # the flood has gone round every place four times
+        time.sleep(0.3)
+        played(waiting, 1)  # its first message, answered Code 200
+        for number in range(2, 5):  # connectors that connect during the flood and send at once still get in
+            reply, _ = new_connector_shot(served.port, number)
+            assert reply["Code"] == 200 and reply["ShotNumber"] == number, reply
+    finally:
+        flood.kill()
+        flood.wait()
+        waiting.close()
+
+
+def test_the_first_connections_keep_their_places_the_newer_ones_give_way_oldest_first(served):
+    first = held(served, WAITING_KEPT)
+    newer = held(served, MAX_CONNECTIONS - WAITING_KEPT)
+    for number in range(1, 3 * MAX_CONNECTIONS):  # connectors in turn, each sending at once, then leaving
+        reply, _ = new_connector_shot(served.port, number)
+        assert reply["Code"] == 200, reply
+    data, _ = until_closed(newer[0], timeout_s=5)  # the oldest of the newer ones went first
+    assert "sent no valid message since it connected" in refusal(data, EVICTED)["Message"]
+    for number, sock in enumerate(first):  # still connected: their first shots are answered
+        played(sock, 100 + number)
+    close_all([*first, *newer])
