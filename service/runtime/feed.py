@@ -16,15 +16,15 @@ announces the current session first, then gets that session's kept shots only.
 from __future__ import annotations
 
 import asyncio
+import itertools
 import time
-from collections import deque
+from collections import Counter, deque
 from dataclasses import dataclass
 from typing import Literal
 
 from golfflight.contract.bay import Player
 from golfflight.contract.requests import ShotRequest
 from golfflight.contract.results import ShotResult
-from golfflight.errors import ServiceError
 from golfflight.flight.engine import EulerStates
 from golfflight.service.runtime.sessions import MAX_SESSIONS, MAX_SHOTS, Session, Sessions, SessionShot
 
@@ -35,14 +35,20 @@ SESSION_SHOTS = MAX_SHOTS
 """Shots kept over all sessions for their downloads (GET /v1/session.csv) and summaries; the oldest go first."""
 
 MAX_VIEWERS = 16
-"""Event streams open at once; one more is refused with 503 (a bay has a screen or two)."""
+"""Event streams open at once (a bay has a screen or two; 16 leaves room for a venue's screens and a page's reconnect
+overlapping its old stream). One more is never refused: it takes the place of the oldest stream of the client
+address that holds the most (`ShotFeed.subscribe`, the new one counted with its own), which ends with a comment
+saying so. A stream says nothing back, so open streams held by a program that never shows them cannot be told from
+screens; what can be told is who holds them: sixteen streams held from one address give way to a screen anywhere
+else, and their own new ones push out only their own. A screen's page opens its stream again at once with
+Last-Event-ID, so one pushed out misses no kept shot."""
+
+VIEWER_GAVE_WAY = ("closed to make room for a new stream: {places} were open (the most this golfflight serves at "
+                   "once) and this address held the most of them; open it again to go on")
+"""The comment that ends a stream giving its place to a new one."""
 
 Source = Literal["http", "batch", "gspro-http", "open-connect"]
 """Where a shot came in: POST /v1/shots, POST /v1/shots/batch, POST /v1/gspro, GSPro Open Connect over TCP."""
-
-
-class TooManyViewers(ServiceError):
-    """MAX_VIEWERS streams are open already."""
 
 
 @dataclass(eq=False)
@@ -70,15 +76,26 @@ class Entry:
         return frame
 
 
+_OPENED = itertools.count()
+
+
 class Viewer:
     """One open stream's queue of shots to send: bounded, the oldest dropped when full; and the session to announce
     before any of them (the stream's first event, and the event that empties a screen)."""
 
-    def __init__(self, capacity: int, session: Session):
+    def __init__(self, capacity: int, session: Session, client: str = ""):
         self.pending: deque[Entry] = deque(maxlen=capacity)
         self.dropped = 0
         self.session: Session | None = session
+        self.client = client
+        self.opened = next(_OPENED)  # the order streams opened in
+        self.ended: str | None = None  # why the stream ends: it gave its place to a new one
         self._wake = asyncio.Event()
+
+    def end(self, reason: str) -> None:
+        """Have the stream end (its next wait returns at once), saying `reason`."""
+        self.ended = reason
+        self._wake.set()
 
     def offer(self, entry: Entry) -> None:
         if len(self.pending) == self.pending.maxlen:
@@ -94,7 +111,7 @@ class Viewer:
 
     async def next(self, timeout_s: float) -> Entry | Session | None:
         """The session to announce, else the next shot to send, or None when none came within `timeout_s`."""
-        if self.session is None and not self.pending:
+        if self.session is None and not self.pending and self.ended is None:
             self._wake.clear()
             try:
                 async with asyncio.timeout(timeout_s):
@@ -159,12 +176,13 @@ class ShotFeed:
             viewer.offer(entry)
         return entry
 
-    def subscribe(self, after_id: int | None = None) -> Viewer:
-        """A new viewer's queue, announcing the current session, then holding its kept shots after `after_id` (all
-        of them without one, or when the id is from before a restart); TooManyViewers when MAX_VIEWERS are open."""
+    def subscribe(self, after_id: int | None = None, client: str = "") -> Viewer:
+        """A new viewer's queue for a stream from `client` (its address), announcing the current session, then holding
+        its kept shots after `after_id` (all of them without one, or when the id is from before a restart); with
+        `max_viewers` open already, one gives its place (`_make_room`)."""
         if len(self._viewers) >= self._max_viewers:
-            raise TooManyViewers(f"{self._max_viewers} viewers are open already: close one and try again")
-        viewer = Viewer(self._history.maxlen, self.sessions.current)
+            self._make_room(client)
+        viewer = Viewer(self._history.maxlen, self.sessions.current, client)
         resume = after_id is not None and after_id < self._next_id
         for entry in self._history:
             if not resume or entry.id > after_id:
@@ -174,3 +192,15 @@ class ShotFeed:
 
     def unsubscribe(self, viewer: Viewer) -> None:
         self._viewers.discard(viewer)
+
+    def _make_room(self, client: str) -> None:
+        """End the oldest stream of the address holding the most streams, a new one from `client` counted with its
+        own (`client`'s own first on a tie), and let it go."""
+        held = Counter(viewer.client for viewer in self._viewers)
+        most = max(held.values())
+        mine = held[client] > 0 and held[client] + 1 >= most
+        address = (lambda viewer: viewer.client == client) if mine else (lambda viewer: held[viewer.client] == most)
+        giving = [viewer for viewer in self._viewers if address(viewer)]
+        oldest = min(giving, key=lambda viewer: viewer.opened)
+        oldest.end(VIEWER_GAVE_WAY.format(places=self._max_viewers))
+        self._viewers.discard(oldest)

@@ -247,11 +247,11 @@ class BayRuntime:
         """Follow the bay file's edits until cancelled."""
         await self._bay.watch()
 
-    def subscribe(self, after_id: int | None = None) -> Viewer:
-        """A screen's queue of the bay's shots (`ShotFeed.subscribe`); NotReady before the model is loaded,
-        TooManyViewers when every place is taken."""
+    def subscribe(self, after_id: int | None = None, client: str = "") -> Viewer:
+        """A screen's queue of the bay's shots, for a stream from address `client` (`ShotFeed.subscribe`: when every
+        place is taken, one gives way); NotReady before the model is loaded."""
         self._ready_engine()
-        return self._feed.subscribe(after_id)
+        return self._feed.subscribe(after_id, client)
 
     def unsubscribe(self, viewer: Viewer) -> None:
         """A screen has gone."""

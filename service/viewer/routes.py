@@ -48,6 +48,7 @@ async def shot_events(request: Request, last_event: str | None = Header(None, al
     """The current session, then every shot flown from now on (and its kept ones, or those after Last-Event-ID) as
     server-sent events; a new session is announced as it starts."""
     runtime = runtime_of(request)
-    viewer = runtime.subscribe(last_event_id(last_event))  # NotReady, TooManyViewers: 503 (contract.refusals)
+    client = request.client.host if request.client else ""
+    viewer = runtime.subscribe(last_event_id(last_event), client)  # NotReady: 503 (contract.refusals)
     headers = {"cache-control": "no-store", "x-accel-buffering": "no"}
     return StreamingResponse(events(runtime, viewer), media_type="text/event-stream", headers=headers)

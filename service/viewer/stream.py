@@ -75,7 +75,8 @@ async def events(
 ) -> AsyncIterator[str]:
     """The viewer's session (first, and again whenever a new one starts) and shots as server-sent events, with a
     keep-alive comment after every `keepalive_s` without one, until `lifetime_s` has passed (None: until the client
-    goes or the server shuts down); unsubscribes it however it ends."""
+    goes, the server shuts down or it gives its place to a new stream, saying so in a comment); unsubscribes it
+    however it ends."""
     stopping = serving_server() if stopping is None else stopping
     ends = None if lifetime_s is None else time.monotonic() + lifetime_s
     try:
@@ -92,6 +93,9 @@ async def events(
             if ends is not None:
                 wait = min(wait, ends - now)
             entry = await viewer.next(max(wait, 0.0))
+            if viewer.ended is not None:  # it gave its place to a new stream
+                yield f": {viewer.ended}\n\n"
+                return
             text = "" if entry is None else frame(entry)
             if text:  # empty: nothing came, or a shot that cannot be shown (`frame`)
                 yield text
