@@ -9,6 +9,8 @@ player reaches every connector as Code 201 player information.
 
 from __future__ import annotations
 
+from functools import partial
+
 import asyncio
 from contextlib import asynccontextmanager
 
@@ -38,7 +40,7 @@ def create_app(settings: ServiceSettings | None = None) -> FastAPI:
     @asynccontextmanager
     async def lifespan(app: FastAPI):
         exit_with_parent()  # a worker of `serve --workers N` ends with its supervisor, however that dies
-        tcp = OpenConnectServer(lambda message: runtime.fly_gspro(message, "open-connect")) if connect else None
+        tcp = OpenConnectServer(partial(runtime.fly_gspro, source="open-connect")) if connect else None
         if tcp:  # taken before the model loads: a port that cannot be had stops the startup at once
             await tcp.start(connect, listening=False)
             runtime.on_player_change(lambda changed: _tell(tcp, changed))

@@ -463,7 +463,7 @@ def test_shutdown_closes_every_connection_and_the_port(tmp_path):
 def test_a_failure_inside_an_answer_is_answered_and_the_connection_kept():
     calls = []
 
-    def answer(message):
+    def answer(message, client):
         calls.append(message.ShotNumber)
         if len(calls) == 1:
             raise RuntimeError("a bug")

@@ -46,7 +46,7 @@ class Served:
             self.loop = asyncio.new_event_loop()
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
         self.thread.start()
-        self.server = OpenConnectServer(lambda message: fly_message(engine, message), limits)
+        self.server = OpenConnectServer(lambda message, client: fly_message(engine, message), limits)
         self.on_loop(self.server.start(ConnectAddress(0)))
         self.port = self.server.port
 

@@ -386,3 +386,18 @@ def test_the_page_shows_the_summary_and_ellipses_and_new_session_empties_every_s
         assert "formula" in page.inner_text("#session-message") and page.locator("#shots tbody tr").count() == 1
         assert errors == []
     assert (tmp_path / "summary.png").stat().st_size > 20_000
+
+
+def test_past_the_cap_the_source_holding_the_most_lets_its_oldest_go():
+    sessions = Sessions(max_shots=6, max_sessions=2)
+    for n in range(2):
+        sessions.add(fake_shot(n, "DR", 200.0)._replace(client="bay"))
+    sessions.start(None)
+    for n in range(2, 9):  # another address's flood: past the cap, only its own oldest go
+        sessions.add(fake_shot(n, "PW", 120.0)._replace(client="flood"))
+    assert [s.id for s in sessions.get(1).shots] == [0, 1] and [s.id for s in sessions.current.shots] == [5, 6, 7, 8]
+    assert sessions.current.dropped == 3 and sessions.get(1).dropped == 0
+    sessions.start(None)  # session 1 forgotten with its shots: the flood's next shots fit beside its own
+    for n in range(9, 11):
+        sessions.add(fake_shot(n, "PW", 120.0)._replace(client="flood"))
+    assert [s.id for s in sessions.get(2).shots] == [5, 6, 7, 8] and len(sessions.current.shots) == 2

@@ -46,12 +46,14 @@ import logging
 import socket
 import time
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 from golfflight.contract.gspro import GSProReply
 from golfflight.service.open_connect.framing import ObjectFramer, Refused
 from golfflight.service.open_connect.limits import ConnectorLimits, TokenBucket
-from golfflight.service.open_connect.replies import Answer, Replied, encoded, player_information, reply_to
+from golfflight.service.open_connect.replies import Replied, encoded, player_information, reply_to
 
 PAUSE_S = 2.0
 """Silence after which a half-received object counts as paused (`ObjectFramer.stall`): a connector writes a message
@@ -108,12 +110,17 @@ class ConnectAddress:
     host: str = "127.0.0.1"
 
 
+ClientAnswer = Callable[..., GSProReply]
+"""Flies a message that carries BallData, called `answer(message, client=address)`: the service's shared GSPro
+answer, told the connector's address (its shots' share of the session memory, `service.runtime.shares`)."""
+
+
 class OpenConnectServer:
     """GSPro Open Connect v1 on a TCP port; `answer` flies each message that carries a shot (called on the event
-    loop's thread that `start` ran on). `limits` bound what each connector may do (default `limits.ConnectorLimits()`:
-    the module's constants)."""
+    loop's thread that `start` ran on, with the connector's address). `limits` bound what each connector may do
+    (default `limits.ConnectorLimits()`: the module's constants)."""
 
-    def __init__(self, answer: Answer, limits: ConnectorLimits | None = None):
+    def __init__(self, answer: ClientAnswer, limits: ConnectorLimits | None = None):
         self.answer = answer
         self.limits = limits or ConnectorLimits()
         self._server: asyncio.Server | None = None
@@ -251,10 +258,11 @@ class OpenConnectServer:
             self._waiting.popleft().work(deadline)
         self._turn = self._loop.call_soon(self._take_turn) if self._waiting else None
 
-    def reply(self, item: bytes | Refused) -> Replied:
-        """`reply_to`, with any unexpected failure answered (and logged) instead of ending the connection."""
+    def reply(self, item: bytes | Refused, client: str) -> Replied:
+        """`reply_to` for a connection from address `client`, with any unexpected failure answered (and logged)
+        instead of ending the connection."""
         try:
-            return reply_to(item, self.answer)
+            return reply_to(item, partial(self.answer, client=client))
         except Exception:
             log.exception("GSPro Open Connect: answering a message failed")
             return Replied(GSProReply(Code=500, Message=INTERNAL_ERROR), False)
@@ -290,6 +298,7 @@ class Connection(asyncio.Protocol):
         self._unread: asyncio.TimerHandle | None = None  # UNREAD_LIMIT_S of replies left unread
         self._ending: asyncio.TimerHandle | None = None  # LINGER_S after a refusal
         self._lingered = 0  # bytes dropped since the refusal
+        self.client = ""  # the connector's address (`connection_made`): its shots' share of the session memory
         self.admitted = time.monotonic()
         self.last_message: float | None = None
 
@@ -304,6 +313,8 @@ class Connection(asyncio.Protocol):
 
     def connection_made(self, transport: asyncio.Transport) -> None:
         self.transport = transport
+        peer = transport.get_extra_info("peername")
+        self.client = peer[0] if isinstance(peer, tuple) and peer else ""
         self.server.admit(self)
         if self in self.server.connections:
             self.server.events.info(f"a connector connected from {_peer(transport)} "
@@ -397,7 +408,7 @@ class Connection(asyncio.Protocol):
         if not self.messages.take():
             self.server.refuse(self, "a connector sent messages too fast: closed", self.limits.too_many_messages())
             return
-        reply, valid = self.server.reply(item)
+        reply, valid = self.server.reply(item, self.client)
         if valid:
             self.last_message = time.monotonic()
         if reply is not None:

@@ -19,6 +19,7 @@ import asyncio
 import itertools
 import time
 from collections import Counter, deque
+from collections.abc import ValuesView
 from dataclasses import dataclass
 from typing import Literal
 
@@ -137,7 +138,7 @@ class ShotFeed:
         self._next_id = 1
 
     @property
-    def session(self) -> deque[SessionShot]:
+    def session(self) -> ValuesView[SessionShot]:
         """The current session's shots kept, oldest first."""
         return self.sessions.current.shots
 
@@ -161,9 +162,10 @@ class ShotFeed:
         return tuple(self._viewers)
 
     def publish(self, source: Source, request: ShotRequest, result: ShotResult, states: EulerStates | None,
-                flight_time_s: float, **details) -> Entry:
+                flight_time_s: float, client: str = "", **details) -> Entry:
         """A shot flown: its request as flown, its result (trajectory and normalized flight left out: the states
-        are the path) and the states it was read from; `details` are Entry's shot_number, player, putt, club_data."""
+        are the path) and the states it was read from, from address `client` (its share of the session memory);
+        `details` are Entry's shot_number, player, putt, club_data."""
         result = result.model_copy(update={"trajectory": None, "normalized": None})
         session = self.sessions.current
         entry = Entry(self._next_id, source, time.time(), request, result, states, flight_time_s, **details,
@@ -171,7 +173,7 @@ class ShotFeed:
         self._next_id += 1
         self._history.append(entry)
         self.sessions.add(SessionShot(entry.id, entry.received_unix_s, source, entry.shot_number, entry.player,
-                                      entry.putt, request, result))
+                                      entry.putt, request, result, client=client))
         for viewer in self._viewers:
             viewer.offer(entry)
         return entry

@@ -134,10 +134,11 @@ class BayRuntime:
         return {name: report() for name, report in self._reporters.items()}
 
     def fly(self, request: ShotRequest, source: Source, *, show: bool = True, shot_number: int | None = None,
-            club_data: dict | None = None, flat: bool = True) -> Flown:
+            club_data: dict | None = None, flat: bool = True, client: str = "") -> Flown:
         """Fly `request` in the bay's conditions where it gives none of its own; with `show`, publish it to the
-        screens with the states it was read from. A connector's shot with the putter selected is a putt. NotReady
-        before the model is loaded; FlightError when it cannot land."""
+        screens with the states it was read from, in the session memory's share of `source` and address `client`.
+        A connector's shot with the putter selected is a putt. NotReady before the model is loaded; FlightError
+        when it cannot land."""
         engine = self._ready_engine()
         bay = self._bay.conditions
         request = in_bay(request, bay)
@@ -151,26 +152,27 @@ class BayRuntime:
         entry = None
         if show:
             entry = self._feed.publish(source, request, result, flight.states, flight.flight_time_s,
-                                      shot_number=shot_number, player=player, putt=putt,
+                                      client, shot_number=shot_number, player=player, putt=putt,
                                       club_data=club_data)
         return Flown(request, result, flight, entry)
 
-    def fly_gspro(self, message: GSProMessage, source: Source = "gspro-http") -> GSProReply:
-        """A connector's shot (a message with BallData), over HTTP or TCP alike: Code 200 with its flight in the
-        bay, shown on its screens; Code 500 saying why it cannot fly; Code 503 until the model is ready (the codes of
-        `contract.refusals.FAILURES`)."""
+    def fly_gspro(self, message: GSProMessage, source: Source = "gspro-http", client: str = "") -> GSProReply:
+        """A connector's shot (a message with BallData) from address `client`, over HTTP or TCP alike: Code 200 with
+        its flight in the bay, shown on its screens; Code 500 saying why it cannot fly; Code 503 until the model is
+        ready (the codes of `contract.refusals.FAILURES`)."""
         try:
             flown = self.fly(shot_request(message), source, shot_number=message.ShotNumber,
-                             club_data=message.ClubData)
+                             club_data=message.ClubData, client=client)
         except (ValueError, GolfflightError) as error:  # ValueError: pydantic's, for a message's values
             return failed_reply(message, error)
         return shot_reply(message, flown.result)
 
-    async def fly_batch(self, body: bytes, show: bool) -> bytes:
+    async def fly_batch(self, body: bytes, show: bool, client: str = "") -> bytes:
         """A raw batch request body's encoded BatchResult, read, validated and flown in the batch process (the bay's
         conditions filled in where a shot gives none); with `show`, its last shots go to the screens with the states
-        they came from. RequestRefused with its 422 details when the body is invalid or asks for too many trajectory
-        points; BatchProcessDied when the batch process died under it."""
+        they came from, in the session memory's share of address `client`. RequestRefused with its 422 details when
+        the body is invalid or asks for too many trajectory points; BatchProcessDied when the batch process died
+        under it."""
         self._ready_engine()
         bay = self._bay.conditions
         filled = bay if any(getattr(bay, name) is not None for name in CONDITION_FIELDS) else None
@@ -180,7 +182,7 @@ class BayRuntime:
         self._record_simulation("batch", answer.seconds)
         self._metrics.batch_shots.observe(answer.shots)
         for _, (shot, result, states, flight_time_s) in sorted(answer.shown.items()):
-            self._feed.publish("batch", shot, result, states, flight_time_s)
+            self._feed.publish("batch", shot, result, states, flight_time_s, client)
         return answer.body
 
     def latency(self) -> dict:

@@ -1,16 +1,17 @@
 """The bay's sessions: each a player's run of shots, the one the bay's shots go to now the last started. The service
 starts with session 1; POST /v1/sessions starts the next (`ShotFeed.start_session` also empties the screens).
 
-Memory is bounded over all sessions: at most MAX_SHOTS shots are kept (the oldest shot of the oldest session with
-shots goes first, counted as dropped in its session), and at most MAX_SESSIONS sessions (starting one more forgets the
-oldest, with its shots). Each session keeps its clubs' running sums (`club_stats`), updated as shots come and go, so
+Memory is bounded over all sessions: at most MAX_SHOTS shots are kept, shared among their sources (`shares`: the
+oldest shot of the source holding the most goes first, counted as dropped in its session), and at most MAX_SESSIONS
+sessions (starting one more forgets the oldest, with its shots). Each session keeps its clubs' running sums (`club_stats`), updated as shots come and go, so
 its summary never walks its shots. Everything here runs on the service's event loop thread.
 """
 
 from __future__ import annotations
 
 import time
-from collections import OrderedDict, deque
+from collections import OrderedDict
+from collections.abc import ValuesView
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -19,12 +20,16 @@ from golfflight.contract.requests import ShotRequest
 from golfflight.contract.results import ShotResult
 from golfflight.contract.session import ClubSummary, SessionInfo, SessionList, SessionSummary
 from golfflight.service.runtime.club_stats import ELLIPSE_PROBABILITY, ClubStats, figures
+from golfflight.service.runtime.shares import SourceShares
 
 if TYPE_CHECKING:
     from golfflight.service.runtime.feed import Source
 
 MAX_SHOTS = 10_000
-"""Shots kept over all sessions (their CSV and summaries): a long range session; about 4 kB each, 40 MB in all."""
+"""Shots kept over all sessions (their CSV and summaries): a long range session; about 4 kB each, 40 MB in all. Past
+it, the source holding the most shots (`SessionShot.share`: where they came in and from which address) lets its
+oldest go, so no source's flood can push out the shots of one that holds fewer: before (issue 55) the oldest shot
+of all went first, and 8 connections at 600 shots a second emptied an older session of 300 shots in 18 s."""
 
 MAX_SESSIONS = 100
 """Sessions kept: starting one more forgets the oldest, and its shots."""
@@ -41,6 +46,13 @@ class SessionShot(NamedTuple):
     request: ShotRequest
     result: ShotResult
     session: int = 0
+    client: str = ""
+
+    @property
+    def share(self) -> tuple[str, str]:
+        """The share of the session memory it counts in: where it came in and the address it came from (a connector's
+        connections from one machine share one; a proxy's clients share its address)."""
+        return self.source, self.client
 
 
 ClubKey = tuple[str | None, bool]
@@ -61,24 +73,29 @@ def _bag_place(key: ClubKey) -> tuple[int, int]:
 
 @dataclass(eq=False)
 class Session:
-    """One session: who and since when, its shots kept (oldest first), how many were dropped by the cap, and its
-    clubs' running sums."""
+    """One session: who and since when, its shots kept (by id, oldest first), how many were dropped by the cap, and
+    its clubs' running sums."""
 
     id: int
     player: str | None
     started_unix_s: float
-    shots: deque[SessionShot] = field(default_factory=deque)
+    kept: dict[int, SessionShot] = field(default_factory=dict)
     dropped: int = 0
     clubs: dict[ClubKey, ClubStats] = field(default_factory=dict)
 
+    @property
+    def shots(self) -> ValuesView[SessionShot]:
+        """Its shots kept, oldest first."""
+        return self.kept.values()
+
     def add(self, shot: SessionShot) -> None:
-        self.shots.append(shot)
+        self.kept[shot.id] = shot
         key, numbers = _club_of(shot), figures(shot.result)
         self.clubs.setdefault(key, ClubStats(numbers)).add(numbers)
 
-    def drop_oldest(self) -> None:
-        """Let the oldest shot go (the cap): out of the shots and out of its club's sums."""
-        shot = self.shots.popleft()
+    def drop(self, shot: SessionShot) -> None:
+        """Let a shot go (the cap): out of the shots and out of its club's sums."""
+        del self.kept[shot.id]
         self.dropped += 1
         key = _club_of(shot)
         stats = self.clubs[key]
@@ -108,6 +125,7 @@ class Sessions:
         self._kept: OrderedDict[int, Session] = OrderedDict()
         self._next_id = 1
         self._shots = 0
+        self._shares = SourceShares()
         self.start(None)
 
     @property
@@ -122,6 +140,7 @@ class Sessions:
         while len(self._kept) > self.max_sessions:
             _, forgotten = self._kept.popitem(last=False)
             self._shots -= len(forgotten.shots)
+            self._shares.drop_session(forgotten.id)
         return session
 
     def get(self, session_id: int | None) -> Session | None:
@@ -129,12 +148,14 @@ class Sessions:
         return self.current if session_id is None else self._kept.get(session_id)
 
     def add(self, shot: SessionShot) -> None:
-        """A shot of the current session; past `max_shots`, the oldest kept shot goes."""
-        self.current.add(shot._replace(session=self.current.id))
+        """A shot of the current session; past `max_shots`, the oldest shot of the source holding the most goes."""
+        shot = shot._replace(session=self.current.id)
+        self.current.add(shot)
+        self._shares.add(shot.share, shot)
         self._shots += 1
         while self._shots > self.max_shots:
-            oldest = next(s for s in self._kept.values() if s.shots)
-            oldest.drop_oldest()
+            dropped = self._shares.largest_oldest()
+            self._kept[dropped.session].drop(dropped)
             self._shots -= 1
 
     def listing(self) -> SessionList:

@@ -6,6 +6,7 @@ from fastapi import APIRouter, Request
 from fastapi.responses import Response
 from golfflight.contract.gspro import GSProMessage, GSProReply
 from golfflight.contract.refusals import FAILURES
+from golfflight.service.api.client_address import client_address
 from golfflight.service.api.direct import DirectRoute
 from golfflight.service.api.paths import GSPRO_PATH
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
@@ -35,5 +36,5 @@ async def gspro(message: GSProMessage, http: Request) -> Response:
     if message.BallData is None:
         nothing = GSProReply(Code=200, Message="no ball data: nothing to fly", ShotNumber=message.ShotNumber)
         return json_response(nothing)
-    reply = runtime_of(http).fly_gspro(message)
+    reply = runtime_of(http).fly_gspro(message, client=client_address(http))
     return json_response(reply, GSPRO_STATUS[reply.Code])

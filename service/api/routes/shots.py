@@ -9,6 +9,7 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import Response
 from golfflight.contract.requests import MAX_BATCH_SHOTS, MAX_BATCH_TRAJECTORIES, BatchRequest, ShotRequest
 from golfflight.contract.results import BatchResult, ShotResult
+from golfflight.service.api.client_address import client_address
 from golfflight.service.api.direct import DirectRoute, RawBodyRoute
 from golfflight.service.api.routes.responses import ERROR_RESPONSES, json_response
 from golfflight.service.runtime import runtime_of
@@ -32,13 +33,13 @@ async def shot(request: ShotRequest, http: Request, viewer: bool = ShowOnViewer)
     """Fly one shot: launch in SI or launch-monitor units, optional wind, air, ground, normalized and trajectory;
     the bay's conditions (GET /v1/bay) where the shot gives none."""
     # `request` was validated once (`service.api.direct`); the runtime comes from the app (`runtime_of`)
-    return json_response(runtime_of(http).fly(request, "http", show=viewer).result)
+    return json_response(runtime_of(http).fly(request, "http", show=viewer, client=client_address(http)).result)
 
 
 async def batch(request: BatchRequest, http: Request, viewer: bool = ShowOnViewer) -> Response:
     """The batch process reads, validates and flies the raw body (the bay's conditions filled in where a shot gives
     none) or refuses it; `request` gives FastAPI the schema and is None on the direct path (`RawBodyRoute`)."""
-    body = await runtime_of(http).fly_batch(await http.body(), show=viewer)
+    body = await runtime_of(http).fly_batch(await http.body(), show=viewer, client=client_address(http))
     return Response(body, media_type="application/json")
 
 
