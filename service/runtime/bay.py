@@ -90,13 +90,16 @@ class Bay:
             self._refresh()
             return self._problem
 
-    def _file_stamp(self) -> tuple[int, int, int] | None:
-        """When, how long and which file (a replaced file is another inode): a change of any is read again."""
+    def _file_stamp(self) -> tuple[int, int, int, int] | None:
+        """When its content and when its inode last changed, how long and which file (a replaced file is another
+        inode): a change of any is read again. The inode's change time (ctime) moves with a chmod or chown too, so
+        a file made unreadable (`chmod 000`) is reported at once, and one made readable again heals; with the
+        content's time alone, neither was noticed (issue 55)."""
         try:
             info = self.path.stat()
         except OSError:
             return None
-        return info.st_mtime_ns, info.st_size, info.st_ino
+        return info.st_mtime_ns, info.st_ctime_ns, info.st_size, info.st_ino
 
     def _refresh(self) -> None:
         """Re-read the bay file if it changed since it was last read or written; a file that is gone or broken
