@@ -1,8 +1,8 @@
 """Each source's share of the session memory (issue 55, item 9): the shot cap used to let the oldest shot of all go
 first, so one connector's flood (8 connections at 600 shots a second) emptied an older session of another's shots.
 Now the source holding the most lets its own oldest go. The whole service on loopback: a connector on 127.0.0.2
-and HTTP shots from 127.0.0.1 play a session, then a flood from 127.0.0.1 on 8 Open Connect connections sends three times the cap (here 120
-shots: the same rule as the shipped 10,000, met in a second instead of half a minute)."""
+and HTTP shots from 127.0.0.1 play a session, then a flood from 127.0.0.1 on 8 Open Connect connections sends three
+times the cap (here 120 shots: the same rule as the shipped 10,000, met in a second instead of half a minute)."""
 
 from __future__ import annotations
 

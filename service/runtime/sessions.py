@@ -3,8 +3,9 @@ starts with session 1; POST /v1/sessions starts the next (`ShotFeed.start_sessio
 
 Memory is bounded over all sessions: at most MAX_SHOTS shots are kept, shared among their sources (`shares`: the
 oldest shot of the source holding the most goes first, counted as dropped in its session), and at most MAX_SESSIONS
-sessions (starting one more forgets the oldest, with its shots). Each session keeps its clubs' running sums (`club_stats`), updated as shots come and go, so
-its summary never walks its shots. Everything here runs on the service's event loop thread.
+sessions (starting one more forgets the oldest, with its shots). Each session keeps its clubs' running sums
+(`club_stats`), updated as shots come and go, so its summary never walks its shots. Everything here runs on the
+service's event loop thread.
 """
 
 from __future__ import annotations
