@@ -30,24 +30,8 @@ import httpx
 from bench_hostile import start_service
 from common import REPO
 
-FLOOD = """
-import select, socket, sys
-port = int(sys.argv[1])
-opened = lambda: socket.create_connection(("127.0.0.1", port))
-sockets = [opened() for _ in range(20)]
-print("connected", flush=True)
-while True:
-    for sock in select.select(sockets, [], [], 0.05)[0]:
-        try:
-            data = sock.recv(65536)
-        except OSError:
-            data = b""
-        if not data:
-            sock.close()
-            sockets[sockets.index(sock)] = opened()
-"""
-"""20 sockets that send nothing, each connecting again as soon as it is closed (it reads only to see the close)."""
-
+FLOOD = Path(__file__).with_name("silent_flood.py")
+"""20 sockets that send nothing, each connecting again as soon as it is closed."""
 
 FLOOD_SHOTS = 10_500
 """The flood's shots: past the 10,000 the sessions keep."""
@@ -86,7 +70,7 @@ def waiting_connector(base: str, port: int, trials: int) -> tuple[int, int]:
     waited = at_once = 0
     for trial in range(trials):
         connector = connected(port)
-        flood = subprocess.Popen([sys.executable, "-c", FLOOD, str(port)], stdout=subprocess.PIPE)
+        flood = subprocess.Popen([sys.executable, str(FLOOD), str(port)], stdout=subprocess.PIPE)
         flood.stdout.readline()
         goal, deadline = evicted(base) + 64, time.monotonic() + 20
         while evicted(base) < goal and time.monotonic() < deadline:

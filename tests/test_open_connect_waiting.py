@@ -9,6 +9,7 @@ from __future__ import annotations
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 from golfflight.service.open_connect.limits import MAX_CONNECTIONS, WAITING_KEPT
 
@@ -18,30 +19,13 @@ from tests.test_open_connect_limits import Served, refusal, served, until_closed
 FLOOD_SOCKETS = 20
 """The flood's sockets: more than the places, so that it always has one waiting to take a place."""
 
-FLOOD = """
-import select, socket, sys
-port, count = int(sys.argv[1]), int(sys.argv[2])
-opened = lambda: socket.create_connection(("127.0.0.1", port))
-sockets = [opened() for _ in range(count)]
-print("connected", flush=True)
-while True:
-    readable, _, _ = select.select(sockets, [], [], 0.05)
-    for sock in readable:
-        try:
-            data = sock.recv(65536)
-        except OSError:
-            data = b""
-        if not data:
-            sock.close()
-            sockets[sockets.index(sock)] = opened()
-"""
-"""Holds `count` sockets to the port, sending nothing, and connects again as soon as one is closed (it reads only
-to see the close)."""
+FLOOD = Path(__file__).resolve().parents[1] / "benchmarks" / "silent_flood.py"
+"""Holds sockets to the port, sending nothing, and connects again as soon as one is closed."""
 
 
 def flooding(port: int) -> subprocess.Popen:
     """The flood's process, once all its sockets are connected."""
-    flood = subprocess.Popen([sys.executable, "-c", FLOOD, str(port), str(FLOOD_SOCKETS)], stdout=subprocess.PIPE)
+    flood = subprocess.Popen([sys.executable, str(FLOOD), str(port), str(FLOOD_SOCKETS)], stdout=subprocess.PIPE)
     assert flood.stdout.readline() == b"connected\n"
     return flood
 

@@ -30,10 +30,6 @@ class SourceShares:
         self._holding: dict[int, dict[Hashable, None]] = {}  # a count -> the sources holding it, in arrival order
         self._most = 0
 
-    def __len__(self) -> int:
-        """Sources holding shots."""
-        return len(self._shots)
-
     def add(self, source: Hashable, shot: Shot) -> None:
         """A new shot of `source`, its newest."""
         kept = self._shots.setdefault(source, deque())
