@@ -9,10 +9,9 @@ player reaches every connector as Code 201 player information.
 
 from __future__ import annotations
 
-from functools import partial
-
 import asyncio
 from contextlib import asynccontextmanager
+from functools import partial
 
 from fastapi import FastAPI
 from golfflight.contract.bay import Player

@@ -281,9 +281,10 @@ class ObjectFramer:
 
     def _message_inside(self, began: int, found: list[bytes | Refused]) -> bool:
         """Whether the object that just closed inside the open one (`began` there; the caller looks only at members
-        less than MEMBER_DEPTH deep) is a whole message of its own: its first key is one of a message's own, which no member of a message
-        has, and it is valid JSON. Then the open object was cut right after a key's colon, where an object may
-        begin, and a new message followed at once: the cut object is given up (one refusal) and the message found."""
+        less than MEMBER_DEPTH deep) is a whole message of its own: its first key is one of a message's own, which
+        no member of a message has, and it is valid JSON. Then the open object was cut right after a key's colon,
+        where an object may begin, and a new message followed at once: the cut object is given up (one refusal) and
+        the message found."""
         if self._oversized or not _MESSAGE_START.match(self._object, began):
             return False
         member = bytes(self._object[began:])

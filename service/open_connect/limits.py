@@ -34,12 +34,13 @@ WAITING_KEPT = 4
 """Connections with no valid message yet that keep their places against new connections: the WAITING_KEPT that
 connected first. A real connector connects when it starts and sends nothing until the golfer hits (minutes), and
 nothing on the wire tells it from a socket held idle; what does is that it stays, while a flood's sockets come and
-go. So a connector that connected before a flood keeps its place however long it waits, while the other silent
-connections (the newer ones) give way, the oldest of them first: a connector that connects during a flood of
-sockets that never send a valid message still gets MAX_CONNECTIONS - WAITING_KEPT - 1 = 11 newer connections' time
-to send its first message, after which its place is kept as any playing connector's. Four covers a bay's connector,
-its reconnect overlapping the old connection, and a second program on the bay; more would let sockets held idle
-before anyone connects shrink what newcomers share (16 - 4 = 12 places), fewer would drop a waiting connector."""
+go. So a connector that connected before a flood (among the first WAITING_KEPT silent ones) keeps its place however
+long it waits, while the other silent connections (the newer ones) give way, the oldest of them first: a connector
+that connects during a flood of sockets that never send a valid message still gets MAX_CONNECTIONS - WAITING_KEPT -
+1 = 11 newer connections' time to send its first message, after which its place is kept as any playing connector's.
+Four covers a bay's connector, its reconnect overlapping the old connection and one more; more would let sockets
+held idle before anyone connects shrink what newcomers share (16 - 4 = 12 places), fewer would drop a waiting
+connector sooner."""
 
 PROTECTED_S = 60.0
 """How long a valid message (a shot, a heartbeat, any message that validates) keeps its connection's place against

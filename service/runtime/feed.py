@@ -33,7 +33,8 @@ HISTORY = 50
 """Shots kept for viewers that open (or reconnect) later, and the length of each viewer's queue."""
 
 SESSION_SHOTS = MAX_SHOTS
-"""Shots kept over all sessions for their downloads (GET /v1/session.csv) and summaries; the oldest go first."""
+"""Shots kept over all sessions for their downloads (GET /v1/session.csv) and summaries; past it, the source holding
+the most lets its oldest go (`sessions`)."""
 
 MAX_VIEWERS = 16
 """Event streams open at once (a bay has a screen or two; 16 leaves room for a venue's screens and a page's reconnect
