@@ -8,6 +8,8 @@ Starts `golfflight serve --port P --connect-port Q` of this checkout (or of --tr
     send a message; once they have gone round every place four times (64 evictions), 0.3 s on, the connector sends
     its first shot: answered Code 200, or pushed out (Code 503) before it could;
 (b) with that flood running, a connector that connects and sends its shot at once: Code 200 or not;
+(e) the flood from 127.0.0.3 instead; once it has gone round every place (16 evictions), a connector on 127.0.0.1
+    connects; 64 evictions and 0.3 s on, it sends its first shot: Code 200 or not;
 (c) 16 event streams opened and never read, then one more: does it get its stream (200) or a 503;
 (d) a connector on 127.0.0.2 plays 300 shots in session 1; session 2 starts; 8 connections from 127.0.0.1 send
     shots back to back (connecting again when closed for their rate) until 10,500 are answered, past the 10,000
@@ -64,17 +66,28 @@ def evicted(base: str) -> int:
     return httpx.get(base + "/healthz", timeout=10).json()["open_connect"]["evicted"]
 
 
+def flooding(port: int, source: str) -> subprocess.Popen:
+    """The flood from address `source`, once its sockets are connected."""
+    flood = subprocess.Popen([sys.executable, str(FLOOD), str(port), "20", source], stdout=subprocess.PIPE)
+    flood.stdout.readline()
+    return flood
+
+
+def evicted_past(base: str, count: int) -> None:
+    """Wait until `count` more connections have given their places (or 20 s)."""
+    goal, deadline = evicted(base) + count, time.monotonic() + 20
+    while evicted(base) < goal and time.monotonic() < deadline:
+        time.sleep(0.02)
+
+
 def waiting_connector(base: str, port: int, trials: int) -> tuple[int, int]:
     """(a) and (b): Code 200s of `trials` connectors that connected first and waited, and of `trials` that
     connected during the flood and sent at once."""
     waited = at_once = 0
     for trial in range(trials):
         connector = connected(port)
-        flood = subprocess.Popen([sys.executable, str(FLOOD), str(port)], stdout=subprocess.PIPE)
-        flood.stdout.readline()
-        goal, deadline = evicted(base) + 64, time.monotonic() + 20
-        while evicted(base) < goal and time.monotonic() < deadline:
-            time.sleep(0.02)
+        flood = flooding(port, "127.0.0.1")
+        evicted_past(base, 64)
         time.sleep(0.3)
         waited += code_of(connector, trial) == 200
         newcomer = connected(port)
@@ -84,6 +97,22 @@ def waiting_connector(base: str, port: int, trials: int) -> tuple[int, int]:
         flood.kill()
         flood.wait()
     return waited, at_once
+
+
+def joined_during_flood(base: str, port: int, trials: int) -> int:
+    """(e): Code 200s of `trials` connectors that connected during a flood from another address and waited."""
+    waited = 0
+    for trial in range(trials):
+        flood = flooding(port, "127.0.0.3")
+        evicted_past(base, 16)
+        connector = connected(port)
+        evicted_past(base, 64)
+        time.sleep(0.3)
+        waited += code_of(connector, trial) == 200
+        connector.close()
+        flood.kill()
+        flood.wait()
+    return waited
 
 
 def viewer_places(base: str) -> int:
@@ -143,6 +172,8 @@ def main() -> None:
         waited, at_once = waiting_connector(base, port, args.trials)
         print(f"(a) connected first, first shot 0.3 s after 64 evictions: {waited} of {args.trials} Code 200")
         print(f"(b) connected during the flood, shot at once: {at_once} of {args.trials} Code 200")
+        waited = joined_during_flood(base, port, args.trials)
+        print(f"(e) connected during a flood from another address, waited: {waited} of {args.trials} Code 200")
         print(f"(c) a 17th event stream past 16 held unread: HTTP {viewer_places(base)}")
         played, kept, answered = session_kept(base, port, args.flood_s)
         print(f"(d) session 1's {played} shots: {kept} kept after {answered} flood shots from another address")

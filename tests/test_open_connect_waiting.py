@@ -2,10 +2,12 @@
 it starts and sends nothing until the golfer hits. Under a flood of sockets that never send a valid message,
 connecting again whenever closed (a program in a process of its own), the connector that connected first keeps its
 place however long it waits, and a connector that connects during the flood and sends its shot at once still gets
-in. Real TCP sockets on loopback against a real `OpenConnectServer` (`Served`)."""
+in; one that connects during a flood from another address keeps its place while it waits. Real TCP sockets on
+loopback against a real `OpenConnectServer` (`Served`)."""
 
 from __future__ import annotations
 
+import socket
 import subprocess
 import sys
 import time
@@ -23,9 +25,10 @@ FLOOD = Path(__file__).resolve().parents[1] / "benchmarks" / "silent_flood.py"
 """Holds sockets to the port, sending nothing, and connects again as soon as one is closed."""
 
 
-def flooding(port: int) -> subprocess.Popen:
-    """The flood's process, once all its sockets are connected."""
-    flood = subprocess.Popen([sys.executable, str(FLOOD), str(port), str(FLOOD_SOCKETS)], stdout=subprocess.PIPE)
+def flooding(port: int, source: str = "127.0.0.1") -> subprocess.Popen:
+    """The flood's process from address `source`, once all its sockets are connected."""
+    command = [sys.executable, str(FLOOD), str(port), str(FLOOD_SOCKETS), source]
+    flood = subprocess.Popen(command, stdout=subprocess.PIPE)
     assert flood.stdout.readline() == b"connected\n"
     return flood
 
@@ -66,3 +69,17 @@ def test_the_first_connections_keep_their_places_the_newer_ones_give_way_oldest_
     for number, sock in enumerate(first):  # still connected: their first shots are answered
         played(sock, 100 + number)
     close_all([*first, *newer])
+
+
+def test_a_connector_that_connects_during_a_flood_from_another_address_keeps_its_place_while_it_waits(served):
+    flood = flooding(served.port, "127.0.0.3")
+    try:
+        evicted_past(served, MAX_CONNECTIONS)
+        waiting = socket.create_connection(("127.0.0.1", served.port), timeout=5)  # the bay's own connector
+        evicted_past(served, 4 * MAX_CONNECTIONS)  # the flood's own sockets give way to each other
+        time.sleep(0.3)
+        played(waiting, 5)
+        waiting.close()
+    finally:
+        flood.kill()
+        flood.wait()

@@ -35,9 +35,11 @@ WAITING_KEPT = 4
 connected first. A real connector connects when it starts and sends nothing until the golfer hits (minutes), and
 nothing on the wire tells it from a socket held idle; what does is that it stays, while a flood's sockets come and
 go. So a connector that connected before a flood (among the first WAITING_KEPT silent ones) keeps its place however
-long it waits, while the other silent connections (the newer ones) give way, the oldest of them first: a connector
-that connects during a flood of sockets that never send a valid message still gets MAX_CONNECTIONS - WAITING_KEPT -
-1 = 11 newer connections' time to send its first message, after which its place is kept as any playing connector's.
+long it waits, while the other silent connections (the newer ones) give way: the oldest of those of the address
+that holds the most of them. A flood's sockets from one address so push out only their own, and a connector on
+another address that connects during the flood keeps its place while it waits too; one on the flood's own address
+(loopback, say) still gets MAX_CONNECTIONS - WAITING_KEPT - 1 = 11 newer connections' time to send its first
+message, after which its place is kept as any playing connector's.
 Four covers a bay's connector, its reconnect overlapping the old connection and one more; more would let sockets
 held idle before anyone connects shrink what newcomers share (16 - 4 = 12 places), fewer would drop a waiting
 connector sooner."""
@@ -48,7 +50,7 @@ new connections once all MAX_CONNECTIONS are taken. Nothing is closed for being 
 may not hit for minutes and some connectors send no heartbeat, so any idle timeout would drop real connectors. Under
 pressure, a connection that never sent a valid message (an idle socket, one trickling bytes that never make a
 message, a new connection that has sent nothing yet) gives way first: those past the WAITING_KEPT that connected
-first, the oldest of them first; then those WAITING_KEPT, the newest first; then one quiet longer than this, the
+first, the oldest of the address holding the most of them first; then those WAITING_KEPT, the newest first; then one quiet longer than this, the
 quietest first. A minute covers a connector's heartbeats (every few seconds) and a golfer's shots, so a flood of new
 connections cannot push out a bay that is playing."""
 

@@ -30,12 +30,12 @@ The turns also keep `answer` on the loop the rest of the service runs on, so it 
 Places: MAX_CONNECTIONS connections are served at once, and nothing is closed for being quiet (a golfer may not hit
 for minutes; some connectors send no heartbeat). A new connection when every place is taken is admitted on
 probation: it takes the place of the connection that gives way first (`OpenConnectServer._giving_way`: of those that
-never sent a valid message, the oldest past the `limits.WAITING_KEPT` that connected first, then those kept, the
-newest first; then the quietest), which gets Code 503 saying why and a close; a connection with a valid message in
+never sent a valid message, past the `limits.WAITING_KEPT` that connected first, the oldest of the address holding
+the most; then those kept, the newest first; then the quietest), which gets Code 503 saying why and a close; a connection with a valid message in
 the last `limits.PROTECTED_S` never gives way, and when all are so, the new one is refused instead. So sixteen
 sockets held idle, or trickling bytes that make no message, lose their places to the next connector; a flood of new
 connections pushes out only its own (they never send a message), never a connector that is playing nor one that
-connected before it and waits for its golfer. A program that sends valid messages on sixteen sockets looks like
+connected before it and waits for its golfer, nor, from another address, one that connected during it. A program that sends valid messages on sixteen sockets looks like
 sixteen connectors: with no authentication, nothing tells them apart.
 """
 
@@ -45,7 +45,7 @@ import asyncio
 import logging
 import socket
 import time
-from collections import deque
+from collections import Counter, deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -197,7 +197,7 @@ class OpenConnectServer:
     def admit(self, connection: Connection) -> None:
         """Serve a new connection (its buffers bounded), in the place of one that gives way when MAX_CONNECTIONS
         are served already (`_make_room`), or refuse it when none does."""
-        if len(self.connections) >= self.limits.max_connections and not self._make_room():
+        if len(self.connections) >= self.limits.max_connections and not self._make_room(connection):
             logged = f"a connection refused, {self.limits.max_connections} connected already, each of them playing"
             self.refuse(connection, logged, self.limits.too_many_connections())
             return
@@ -209,8 +209,8 @@ class OpenConnectServer:
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, self.limits.receive_buffer_bytes)
         transport.set_write_buffer_limits(high=self.limits.unread_reply_bytes)
 
-    def _make_room(self) -> bool:
-        """Free a place for a new connection: end one closing already (its connector left, or it was dropped), or
+    def _make_room(self, new: Connection) -> bool:
+        """Free a place for the `new` connection: end one closing already (its connector left, or it was dropped), or
         close the one that gives way first (Code 503 saying why); False when every connection is protected (a valid
         message in the last `limits.PROTECTED_S`)."""
         leaving = next((connection for connection in self.connections if connection.transport.is_closing()), None)
@@ -219,7 +219,7 @@ class OpenConnectServer:
             self.connections.discard(leaving)
             return True
         now = time.monotonic()
-        quitting = self._giving_way(now)
+        quitting = self._giving_way(now, new.client)
         if quitting is None:
             return False
         self.events.warning("a connection closed to make room for a new one")
@@ -227,14 +227,17 @@ class OpenConnectServer:
         quitting.refuse(self.limits.evicted(now - quitting.last_heard, quitting.last_message is not None))
         return True
 
-    def _giving_way(self, now: float) -> Connection | None:
-        """The connection that gives its place to a new one: of those with no valid message yet, the oldest past the
-        `limits.WAITING_KEPT` that connected first, else the newest of those; else the quietest unprotected one that
-        sent one; None when every connection is protected."""
+    def _giving_way(self, now: float, client: str) -> Connection | None:
+        """The connection that gives its place to a new one from address `client`: of those with no valid message
+        yet, past the `limits.WAITING_KEPT` that connected first, the oldest of the address holding the most of
+        them (the new one counted with its own); else the newest of those kept; else the quietest unprotected one
+        that sent one; None when every connection is protected."""
         waiting = sorted((c for c in self.connections if c.last_message is None), key=lambda c: c.admitted)
         kept, newer = waiting[: self.limits.waiting_kept], waiting[self.limits.waiting_kept :]
         if newer:
-            return newer[0]
+            held = Counter(c.client for c in newer)
+            held[client] += 1
+            return max(newer, key=lambda c: held[c.client])  # the first (oldest) of the most held
         if kept:
             return kept[-1]
         exposed = [c for c in self.connections if not c.protected(now)]
