@@ -63,7 +63,7 @@ one is read."""
 PIECE_BYTES = 1024
 """Input framed at a time. Framing is pure Python for anything but one whole object in one piece: 1 KiB of the
 cheapest objects to send (`{"a":{}}`, 128 of them) takes about 0.6 ms on the 2-core machine, 1.4 times that since
-the framer finds a new object after an unfinished one (issue 55: docs/reliability.md § 8), a connector's shot
+the framer finds a new object after an unfinished one (issue 55: docs/reliability.md § 10), a connector's shot
 (about 600 bytes, one piece) a few microseconds."""
 TURN_S = 0.001
 """Open Connect's work (every connection's together) in one turn of the event loop, before everything else that is
