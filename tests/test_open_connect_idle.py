@@ -1,7 +1,7 @@
 """Open Connect's places (issue 42): sockets held idle, or trickling bytes that make no message, give their place to
-a new connector when every place is taken (all but the WAITING_KEPT that connected first: issue 55); a connector that has sent a valid message keeps its place against a flood
-of new connections. Real TCP sockets on loopback against a real server (`Served`, as in the limits' tests), and the
-whole service for /healthz."""
+a new connector when every place is taken (all but the WAITING_KEPT that connected first: issue 55); a connector
+that has sent a valid message keeps its place against a flood of new connections. Real TCP sockets on loopback
+against a real server (`Served`, as in the limits' tests), and the whole service for /healthz."""
 
 from __future__ import annotations
 
