@@ -39,11 +39,12 @@ def route_template(routes: list[BaseRoute], scope: dict, path: tuple[str, str] |
 
 class RequestMetrics:
     """Counts and times every HTTP request by route template, method and status; the requests on `timed_routes`
-    (the simulation routes) also go to `rolling`, /v1/latency's request window."""
+    (the simulation routes, each with its kind) also go to `rolling[kind]`, /v1/latency's request windows."""
 
-    def __init__(self, app, metrics: ServiceMetrics, routes: list[BaseRoute], rolling: Rolling, timed_routes: set[str]):
+    def __init__(self, app, metrics: ServiceMetrics, routes: list[BaseRoute], rolling: dict[str, Rolling],
+                 timed_routes: dict[str, str]):
         self.app, self.metrics, self.routes = app, metrics, routes
-        self.rolling, self.timed_routes = rolling, frozenset(timed_routes)
+        self.timed = {route: rolling[kind] for route, kind in timed_routes.items()}
         self._series: dict[tuple[str, str, int], tuple] = {}
 
     def _series_of(self, route: str, method: str, status: int) -> tuple:
@@ -80,5 +81,6 @@ class RequestMetrics:
             requests, durations = self._series_of(route, method, status)
             requests.inc()
             durations.observe(seconds)
-            if route in self.timed_routes:
-                self.rolling.add(seconds)
+            window = self.timed.get(route)
+            if window is not None:
+                window.add(seconds)

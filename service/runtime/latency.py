@@ -1,11 +1,17 @@
 """Rolling latency figures of the running service (GET /v1/latency): server-side simulation time and whole requests,
-fed by the same measurements as /metrics' histograms (`service.runtime.metrics`)."""
+single shots and batches apart, fed by the same measurements as /metrics' histograms (`service.runtime.metrics`,
+whose `kind` label they share)."""
 
 from __future__ import annotations
 
 from collections import deque
+from typing import Literal
 
 import numpy as np
+
+Kind = Literal["shot", "batch"]
+"""A single shot (POST /v1/shots, POST /v1/gspro, Open Connect over TCP) or a batch (POST /v1/shots/batch)."""
+KINDS: tuple[Kind, ...] = ("shot", "batch")
 
 WINDOW = 10_000
 """Most recent samples kept per figure."""

@@ -14,7 +14,7 @@ import gc
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Literal
+from typing import Callable
 
 from golfflight.contract.bay import CONDITION_FIELDS, PUTTER, BayConditions, Player, in_bay
 from golfflight.contract.flying import fly_request
@@ -28,7 +28,7 @@ from golfflight.flight.engine import FlightEngine, ShotFlight
 from golfflight.service.runtime.batch_process import BatchProcess
 from golfflight.service.runtime.bay import Bay
 from golfflight.service.runtime.feed import Entry, ShotFeed, Source, Viewer
-from golfflight.service.runtime.latency import Rolling
+from golfflight.service.runtime.latency import KINDS, Kind, Rolling
 from golfflight.service.runtime.metrics import ServiceMetrics
 from golfflight.service.runtime.sessions import Session
 from golfflight.weights_schema.model_card import ModelCard
@@ -77,12 +77,12 @@ class BayRuntime:
         self._bay = bay or Bay()
         self._engine: FlightEngine | None = None
         self._error: str | None = None
-        self._simulation = Rolling()
-        self._requests = Rolling()
+        self._simulation = {kind: Rolling() for kind in KINDS}
+        self._requests = {kind: Rolling() for kind in KINDS}
         self._batches = BatchProcess(bundle_dir)
         self._feed = ShotFeed()
         self._metrics = ServiceMetrics(self._model_labels)
-        self._simulation_seconds = {kind: self._metrics.simulation_seconds.labels(kind) for kind in ("shot", "batch")}
+        self._simulation_seconds = {kind: self._metrics.simulation_seconds.labels(kind) for kind in KINDS}
         self._reporters: dict[str, Callable[[], dict]] = {"batch_process": self._batches.health}
 
     def _model_labels(self) -> dict[str, str] | None:
@@ -91,10 +91,10 @@ class BayRuntime:
             return None
         return {"variant": self._engine.variant, "sha256": self._engine.sha256, "version": __version__}
 
-    def _record_simulation(self, kind: Literal["shot", "batch"], seconds: float) -> None:
-        """One simulation's engine time, into /v1/latency's window and /metrics' histogram (its two label sets
-        bound once, at start-up, not looked up per shot)."""
-        self._simulation.add(seconds)
+    def _record_simulation(self, kind: Kind, seconds: float) -> None:
+        """One simulation's engine time, into /v1/latency's window of its kind and /metrics' histogram (its two
+        label sets bound once, at start-up, not looked up per shot)."""
+        self._simulation[kind].add(seconds)
         self._simulation_seconds[kind].observe(seconds)
 
     def _ready_engine(self) -> FlightEngine:
@@ -186,15 +186,18 @@ class BayRuntime:
         return answer.body
 
     def latency(self) -> dict:
-        """GET /v1/latency: the rolling p50/p95/p99 of simulation time and of whole requests, and PROBE_SHOT flown
-        now on the served single-shot path (in standard air, shown nowhere, left out of the windows)."""
+        """GET /v1/latency: the rolling p50/p95/p99 of single shots' simulation time and whole requests, those of
+        batches apart (`batch`: one 10,000-shot batch takes seconds, and mixed in it read as every shot's p99), and
+        PROBE_SHOT flown now on the served single-shot path (in standard air, shown nowhere, left out of the
+        windows)."""
         engine = self._ready_engine()
         started = time.perf_counter()
         fly_request(engine, PROBE_SHOT)
         probe_ms = (time.perf_counter() - started) * 1e3
         return {
-            "simulation": self._simulation.summary(),
-            "request": self._requests.summary(),
+            "simulation": self._simulation["shot"].summary(),
+            "request": self._requests["shot"].summary(),
+            "batch": {"simulation": self._simulation["batch"].summary(), "request": self._requests["batch"].summary()},
             "probe": {"shot": PROBE_SHOT.model_dump(exclude_none=True), "simulation_ms": probe_ms},
         }
 
@@ -219,9 +222,9 @@ class BayRuntime:
         """GET /metrics: every metric in Prometheus's text format (every worker's, several workers sharing)."""
         return self._metrics.exposition()
 
-    def request_sinks(self) -> tuple[ServiceMetrics, Rolling]:
+    def request_sinks(self) -> tuple[ServiceMetrics, dict[Kind, Rolling]]:
         """Where the HTTP adapter counts and times each request: the Prometheus metrics and /v1/latency's request
-        window (`service.api.request_metrics`)."""
+        windows, one a kind (`service.api.request_metrics`)."""
         return self._metrics, self._requests
 
     def bay(self) -> BayConditions:
