@@ -14,35 +14,19 @@ from __future__ import annotations
 
 from typing import Literal
 
+from golfflight.contract.clubs import ClubName
 from golfflight.contract.requests import AirRequest, GroundRequest, ShotRequest, Strict, WindRequest
 from pydantic import Field
 
 CONDITION_FIELDS = ("air", "wind", "ground")
 
-GSPRO_CLUBS: dict[str, str] = {
-    "DR": "Driver",
-    **{f"W{n}": f"{n}-wood" for n in range(2, 8)},
-    **{f"H{n}": f"{n}-hybrid" for n in range(2, 8)},
-    **{f"I{n}": f"{n}-iron" for n in range(1, 10)},
-    "PW": "Pitching wedge",
-    "GW": "Gap wedge",
-    "SW": "Sand wedge",
-    "LW": "Lob wedge",
-    "PT": "Putter",
-}
-"""GSPro's club codes (Open Connect's Code 201 `Player.Club`), in the bag's order, with the name a screen shows."""
-
-PUTTER = "PT"
-"""The club code that makes a bay shot a putt: it rolls on the bay's ground from the start."""
-
-ClubCode = Literal[tuple(GSPRO_CLUBS)]
-
 
 class Player(Strict):
-    """Who is at the mat: the club selected (a GSPro club code) and the hand they play. Connectors hear of every
+    """Who is at the mat: the club selected (any name `contract.clubs` takes, kept as its GSPro code) and the hand
+    they play. Connectors hear of every
     change as Open Connect's Code 201 player information."""
 
-    club: ClubCode = Field("DR", description=f"GSPro club code: {', '.join(GSPRO_CLUBS)}")
+    club: ClubName = Field("DR", description="the club selected, as its GSPro code")
     handed: Literal["RH", "LH"] = Field("RH", description="right- or left-handed")
 
 
@@ -62,7 +46,7 @@ class BayConditions(Strict):
 class PlayerUpdate(Strict):
     """The player's fields to change; an omitted one keeps its value."""
 
-    club: ClubCode | None = Field(None, description=f"GSPro club code: {', '.join(GSPRO_CLUBS)}")
+    club: ClubName | None = Field(None, description="the club selected, as its GSPro code")
     handed: Literal["RH", "LH"] | None = None
 
 
@@ -115,3 +99,4 @@ def in_bay(shot: ShotRequest, bay: BayConditions) -> ShotRequest:
     if shot.air is not None and bay.air is not None:
         updates["air"] = air_in_bay(shot.air, bay.air)
     return shot.model_copy(update=updates) if updates else shot
+

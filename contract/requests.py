@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
+from golfflight.contract.clubs import ClubName
 from golfflight.errors import InputError
 from golfflight.flight import limits
 from golfflight.flight.conditions import NORMALIZED_HUMIDITY_PCT, NORMALIZED_TEMPERATURE_C
@@ -276,6 +277,10 @@ class ShotRequest(Strict):
     )
     trajectory: TrajectoryRequest | None = None
     ground: GroundRequest | None = None
+    club: ClubName | None = Field(
+        None, description="the club hit, if the shot is to count in its club's row of the bay's session summary (a "
+        "shot that did not come from the bay's launch monitor counts in none without one); never changes the flight"
+    )
 
     @model_validator(mode="after")
     def _one_form_each(self) -> ShotRequest:

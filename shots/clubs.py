@@ -9,8 +9,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, NamedTuple, Protocol
 
-from golfflight.errors import InputError
-
 if TYPE_CHECKING:
     import numpy as np
 
@@ -80,58 +78,10 @@ def club_weights() -> list[float]:
 
 
 CLUB_NAMES: tuple[str, ...] = tuple(club.name for club in CLUBS)
-"""The canonical club names, longest to shortest club: what the CLI, the viewer and the API show."""
-
-_NUMBERED = {"wood": (3, 5), "iron": (3, 4, 5, 6, 7, 8, 9)}
-
-GSPRO_NEAREST: dict[str, str] = {
-    **{f"w{n}": "3-wood" for n in (2, 4)},
-    **{f"w{n}": "5-wood" for n in (6, 7)},
-    **{f"h{n}": "Hybrid" for n in range(2, 8)},
-    **{f"i{n}": "3-iron" for n in (1, 2)},
-}
-"""GSPro's club codes (a bay's player) with no launch of their own here, in `club_key` form -> the nearest club
-that has one: W2 and W4 fly as the 3-wood, W6 and W7 as the 5-wood, H2-H7 as the hybrid, I1 and I2 as the 3-iron.
-The putter (PT) has no flight to start from."""
-
-CLUB_ALIASES: dict[str, str] = {
-    **{alias: "Driver" for alias in ("driver", "dr", "d", "1w", "1wood", "w1")},
-    **{
-        alias: f"{number}-{kind}"
-        for kind, numbers in _NUMBERED.items()
-        for number in numbers
-        for alias in (f"{number}{kind}", f"{number}{kind[0]}", f"{kind[0]}{number}")
-    },
-    **{alias: "Hybrid" for alias in ("hybrid", "hy", "hyb", "h", "rescue")},
-    **GSPRO_NEAREST,
-    **{alias: "PW" for alias in ("pw", "pitchingwedge", "pitching", "p")},
-    **{alias: "GW" for alias in ("gw", "gapwedge", "gap", "aw", "approachwedge", "approach", "uw", "utilitywedge")},
-    **{alias: "SW" for alias in ("sw", "sandwedge", "sand")},
-    **{alias: "LW" for alias in ("lw", "lobwedge", "lob")},
-}
-"""What a golfer types, in `club_key` form -> the canonical name: `dr`, `3w`, `7i`, `7 iron`, `7-Iron`, `pw`, `sand
-wedge`, and every GSPro club code but the putter (`DR`, `W3`, `H4`, `I7`, `PW`, ...; `GSPRO_NEAREST`). Every canonical
-name is its own alias."""
+"""The launch table's club names, longest to shortest club (`contract.clubs.FLIES_AS` names a GSPro code's)."""
 
 
-def club_key(text: str) -> str:
-    """A club name as the alias table looks it up: lower case, without spaces, hyphens, underscores or dots."""
-    return "".join(ch for ch in text.strip().lower() if ch not in " \t-_.")
-
-
-def canonical_club_name(text: str) -> str:
-    """The canonical name (`CLUB_NAMES`) of a club as a golfer types it (any case, `7i`, `7 iron`, `7-Iron`, `dr`,
-    `3w`, `pw`, ...); ValueError listing the accepted names if it is none of them."""
-    name = CLUB_ALIASES.get(club_key(text)) if isinstance(text, str) else None
-    if name is None:
-        raise InputError(
-            f"unknown club {text!r}: give one of {', '.join(CLUB_NAMES)} (any case; also short forms such as dr, 3w, "
-            "7i, 7 iron, hy, pw, gw, sw, lw)"
-        )
-    return name
-
-
-def club_named(text: str) -> ClubLaunch:
-    """The club of CLUBS a golfer's name for it means (`canonical_club_name`); ValueError listing the names if none."""
-    name = canonical_club_name(text)
+def club_launch(name: str) -> ClubLaunch:
+    """The club of CLUBS with this canonical name (`CLUB_NAMES`); which club a golfer's name means is
+    `contract.clubs`' to say."""
     return next(club for club in CLUBS if club.name == name)

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from golfflight.contract.bay import GSPRO_CLUBS
+from golfflight.contract.clubs import CLUB_ALIASES, FLIES_AS, GSPRO_CLUBS, club_code, club_key
 from golfflight.contract.inputs import air_of
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import MPH_TO_MPS
@@ -21,10 +21,11 @@ from golfflight.service.app import create_app
 from golfflight.service.settings import ServiceSettings
 from golfflight.service.viewer.page import ASSETS
 from golfflight.shots import reference_world
-from golfflight.shots.clubs import CLUB_ALIASES, CLUB_NAMES, CLUBS, canonical_club_name, club_key, club_named
+from golfflight.shots.clubs import CLUB_NAMES, CLUBS
 from golfflight.shots.reference_world import fly_reference
 
 from golfflight.cli import main
+from golfflight.commands.fly import club_named
 from tests.servers import running
 
 REPO = Path(__file__).resolve().parents[1]
@@ -158,28 +159,29 @@ def test_a_reference_shot_the_world_cannot_bring_down_is_refused_in_one_line(mon
     ]
 
 
-@pytest.mark.parametrize("typed", ["7i", "7 iron", "7-Iron", "7-iron", "7IRON", "i7", " 7 Iron "])
+@pytest.mark.parametrize("typed", ["7i", "7 iron", "7-Iron", "7-iron", "7IRON", "i7", " 7 Iron ", "I7"])
 def test_what_a_golfer_types_names_the_canonical_club(typed):
-    assert canonical_club_name(typed) == "7-iron"
+    assert club_code(typed) == "I7"
     assert club_named(typed) == next(c for c in CLUBS if c.name == "7-iron")
 
 
 def test_the_alias_table_covers_every_club_and_refuses_unknown_names(capsys):
     assert CLUB_NAMES == tuple(c.name for c in CLUBS)
-    assert set(CLUB_ALIASES.values()) == set(CLUB_NAMES)
+    assert set(CLUB_ALIASES.values()) == set(GSPRO_CLUBS) and set(FLIES_AS) == set(GSPRO_CLUBS)
+    assert {name for name in FLIES_AS.values() if name} == set(CLUB_NAMES)
     for name in CLUB_NAMES:
-        assert canonical_club_name(name) == name and canonical_club_name(name.lower()) == name
+        assert club_named(name).name == name and club_named(name.lower()).name == name
     for typed, name in {"dr": "Driver", "DRIVER": "Driver", "3w": "3-wood", "W5": "5-wood", "hy": "Hybrid",
                         "pw": "PW", "Gap Wedge": "GW", "sw": "SW", "lob wedge": "LW", "9i": "9-iron"}.items():
-        assert canonical_club_name(typed) == name, typed
+        assert club_named(typed).name == name, typed
     assert all(club_key(alias) == alias for alias in CLUB_ALIASES)
-    for unknown in ("putter", "", "10i", "2w"):
+    for unknown in ("", "10i", "8w", "wedge"):
         with pytest.raises(ValueError) as error:
             club_named(unknown)
-        assert all(name in str(error.value) for name in CLUB_NAMES)
+        assert "unknown club" in str(error.value) and all(code in str(error.value) for code in GSPRO_CLUBS)
     assert main(["fly", "--club", "putter"]) == 2
     err = capsys.readouterr().err
-    assert len(err.splitlines()) == 1 and "unknown club 'putter'" in err and "7-iron" in err and "Driver" in err
+    assert len(err.splitlines()) == 1 and "putter has no tour-average launch" in err and "7-iron" in err
 
 
 def test_the_viewer_offers_gspros_clubs_by_their_codes():
@@ -193,10 +195,7 @@ def test_the_viewer_offers_gspros_clubs_by_their_codes():
 def test_every_gspro_club_code_but_the_putter_names_a_club_to_fly():
     """Issue 43: `fly --club H4` was refused though the bay takes GSPro's codes; each now flies as the nearest club
     with a launch of its own, and the putter still says what it takes."""
-    from golfflight.contract.bay import GSPRO_CLUBS
-    from golfflight.shots.clubs import CLUB_NAMES, canonical_club_name
-
-    assert {canonical_club_name(code) for code in GSPRO_CLUBS if code != "PT"} <= set(CLUB_NAMES)
-    assert canonical_club_name("H4") == "Hybrid" and canonical_club_name("w2") == "3-wood"
-    with pytest.raises(ValueError, match="unknown club 'PT'"):
-        canonical_club_name("PT")
+    assert {club_named(code).name for code in GSPRO_CLUBS if code != "PT"} <= set(CLUB_NAMES)
+    assert club_named("H4").name == "Hybrid" and club_named("w2").name == "3-wood"
+    with pytest.raises(ValueError, match="'PT': the putter has no tour-average launch"):
+        club_named("PT")

@@ -264,7 +264,7 @@ def test_player_information_reaches_every_connector_and_nothing_is_pushed_on_con
     with pytest.raises(ValueError, match="handed"):
         served.server.send_player("DR", "right")
     with pytest.raises(ValueError, match="club"):
-        served.server.send_player("driver", "RH")
+        served.server.send_player("wedge", "RH")
     for sock in (first, second, later):
         sock.close()
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import browser
 import httpx
 import pytest
-from golfflight.contract.bay import GSPRO_CLUBS
+from golfflight.contract.clubs import GSPRO_CLUBS
 from golfflight.contract.flying import fly_request
 from golfflight.contract.requests import ShotRequest
 from golfflight.service.app import create_app

@@ -16,11 +16,12 @@ import re
 from pydantic import ValidationError
 
 from golfflight.commands import COMMANDS
+from golfflight.contract.clubs import FLIES_AS, GSPRO_CLUBS, club_code
 from golfflight.contract.figures import FIGURES, Figure
 from golfflight.errors import InputError
 from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.limits import WIND_SPEED_MPS, Range
-from golfflight.shots.clubs import CLUB_NAMES, club_named
+from golfflight.shots.clubs import CLUB_NAMES, ClubLaunch, club_launch
 
 WIND_SPEED_MPH = Range(WIND_SPEED_MPS.low, math.floor(WIND_SPEED_MPS.high / MPH_TO_MPS * 10) / 10, "mph")
 """The request's wind range (`flight.limits.WIND_SPEED_MPS`, 0 to 30 m/s) in mph, for --wind-speed-mph: 0 to 67.1."""
@@ -59,8 +60,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--club",
         default="Driver",
-        help=f"start from this club's tour-average launch: {', '.join(CLUB_NAMES)} (any case), or as typed: dr, 3w, "
-        "7i, 7 iron, pw, ...",
+        help=f"start from this club's tour-average launch: {', '.join(CLUB_NAMES)} (any case), as typed: dr, 3w, "
+        "7i, 7 iron, pw, ..., or a GSPro club code (DR, W3, H4, I7, PW, ...): the names the bay takes",
     )
     parser.add_argument(
         "--model", help="model bundle directory (default: as `golfflight serve`: $GOLFFLIGHT_MODEL, models/default)"
@@ -134,6 +135,18 @@ def wind_speed_mps(args: argparse.Namespace) -> float | None:
         details = describe_errors(error.errors(), {"wind_speed_mph": bounds})
         raise InputError(_refusal([{**d, "field": "wind_speed_mph"} for d in details])) from None
     return args.wind_speed_mph * MPH_TO_MPS
+
+
+def club_named(text: str) -> ClubLaunch:
+    """The tour-average launch `--club` starts from: the club's GSPro code (`contract.clubs.club_code`, the names
+    every surface takes) and the launch that code flies as (`FLIES_AS`); InputError for an unknown name and for the
+    putter, which has no flight to start from."""
+    code = club_code(text)
+    name = FLIES_AS[code]
+    if name is None:
+        raise InputError(f"--club {text!r}: the {GSPRO_CLUBS[code].lower()} has no tour-average launch to fly; give "
+                         f"one of {', '.join(CLUB_NAMES)} or another club's name or GSPro code")
+    return club_launch(name)
 
 
 def request_of(args: argparse.Namespace) -> tuple[str, dict]:

@@ -10,10 +10,10 @@ says too whether its object was a valid message: a connection that sends them ke
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Callable
 from typing import NamedTuple
 
+from golfflight.contract.clubs import club_code
 from golfflight.contract.gspro import GSProMessage, GSProReply, invalid_message, shot_number_of
 from golfflight.errors import InputError
 from golfflight.service.open_connect.framing import Refused
@@ -24,8 +24,6 @@ Answer = Callable[[GSProMessage], GSProReply]
 
 HANDED = ("RH", "LH")
 """The player's hand as GSPro writes it."""
-CLUB = re.compile(r"[A-Z0-9]{1,4}")
-"""A GSPro club code: DR, W3, H4, I7, PW, GW, SW, LW, PT and the like (connectors switch to putting on PT)."""
 
 
 def encoded(reply: GSProReply) -> bytes:
@@ -34,13 +32,12 @@ def encoded(reply: GSProReply) -> bytes:
 
 
 def player_information(club: str, handed: str) -> bytes:
-    """The Code 201 object GSPro pushes when the player or the club changes, as it goes on the wire; ValueError for a
-    hand other than RH or LH or a club that is not a GSPro club code."""
+    """The Code 201 object GSPro pushes when the player or the club changes, as it goes on the wire, the club as its
+    GSPro code (connectors switch to putting on PT) whichever name it is given by (`contract.clubs.club_code`);
+    ValueError for a hand other than RH or LH or a club no name of which it is."""
     if handed not in HANDED:
         raise InputError(f"handed must be one of {', '.join(HANDED)}, got {handed!r}")
-    if not isinstance(club, str) or not CLUB.fullmatch(club):
-        raise InputError(f"club must be a GSPro club code (DR, I7, PW, PT, ...), got {club!r}")
-    player = {"Code": 201, "Message": "GSPro Player Information", "Player": {"Handed": handed, "Club": club}}
+    player = {"Code": 201, "Message": "GSPro Player Information", "Player": {"Handed": handed, "Club": club_code(club)}}
     return json.dumps(player, separators=(",", ":")).encode()
 
 

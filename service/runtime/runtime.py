@@ -16,7 +16,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from golfflight.contract.bay import CONDITION_FIELDS, PUTTER, BayConditions, Player, in_bay
+from golfflight.contract.bay import CONDITION_FIELDS, BayConditions, Player, in_bay
+from golfflight.contract.clubs import PUTTER
 from golfflight.contract.flying import fly_request
 from golfflight.contract.gspro import GSProMessage, GSProReply, failed_reply, shot_reply, shot_request
 from golfflight.contract.refusals import RequestRefused

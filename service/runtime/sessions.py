@@ -16,7 +16,8 @@ from collections.abc import ValuesView
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, NamedTuple
 
-from golfflight.contract.bay import GSPRO_CLUBS, Player
+from golfflight.contract.bay import Player
+from golfflight.contract.clubs import GSPRO_CLUBS
 from golfflight.contract.requests import ShotRequest
 from golfflight.contract.results import ShotResult
 from golfflight.contract.session import ClubSummary, SessionInfo, SessionList, SessionSummary

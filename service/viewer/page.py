@@ -1,6 +1,6 @@
 """The viewer page, its scripts (`viewer.js`; `session.js`: the session's events, summary and "New session") and
 style, shipped in `static/` (package data) and read once at import; the page's club menu is filled in from GSPro's
-club codes (`contract.bay.GSPRO_CLUBS`: the value a code, the label its name), the clubs the bay's player can select
+club codes (`contract.clubs.GSPRO_CLUBS`: the value a code, the label its name), the clubs the bay's player can select
 (`PATCH /v1/bay {"player": {"club": CODE}}`) and each shot's event names, and the bay form's ground menu from the
 surfaces a request may name (`flight.ground.SURFACES`)."""
 
@@ -9,12 +9,12 @@ from __future__ import annotations
 from html import escape
 from importlib.resources import files
 
-from golfflight.contract.bay import GSPRO_CLUBS
+from golfflight.contract.clubs import GSPRO_CLUBS
 from golfflight.flight.ground import SURFACES
 
 PAGE_PATH = "/viewer"
 
-CLUB_OPTIONS_MARKER = b"<!-- club options: contract.bay.GSPRO_CLUBS, filled in by service/viewer/page.py -->"
+CLUB_OPTIONS_MARKER = b"<!-- club options: contract.clubs.GSPRO_CLUBS, filled in by service/viewer/page.py -->"
 
 
 def with_club_options(page: bytes) -> bytes:

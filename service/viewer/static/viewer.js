@@ -80,7 +80,7 @@ function side(value, digits = 1) {
   return [text, Number(text) === 0 ? "" : value > 0 ? "R" : "L"];
 }
 
-// ---- clubs: GSPro's codes, named as the page's club menu names them (filled in from contract.bay.GSPRO_CLUBS) --
+// ---- clubs: GSPro's codes, named as the page's club menu names them (filled in from contract.clubs.GSPRO_CLUBS) --
 
 /** GSPro club code -> its name, from the club menu's options. */
 const CLUB_NAMES = new Map();
