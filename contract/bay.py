@@ -14,8 +14,11 @@ from __future__ import annotations
 
 from typing import Literal
 
-from golfflight.contract.clubs import ClubName
+from golfflight.contract.clubs import PUTTER, ClubName
+from golfflight.contract.inputs import launch_of
+from golfflight.contract.putter import not_a_putt
 from golfflight.contract.requests import AirRequest, GroundRequest, ShotRequest, Strict, WindRequest
+from golfflight.contract.results import ConditionSource, FlownIn
 from pydantic import Field
 
 CONDITION_FIELDS = ("air", "wind", "ground")
@@ -100,3 +103,26 @@ def in_bay(shot: ShotRequest, bay: BayConditions) -> ShotRequest:
         updates["air"] = air_in_bay(shot.air, bay.air)
     return shot.model_copy(update=updates) if updates else shot
 
+
+DEFAULTS = {"air": AirRequest(), "wind": WindRequest(speed_mps=0.0), "ground": GroundRequest()}
+"""What a shot flies in where neither it nor the bay gives a condition, as the echo writes it (`flown_in`)."""
+
+
+def _source(shot: ShotRequest, bay: BayConditions, flown: ShotRequest, name: str) -> ConditionSource:
+    """Where the condition `name` of `flown` (the shot in the bay) came from."""
+    own, bays = getattr(shot, name), getattr(bay, name)
+    if own is None:
+        return "default" if bays is None else "bay"
+    return "shot and bay" if getattr(flown, name) != own else "shot"
+
+
+def flown_in(shot: ShotRequest, bay: BayConditions, connector: bool = False) -> tuple[ShotRequest, FlownIn]:
+    """The shot as flown in the bay (`in_bay`) and what it flew in: each condition, where it came from, and whether it
+    rolls as a putt: a connector's shot with the putter selected does, unless no putt can leave as it did
+    (`contract.putter.not_a_putt`, whose reason becomes the note)."""
+    flown = in_bay(shot, bay)
+    note = not_a_putt(launch_of(shot)) if connector and bay.player.club == PUTTER else None
+    putt = connector and bay.player.club == PUTTER and note is None
+    echo = {name: getattr(flown, name) or DEFAULTS[name] for name in CONDITION_FIELDS}
+    sources = {f"{name}_from": _source(shot, bay, flown, name) for name in CONDITION_FIELDS}
+    return flown, FlownIn.model_construct(**echo, **sources, putt=putt, note=note)

@@ -231,7 +231,7 @@ AIR_DENSITY = "air_density_kg_m3"
 ELEVATION_COLUMNS = ("ground_elevation_m", "ground_elevation_ft")
 """Columns that can put the ground off the tee's elevation, so that flat_* columns come back (`result_columns`)."""
 
-LEFT_OUT = ("trajectory", "normalized", "flat", "conditions")
+LEFT_OUT = ("trajectory", "normalized", "flat", "conditions", "flown_in")
 """Result fields that are not flat numbers of the flight (the nested flights get prefixed columns instead)."""
 
 

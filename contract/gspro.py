@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from golfflight.contract.bay import BayConditions, in_bay
+from golfflight.contract.bay import BayConditions, flown_in
 from golfflight.contract.flying import fly_request
 from golfflight.contract.inputs import spin_from_components
 from golfflight.contract.refusals import answer_to, describe_errors, encodable
@@ -256,16 +256,16 @@ def failed_reply(message: GSProMessage, error: Exception) -> GSProReply:
     return GSProReply(Code=answer_to(error).open_connect_code, Message=str(error), ShotNumber=message.ShotNumber)
 
 
-def fly_message(
-    engine: FlightEngine, message: GSProMessage, bay: BayConditions | None = None, putt: bool = False
-) -> GSProReply:
-    """The reply to a message with BallData: Code 200 with its flight in the bay's conditions (`contract.bay`;
-    without a bay: standard air, calm, rolled to rest on a level fairway), or Code 500 saying why it could not fly.
-    Open Connect carries ball data only: its shots always fly in the bay's air, wind and ground. The served bay
-    flies messages through `service.runtime`, which keeps the flight's states for its screens too."""
+def fly_message(engine: FlightEngine, message: GSProMessage, bay: BayConditions | None = None) -> GSProReply:
+    """The reply to a message with BallData: Code 200 with its flight in the bay's conditions and saying what it flew
+    in (`contract.bay.flown_in`; without a bay: standard air, calm, rolled to rest on a level fairway; with the
+    putter selected, a putt if a putt can leave as it did), or Code 500 saying why it could not fly. Open Connect
+    carries ball data only: its shots always fly in the bay's air, wind and ground. The served bay flies messages
+    through `service.runtime`, which keeps the flight's states for its screens too."""
     try:
-        request = in_bay(shot_request(message), bay or BayConditions())
-        result, _ = fly_request(engine, request, putt=putt, flat=False)
+        request, echo = flown_in(shot_request(message), bay or BayConditions(), connector=True)
+        result, _ = fly_request(engine, request, putt=echo.putt, flat=False)
     except (ValueError, FlightError) as error:
         return failed_reply(message, error)
+    result.flown_in = echo
     return shot_reply(message, result)

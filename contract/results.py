@@ -4,8 +4,10 @@ object), so a figure added there is in every result, the OpenAPI schema and the 
 
 from __future__ import annotations
 
+from typing import Literal
+
 from golfflight.contract.figures import FIGURES, FLAT_FIGURES, LANDING, REST, Figure, Point
-from golfflight.contract.requests import ReferenceAir
+from golfflight.contract.requests import AirRequest, GroundRequest, ReferenceAir, WindRequest
 from pydantic import BaseModel, Field, create_model
 
 
@@ -79,13 +81,37 @@ FlatFlight = create_model(
 )
 
 
+ConditionSource = Literal["shot", "bay", "shot and bay", "default"]
+"""Where a condition flown in came from: the shot's own, the bay's, the shot's air quantities over the bay's, or the
+default (ICAO standard air, calm, a level fairway at the tee's height)."""
+
+
+class FlownIn(BaseModel):
+    """What a shot flown by the service flew in and how: the air, wind and ground as flown, where each came from, and
+    whether it was rolled as a putt (with the putter selected, a note says why a shot was flown as a full one)."""
+
+    air: AirRequest = Field(description="the air flown in ({}: ICAO standard air)")
+    air_from: ConditionSource
+    wind: WindRequest = Field(description="the wind flown in (speed 0: calm)")
+    wind_from: ConditionSource
+    ground: GroundRequest = Field(description="the ground it came down, bounced and rolled on")
+    ground_from: ConditionSource
+    putt: bool = Field(False, description="rolled on the ground from the start (a connector's shot with the putter "
+                       "selected)")
+    note: str | None = Field(None, description="how the shot was read, when that is not what one would guess: a "
+                             "connector's shot with the putter selected that no putt can be is flown as a full shot")
+
+
 class ShotResult(FlightResult):
-    """The flight in the conditions given, and in reference conditions when asked for."""
+    """The flight in the conditions given, and in reference conditions when asked for; a served shot says what it
+    flew in (`flown_in`)."""
 
     normalized: NormalizedFlight | None = None
     flat: FlatFlight | None = Field(
         None, description="only when the ground's elevation (elevation_m or elevation_ft) is not 0: the flight to z = 0"
     )
+    flown_in: FlownIn | None = Field(None, description="the service's answers only: the conditions it flew in, "
+                                     "where each came from, and whether it was a putt")
 
 
 class ShotFailure(BaseModel):

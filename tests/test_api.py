@@ -64,6 +64,7 @@ def test_single_shot_in_both_unit_forms(client):
         "roll_yd",
         "rest",
         "bounces",
+        "flown_in",
     }
     assert set(monitor) == expected
     faded = shot(client, **SEVEN_IRON | {"spin_rpm": None}, back_spin_rpm=7000.0, side_spin_rpm=800.0)
@@ -163,8 +164,8 @@ def test_invalid_requests_name_the_field_value_and_range(client):
     assert detail["field"] == "ball_speed_mps" and detail["value"] == 150.0 and detail["allowed"] == "0.5 to 100 m/s"
     both = client.post("/v1/shots", json={**SEVEN_IRON, "ball_speed_mph": 120.0})
     assert both.status_code == 422 and "exactly one of ball_speed_mps or ball_speed_mph" in both.text
-    unknown = client.post("/v1/shots", json={**SEVEN_IRON, "club": "7i"})
-    assert unknown.status_code == 422 and unknown.json()["detail"][0]["field"] == "club"
+    unknown = client.post("/v1/shots", json={**SEVEN_IRON, "club_speed_mph": 90.0})
+    assert unknown.status_code == 422 and unknown.json()["detail"][0]["field"] == "club_speed_mph"
     nan = client.post(
         "/v1/shots",
         content=json.dumps({**SEVEN_IRON, "launch_angle_deg": float("nan")}),

@@ -68,6 +68,11 @@ def _open_connect_carry(port: int) -> float:
     return reply["Flight"]["carry_m"]
 
 
+def sources(answer: dict) -> set[str]:
+    """Where the answer says its air, wind and ground came from, taken out of it (the rest compares as numbers)."""
+    return {answer["flown_in"].pop(f"{name}_from") for name in ("air", "wind", "ground")}
+
+
 def test_http_batch_and_open_connect_shots_fly_in_the_bay_and_it_survives_a_restart(tmp_path):
     path, port = tmp_path / "bay.json", free_port()
     with running(create_app(ServiceSettings(connect_port=port, bay_file=path))) as http:
@@ -83,9 +88,11 @@ def test_http_batch_and_open_connect_shots_fly_in_the_bay_and_it_survives_a_rest
                                                           "slope_deg": 0.0, "slope_dir_deg": 0.0}}
         in_bay_shot = shot(http, **SEVEN_IRON)
         explicit = shot(http, **SEVEN_IRON, **DENVER_HEAT)
+        assert sources(in_bay_shot) == {"bay"} and sources(explicit) == {"shot"}
         assert in_bay_shot == explicit and in_bay_shot["carry_m"] != calm["carry_m"]
         assert in_bay_shot["total_m"] - in_bay_shot["carry_m"] != calm["total_m"] - calm["carry_m"], "the green"
         own = shot(http, **SEVEN_IRON, air={}, wind={"speed_mps": 0.0}, ground={"surface": "fairway"})
+        assert own.pop("flown_in")["air_from"] == "shot" and calm.pop("flown_in")["air_from"] == "default"
         assert own == calm, "a shot's own conditions win"
         batch = http.post("/v1/shots/batch", json={"shots": [SEVEN_IRON]}).json()["results"][0]
         assert batch["carry_m"] == pytest.approx(explicit["carry_m"], abs=1e-6)
@@ -94,7 +101,8 @@ def test_http_batch_and_open_connect_shots_fly_in_the_bay_and_it_survives_a_rest
         assert tcp == pytest.approx(shot(http, ball_speed_mph=123.0, launch_angle_deg=16.0, spin_rpm=7100.0,
                                          **DENVER_HEAT)["carry_m"], abs=1e-6)
     with running(create_app(ServiceSettings(bay_file=path))) as http:
-        assert shot(http, **SEVEN_IRON) == explicit, "the bay came back from its file"
+        restarted = shot(http, **SEVEN_IRON)
+        assert sources(restarted) == {"bay"} and restarted == explicit, "the bay came back from its file"
 
 
 def test_a_bad_bay_is_refused_like_a_bad_shot_and_changes_nothing(tmp_path):

@@ -51,7 +51,10 @@ def test_fly_flies_the_served_model_as_post_v1_shots_does(api, capsys):
     assert out["flight"]["carry_m"] == pytest.approx(engine.fly(launch).carry_m, abs=1e-9)
     served = api.post("/v1/shots", json=out["request"])
     assert served.status_code == 200
-    assert out["flight"] == served.json()  # every field of the API's result, the same numbers
+    answered = served.json()
+    flown_in = answered.pop("flown_in")  # the service says what it flew in; the command line flies in no bay
+    assert out["flight"] == answered  # every other field of the API's result, the same numbers
+    assert {flown_in[f"{name}_from"] for name in ("air", "wind", "ground")} == {"default"}
     for field in ("carry_m", "carry_yd", "total_m", "total_yd", "apex_m", "apex_yd", "lateral_m", "landing_angle_deg"):
         assert field in out["flight"], field
 

@@ -274,7 +274,7 @@ def test_the_page_in_chromium_draws_shots_from_http_and_open_connect(tmp_path):
 
             pick_club(page, "DR")
             started = time.perf_counter()
-            driver = http.post("/v1/shots?viewer=1", json=DRIVER, headers=KEYED).json()
+            driver = http.post("/v1/shots?viewer=1", json={**DRIVER, "club": "driver"}, headers=KEYED).json()
             page.wait_for_selector("#shots tbody tr[data-shot='1']", timeout=10_000)
             seen_s = time.perf_counter() - started
             assert page.inner_text("#n-carry").startswith(f"{driver['carry_yd']:.1f}")

@@ -154,7 +154,7 @@ def _straight_shot_on_the_centre_line(page, http) -> dict:
     bottom centre up the target line. The behind view's geometry."""
     pick_club(page, "DR")
     assert http.post("/v1/shots/batch", json={"shots": [DRIVER] * 60}, headers=KEYED).status_code == 200
-    straight = http.post("/v1/shots?viewer=true", json=STRAIGHT, headers=KEYED).json()
+    straight = http.post("/v1/shots?viewer=true", json={**STRAIGHT, "club": "DR"}, headers=KEYED).json()
     assert straight["lateral_m"] == pytest.approx(0.0, abs=1e-6)
     path = _latest_path(page)
     assert page.locator("#shots tbody tr").count() == 1 and "Driver: 1 shot" in page.inner_text("#legend")

@@ -11,7 +11,7 @@ import time
 from typing import NamedTuple
 
 from golfflight.contract.batch_body import read_batch
-from golfflight.contract.bay import BayConditions, in_bay
+from golfflight.contract.bay import BayConditions, flown_in
 from golfflight.contract.flying import fly_requests
 from golfflight.contract.refusals import RequestRefused
 from golfflight.contract.requests import ShotRequest
@@ -69,19 +69,22 @@ def _for_screens(result: ShotResult) -> ShotResult:
 
 
 def fly_and_encode(body: bytes, shown: int = 0, bay: BayConditions | None = None) -> FlownBatch | RequestRefused:
-    """A raw batch request body flown (`FlownBatch`), the `bay`'s conditions filled in where a shot gives none, the
-    last `shown` shots kept with their states; or its refusal, the 422 details the HTTP app would give (`read_batch`,
+    """A raw batch request body flown (`FlownBatch`), the `bay`'s conditions filled in where a shot gives none and
+    each result saying what it flew in (`contract.bay.flown_in`), the last `shown` shots kept with their states; or
+    its refusal, the 422 details the HTTP app would give (`read_batch`,
     `contract.trajectory_size`), returned rather than raised so that it crosses back to the server whole."""
     assert _engine is not None
     try:
-        shots = read_batch(body).shots
-        if bay is not None:
-            shots = [in_bay(shot, bay) for shot in shots]
+        bay = bay or BayConditions()
+        shots, echoes = zip(*(flown_in(shot, bay) for shot in read_batch(body).shots), strict=True)
         started = time.perf_counter()
-        results, flights = fly_requests(_engine, shots, shown)
+        results, flights = fly_requests(_engine, list(shots), shown)
     except RequestRefused as refused:  # the body, or the trajectory points it asks for (`contract.trajectory_size`)
         return refused
     seconds = time.perf_counter() - started
+    for result, echo in zip(results, echoes, strict=True):
+        if isinstance(result, ShotResult):
+            result.flown_in = echo
     kept = {i: (shots[i], _for_screens(results[i]), flight.states, flight.flight_time_s)
             for i, flight in flights.items()}
     return FlownBatch(encode_results(results), seconds, len(shots), kept)

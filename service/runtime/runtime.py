@@ -16,8 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from golfflight.contract.bay import CONDITION_FIELDS, BayConditions, Player, in_bay
-from golfflight.contract.clubs import PUTTER
+from golfflight.contract.bay import CONDITION_FIELDS, BayConditions, Player, flown_in
 from golfflight.contract.flying import fly_request
 from golfflight.contract.gspro import GSProMessage, GSProReply, failed_reply, shot_reply, shot_request
 from golfflight.contract.refusals import RequestRefused
@@ -39,11 +38,19 @@ from golfflight import __version__
 PROBE_SHOT = ShotRequest(ball_speed_mps=55.0, launch_angle_deg=16.0, spin_rpm=7100.0)
 """The shot /v1/latency times on demand: a tour-average 7-iron in standard air."""
 
-PLAYER_SOURCES = frozenset({"http", "gspro-http", "open-connect"})
-"""Shots hit in this bay, tagged with the bay's player (batches are a studio's files, not the player's swings)."""
-
 GSPRO_SOURCES = frozenset({"gspro-http", "open-connect"})
-"""Shots from a launch monitor's connector: with the putter selected they are putts, as in GSPro."""
+"""Shots from the bay's launch monitor (its connector): hit with the bay's player's club, so with the putter selected
+they are putts, as in GSPro. Any other shot is hit with the club it names, if any."""
+
+
+def player_of(request: ShotRequest, source: Source, bay: BayConditions) -> Player | None:
+    """Who hit a shot, as its session's club statistics count it: the bay's player for the bay's launch monitor;
+    for any other shot the club it names (`ShotRequest.club`) with the bay player's hand, or no one."""
+    if source in GSPRO_SOURCES:
+        return bay.player
+    if request.club is not None:
+        return Player.model_construct(club=request.club, handed=bay.player.handed)
+    return None
 
 
 class NotReady(ServiceError):
@@ -136,25 +143,25 @@ class BayRuntime:
 
     def fly(self, request: ShotRequest, source: Source, *, show: bool = True, shot_number: int | None = None,
             club_data: dict | None = None, flat: bool = True, client: str = "") -> Flown:
-        """Fly `request` in the bay's conditions where it gives none of its own; with `show`, publish it to the
-        screens with the states it was read from, in the session memory's share of `source` and address `client`.
-        A connector's shot with the putter selected is a putt. NotReady before the model is loaded; FlightError
-        when it cannot land."""
+        """Fly `request` in the bay's conditions where it gives none of its own, its result saying what it flew in
+        (`contract.bay.flown_in`); with `show`, publish it to the screens with the states it was read from, in the
+        session memory's share of `source` and address `client`. A connector's shot with the putter selected is a
+        putt, unless no putt can leave as it did. NotReady before the model is loaded; FlightError when it cannot
+        land."""
         engine = self._ready_engine()
         bay = self._bay.conditions
-        request = in_bay(request, bay)
-        player = bay.player if source in PLAYER_SOURCES else None
-        putt = source in GSPRO_SOURCES and bay.player.club == PUTTER
+        request, echo = flown_in(request, bay, connector=source in GSPRO_SOURCES)
         started = time.perf_counter()
         try:
-            result, flight = fly_request(engine, request, keep_states=show, putt=putt, flat=flat)
+            result, flight = fly_request(engine, request, keep_states=show, putt=echo.putt, flat=flat)
         finally:
             self._record_simulation("shot", time.perf_counter() - started)
+        result.flown_in = echo
         entry = None
         if show:
             entry = self._feed.publish(source, request, result, flight.states, flight.flight_time_s,
-                                      client, shot_number=shot_number, player=player, putt=putt,
-                                      club_data=club_data)
+                                      client, shot_number=shot_number, player=player_of(request, source, bay),
+                                      putt=echo.putt, club_data=club_data)
         return Flown(request, result, flight, entry)
 
     def fly_gspro(self, message: GSProMessage, source: Source = "gspro-http", client: str = "") -> GSProReply:
@@ -170,10 +177,10 @@ class BayRuntime:
 
     async def fly_batch(self, body: bytes, show: bool, client: str = "") -> bytes:
         """A raw batch request body's encoded BatchResult, read, validated and flown in the batch process (the bay's
-        conditions filled in where a shot gives none); with `show`, its last shots go to the screens with the states
-        they came from, in the session memory's share of address `client`. RequestRefused with its 422 details when
-        the body is invalid or asks for too many trajectory points; BatchProcessDied when the batch process died
-        under it."""
+        conditions filled in where a shot gives none, each result saying what it flew in); with `show`, its last
+        shots go to the screens with the states they came from, each counted in the club it names, if any, in the
+        session memory's share of address `client`. RequestRefused with its 422 details when the body is invalid or
+        asks for too many trajectory points; BatchProcessDied when the batch process died under it."""
         self._ready_engine()
         bay = self._bay.conditions
         filled = bay if any(getattr(bay, name) is not None for name in CONDITION_FIELDS) else None
@@ -183,7 +190,8 @@ class BayRuntime:
         self._record_simulation("batch", answer.seconds)
         self._metrics.batch_shots.observe(answer.shots)
         for _, (shot, result, states, flight_time_s) in sorted(answer.shown.items()):
-            self._feed.publish("batch", shot, result, states, flight_time_s, client)
+            self._feed.publish("batch", shot, result, states, flight_time_s, client,
+                               player=player_of(shot, "batch", bay))
         return answer.body
 
     def latency(self) -> dict:
