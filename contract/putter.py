@@ -24,5 +24,5 @@ def not_a_putt(launch: Launch) -> str | None:
     speed, angle = launch.ball_speed_mps, launch.launch_angle_deg
     if speed <= PUTT_MAX_SPEED_MPS and angle <= PUTT_MAX_LAUNCH_DEG:
         return None
-    return (f"the putter is selected, but {speed / MPH_TO_MPS:.1f} mph at {angle:.1f} deg is no putt (a putt leaves "
+    return (f"The putter is selected, but {speed / MPH_TO_MPS:.1f} mph at {angle:.1f} deg is no putt (a putt leaves "
             f"at most {PUTT_MAX_SPEED_MPH:g} mph and {PUTT_MAX_LAUNCH_DEG:g} deg): flown as a full shot")

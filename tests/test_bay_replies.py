@@ -8,11 +8,14 @@ from __future__ import annotations
 
 import json
 
+import browser
 import pytest
 from golfflight.contract.putter import PUTT_MAX_LAUNCH_DEG, PUTT_MAX_SPEED_MPH
 from golfflight.service.app import create_app
 from golfflight.service.settings import ServiceSettings
 from test_bay_runtime import PUTT_MPS, Connector, message, shot_events
+from test_viewer import KEYED
+from test_viewer_bay import live_viewer
 
 from tests.servers import free_port, running
 
@@ -168,3 +171,27 @@ def test_an_unknown_club_is_refused_naming_the_field_and_what_is_taken(bay):
         detail = answer.json()["detail"][0]
         assert detail["field"] == field and "unknown club" in detail["message"]
         assert "I7" in detail["message"] and "7i" in detail["message"]
+
+
+NOTE_SHOWN = "() => !document.querySelector('#shot-note').hidden"
+NOTE_HIDDEN = "() => document.querySelector('#shot-note').hidden"
+
+
+@pytest.mark.skipif(browser.missing() is not None, reason=str(browser.missing()))
+@pytest.mark.parametrize("width", [400, 1280])
+def test_the_viewer_says_a_putter_shot_flew_as_a_full_shot_and_a_putt_rolled(width):
+    """The page shows the reply's note beside the last shot's numbers, whole within the page's width, and takes it
+    away for the putt that follows."""
+    with live_viewer(width, 900) as (page, http, _port, errors):
+        assert http.patch("/v1/bay", json=GREEN, headers=KEYED).status_code == 200
+        drive = http.post("/v1/gspro", json=json.loads(message(1, DRIVE)), headers=KEYED).json()
+        page.wait_for_function(NOTE_SHOWN, timeout=10_000)
+        note = page.locator("#shot-note")
+        assert note.inner_text() == drive["Flight"]["flown_in"]["note"]
+        box = note.bounding_box()
+        assert box["width"] > 0 and box["x"] >= 0 and box["x"] + box["width"] <= width
+        assert not page.inner_text("#last-source").endswith("putt")
+        assert http.post("/v1/gspro", json=json.loads(message(2, PUTT)), headers=KEYED).json()["Code"] == 200
+        page.wait_for_function(NOTE_HIDDEN, timeout=10_000)
+        assert page.inner_text("#last-source").endswith("putt")
+        assert errors == []

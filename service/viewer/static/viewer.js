@@ -898,6 +898,15 @@ function showClubData(clubData) {
   list.hidden = title.hidden = entries.length === 0;
 }
 
+/** How the last shot was read, when that is not what one would guess (the reply's flown_in.note: a full swing with
+ * the putter selected, flown as a full shot); hidden otherwise. */
+function showNote(shot) {
+  const note = document.getElementById("shot-note");
+  const flownIn = shot ? shot.event.flight.flown_in : null;
+  note.textContent = flownIn && flownIn.note ? flownIn.note : "";
+  note.hidden = !note.textContent;
+}
+
 function showNumbers(shot) {
   const source = document.getElementById("last-source");
   source.textContent = shot
@@ -905,6 +914,7 @@ function showNumbers(shot) {
       + (shot.club ? ` · ${clubName(shot.club)}` : "") + (shot.event.putt ? " putt" : "")
     : "";
   showClubData(shot ? shot.event.club_data : null);
+  showNote(shot);
   if (!shot) return;
   const { launch, flight } = shot.event;
   const spin = spinParts(launch);
