@@ -26,8 +26,7 @@ CONDITION_FIELDS = ("air", "wind", "ground")
 
 class Player(Strict):
     """Who is at the mat: the club selected (any name `contract.clubs` takes, kept as its GSPro code) and the hand
-    they play. Connectors hear of every
-    change as Open Connect's Code 201 player information."""
+    they play. Connectors hear of every change as Open Connect's Code 201 player information."""
 
     club: ClubName = Field("DR", description="the club selected, as its GSPro code")
     handed: Literal["RH", "LH"] = Field("RH", description="right- or left-handed")

@@ -1,6 +1,7 @@
 """Whether a connector's shot with the putter selected is a putt: golfers forget to switch clubs, and a drive rolled
 as a putt went 3,334 yd on a stimp-11 green (issue 56). A ball that leaves faster or steeper than any putt is flown as
-the full shot it is, and the reply says why (docs/service.md, "Putts", gives the numbers' sources).
+the full shot it is, and the reply says why (docs/service.md, "A full swing with the putter selected flies", gives
+the numbers' sources).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ PUTT_MAX_SPEED_MPS = PUTT_MAX_SPEED_MPH * MPH_TO_MPS
 
 PUTT_MAX_LAUNCH_DEG = 10.0
 """The steepest launch rolled as a putt: five times a putt's ideal 2 degrees (SAM PuttLab), over any putter's loft
-and upward stroke; a driver launches at 10-11 degrees and 100 mph or more, a wedge at 25-35 degrees."""
+and upward stroke; a tour driver launches at 10.5 degrees and 171 mph, the wedges at 24-33 degrees (`shots.clubs`)."""
 
 
 def not_a_putt(launch: Launch) -> str | None:
