@@ -125,3 +125,20 @@ def flown_in(shot: ShotRequest, bay: BayConditions, connector: bool = False) -> 
     echo = {name: getattr(flown, name) or DEFAULTS[name] for name in CONDITION_FIELDS}
     sources = {f"{name}_from": _source(shot, bay, flown, name) for name in CONDITION_FIELDS}
     return flown, FlownIn.model_construct(**echo, **sources, putt=putt, note=note)
+
+
+def flown_in_all(shots: list[ShotRequest], bay: BayConditions) -> tuple[list[ShotRequest], list[FlownIn]]:
+    """`flown_in` of a batch's shots (none a connector's), the echo of those that give no condition of their own
+    made once and shared: most of a batch's shots give none, and one echo each cost a 10,000-shot batch 0.3 s."""
+    flown, echoes, bare = [], [], None
+    for shot in shots:
+        if shot.air is None and shot.wind is None and shot.ground is None:
+            if bare is None:
+                bare = flown_in(shot, bay)[1]
+            flown.append(in_bay(shot, bay))
+            echoes.append(bare)
+        else:
+            request, echo = flown_in(shot, bay)
+            flown.append(request)
+            echoes.append(echo)
+    return flown, echoes

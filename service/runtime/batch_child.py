@@ -11,7 +11,7 @@ import time
 from typing import NamedTuple
 
 from golfflight.contract.batch_body import read_batch
-from golfflight.contract.bay import BayConditions, flown_in
+from golfflight.contract.bay import BayConditions, flown_in_all
 from golfflight.contract.flying import fly_requests
 from golfflight.contract.refusals import RequestRefused
 from golfflight.contract.requests import ShotRequest
@@ -70,15 +70,15 @@ def _for_screens(result: ShotResult) -> ShotResult:
 
 def fly_and_encode(body: bytes, shown: int = 0, bay: BayConditions | None = None) -> FlownBatch | RequestRefused:
     """A raw batch request body flown (`FlownBatch`), the `bay`'s conditions filled in where a shot gives none and
-    each result saying what it flew in (`contract.bay.flown_in`), the last `shown` shots kept with their states; or
+    each result saying what it flew in (`contract.bay.flown_in_all`), the last `shown` shots kept with their states; or
     its refusal, the 422 details the HTTP app would give (`read_batch`,
     `contract.trajectory_size`), returned rather than raised so that it crosses back to the server whole."""
     assert _engine is not None
     try:
         bay = bay or BayConditions()
-        shots, echoes = zip(*(flown_in(shot, bay) for shot in read_batch(body).shots), strict=True)
+        shots, echoes = flown_in_all(read_batch(body).shots, bay)
         started = time.perf_counter()
-        results, flights = fly_requests(_engine, list(shots), shown)
+        results, flights = fly_requests(_engine, shots, shown)
     except RequestRefused as refused:  # the body, or the trajectory points it asks for (`contract.trajectory_size`)
         return refused
     seconds = time.perf_counter() - started
