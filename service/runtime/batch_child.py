@@ -70,9 +70,9 @@ def _for_screens(result: ShotResult) -> ShotResult:
 
 def fly_and_encode(body: bytes, shown: int = 0, bay: BayConditions | None = None) -> FlownBatch | RequestRefused:
     """A raw batch request body flown (`FlownBatch`), the `bay`'s conditions filled in where a shot gives none and
-    each result saying what it flew in (`contract.bay.flown_in_all`), the last `shown` shots kept with their states; or
-    its refusal, the 422 details the HTTP app would give (`read_batch`,
-    `contract.trajectory_size`), returned rather than raised so that it crosses back to the server whole."""
+    each result saying what it flew in (`contract.bay.flown_in_all`), the last `shown` shots kept with their
+    states; or its refusal, the 422 details the HTTP app would give (`read_batch`, `contract.trajectory_size`),
+    returned rather than raised so that it crosses back to the server whole."""
     assert _engine is not None
     try:
         bay = bay or BayConditions()
