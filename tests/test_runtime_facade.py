@@ -39,7 +39,7 @@ def _touched(path: Path) -> list[tuple[int, str]]:
 def test_the_facade_is_the_set_the_issue_names():
     assert {"fly", "fly_batch", "fly_gspro", "latency", "health", "model", "bay", "set_bay", "update_bay",
             "subscribe", "unsubscribe", "start_session", "session", "sessions", "session_summary", "metrics",
-            "request_sinks", "load", "stop", "watch_bay", "on_player_change", "add_reporter"} == FACADE
+            "request_sinks", "load", "stop", "watch_bay", "on_player_change", "add_reporter", "bay_file"} == FACADE
 
 
 def test_adapters_and_the_assembly_use_only_the_runtimes_public_methods():
