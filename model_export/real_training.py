@@ -21,6 +21,7 @@ from golfflight.model_export.export import export_bundle
 from golfflight.model_export.joint import JointConfig, JointResult, soup_runs, train_joint, train_joint_runs
 from golfflight.model_export.observations import NOISE, OBSERVABLES, PATH_OBSERVATIONS, PATH_SIGMA_M
 from golfflight.model_export.real_data import SourceData, build
+from golfflight.model_export.real_variants import NN_NOT_SERVED, Start
 from golfflight.model_export.training import TrainConfig, load_checkpoint
 from golfflight.shots.progress import progress_bar, progress_step
 from golfflight.shots.records import read_shots
@@ -170,12 +171,12 @@ def export_real(run_dir: Path, data_file: Path, sources: list[SourceData], out: 
     return card
 
 
-def _network(init: str | os.PathLike) -> nn.Module:
-    """A fresh copy of the network of the bundle INIT (a seed's start, or the module the soup's weights go into)."""
+def _network(init: str | os.PathLike | Start) -> nn.Module:
+    """A fresh copy of the starting network (a seed's start, or the module the soup's weights go into): the bundle
+    INIT's, or a variant's start."""
     from golfflight.model_export.bundle_model import model_from_bundle
 
-    model, _ = model_from_bundle(init)
-    return model
+    return init.network() if isinstance(init, Start) else model_from_bundle(init)[0]
 
 
 @dataclass(frozen=True)
@@ -198,13 +199,13 @@ class SeedPlan:
                              "another, or side by side with --stack-seeds")
 
 
-def train_seed(data_file: Path, run_dir: Path, init: str | os.PathLike, config: JointConfig, threads: int,
+def train_seed(data_file: Path, run_dir: Path, init: str | os.PathLike | Start, config: JointConfig, threads: int,
                progress: bool, device: str = DEFAULT_DEVICE, compile_step: bool = False) -> JointResult:
     """One seed's joint run from the bundle `init` on `device` (a process of its own when seeds run in parallel)."""
     return train_joint(data_file, run_dir, config, _start(init, threads), progress, device, compile_step)
 
 
-def train_stacked(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig],
+def train_stacked(data_file: Path, work: Path, init: str | os.PathLike | Start, configs: dict[str, JointConfig],
                   threads: int, progress: bool, device: str = DEFAULT_DEVICE, compile_step: bool = False
                   ) -> dict[str, JointResult]:
     """Seeds side by side in one rollout from the bundle `init` (`joint.train_joint_runs`), each in WORK/NAME."""
@@ -213,7 +214,7 @@ def train_stacked(data_file: Path, work: Path, init: str | os.PathLike, configs:
     return dict(zip(configs, results))
 
 
-def _start(init: str | os.PathLike, threads: int) -> nn.Module:
+def _start(init: str | os.PathLike | Start, threads: int) -> nn.Module:
     """The network of the bundle `init` in training mode, with torch on `threads` CPU threads in this process."""
     import torch
 
@@ -223,7 +224,7 @@ def _start(init: str | os.PathLike, threads: int) -> nn.Module:
     return model
 
 
-def train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: dict[str, JointConfig],
+def train_seeds(data_file: Path, work: Path, init: str | os.PathLike | Start, configs: dict[str, JointConfig],
                  plan: SeedPlan, progress: bool) -> dict[str, JointResult]:
     """Each seed's joint run (WORK/NAME), by name, as `plan` says. In this process: stacked, or one after the other,
     with their epoch bars. In several (`plan.jobs`, silent there): a seed or a stack of seeds each, with a bar over
@@ -258,16 +259,18 @@ def train_seeds(data_file: Path, work: Path, init: str | os.PathLike, configs: d
     return {name: done[name] for name in names}
 
 
-def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str | os.PathLike,
+def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str | os.PathLike | Start,
                config: JointConfig, seeds: tuple[int, ...], out: str | os.PathLike | None,
                source_names: tuple[str, ...] | None = None, progress: bool = True,
                plan: SeedPlan = SeedPlan()) -> RealRun:
-    """Build WORK/real_flights.csv from DATA_ROOT, train one joint run per seed from the bundle INIT (WORK/seed-S,
-    as `plan` says), average several seeds' weights into a soup (WORK/soup, scored on the CPU), and export the run
-    with the lowest validation felt error to OUT (if given). With `progress`, each step, and the epochs (one seed at
-    a time or all stacked) or the seeds (several processes), go to standard error."""
-    from golfflight.weights_schema.bundle import load_bundle
-
+    """Build WORK/real_flights.csv from DATA_ROOT, train one run per seed from INIT (a bundle, or a variant's
+    `Start`: WORK/seed-S, as `plan` says), average several physics seeds' weights into a soup (WORK/soup, scored on
+    the CPU), and export the run with the lowest validation felt error to OUT (if given; never for NN, refused
+    before anything runs). With `progress`, each step, and the epochs (one seed at a time or all stacked) or the
+    seeds (several processes), go to standard error."""
+    landing_nn = isinstance(init, Start) and init.variant == "nn"
+    if landing_nn and out is not None:
+        raise InputError(NN_NOT_SERVED)
     plan.check()
     started = time.perf_counter()
     work = Path(work)
@@ -276,20 +279,47 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     progress_step(f"building {data_file} from the real sources...", progress)
     sources = build(data_root, data_file, *(() if source_names is None else (source_names,)))
     configs = {f"seed-{seed}": replace(config, seed=seed) for seed in seeds}
-    runs = train_seeds(data_file, work, init, configs, plan, progress)
-    finished = [run.out_dir for run in runs.values() if run.final]
-    if len(finished) > 1:
-        progress_step(f"averaging {len(finished)} seeds' weights (the soup)...", progress)
-        runs[SOUP] = soup_runs(data_file, finished, work / SOUP, _network(init))
+    if landing_nn:
+        runs = _train_landing_nn_seeds(data_file, work, configs, plan.threads, progress)
+    else:
+        runs = train_seeds(data_file, work, init, configs, plan, progress)
+        finished = [run.out_dir for run in runs.values() if run.final]
+        if len(finished) > 1:
+            progress_step(f"averaging {len(finished)} seeds' weights (the soup)...", progress)
+            runs[SOUP] = soup_runs(data_file, finished, work / SOUP, _network(init))
     chosen = min(runs, key=lambda s: runs[s].final["val_loss"] if runs[s].final else float("inf"))
     exported = None
     if out is not None:
-        from golfflight.evaluation.held_out import record_held_out
-
-        progress_step(f"exporting {chosen} to {out} and measuring its held-out errors...", progress)
-        card, _ = load_bundle(init)
-        export_real(runs[chosen].out_dir, data_file, sources, Path(out), card.variant,
-                    tuple(card.architecture.hidden_units))
-        exported = record_held_out(out, data_root)
+        exported = _export_chosen(runs[chosen], data_file, sources, Path(out), init, data_root, progress)
     return RealRun(data_file, sources, runs, chosen, exported, time.perf_counter() - started)
 
+
+def _train_landing_nn_seeds(data_file: Path, work: Path, configs: dict[str, JointConfig], threads: int,
+                            progress: bool) -> dict[str, JointResult]:
+    """NN's seeds one after another in this process (a fresh network each, `real_nn.train_landing_nn`)."""
+    import torch
+    from golfflight.model_export import DEFAULT_HIDDEN
+    from golfflight.model_export.real_nn import train_landing_nn
+
+    torch.set_num_threads(threads)
+    runs = {}
+    for index, (name, c) in enumerate(configs.items(), start=1):
+        progress_step(f"{name} ({index} of {len(configs)})", progress)
+        runs[name] = train_landing_nn(data_file, work / name, c, DEFAULT_HIDDEN, progress)
+    return runs
+
+
+def _export_chosen(run: JointResult, data_file: Path, sources: list[SourceData], out: Path,
+                   init: str | os.PathLike | Start, data_root: str | os.PathLike, progress: bool) -> ModelCard:
+    """Export the chosen physics run to OUT as its variant's bundle and measure its held-out errors into the card."""
+    from golfflight.evaluation.held_out import record_held_out
+    from golfflight.weights_schema.bundle import load_bundle
+
+    progress_step(f"exporting {run.out_dir.name} to {out} and measuring its held-out errors...", progress)
+    if isinstance(init, Start):
+        variant, hidden = init.variant, tuple(getattr(init.network(), "hidden", ()))
+    else:
+        card, _ = load_bundle(init)
+        variant, hidden = card.variant, tuple(card.architecture.hidden_units)
+    export_real(run.out_dir, data_file, sources, out, variant, hidden)
+    return record_held_out(out, data_root)

@@ -1,5 +1,5 @@
-"""`golfflight train-real`: Phys-NN+ trained on real flights with the unrecorded conditions as latent parameters
-(thin layer over model_export.real_training)."""
+"""`golfflight train-real`: Phys-NN+ (or the paper's baselines, Phys-Q and NN) trained on real flights with the
+unrecorded conditions as latent parameters (thin layer over model_export.real_training)."""
 
 from __future__ import annotations
 
@@ -30,7 +30,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--work", required=True, help="directory for the merged data and each seed's run")
     parser.add_argument("--out", help="bundle directory to export the chosen run to")
-    parser.add_argument("--init", default="models/synthetic", help="bundle to start from (default models/synthetic)")
+    parser.add_argument("--variant", default="phys-nn+", choices=("phys-nn+", "phys-q", "nn"),
+                        help="what to train (docs/training_real.md): phys-nn+ (default, the served model), phys-q (C_L, "
+                        "C_D quadratic in the spin ratio, C_M = p*S, refitted from Ferguson 2022's coefficients) or "
+                        "nn (launch -> landing point, evaluated only: it cannot be exported or served)")
+    parser.add_argument("--init", default=None, help="bundle to start from (default: models/synthetic for phys-nn+; "
+                        "Ferguson 2022's coefficients for phys-q; nn starts fresh and takes none)")
     parser.add_argument("--data-root", default=None, help="shared data folder (default ../shared/data)")
     parser.add_argument("--sources", default=",".join(DEFAULT_SOURCES),
                         help=f"comma-separated subset of {list(SOURCES)} (default: {','.join(DEFAULT_SOURCES)})")
@@ -53,6 +58,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from golfflight.model_export.real_variants import NN_NOT_SERVED, start_of
+
+    if args.variant == "nn" and args.out:
+        raise SystemExit(f"golfflight train-real: {NN_NOT_SERVED}")
     from golfflight.model_export.joint import JointConfig
     from golfflight.model_export.real_data import BUILDERS
     from golfflight.model_export.real_training import SeedPlan, train_real
@@ -63,7 +72,8 @@ def run(args: argparse.Namespace) -> int:
         raise SystemExit(f"golfflight train-real: --sources: unknown {unknown}; choose from {list(BUILDERS)}")
     if args.epochs < 1:
         raise SystemExit(f"golfflight train-real: --epochs must be at least 1, got {args.epochs}")
-    result = train_real(args.data_root or shared_data_dir(), args.work, args.init,
+    start = start_of(args.variant, args.init)
+    result = train_real(args.data_root or shared_data_dir(), args.work, start,
                         JointConfig(epochs=args.epochs, lr=args.lr), args.seeds, args.out, names,
                         progress=not args.quiet, plan=SeedPlan(args.device, args.jobs, args.threads,
                                                                args.stack_seeds, args.compile))
