@@ -43,6 +43,7 @@ from golfflight.flight.physics import initial_state
 from golfflight.model_export.real_sources import DEFAULT_SOURCES, SOURCES
 from golfflight.shots.heldout import check_training_rows, shot_round
 from golfflight.shots.pbp import load_pbp, recorded_apex
+from golfflight.shots.range_blocks import driver_groups
 from golfflight.shots.records import ShotRecord, trajectories_path, write_shots, write_trajectories
 from golfflight.shots.reference_world import TOUR_AVERAGES_FILE, ClubAverage, fly_reference, read_tour_averages
 from golfflight.shots.source_air import KNOWN_AIR
@@ -63,8 +64,6 @@ TOUR_CHAMPIONSHIP_TRAIN_ROUNDS = (1, 2)
 TABLE_VAL_EVERY = 3
 """Every third club of the tour-averages table (3-wood, 3-iron, 6-iron, 9-iron) is validation."""
 
-GAP_LINES = 3
-BLOCK_SHOTS = 40
 VAL_EVERY = 4
 PATH_INTERVAL_S = 0.5
 """Spacing of the trajectory samples trained on, up to the radar's last measured time."""
@@ -97,24 +96,6 @@ def _tag(records: list[ShotRecord], source: str, groups: list[str], val: set[str
                              "shot_id": f"{source}:{r.shot_id}", **conditions})
         for r, g in zip(records, groups, strict=True)
     ]
-
-
-def driver_groups(records: list[ShotRecord]) -> list[str]:
-    """A conditions group per record of the driver file (ids = file lines): runs of nearby lines of one ball type."""
-    groups: list[str] = []
-    previous: tuple[int, str | None] | None = None
-    size = 0
-    for record in records:
-        line = int(record.shot_id)
-        same = previous is not None and line - previous[0] <= GAP_LINES and record.ball == previous[1]
-        if not same or size >= BLOCK_SHOTS:
-            groups.append(f"L{line}")
-            size = 0
-        else:
-            groups.append(groups[-1])
-        size += 1
-        previous = (line, record.ball)
-    return groups
 
 
 def _every_nth_val(groups: list[str]) -> set[str]:

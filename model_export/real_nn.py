@@ -16,6 +16,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import torch
 from golfflight.model_export.joint import (
     JointConfig,
@@ -30,7 +31,8 @@ from golfflight.model_export.joint import (
 )
 from golfflight.model_export.observations import ObservedShots, load_observed
 from golfflight.model_export.training import CHECKPOINT_FORMAT, load_checkpoint, save_checkpoint
-from golfflight.model_export.variants import LandingNN
+from golfflight.evaluation.landing_network import LANDING_WEIGHTS_FILE
+from golfflight.model_export.variants import LANDING_SCALE_M, SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, LandingNN
 from golfflight.shots.files import write_text_atomic
 from golfflight.shots.progress import print_line, progress_bar
 from torch import nn
@@ -69,7 +71,8 @@ def evaluate_nn(model: nn.Module, shots: ObservedShots, config: JointConfig, sou
 def train_landing_nn(data_path: str | os.PathLike, out_dir: str | os.PathLike, config: JointConfig,
                      hidden: tuple[int, ...], progress: bool = True) -> JointResult:
     """Train NN from a fresh network (initialised from `config.seed`) on the merged file's landing points; writes
-    OUT/last.pt (kind 'landing-nn') and history.json of the last epoch, as a joint run does."""
+    OUT/last.pt (kind 'landing-nn') and history.json of the last epoch, as a joint run does, and its weights as
+    NumPy arrays (LANDING_WEIGHTS_FILE) for the torch-free comparison."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     data = load_observed(data_path, config.weights)
@@ -95,7 +98,19 @@ def train_landing_nn(data_path: str | os.PathLike, out_dir: str | os.PathLike, c
                                       "model": model.state_dict(), "noise": noise.run_state(0), "history": history})
     write_text_atomic(out / "history.json",
                       json.dumps({"config": config.as_dict(), "final": final, "epochs": history}, indent=2) + "\n")
+    write_landing_weights(model, out / LANDING_WEIGHTS_FILE)
     return JointResult(out, history, final)
+
+
+def write_landing_weights(model: LandingNN, path: Path) -> None:
+    """The network's layers and scales as NumPy arrays (`evaluation.landing_network` reads them without torch)."""
+    layers = [layer for layer in model.net if isinstance(layer, nn.Linear)]
+    arrays = {f"weight_{i}": layer.weight.detach().numpy() for i, layer in enumerate(layers)}
+    arrays |= {f"bias_{i}": layer.bias.detach().numpy() for i, layer in enumerate(layers)}
+    arrays["input_scale"] = np.array([VELOCITY_SCALE_MPS] * 3 + [SPIN_SCALE_RADPS] * 3)
+    arrays["output_scale"] = np.array(LANDING_SCALE_M)
+    with path.open("wb") as handle:
+        np.savez(handle, **arrays)
 
 
 def _epoch(model: nn.Module, noise: NoiseScales, optimizer: torch.optim.Optimizer,
