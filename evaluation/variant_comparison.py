@@ -59,9 +59,22 @@ class Predictor(Protocol):
     def __call__(self, shots: ShotSet, air: Air | None) -> dict[str, np.ndarray]: ...
 
 
+def _carry_where_only_distance(errors: dict[str, np.ndarray], carry_m: np.ndarray, shots: ShotSet
+                               ) -> dict[str, np.ndarray]:
+    """The carry error of shots that record their carry distance but no landing point (THE PLAYERS' apexRange,
+    `docs/real_data.md`), which `outcome_errors` leaves NaN: the model's carry against that distance."""
+    x, y = shots.column("carry_x_m"), shots.column("carry_y_m")
+    only_distance = np.isnan(x) & np.isfinite(y)
+    return errors | {"carry_m": np.where(only_distance, carry_m - y, errors["carry_m"])}
+
+
 def flown(model: EvaluatedModel) -> Predictor:
     """A physics model's errors: each shot flown calm in `air` (None: the model's own)."""
-    return lambda shots, air: outcome_errors(model.simulate(shots.launch(), air), shots)
+
+    def errors(shots: ShotSet, air: Air | None) -> dict[str, np.ndarray]:
+        flight = model.simulate(shots.launch(), air)
+        return _carry_where_only_distance(outcome_errors(flight, shots), flight.carry_m, shots)
+    return errors
 
 
 def predicted_landing(network: LandingNetwork) -> Predictor:
@@ -70,8 +83,11 @@ def predicted_landing(network: LandingNetwork) -> Predictor:
     def errors(shots: ShotSet, air: Air | None) -> dict[str, np.ndarray]:
         landing = network.landing(shots.launch())
         x, y = shots.column("carry_x_m"), shots.column("carry_y_m")
-        return {"carry_m": np.hypot(landing[:, 0], landing[:, 1]) - np.hypot(x, y), "side_m": landing[:, 0] - x,
-                "landing_m": np.hypot(landing[:, 0] - x, landing[:, 1] - y), "apex_m": np.full(len(x), np.nan)}
+        carry = np.hypot(landing[:, 0], landing[:, 1])
+        return _carry_where_only_distance(
+            {"carry_m": carry - np.hypot(x, y), "side_m": landing[:, 0] - x,
+             "landing_m": np.hypot(landing[:, 0] - x, landing[:, 1] - y), "apex_m": np.full(len(x), np.nan)},
+            carry, shots)
     return errors
 
 

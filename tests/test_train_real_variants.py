@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 import torch
 from golfflight.evaluation.landing_network import LandingNetwork
-from golfflight.evaluation.variant_comparison import block_bootstrap
+from golfflight.evaluation.accuracy_flyers import ferguson_flyer
+from golfflight.evaluation.variant_comparison import block_bootstrap, flown
 from golfflight.flight.coefficients import FERGUSON_2022
 from golfflight.flight.physics import initial_state
 from golfflight.model_export.joint import JointConfig
@@ -24,7 +25,7 @@ from golfflight.model_export.real_nn import landing_nn_from_checkpoint
 from golfflight.model_export.real_training import DATA_FILE, train_real
 from golfflight.model_export.real_variants import Start, start_of
 from golfflight.shots.paths import REPO_ROOT
-from golfflight.shots.records import read_shots
+from golfflight.shots.records import ShotRecord, ShotSet, read_shots
 from golfflight.errors import InputError
 from test_real_training import _driver_file
 
@@ -168,3 +169,14 @@ def test_a_start_bundle_of_another_variant_is_refused_naming_both():
         Start("phys-q", str(REPO_ROOT / "models" / "default")).network()
     with pytest.raises(InputError, match="takes no --init"):
         start_of("nn", REPO_ROOT / "models" / "default")
+
+
+def test_a_shot_that_records_only_its_carry_distance_is_compared_on_carry():
+    record = ShotRecord(shot_id="players:1", ball_speed_mps=70, launch_angle_deg=12, launch_direction_deg=0,
+                        spin_rpm=2500, spin_axis_deg=0, carry_y_m=200.0)
+    shots = ShotSet([record])
+    ferguson = ferguson_flyer()
+    errors = flown(ferguson)(shots, None)
+    carry = ferguson.simulate(shots.launch()).carry_m
+    np.testing.assert_allclose(errors["carry_m"], carry - 200.0)
+    assert np.isnan(errors["landing_m"]).all() and np.isnan(errors["side_m"]).all()
