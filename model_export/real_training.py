@@ -262,8 +262,9 @@ def train_seeds(data_file: Path, work: Path, init: str | os.PathLike | Start, co
 def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str | os.PathLike | Start,
                config: JointConfig, seeds: tuple[int, ...], out: str | os.PathLike | None,
                source_names: tuple[str, ...] | None = None, progress: bool = True,
-               plan: SeedPlan = SeedPlan()) -> RealRun:
-    """Build WORK/real_flights.csv from DATA_ROOT, train one run per seed from INIT (a bundle, or a variant's
+               plan: SeedPlan = SeedPlan(), train_fraction: float = 1.0) -> RealRun:
+    """Build WORK/real_flights.csv from DATA_ROOT (`train_fraction` of each source's training shots, for a learning
+    curve: `thin_training_rows`), train one run per seed from INIT (a bundle, or a variant's
     `Start`: WORK/seed-S, as `plan` says), average several physics seeds' weights into a soup (WORK/soup, scored on
     the CPU), and export the run with the lowest validation felt error to OUT (if given; never for NN, refused
     before anything runs). With `progress`, each step, and the epochs (one seed at a time or all stacked) or the
@@ -271,6 +272,8 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     landing_nn = isinstance(init, Start) and init.variant == "nn"
     if landing_nn and out is not None:
         raise InputError(NN_NOT_SERVED)
+    if not 0.0 < train_fraction <= 1.0:
+        raise InputError(f"--train-fraction must be above 0 and at most 1, got {train_fraction}")
     plan.check()
     started = time.perf_counter()
     work = Path(work)
@@ -278,6 +281,8 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     data_file = work / DATA_FILE
     progress_step(f"building {data_file} from the real sources...", progress)
     sources = build(data_root, data_file, *(() if source_names is None else (source_names,)))
+    if train_fraction < 1.0:
+        thin_training_rows(data_file, train_fraction)
     configs = {f"seed-{seed}": replace(config, seed=seed) for seed in seeds}
     if landing_nn:
         runs = _train_landing_nn_seeds(data_file, work, configs, plan.threads, progress)
@@ -292,6 +297,25 @@ def train_real(data_root: str | os.PathLike, work: str | os.PathLike, init: str 
     if out is not None:
         exported = _export_chosen(runs[chosen], data_file, sources, Path(out), init, data_root, progress)
     return RealRun(data_file, sources, runs, chosen, exported, time.perf_counter() - started)
+
+
+LEARNING_CURVE_SEED = 0
+"""Every variant and seed of a learning-curve point trains on the same subset of shots."""
+
+
+def thin_training_rows(data_file: Path, fraction: float, seed: int = LEARNING_CURVE_SEED) -> None:
+    """Rewrite the merged file with `fraction` of each source's training shots (at least one, drawn with `seed`, in
+    file order) and every validation shot: a smaller set of the same sources for the learning curve."""
+    from golfflight.shots.records import write_shots
+
+    records = read_shots(data_file).records
+    rng = np.random.default_rng(seed)
+    keep = np.array([r.split != "train" for r in records])
+    for source in dict.fromkeys(r.source for r in records):
+        train = np.flatnonzero([r.source == source and r.split == "train" for r in records])
+        if len(train):
+            keep[rng.permutation(train)[:max(1, round(fraction * len(train)))]] = True
+    write_shots(data_file, [r for r, kept in zip(records, keep) if kept])
 
 
 def _train_landing_nn_seeds(data_file: Path, work: Path, configs: dict[str, JointConfig], threads: int,

@@ -10,6 +10,7 @@ import os
 import re
 import subprocess
 import sys
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +23,8 @@ from golfflight.flight.coefficients import FERGUSON_2022
 from golfflight.flight.physics import initial_state
 from golfflight.model_export.joint import JointConfig
 from golfflight.model_export.real_nn import landing_nn_from_checkpoint
-from golfflight.model_export.real_training import DATA_FILE, train_real
+from golfflight.model_export.real_data import build
+from golfflight.model_export.real_training import DATA_FILE, thin_training_rows, train_real
 from golfflight.model_export.real_variants import Start, start_of
 from golfflight.shots.paths import REPO_ROOT
 from golfflight.shots.records import ShotRecord, ShotSet, read_shots
@@ -180,3 +182,23 @@ def test_a_shot_that_records_only_its_carry_distance_is_compared_on_carry():
     carry = ferguson.simulate(shots.launch()).carry_m
     np.testing.assert_allclose(errors["carry_m"], carry - 200.0)
     assert np.isnan(errors["landing_m"]).all() and np.isnan(errors["side_m"]).all()
+
+
+def test_a_learning_curve_point_keeps_a_fraction_of_each_sources_training_shots_and_all_validation(data_root, tmp_path):
+    build(data_root, tmp_path / "whole.csv", ("trackman-outdoor", "trackman-model"))
+    for name in ("a.csv", "b.csv"):
+        build(data_root, tmp_path / name, ("trackman-outdoor", "trackman-model"))
+        thin_training_rows(tmp_path / name, 0.5)
+    assert (tmp_path / "a.csv").read_text() == (tmp_path / "b.csv").read_text(), "the same shots every time"
+
+    def counts(path: Path) -> Counter:
+        shots = read_shots(path)
+        return Counter(zip(shots.column("source"), shots.column("split")))
+
+    full, half = counts(tmp_path / "whole.csv"), counts(tmp_path / "a.csv")
+    for (source, split), n in full.items():
+        assert half[(source, split)] == (n if split == "val" else max(1, round(n / 2))), (source, split)
+    done = subprocess.run([sys.executable, "-m", "golfflight", "train-real", "--work", str(tmp_path / "w"),
+                           "--data-root", str(data_root), "--train-fraction", "1.5"],
+                          capture_output=True, text=True, env=ENV, timeout=120)
+    assert done.returncode != 0 and "--train-fraction must be above 0 and at most 1, got 1.5" in done.stderr

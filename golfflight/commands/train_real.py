@@ -51,6 +51,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "clipping: the same runs up to float rounding), for about one seed's kernel launches on a GPU; "
                         "with --jobs N, the seeds shared out over N processes, each stacking its share")
     parser.add_argument("--compile", action="store_true", help=COMPILE_HELP)
+    parser.add_argument("--train-fraction", type=float, default=1.0,
+                        help="train on this fraction (above 0, at most 1) of each source's training shots, the same "
+                        "shots for every variant and seed; validation unchanged (the learning curve, docs/accuracy.md)")
     parser.add_argument(
         "--quiet", action="store_true", help="no progress on standard error and no line per epoch on standard output"
     )
@@ -76,7 +79,8 @@ def run(args: argparse.Namespace) -> int:
     result = train_real(args.data_root or shared_data_dir(), args.work, start,
                         JointConfig(epochs=args.epochs, lr=args.lr), args.seeds, args.out, names,
                         progress=not args.quiet, plan=SeedPlan(args.device, args.jobs, args.threads,
-                                                               args.stack_seeds, args.compile))
+                                                               args.stack_seeds, args.compile),
+                        train_fraction=args.train_fraction)
     for data in result.sources:
         print(f"{data.name}: {len(data.records)} shots ({data.kind})")
     for name, run_result in result.runs.items():
