@@ -3,7 +3,7 @@ between seeds that docs/training_real.md reports (the run itself picks its run o
 held-out sets for that one). Exports each seed's last epoch to WORK/seed-S/bundle (the soup to WORK/soup/bundle)
 and prints a markdown table.
 
-    python3 scripts/held_out_per_seed.py WORK [--data DIR] [--init models/synthetic]
+    python3 scripts/held_out_per_seed.py WORK [--data DIR] [--init models/synthetic | --variant phys-q]
 """
 
 from __future__ import annotations
@@ -37,15 +37,20 @@ def main() -> int:
     parser.add_argument("work", type=Path, help="the --work directory of a train-real run")
     parser.add_argument("--data", type=Path, default=shared_data_dir(), help="the shared data folder")
     parser.add_argument("--init", default="models/synthetic", help="the run's --init bundle (its architecture)")
+    parser.add_argument("--variant", choices=("phys-nn+", "phys-q"), default="phys-nn+",
+                        help="the run's --variant (phys-q: no --init, Ferguson 2022's quadratic form)")
     args = parser.parse_args()
     sources = build(args.data, args.work / "sources_for_cards.csv", DEFAULT_SOURCES)
-    init, _ = load_bundle(args.init)
+    if args.variant == "phys-q":
+        variant, hidden = "phys-q", ()
+    else:
+        init, _ = load_bundle(args.init)
+        variant, hidden = init.variant, tuple(init.architecture.hidden_units)
     rows = []
     soup = [args.work / SOUP] if (args.work / SOUP / "last.pt").is_file() else []
     for seed_dir in sorted(args.work.glob("seed-*")) + soup:
         bundle = seed_dir / "bundle"
-        export_real(seed_dir, args.work / DATA_FILE, sources, bundle, init.variant,
-                    tuple(init.architecture.hidden_units))
+        export_real(seed_dir, args.work / DATA_FILE, sources, bundle, variant, hidden)
         rows.append([seed_dir.name, *cells(record_held_out(bundle, args.data))])
     print("\n".join(table(["run", "TrackMan drivers, all: landing error",
                            "TOUR Championship rounds 3-4: apex MAE, all / par 3 / par 4-5"], rows)))
