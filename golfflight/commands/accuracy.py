@@ -72,8 +72,8 @@ def run(args: argparse.Namespace) -> int:
         torch.set_num_threads(1)  # batches of 64 shots: a second thread only adds synchronisation
         finetune = training.finetune
     figures = args.figures or Path(args.out).parent / "figures"
-    report = run_accuracy(args.model, args.out, figures, args.data_dir, args.finetune_epochs, synthetic=_synthetic(args),
-                          finetune=finetune, progress=not args.quiet)
+    report = run_accuracy(args.model, args.out, figures, args.data_dir, args.finetune_epochs,
+                          synthetic=_synthetic(args), finetune=finetune, progress=not args.quiet)
     print(report.markdown, end="")
     print(f"wrote {args.out}" + "".join(f", {path}" for path in report.figures))
     return 0
