@@ -140,3 +140,20 @@ def path_error(times_s: np.ndarray, errors_m: Sequence[np.ndarray], path: str | 
     axis.grid(alpha=0.3)
     axis.legend()
     return _save(figure, path)
+
+
+def learning_curve(shots: dict[str, np.ndarray], errors: dict[str, np.ndarray], spans: dict[str, np.ndarray],
+                   path: str | os.PathLike, ylabel: str) -> Path:
+    """Error against training shots, a line per model: `errors[label]` at `shots[label]` (log axis), with the range
+    over seeds `spans[label]` [n, 2] as bars."""
+    figure, axis = plt.subplots(figsize=(6.5, 4.2))
+    for label, n in shots.items():
+        low, high = spans[label][:, 0], spans[label][:, 1]
+        axis.errorbar(n, errors[label], yerr=[errors[label] - low, high - errors[label]], marker="o", capsize=3,
+                      label=label)
+    axis.set_xscale("log")
+    axis.set_xlabel("training shots")
+    axis.set_ylabel(ylabel)
+    axis.grid(alpha=0.3)
+    axis.legend()
+    return _save(figure, path)

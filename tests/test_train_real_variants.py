@@ -202,3 +202,15 @@ def test_a_learning_curve_point_keeps_a_fraction_of_each_sources_training_shots_
                            "--data-root", str(data_root), "--train-fraction", "1.5"],
                           capture_output=True, text=True, env=ENV, timeout=120)
     assert done.returncode != 0 and "--train-fraction must be above 0 and at most 1, got 1.5" in done.stderr
+
+
+def test_the_learning_curve_figure_draws_each_variant_against_its_training_shots(tmp_path):
+    from golfflight.evaluation.figures import learning_curve
+    from PIL import Image
+
+    shots = {"Phys-Q": np.array([1700, 3400, 6800]), "NN": np.array([1700, 6800])}
+    errors = {"Phys-Q": np.array([11.0, 10.2, 9.8]), "NN": np.array([14.0, 12.0])}
+    spans = {label: np.stack([e - 0.5, e + 0.5], axis=1) for label, e in errors.items()}
+    path = learning_curve(shots, errors, spans, tmp_path / "curve.png", "felt error (m)")
+    with Image.open(path) as image:
+        assert image.format == "PNG" and image.size[0] > 400 and len(image.getcolors(256) or []) > 3
