@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 import torch
+from golfflight.evaluation.landing_network import LANDING_WEIGHTS_FILE
 from golfflight.model_export.joint import (
     JointConfig,
     JointResult,
@@ -31,7 +32,6 @@ from golfflight.model_export.joint import (
 )
 from golfflight.model_export.observations import ObservedShots, load_observed
 from golfflight.model_export.training import CHECKPOINT_FORMAT, load_checkpoint, save_checkpoint
-from golfflight.evaluation.landing_network import LANDING_WEIGHTS_FILE
 from golfflight.model_export.variants import LANDING_SCALE_M, SPIN_SCALE_RADPS, VELOCITY_SCALE_MPS, LandingNN
 from golfflight.shots.files import write_text_atomic
 from golfflight.shots.progress import print_line, progress_bar

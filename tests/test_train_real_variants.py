@@ -101,7 +101,8 @@ def test_nn_trains_an_epoch_and_is_evaluated_on_the_validation_blocks(trained):
               "spin_axis_deg": np.array([0.0])}
     state = initial_state(**launch)
     with torch.no_grad():
-        in_torch = model(torch.tensor(state.velocity, dtype=torch.float32), torch.tensor(state.spin, dtype=torch.float32))
+        in_torch = model(torch.tensor(state.velocity, dtype=torch.float32),
+                         torch.tensor(state.spin, dtype=torch.float32))
     np.testing.assert_allclose(LandingNetwork(work / "seed-0").landing(launch), in_torch.numpy(), rtol=1e-4, atol=1e-3)
     assert max(_training_lines(work)) <= 2942
 

@@ -31,9 +31,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--work", required=True, help="directory for the merged data and each seed's run")
     parser.add_argument("--out", help="bundle directory to export the chosen run to")
     parser.add_argument("--variant", default="phys-nn+", choices=("phys-nn+", "phys-q", "nn"),
-                        help="what to train (docs/training_real.md): phys-nn+ (default, the served model), phys-q (C_L, "
-                        "C_D quadratic in the spin ratio, C_M = p*S, refitted from Ferguson 2022's coefficients) or "
-                        "nn (launch -> landing point, evaluated only: it cannot be exported or served)")
+                        help="what to train (docs/training_real.md): phys-nn+ (default, the served model), "
+                        "phys-q (C_L, C_D quadratic in the spin ratio, C_M = p*S, refitted from Ferguson 2022's "
+                        "coefficients) or nn (launch -> landing point, evaluated only: never exported or served)")
     parser.add_argument("--init", default=None, help="bundle to start from (default: models/synthetic for phys-nn+; "
                         "Ferguson 2022's coefficients for phys-q; nn starts fresh and takes none)")
     parser.add_argument("--data-root", default=None, help="shared data folder (default ../shared/data)")
