@@ -163,10 +163,10 @@ def test_outcomes_the_baseline_never_recorded_are_not_compared(served):
     """A baseline that records only the apex (as tour feeds do) teaches nothing about carry: a new session's carry,
     side, time and landing angle are set aside and said so, not read as a change (the form's own carry error was
     once named another ball), and a new session with nothing the baseline records is refused."""
-    clean = conceal({}, 150, seed=5, model=ferguson_world(), launch_seed=1)
+    clean = conceal({}, 90, seed=5, model=ferguson_world(), launch_seed=1)
     baseline = learn_form(_apex_only(from_shot_set(clean.shots, source="apex feed")), served, seed=5)
     assert baseline.informs == ("apex_m",)
-    new = from_shot_set(conceal({}, 150, seed=5, model=ferguson_world()).shots, source="same")
+    new = from_shot_set(conceal({}, 90, seed=5, model=ferguson_world()).shots, source="same")
     report = diagnose(new, served, seed=5, progress=False, baseline=baseline).report
     assert not any(e.kind in ("venue", "monitor", "ball") for e in report.effects)
     assert any("carry along the line" in note and "not compared" in note for note in report.baseline.cannot_inform)
