@@ -2,10 +2,11 @@
 --before DIR (e.g. `git archive main | tar -x -C DIR`) and one of this checkout, each sent the same valid batches in
 turn, interleaved (before, after, before, ...), so that the machine's load falls on both alike.
 
-python benchmarks/bench_batch_ab.py --before DIR [--rounds 20] [--no-write]
+python benchmarks/bench_batch_ab.py --before DIR [--rounds 20] [--results FILE]
 
-Prints each batch size's median seconds on each server and their ratio (after / before), and writes them, with the
-machine and its load, to benchmarks/batch_ab.json (its own file).
+Prints each batch size's median seconds on each server and their ratio (after / before); with --results FILE, writes
+them, with the machine and its load, to FILE, and without it writes nothing. The tracked figures the docs quote are
+benchmarks/batch_ab.json; a run of record names it: `--results benchmarks/batch_ab.json`.
 """
 
 from __future__ import annotations
@@ -19,9 +20,10 @@ from pathlib import Path
 
 import httpx
 from bench_hostile import start_service
-from common import REPO, machine
+from common import REPO, add_results_flag, machine, save_results
 
-RESULTS_FILE = REPO / "benchmarks" / "batch_ab.json"
+TRACKED_FILE = REPO / "benchmarks" / "batch_ab.json"
+"""This script's figures that docs/reliability.md quotes: written only by a run that names it (--results)."""
 SEVEN_IRON = {"ball_speed_mps": 55.0, "launch_angle_deg": 16.0, "spin_rpm": 7100.0}
 SIZES = (100, 1_000, 10_000)
 
@@ -64,16 +66,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--before", type=Path, required=True, help="the checkout to compare with")
     parser.add_argument("--rounds", type=int, default=20)
-    parser.add_argument("--no-write", action="store_true")
+    add_results_flag(parser, TRACKED_FILE)
     args = parser.parse_args()
     rows = run(args.before, args.rounds)
     print(f"{'shots':>7} {'before ms':>10} {'after ms':>10} {'after/before':>13}")
     for row in rows:
         print(f"{row['shots']:>7,} {row['before_median_ms']:>10.1f} {row['after_median_ms']:>10.1f} "
               f"{row['after_over_before']:>13.3f}")
-    if not args.no_write:
-        RESULTS_FILE.write_text(json.dumps({"script": "benchmarks/bench_batch_ab.py", "machine": machine(),
-                                            "rows": rows}, indent=2) + "\n")
+    save_results(args.results, {"script": "benchmarks/bench_batch_ab.py", "machine": machine(), "rows": rows})
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """A connector's Open Connect shots and HTTP single shots while other clients loop 10,000-shot batches (issue 55,
 item 3): do large batch bodies, valid or not, hold up the event loop everyone else is served by?
 
-python benchmarks/bench_batch_load.py [--seconds 15] [--label after] [--tree DIR] [--no-write]
+python benchmarks/bench_batch_load.py [--seconds 15] [--label after] [--tree DIR] [--results FILE]
 
 Starts `golfflight serve --port P --connect-port Q` in a subprocess (of this checkout, or of --tree DIR: e.g.
 `git archive main | tar -x -C DIR` for a before run), waits for GET /healthz, then for each scenario starts its batch
@@ -12,8 +12,9 @@ quiet; 2 and 6 clients looping invalid batches (`{"ball_speed_mps": 500, ...}` x
 clients looping `{"shots": [1, 1, ...]}` (10,000 entries, 20 KB); 1 client looping valid batches of 10,000 shots.
 
 Prints a table (p50, p99, max per timed client, each p99 as a multiple of the quiet one, the batch answers' count
-and size) and writes benchmarks/batch_load.json, its own file: a run replaces only the rows of its --label, so the
-file can hold a before and an after run.
+and size); with --results FILE, writes its rows into FILE, replacing only the rows of its --label, so the file can
+hold a before and an after run; without it writes nothing. The tracked figures the docs quote are
+benchmarks/batch_load.json; a run of record names it: `--results benchmarks/batch_load.json`.
 """
 
 from __future__ import annotations
@@ -28,10 +29,11 @@ from pathlib import Path
 
 import numpy as np
 from bench_hostile import CONNECT_SHOT, SHOT, start_service
-from common import REPO, machine
+from common import REPO, add_results_flag, machine, read_results, save_results
 from server import HOST
 
-RESULTS_FILE = REPO / "benchmarks" / "batch_load.json"
+TRACKED_FILE = REPO / "benchmarks" / "batch_load.json"
+"""This script's figures that docs/reliability.md quotes: written only by a run that names it (--results)."""
 TARGET_MULTIPLE = 3.0
 """Issue 55: under each load, the connector's and the HTTP client's p99 within 3x their quiet p99."""
 CONNECTOR_GAP_S = 0.05
@@ -189,25 +191,22 @@ def print_rows(rows: list[dict]) -> None:
               f"{row['load_average_1m']:>5.2f}")
 
 
-def write_rows(rows: list[dict], label: str) -> None:
-    """benchmarks/batch_load.json: this run's rows in place of the earlier rows of its label."""
-    kept = json.loads(RESULTS_FILE.read_text())["rows"] if RESULTS_FILE.exists() else []
-    kept = [row for row in kept if row["label"] != label] + rows
-    document = {"script": "benchmarks/bench_batch_load.py", "machine": machine(), "rows": kept}
-    RESULTS_FILE.write_text(json.dumps(document, indent=2) + "\n")
+def write_rows(rows: list[dict], label: str, path: Path | None) -> None:
+    """The results file named (none: nothing written): this run's rows in place of the earlier rows of its label."""
+    kept = [row for row in read_results(path).get("rows", []) if row["label"] != label] + rows
+    save_results(path, {"script": "benchmarks/bench_batch_load.py", "machine": machine(), "rows": kept})
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seconds", type=float, default=15.0, help="timed seconds per scenario")
-    parser.add_argument("--label", default="after")
+    parser.add_argument("--label", default="after", help="this run's rows replace only that label's in --results FILE")
     parser.add_argument("--tree", type=Path, default=REPO, help="the checkout to serve (default: this one)")
-    parser.add_argument("--no-write", action="store_true")
+    add_results_flag(parser, TRACKED_FILE)
     args = parser.parse_args()
     rows = run(args.tree, args.seconds, args.label)
     print_rows(rows)
-    if not args.no_write:
-        write_rows(rows, args.label)
+    write_rows(rows, args.label, args.results)
 
 
 if __name__ == "__main__":

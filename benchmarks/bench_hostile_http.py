@@ -1,7 +1,7 @@
 """One hostile HTTP client on the bay's network (issue 55 items 1, 5 and 7): do a connector's shots and HTTP single
 shots keep their pace, and does the server's memory stay bounded?
 
-python benchmarks/bench_hostile_http.py [--before-tree DIR] [--seconds 8] [--shots 10000] [--no-write]
+python benchmarks/bench_hostile_http.py [--before-tree DIR] [--seconds 8] [--shots 10000] [--results FILE]
 
 Starts `golfflight serve --connect-port Q` of this checkout ("after") and, with --before-tree DIR (e.g. `git archive
 main | tar -x -C DIR`), of that checkout too ("before"), both at once, so that every scenario runs on each in turn
@@ -15,7 +15,8 @@ an API key ($GOLFFLIGHT_API_KEY, the timed clients sending it): (quiet); (7) 30 
 chunked body without the key and never finishing it, each replaced when closed. The attackers run in processes of
 their own. Between scenarios the script waits for the server to go idle.
 
-Prints a table and writes benchmarks/hostile_http.json (this script's own file).
+Prints a table; with --results FILE, writes it to FILE, and without it writes nothing. The tracked figures the docs
+quote are benchmarks/hostile_http.json; a run of record names it: `--results benchmarks/hostile_http.json`.
 """
 
 from __future__ import annotations
@@ -34,10 +35,11 @@ from pathlib import Path
 import httpx
 import psutil
 from bench_session_download import connector_shots, figures
-from common import REPO, machine
+from common import REPO, add_results_flag, machine, save_results
 from server import HOST, RawHttp, Server, free_port, start
 
-OUT = REPO / "benchmarks" / "hostile_http.json"
+TRACKED_FILE = REPO / "benchmarks" / "hostile_http.json"
+"""This script's figures that docs/reliability.md quotes: written only by a run that names it (--results)."""
 KEY = "bench-hostile-http"
 SHOT = {"ball_speed_mph": 150, "launch_angle_deg": 12, "spin_rpm": 3000}
 HEAD_BYTES = 8 * 2**20
@@ -249,14 +251,13 @@ def main() -> None:
     parser.add_argument("--before-tree", type=Path)
     parser.add_argument("--seconds", type=float, default=8.0)
     parser.add_argument("--shots", type=int, default=10_000)
-    parser.add_argument("--no-write", action="store_true")
+    add_results_flag(parser, TRACKED_FILE)
     args = parser.parse_args()
     rows, csv_seconds = run(args)
     print_table(rows, csv_seconds)
-    if not args.no_write:
-        data = {"machine": machine(), "before_tree": str(args.before_tree) if args.before_tree else None,
-                "seconds": args.seconds, "session_shots": args.shots, "rows": rows, "csv_download_s": csv_seconds}
-        OUT.write_text(json.dumps(data, indent=2) + "\n")
+    data = {"machine": machine(), "before_tree": str(args.before_tree) if args.before_tree else None,
+            "seconds": args.seconds, "session_shots": args.shots, "rows": rows, "csv_download_s": csv_seconds}
+    save_results(args.results, data)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """Who keeps a place, and whose shots stay, on a hostile network (issue 55, items 2, 8 and 9): counts, before and after.
 
-python benchmarks/bench_places.py [--tree DIR] [--trials 10] [--flood-s 90]
+python benchmarks/bench_places.py [--tree DIR] [--trials 10] [--flood-s 90] [--results FILE]
 
 Starts `golfflight serve --port P --connect-port Q` of this checkout (or of --tree DIR, e.g. `git archive main | tar
 -x -C DIR` for a before run), as bench_hostile.py does, and counts:
@@ -14,7 +14,8 @@ Starts `golfflight serve --port P --connect-port Q` of this checkout (or of --tr
 (d) a connector on 127.0.0.2 plays 300 shots in session 1; session 2 starts; 8 connections from 127.0.0.1 send
     shots back to back (connecting again when closed for their rate) until 10,500 are answered, past the 10,000
     kept, or --flood-s seconds: how many of session 1's 300 shots are kept.
-Prints one line per scenario.
+Prints one line per scenario; with --results FILE, writes the counts, with the machine and its load, to FILE, and
+without it writes nothing (no run of it is tracked: docs/reliability.md quotes the printed counts).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from pathlib import Path
 
 import httpx
 from bench_hostile import start_service
-from common import REPO
+from common import REPO, add_results_flag, machine, save_results
 
 FLOOD = Path(__file__).with_name("silent_flood.py")
 """20 sockets that send nothing, each connecting again as soon as it is closed."""
@@ -161,25 +162,37 @@ def session_kept(base: str, port: int, flood_s: float) -> tuple[int, int, int]:
     return played, first["shots"], sum(answered)
 
 
+def counted(base: str, port: int, trials: int, flood_s: float) -> dict:
+    """Every scenario's counts, each printed as it is counted."""
+    waited, at_once = waiting_connector(base, port, trials)
+    print(f"(a) connected first, first shot 0.3 s after 64 evictions: {waited} of {trials} Code 200")
+    print(f"(b) connected during the flood, shot at once: {at_once} of {trials} Code 200")
+    other_address = joined_during_flood(base, port, trials)
+    print(f"(e) connected during a flood from another address, waited: {other_address} of {trials} Code 200")
+    stream_status = viewer_places(base)
+    print(f"(c) a 17th event stream past 16 held unread: HTTP {stream_status}")
+    played, kept, answered = session_kept(base, port, flood_s)
+    print(f"(d) session 1's {played} shots: {kept} kept after {answered} flood shots from another address")
+    return {"a_connected_first_code_200": waited, "b_shot_at_once_code_200": at_once,
+            "e_other_address_code_200": other_address, "c_17th_stream_http_status": stream_status,
+            "d_session_1_played": played, "d_session_1_kept": kept, "d_flood_shots_answered": answered}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tree", type=Path, default=REPO)
     parser.add_argument("--trials", type=int, default=10)
     parser.add_argument("--flood-s", type=float, default=90.0)
+    add_results_flag(parser, tracked=None)
     args = parser.parse_args()
     process, base, port = start_service(args.tree)
     try:
-        waited, at_once = waiting_connector(base, port, args.trials)
-        print(f"(a) connected first, first shot 0.3 s after 64 evictions: {waited} of {args.trials} Code 200")
-        print(f"(b) connected during the flood, shot at once: {at_once} of {args.trials} Code 200")
-        waited = joined_during_flood(base, port, args.trials)
-        print(f"(e) connected during a flood from another address, waited: {waited} of {args.trials} Code 200")
-        print(f"(c) a 17th event stream past 16 held unread: HTTP {viewer_places(base)}")
-        played, kept, answered = session_kept(base, port, args.flood_s)
-        print(f"(d) session 1's {played} shots: {kept} kept after {answered} flood shots from another address")
+        counts = counted(base, port, args.trials, args.flood_s)
     finally:
         process.terminate()
         process.wait(60)
+    save_results(args.results, {"script": "benchmarks/bench_places.py", "machine": machine(), "tree": str(args.tree),
+                                "trials": args.trials, "flood_s": args.flood_s, "counts": counts})
 
 
 if __name__ == "__main__":

@@ -2,12 +2,14 @@
 in a thread beside it (pydantic-core holds the GIL while it validates, so a thread may stall the loop as well). The
 batch process, the third place, is measured by `bench_batch_load.py` and `tests/test_batch_off_loop.py`.
 
-python benchmarks/bench_validation_gil.py [--rounds 3] [--no-write]
+python benchmarks/bench_validation_gil.py [--rounds 3] [--results FILE]
 
 An asyncio ticker sleeps 1 ms at a time and records how late each wake-up is, while `contract.batch_body.read_batch`
 reads an invalid body (`{"ball_speed_mps": 500, ...}` x 10,000: json.loads, the model and 20 problems described)
 or a valid one, `--rounds` times, on the loop or in `asyncio.to_thread`, the two alternating. Prints the worst
-lateness and the time per body, and writes benchmarks/validation_gil.json (its own file).
+lateness and the time per body; with --results FILE, writes them to FILE, and without it writes nothing. The tracked
+figures the docs quote are benchmarks/validation_gil.json; a run of record names it:
+`--results benchmarks/validation_gil.json`.
 """
 
 from __future__ import annotations
@@ -17,11 +19,12 @@ import asyncio
 import json
 import time
 
-from common import REPO, machine
+from common import REPO, add_results_flag, machine, save_results
 from golfflight.contract.batch_body import read_batch
 from golfflight.contract.refusals import RequestRefused
 
-RESULTS_FILE = REPO / "benchmarks" / "validation_gil.json"
+TRACKED_FILE = REPO / "benchmarks" / "validation_gil.json"
+"""This script's figures that docs/reliability.md quotes: written only by a run that names it (--results)."""
 SHOT = {"launch_angle_deg": 12.0, "spin_rpm": 3000.0}
 BODIES = {
     "invalid": json.dumps({"shots": [{**SHOT, "ball_speed_mps": 500.0}] * 10_000}).encode(),
@@ -73,15 +76,13 @@ async def run(rounds: int) -> list[dict]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=3)
-    parser.add_argument("--no-write", action="store_true")
+    add_results_flag(parser, TRACKED_FILE)
     args = parser.parse_args()
     rows = asyncio.run(run(args.rounds))
     print(f"{'body':8} {'where':7} {'worst loop stall ms':>20} {'ms per body':>12}")
     for row in rows:
         print(f"{row['body']:8} {row['where']:7} {row['worst_stall_ms']:>20.1f} {row['ms_per_body']:>12.1f}")
-    if not args.no_write:
-        document = {"script": "benchmarks/bench_validation_gil.py", "machine": machine(), "rows": rows}
-        RESULTS_FILE.write_text(json.dumps(document, indent=2) + "\n")
+    save_results(args.results, {"script": "benchmarks/bench_validation_gil.py", "machine": machine(), "rows": rows})
 
 
 if __name__ == "__main__":

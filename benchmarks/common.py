@@ -97,13 +97,13 @@ def machine() -> dict:
     }
 
 
-def add_results_flag(parser: argparse.ArgumentParser) -> None:
-    """`--results FILE`: where the run's section is merged; without it the run prints its table and writes nothing,
-    so the tracked figures (TRACKED_RESULTS) change only when a run names them on purpose."""
+def add_results_flag(parser: argparse.ArgumentParser, tracked: Path | None = TRACKED_RESULTS) -> None:
+    """`--results FILE`: where the run is written; without it the run prints its table and writes nothing, so a
+    tracked file of figures (`tracked`: TRACKED_RESULTS, or a script's own file) changes only when a run names it."""
+    quoted = f" ({tracked.relative_to(REPO)}: the tracked figures the docs quote)" if tracked is not None else ""
     parser.add_argument(
         "--results", type=Path, metavar="FILE",
-        help=f"merge this run's section into FILE ({TRACKED_RESULTS.relative_to(REPO)}: the tracked figures the docs "
-        "quote); default: print only, write nothing",
+        help=f"write this run's figures to FILE{quoted}; default: print only, write nothing",
     )
 
 
