@@ -213,7 +213,5 @@ class TorchEngineMaker:
     def __call__(self, bundle_dir: str | os.PathLike) -> TorchEngine:
         if self.threads is not None:
             torch.set_num_threads(self.threads)
-        from golfflight.flight.engine import FlightEngine
-
-        return FlightEngine.from_bundle(bundle_dir, "torch", self.device, dtype=self.dtype,
-                                        parts_at_once=self.parts_at_once, compile_step=self.compile_step)
+        return TorchEngine(bundle_dir, device=self.device, dtype=self.dtype, parts_at_once=self.parts_at_once,
+                           compile_step=self.compile_step)

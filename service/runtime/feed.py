@@ -21,13 +21,12 @@ import time
 from collections import Counter, deque
 from collections.abc import ValuesView
 from dataclasses import dataclass
-from typing import Literal
 
 from golfflight.contract.bay import Player
 from golfflight.contract.requests import ShotRequest
 from golfflight.contract.results import ShotResult
 from golfflight.flight.engine import EulerStates
-from golfflight.service.runtime.sessions import MAX_SESSIONS, MAX_SHOTS, Session, Sessions, SessionShot
+from golfflight.service.runtime.sessions import MAX_SESSIONS, MAX_SHOTS, Session, Sessions, SessionShot, Source
 
 HISTORY = 50
 """Shots kept for viewers that open (or reconnect) later, and the length of each viewer's queue."""
@@ -48,10 +47,6 @@ Last-Event-ID, so one pushed out misses no kept shot."""
 VIEWER_GAVE_WAY = ("closed to make room for a new stream: {places} were open (the most this golfflight serves at "
                    "once) and this address held the most of them; open it again to go on")
 """The comment that ends a stream giving its place to a new one."""
-
-Source = Literal["http", "batch", "gspro-http", "open-connect"]
-"""Where a shot came in: POST /v1/shots, POST /v1/shots/batch, POST /v1/gspro, GSPro Open Connect over TCP."""
-
 
 @dataclass(eq=False)
 class Entry:

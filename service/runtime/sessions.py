@@ -14,7 +14,7 @@ import time
 from collections import OrderedDict
 from collections.abc import ValuesView
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, NamedTuple
+from typing import Literal, NamedTuple
 
 from golfflight.contract.bay import Player
 from golfflight.contract.clubs import GSPRO_CLUBS
@@ -24,8 +24,8 @@ from golfflight.contract.session import ClubSummary, SessionInfo, SessionList, S
 from golfflight.service.runtime.club_stats import ELLIPSE_PROBABILITY, ClubStats, figures
 from golfflight.service.runtime.shares import SourceShares
 
-if TYPE_CHECKING:
-    from golfflight.service.runtime.feed import Source
+Source = Literal["http", "batch", "gspro-http", "open-connect"]
+"""Where a shot came in: POST /v1/shots, POST /v1/shots/batch, POST /v1/gspro, GSPro Open Connect over TCP."""
 
 MAX_SHOTS = 10_000
 """Shots kept over all sessions (their CSV and summaries): a long range session; about 4 kB each, 40 MB in all. Past
