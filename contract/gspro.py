@@ -198,7 +198,8 @@ class GSProReply(BaseModel):
 
 
 def launch_from_ball_data(ball: GSProBallData) -> Launch:
-    """The SI launch of a message's BallData; ValueError naming the field when one it needs is missing."""
+    """The SI launch of a message's BallData; InputError naming the field when one it needs is missing, or
+    when BackSpin and SideSpin make a spin out of range."""
     missing = [name for name in ("Speed", "VLA") if getattr(ball, name) is None]
     uses_components = not ball.TotalSpin and (ball.BackSpin or ball.SideSpin)
     if ball.TotalSpin is None and ball.BackSpin is None:
@@ -233,7 +234,7 @@ def invalid_message(errors: list) -> str:
 
 def shot_request(message: GSProMessage) -> ShotRequest:
     """The /v1/shots request of a message's ball (launch only: Open Connect carries no conditions, the bay gives
-    them); ValueError naming the field when one it needs is missing. Built without re-validation: GSProBallData
+    them); InputError naming the field when one it needs is missing (`launch_from_ball_data`). Built without re-validation: GSProBallData
     has checked every value against GSPRO_RANGES."""
     launch = launch_from_ball_data(message.BallData)
     return ShotRequest.model_construct(

@@ -137,7 +137,7 @@ def is_fit(source: str, method: str) -> bool:
 
 
 def _rows(path: str | os.PathLike, columns: tuple[str, ...]) -> list[dict[str, str]]:
-    """The rows of a CSV table that must have these columns (ValueError naming the file and the missing ones)."""
+    """The rows of a CSV table that must have these columns (InputError naming the file and the missing ones)."""
     with Path(path).open(newline="", encoding=CSV_ENCODING) as handle:
         reader = csv.DictReader(handle)
         missing = [c for c in columns if c not in (reader.fieldnames or [])]

@@ -189,7 +189,7 @@ class FlightEngine:
         """Skid and roll one putt to rest on `ground` (`flight.ground.putt_phase`): the ball never leaves it, so the
         flight's figures are its start's (landing at the tee, carry, apex, times and landing angle 0, the launch's
         speed and spin). A putt is played on that ground itself, from the point below the tee: its states lie on the
-        ground's plane through (0, 0, ground.elevation_m), so a screen draws it on the green it rolls on. ValueError
+        ground's plane through (0, 0, ground.elevation_m), so a screen draws it on the green it rolls on. InputError
         for a slope steeper than the surface holds a ball on."""
         rolled = putt_phase(*launch, ground.surface, ground.slope_deg, ground.slope_dir_deg, keep_states)
         states = None

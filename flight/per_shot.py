@@ -31,7 +31,7 @@ class PerShot(Sequence, Generic[T]):
     @classmethod
     def of(cls, given: PerShot[T] | Sequence[T] | T, n: int, name: str = "objects") -> PerShot[T]:
         """`given` as a PerShot of n shots: as it is, one a shot (another sequence), or one object for every
-        shot. ValueError naming `name` where a sequence's length is not n."""
+        shot. InputError naming `name` where a sequence's length is not n."""
         if isinstance(given, PerShot):
             shared = given
         elif isinstance(given, Sequence):

@@ -93,7 +93,7 @@ class TorchEngine:
         `ground_on_device` bounces and rolls the landings on the device (`roll_to_rest`; default: on a GPU) instead
         of NumPy's on the CPU; `set_aside_share` is the share of a part's flying shots that must be down before they
         are set aside (1: never, every shot flies to the part's last step). `devices.DeviceError` for a device this
-        machine lacks, ValueError for a dtype it does not know or a share outside (0, 1]."""
+        machine lacks, InputError for a dtype it does not know or a share outside (0, 1]."""
         if dtype not in DTYPES:
             raise InputError(f"dtype {dtype!r}: choose from {', '.join(DTYPES)}")
         if not 0 < set_aside_share <= 1:

@@ -44,7 +44,7 @@ def _mlp_state(model: PhysNN, weights: dict[str, torch.Tensor], card: ModelCard)
 def model_from_bundle(bundle_dir: str | os.PathLike) -> tuple[nn.Module, ModelCard]:
     """The bundle's coefficient model as a torch module (float32, eval mode) and its card.
 
-    Raises ValueError when the graph's weights do not fit the card's architecture or the rebuilt model does not
+    Raises InputError when the graph's weights do not fit the card's architecture or the rebuilt model does not
     reproduce the graph within the export tolerance."""
     card, onnx_path = load_bundle(bundle_dir)
     model = build_model(card.variant, card.architecture.hidden_units)

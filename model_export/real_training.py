@@ -193,7 +193,7 @@ class SeedPlan:
     compile_step: bool = False
 
     def check(self) -> None:
-        """ValueError, in the command line's words, for a plan that cannot run here."""
+        """InputError, in the command line's words, for a plan that cannot run here."""
         if resolve_device(self.device).type != "cpu" and self.jobs > 1:
             raise InputError(f"--jobs {self.jobs} goes with --device cpu: on {self.device} the seeds run one after "
                              "another, or side by side with --stack-seeds")

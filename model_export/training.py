@@ -158,7 +158,7 @@ def save_checkpoint(path: Path, payload: dict[str, Any]) -> None:
 
 def load_checkpoint(path: str | os.PathLike) -> dict[str, Any]:
     """A checkpoint written by `save_checkpoint` (tensors and plain values only: weights_only loading, which never
-    unpickles code); ValueError naming the file for anything else."""
+    unpickles code); InputError naming the file for anything else."""
     try:
         payload = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as error:  # noqa: BLE001 - torch's weights-only reader raises many types on a corrupt file

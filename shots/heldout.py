@@ -100,7 +100,7 @@ def held_out_rounds(path: str | os.PathLike) -> tuple[int, ...]:
 
 def shot_round(shot_id: str) -> int:
     """The round of a canonical tour shot id ('060-R3-H15-P29725-S1', also behind a 'source:' prefix);
-    ValueError where the id is not one."""
+    InputError where the id is not one."""
     match = TOUR_SHOT_ID.match(shot_id.strip())
     if match is None:
         raise InputError(f"{shot_id!r} is not a tour shot id such as '060-R3-H15-P29725-S1'")

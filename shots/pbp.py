@@ -239,7 +239,7 @@ def recorded_apex(path: str | os.PathLike) -> dict[str, RecordedApex]:
 
 
 def distance_m(text: str) -> float | None:
-    """ShotLink's `distance` text in metres; None where NA or blank; ValueError where it has another form."""
+    """ShotLink's `distance` text in metres; None where NA or blank; InputError where it has another form."""
     text = text.strip()
     if text in MISSING:
         return None

@@ -211,7 +211,7 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int | None, addres
 def gpu_actors(resources: dict, workers: int | None, gpus_per_actor: float) -> int:
     """The actors of a sweep on GPUs: `workers`, or as many as the cluster's GPUs (`resources`,
     `ray.cluster_resources()`) hold at `gpus_per_actor` each (1: one a GPU; 0.5: two) and its CPUs at one each beside
-    the one that reads (Ray Data gives a GPU actor a CPU too); ValueError where the cluster lists no GPU or fewer GPUs
+    the one that reads (Ray Data gives a GPU actor a CPU too); InputError where the cluster lists no GPU or fewer GPUs
     or CPUs than the actors need (an actor Ray cannot place, or a read with no CPU left, would wait for ever)."""
     gpus, cpus = int(resources.get("GPU", 0)), int(resources.get("CPU", 0))
     if gpus < gpus_per_actor:
@@ -244,7 +244,7 @@ def _engine_problem(make_engine: Callable, bundle_dir: str) -> str | None:
 
 
 def check_actor_engine(ray, make_engine: Callable, bundle_dir: str, gpus: float) -> None:
-    """Build one engine as an actor would, in a Ray task asking for `gpus` GPUs, before any actor starts; ValueError
+    """Build one engine as an actor would, in a Ray task asking for `gpus` GPUs, before any actor starts; InputError
     saying why where it fails (a node without torch fails before the task runs: the error's last line says so)."""
     task = ray.remote(num_cpus=1, num_gpus=gpus, max_retries=0)(_engine_problem)
     try:

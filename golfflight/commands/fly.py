@@ -187,7 +187,7 @@ def request_of(args: argparse.Namespace) -> tuple[str, dict]:
 
 
 def checked(shot: dict):
-    """The validated ShotRequest, or ValueError with the API's messages naming the options."""
+    """The validated ShotRequest, or InputError with the API's messages naming the options."""
     from golfflight.contract.refusals import describe_errors
     from golfflight.contract.requests import ShotRequest
 

@@ -34,7 +34,7 @@ def encoded(reply: GSProReply) -> bytes:
 def player_information(club: str, handed: str) -> bytes:
     """The Code 201 object GSPro pushes when the player or the club changes, as it goes on the wire, the club as its
     GSPro code (connectors switch to putting on PT) whichever name it is given by (`contract.clubs.club_code`);
-    ValueError for a hand other than RH or LH or a club no name of which it is."""
+    InputError for a hand other than RH or LH or a club no name of which it is."""
     if handed not in HANDED:
         raise InputError(f"handed must be one of {', '.join(HANDED)}, got {handed!r}")
     player = {"Code": 201, "Message": "GSPro Player Information", "Player": {"Handed": handed, "Club": club_code(club)}}

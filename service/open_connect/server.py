@@ -164,7 +164,7 @@ class OpenConnectServer:
         handed,"Club":club}}`, to every connector connected now. Nothing is pushed to a connector as it connects: one
         that reads a single reply after each shot (MLM2PRO-GSPro-Connector's `recv(2048)`) would take an object it
         did not ask for as its shot's reply if its shot followed at once. `club` is a GSPro club code (DR, I7, PT,
-        ...), `handed` RH or LH; ValueError otherwise. Safe to call from any thread: off the event loop's thread,
+        ...), `handed` RH or LH; InputError otherwise. Safe to call from any thread: off the event loop's thread,
         the push is handed to the loop (`call_soon_threadsafe`) and goes out on its next turn."""
         data = player_information(club, handed)
         try:
