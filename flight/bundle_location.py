@@ -12,7 +12,9 @@ import sys
 import sysconfig
 from pathlib import Path
 
-MODEL_ENV = "GOLFFLIGHT_MODEL"
+from golfflight.flight.environment_variables import MODEL, given
+
+MODEL_ENV = MODEL
 CHECKOUT_MODEL = Path(__file__).resolve().parents[1] / "models" / "default"
 INSTALLED_MODEL = Path("share") / "golfflight" / "models" / "default"
 
@@ -30,8 +32,9 @@ def model_dir(explicit: str | os.PathLike | None = None) -> Path:
     """The bundle directory to load; FileNotFoundError listing where it looked when there is none."""
     if explicit is not None:
         return Path(explicit)
-    if os.environ.get(MODEL_ENV):
-        return Path(os.environ[MODEL_ENV])
+    named = given(MODEL_ENV)
+    if named:
+        return Path(named)
     candidates = [CHECKOUT_MODEL, *installed_model_dirs()]
     for candidate in candidates:
         if (candidate / "model_card.json").is_file():

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
+
+from golfflight.flight.environment_variables import SHARED_DATA, given
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 """The repository checkout this package is imported from."""
 
 
 def shared_data_dir() -> Path:
-    """The shared data folder: $GOLFFLIGHT_SHARED_DATA if set, else `<repo root>/../shared/data`."""
-    return Path(os.environ.get("GOLFFLIGHT_SHARED_DATA", REPO_ROOT.parent / "shared" / "data"))
+    """The shared data folder: $GOLFFLIGHT_SHARED_DATA if set and not empty, else `<repo root>/../shared/data`."""
+    return Path(given(SHARED_DATA) or REPO_ROOT.parent / "shared" / "data")

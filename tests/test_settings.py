@@ -1,11 +1,10 @@
 """The service's one settings object: read once from the GOLFFLIGHT_* variables (or whole, as `serve` hands it to its
-workers), flags over the environment, a bad value refused naming its variable or flag, and no other module of the
-service reading the environment for a setting."""
+workers), flags over the environment, a bad value refused naming its variable or flag (that no other module reads
+the environment: tests/test_environment.py)."""
 
 from __future__ import annotations
 
 import argparse
-import ast
 from pathlib import Path
 
 import pytest
@@ -13,8 +12,6 @@ from golfflight.commands.serve import register, served_settings
 from golfflight.errors import InputError
 from golfflight.flight.bundle_location import CHECKOUT_MODEL, MODEL_ENV
 from golfflight.service.settings import HANDED_DOWN_ENV, ServiceSettings
-
-from tests.test_imports import ROOT
 
 ENVIRONMENT = {
     "GOLFFLIGHT_API_KEY": "secret",
@@ -75,18 +72,3 @@ def test_serve_puts_its_flags_over_the_environment(monkeypatch, tmp_path):
 def test_serve_refuses_a_bad_flag_naming_it():
     with pytest.raises(InputError, match="^--connect-port: .*65535, got 70000$"):
         served_settings(_serve_args("--connect-port", "70000"), ServiceSettings())
-
-
-def _reads_the_environment(path: Path) -> bool:
-    for node in ast.walk(ast.parse(path.read_text(), str(path))):
-        if isinstance(node, ast.Attribute) and node.attr in ("environ", "getenv") and getattr(node.value, "id", "") == "os":
-            return True
-    return False
-
-
-def test_no_other_module_of_the_service_reads_the_environment():
-    readers = {str(path.relative_to(ROOT)) for path in sorted((ROOT / "service").rglob("*.py"))
-               if _reads_the_environment(path)}
-    # metrics: Prometheus's own $PROMETHEUS_MULTIPROC_DIR, which prometheus_client reads in every worker itself
-    assert readers == {"service/settings.py", "service/runtime/metrics.py"}
-    assert not _reads_the_environment(ROOT / "golfflight" / "commands" / "serve.py")

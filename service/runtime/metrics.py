@@ -13,7 +13,6 @@ over every worker.
 
 from __future__ import annotations
 
-import os
 import shutil
 import tempfile
 from collections.abc import Callable, Iterator
@@ -25,8 +24,9 @@ from prometheus_client.exposition import CONTENT_TYPE_LATEST, generate_latest
 from prometheus_client.metrics_core import InfoMetricFamily
 from prometheus_client.multiprocess import MultiProcessCollector
 from golfflight.errors import InputError
+from golfflight.flight.environment_variables import METRICS_DIR, given, set_for_children
 
-MULTIPROC_ENV = "PROMETHEUS_MULTIPROC_DIR"
+MULTIPROC_ENV = METRICS_DIR
 """prometheus-client's switch to multiprocess mode: the directory the worker processes write their samples to."""
 
 CONTENT_TYPE = CONTENT_TYPE_LATEST
@@ -90,7 +90,7 @@ class ServiceMetrics:
         )
         self.registry.register(ModelInfoCollector(model_labels))
         self._scraped = self.registry
-        if os.environ.get(MULTIPROC_ENV):
+        if given(MULTIPROC_ENV):
             self._scraped = CollectorRegistry()
             MultiProcessCollector(self._scraped)
             self._scraped.register(ModelInfoCollector(model_labels))
@@ -107,11 +107,11 @@ def shared_across_workers(workers: int) -> Iterator[Path | None]:
     With $PROMETHEUS_MULTIPROC_DIR set, that directory is used and the sample files an earlier run left in it are
     removed (they would be added to this run's counts). Otherwise several workers get a fresh temporary directory,
     removed when the server stops, and one worker keeps its metrics in memory (None)."""
-    given = os.environ.get(MULTIPROC_ENV)
-    if given:
-        directory = Path(given)
+    named = given(MULTIPROC_ENV)
+    if named:
+        directory = Path(named)
         if not directory.is_dir():
-            raise InputError(f"${MULTIPROC_ENV} is {given!r}: no such directory")
+            raise InputError(f"${MULTIPROC_ENV} is {named!r}: no such directory")
         for stale in directory.glob("*.db"):
             stale.unlink()
         yield directory
@@ -120,9 +120,9 @@ def shared_across_workers(workers: int) -> Iterator[Path | None]:
         yield None
         return
     directory = Path(tempfile.mkdtemp(prefix="golfflight-metrics-"))
-    os.environ[MULTIPROC_ENV] = str(directory)
+    set_for_children(MULTIPROC_ENV, str(directory))
     try:
         yield directory
     finally:
-        del os.environ[MULTIPROC_ENV]
+        set_for_children(MULTIPROC_ENV, None)
         shutil.rmtree(directory, ignore_errors=True)
