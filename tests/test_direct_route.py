@@ -7,12 +7,14 @@ from __future__ import annotations
 import json
 
 import pytest
-from fastapi import APIRouter, Depends, FastAPI, Request
+from fastapi import APIRouter, Depends, Header
 from fastapi.routing import APIRoute
 from golfflight.contract.gspro import GSProMessage
 from golfflight.contract.requests import BatchRequest, ShotRequest
+from golfflight.service.api.dependencies import bay_runtime
 from golfflight.service.api.direct import DirectRoute
 from golfflight.service.app import create_app
+from golfflight.service.runtime import BayRuntime
 from pydantic import ValidationError
 
 from tests.servers import running
@@ -111,21 +113,26 @@ def test_reading_the_bytes_accepts_nothing_fastapi_refuses_nor_reads_it_otherwis
     assert model.model_validate(json.loads(text)) == direct
 
 
-def test_a_route_that_needs_more_than_a_body_and_flags_is_refused():
-    async def engine() -> None:
-        return None
+def test_a_newcomers_route_with_depends_is_served_by_fastapi_beside_the_direct_ones(fastapi_requests):
+    """A route added to a router of DirectRoutes, as `routes/shots.py` builds them, with a `Depends` (the bay
+    runtime), a path and a header parameter: FastAPI solves and answers it, on a real server, while the shipped
+    routes stay on the direct path."""
+    router = APIRouter(prefix="/v1/extra", route_class=DirectRoute)
 
-    router = APIRouter(route_class=DirectRoute)
-    with pytest.raises(TypeError, match="DirectRoute takes one body model"):
+    @router.post("/carry/{unit}")
+    async def carry(request: ShotRequest, unit: str, runtime: BayRuntime = Depends(bay_runtime),
+                    player: str = Header("guest")) -> dict:
+        flown = runtime.fly(request, "http", show=False, client=None).result
+        return {"carry": flown.carry_m if unit == "m" else flown.carry_m / 0.9144, "player": player}
 
-        @router.post("/shot", dependencies=[Depends(engine)])
-        async def shot(request: ShotRequest, http: Request) -> None:
-            return None
-
-    with pytest.raises(TypeError, match="DirectRoute takes one body model"):
-
-        @router.post("/shot/{number}")
-        async def numbered(request: ShotRequest, http: Request, number: int) -> None:
-            return None
-
-    FastAPI().include_router(router)
+    app = create_app()
+    app.include_router(router)
+    with running(app) as client:
+        extended = client.post("/v1/extra/carry/yd", content=json.dumps(SHOT), headers={**JSON, "player": "ana"})
+        shot = client.post("/v1/shots", content=json.dumps(SHOT), headers=JSON)
+        refused = client.post("/v1/extra/carry/yd", content=json.dumps({**SHOT, "spin_rpm": -1.0}), headers=JSON)
+    assert extended.status_code == 200 and shot.status_code == 200
+    assert extended.json() == {"carry": pytest.approx(shot.json()["carry_m"] / 0.9144), "player": "ana"}
+    assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == ["body", "spin_rpm"]
+    assert [path for path in fastapi_requests if path != "/healthz"] == ["/v1/extra/carry/yd"] * 2  # not /v1/shots
+    assert [route.direct_path for route in router.routes] == [False]

@@ -10,6 +10,13 @@ around a route (exception middleware, exit stacks, the router) cost about as muc
 work beside the flight (`docs/benchmarks.md`, issue 25). A route opts in by its class (`DirectRoute`);
 `DirectLanes` is the innermost of the app's middleware and serves those routes' direct requests. A `RawBodyRoute`
 (the batch route) hands its body over unparsed: its endpoint has it read and validated off the event loop.
+
+Extending a router of DirectRoutes (`routes/shots.py`, `routes/gspro.py`) works as in any FastAPI app: a route that
+takes more than one body model, the `Request` and bool query flags (a `Depends`, such as `dependencies.bay_runtime`
+for the bay runtime, a path, header or cookie parameter, another query type, no body) is served by FastAPI's own
+path, its dependencies solved there, and costs what the direct path saves; only the shipped simulation routes need
+the direct path (`tests/test_direct_route.py` holds them on it). A direct endpoint reaches the runtime with
+`service.runtime.runtime_of(http)`, a plain attribute read.
 """
 
 from __future__ import annotations
@@ -39,9 +46,10 @@ FLAG = TypeAdapter(bool)
 
 
 class DirectRoute(APIRoute):
-    """An APIRoute whose valid requests `DirectLanes` hands straight to the endpoint. The endpoint is `async def`,
-    returns a `Response` and takes one body model, the `Request` and boolean query flags, nothing else (no
-    dependencies, path, header or cookie parameters: those only FastAPI's path solves)."""
+    """An APIRoute whose valid requests `DirectLanes` hands straight to the endpoint when the endpoint is `async def`,
+    returns a `Response` and takes one body model, the `Request` and boolean query flags, nothing else (`direct_path`
+    True). Any other endpoint (dependencies, path, header or cookie parameters: what only FastAPI's path solves) is
+    an ordinary APIRoute, `direct_path` False: FastAPI answers all its requests."""
 
     def __init__(self, path: str, endpoint: Any, **kwargs: Any):
         super().__init__(path, endpoint, **kwargs)
@@ -49,8 +57,9 @@ class DirectRoute(APIRoute):
         unsupported = [
             *dependant.dependencies, *dependant.path_params, *dependant.header_params, *dependant.cookie_params
         ] + [flag for flag in dependant.query_params if flag.field_info.annotation is not bool]
-        if unsupported or self.body_field is None or dependant.request_param_name is None:
-            raise TypeError(f"{path}: DirectRoute takes one body model, the Request and bool query flags only")
+        self.direct_path = not unsupported and self.body_field is not None and dependant.request_param_name is not None
+        if not self.direct_path:
+            return
         self.body_model: type[BaseModel] = self.body_field.field_info.annotation
         self._names = self.body_field.name, dependant.request_param_name
         self._flags = {flag.alias.encode(): (flag.name, flag.field_info.default) for flag in dependant.query_params}
@@ -114,7 +123,7 @@ class DirectLanes:
 
     def __init__(self, app, routes: Iterable[APIRoute]):
         self.app = app
-        direct = [route for route in routes if isinstance(route, DirectRoute)]
+        direct = [route for route in routes if isinstance(route, DirectRoute) and route.direct_path]
         self.lanes = {(method, route.path): route for route in direct for method in route.methods}
 
     async def __call__(self, scope, receive, send):
