@@ -15,7 +15,7 @@ from golfflight.errors import InputError
 from golfflight.flight import limits
 from golfflight.flight.conditions import NORMALIZED_HUMIDITY_PCT, NORMALIZED_TEMPERATURE_C
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS
-from golfflight.flight.ground import SURFACES, holding_slope_deg, surface
+from golfflight.flight.ground import SURFACES, check_slope_held, surface
 from golfflight.flight.limits import Range
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -237,12 +237,7 @@ class GroundRequest(Strict):
             raise InputError("ground elevation: give elevation_m or elevation_ft, not both")
         if self.stimp_ft is not None and self.surface != "green":
             raise InputError(f"stimp_ft: a green's reading; surface {self.surface!r} takes none")
-        limit = float(holding_slope_deg(surface(self.surface, self.stimp_ft).rolling_resistance))
-        if self.slope_deg >= limit:
-            raise InputError(
-                f"slope_deg: {self.slope_deg:g} is steeper than {self.surface} holds a ball still on; allowed 0 to "
-                f"{limit - 0.005:.2f} deg on this surface"
-            )
+        check_slope_held(self.slope_deg, surface(self.surface, self.stimp_ft).rolling_resistance, self.surface)
         return self
 
 

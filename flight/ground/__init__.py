@@ -5,7 +5,14 @@ surface parameters; `putt_phase` skids and rolls a putt that starts on the groun
 from golfflight.flight.ground.phase import GroundPath, GroundPhase, OneRest, ground_phase, ground_phase_one
 from golfflight.flight.ground.putt import SKID_FRICTION, PuttPhase, putt_phase
 from golfflight.flight.ground.spec import LEVEL_FAIRWAY, GroundSpec, batch_surface, elevations
-from golfflight.flight.ground.surfaces import SURFACES, Surface, green_rolling_resistance, holding_slope_deg, surface
+from golfflight.flight.ground.surfaces import (
+    SURFACES,
+    Surface,
+    check_slope_held,
+    green_rolling_resistance,
+    holding_slope_deg,
+    surface,
+)
 
 __all__ = [
     "LEVEL_FAIRWAY",
@@ -18,6 +25,7 @@ __all__ = [
     "PuttPhase",
     "Surface",
     "batch_surface",
+    "check_slope_held",
     "elevations",
     "green_rolling_resistance",
     "ground_phase",

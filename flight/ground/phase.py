@@ -36,10 +36,9 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-from golfflight.errors import InputError
 from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
 from golfflight.flight.ground.impact import impact_components
-from golfflight.flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, holding_slope_deg
+from golfflight.flight.ground.surfaces import ROLLING_GRAVITY_FRACTION, Surface, check_slope_held
 from golfflight.flight.ground.vectors import TINY, add, choose, cross, dot, norm, times
 from golfflight.flight import xp
 from golfflight.flight.xp import expm1, log1p, maximum, where
@@ -89,23 +88,22 @@ class OneRest(NamedTuple):
     path: GroundPath | None = None
 
 
-def plane_normals(slope_deg: np.ndarray | float, slope_dir_deg: np.ndarray | float, n: int) -> np.ndarray:
-    """Unit normals [n,3] of planes falling at `slope_deg` towards `slope_dir_deg` (clockwise from the target line
+RADIANS_PER_DEG = math.pi / 180.0
+"""math.radians' and np.radians' own factor: one formula on floats and arrays gives both their bits."""
+
+
+def plane_normal(slope_deg, slope_dir_deg) -> tuple:
+    """Unit normal (x, y, z) of a plane falling at `slope_deg` towards `slope_dir_deg` (clockwise from the target line
     seen from behind the golfer: 0 = falls away towards the target, 90 = falls to the right, 180 = rises towards
-    the target)."""
-    phi = np.broadcast_to(np.radians(slope_deg), (n,))
-    beta = np.broadcast_to(np.radians(slope_dir_deg), (n,))
-    return np.stack([np.sin(phi) * np.sin(beta), np.sin(phi) * np.cos(beta), np.cos(phi)], -1)
+    the target), on floats or [N] arrays."""
+    phi, beta = slope_deg * RADIANS_PER_DEG, slope_dir_deg * RADIANS_PER_DEG
+    return xp.sin(phi) * xp.sin(beta), xp.sin(phi) * xp.cos(beta), xp.cos(phi)
 
 
-def _check_slopes(slope: np.ndarray, resistance: np.ndarray) -> None:
-    steep = slope >= holding_slope_deg(resistance)
-    if np.any(steep):
-        i = int(np.flatnonzero(np.atleast_1d(steep))[0])
-        raise InputError(
-            f"slope_deg {np.atleast_1d(slope)[i]:g} is steeper than the surface holds a ball on "
-            f"({float(np.atleast_1d(holding_slope_deg(resistance))[i]):.2f} deg): it would never come to rest"
-        )
+def plane_normals(slope_deg: np.ndarray | float, slope_dir_deg: np.ndarray | float, n: int) -> np.ndarray:
+    """Unit normals [n,3] of `plane_normal`'s planes, one a ball (each angle shared or one a ball)."""
+    angles = (np.broadcast_to(np.asarray(a, dtype=float), (n,)) for a in (slope_deg, slope_dir_deg))
+    return np.stack(plane_normal(*angles), -1)
 
 
 def hop(position: tuple, velocity: tuple, duration) -> tuple[tuple, tuple]:
@@ -149,6 +147,19 @@ def decay(drag, t):
     return e1, e2
 
 
+def drift_velocity(velocity: tuple, acceleration: tuple, drag, e1) -> tuple:
+    """v(t) = v0 (1 - k E1) + A E1: the velocity after a time whose `decay` factor is E1, under a constant
+    acceleration A plus drag k v."""
+    return add(times(1.0 - drag * e1, velocity), acceleration, e1)
+
+
+def drift(position: tuple, velocity: tuple, acceleration: tuple, drag, t) -> tuple[tuple, tuple]:
+    """Position and velocity after time `t` under a constant acceleration A plus drag k v, exactly (`decay`):
+    x(t) = x0 + v0 E1 + A E2 and `drift_velocity`; the one motion of every roll, stepped or closed form."""
+    e1, e2 = decay(drag, t)
+    return add(add(position, velocity, e1), acceleration, e2), drift_velocity(velocity, acceleration, drag, e1)
+
+
 def slope_step(position: tuple, velocity: tuple, downhill: tuple, brake, drag):
     """One ROLL_STEP_S of a roll on a slope: (stops, time taken, rest point, position, velocity after the step).
     Gravity and the rolling resistance act along the direction of motion at the step's middle (a midpoint step:
@@ -160,12 +171,9 @@ def slope_step(position: tuple, velocity: tuple, downhill: tuple, brake, drag):
     braking = maximum(-dot(acceleration, direction), TINY)
     run, stop_time = stopping(speed, braking, drag)
     stops = stop_time <= ROLL_STEP_S
-    half_e1, _ = decay(drag, 0.5 * ROLL_STEP_S)
-    half = add(times(1.0 - drag * half_e1, velocity), acceleration, half_e1)
+    half = drift_velocity(velocity, acceleration, drag, decay(drag, 0.5 * ROLL_STEP_S)[0])
     midpoint = add(downhill, times(1.0 / maximum(norm(half), TINY), half), -brake)
-    e1, e2 = decay(drag, ROLL_STEP_S)
-    moved = add(add(position, velocity, e1), midpoint, e2)
-    after = add(times(1.0 - drag * e1, velocity), midpoint, e1)
+    moved, after = drift(position, velocity, midpoint, drag, ROLL_STEP_S)
     return stops, where(stops, stop_time, ROLL_STEP_S), add(position, direction, run), moved, after
 
 
@@ -197,22 +205,19 @@ class _Record:
             self.rows[i].append((float(t if self.one else t[i]), self._floats(position, i), self._floats(velocity, i)))
 
     def level(self, flags, start, position: tuple, rolling: tuple, resistance, drag, roll_time) -> None:
-        """The states of the level rolls where `flags` hold every ROLL_STEP_S from their start (closed form; the
-        rest is added by the caller)."""
+        """The states of the level rolls where `flags` hold every ROLL_STEP_S from their start (closed form: `drift`
+        under the rolling resistance; the rest is added by the caller)."""
         if self.rows is None:
             return
         for i in self._balls(flags):
             at, speed_vector = self._floats(position, i), self._floats(rolling, i)
             resistance_i, drag_i, start_i, time_i = (float(v if self.one or np.ndim(v) == 0 else v[i])
                                                      for v in (resistance, drag, start, roll_time))
-            speed = norm(speed_vector)
+            braking = times(-resistance_i * GRAVITY_MPS2 / max(norm(speed_vector), TINY), speed_vector)
             times_s = np.arange(ROLL_STEP_S, time_i - 1e-9, ROLL_STEP_S)
-            e1, e2 = decay(drag_i, times_s)
-            deceleration = resistance_i * GRAVITY_MPS2
-            run, now = speed * e1 - deceleration * e2, speed * (1.0 - drag_i * e1) - deceleration * e1
-            direction = times(1.0 / max(speed, TINY), speed_vector)
-            self.rows[i] += [(start_i + t, add(at, direction, r), times(v, direction))
-                             for t, r, v in zip(times_s.tolist(), run.tolist(), now.tolist(), strict=True)]
+            moved, now = drift(at, speed_vector, braking, drag_i, times_s)
+            states = zip(times_s.tolist(), np.stack(moved, -1).tolist(), np.stack(now, -1).tolist(), strict=True)
+            self.rows[i] += [(start_i + t, tuple(p), tuple(v)) for t, p, v in states]
 
     def paths(self) -> list[GroundPath] | None:
         if self.rows is None:
@@ -308,20 +313,18 @@ def ground_phase(
     (`plane_normals`); `surface` holds floats or [N] arrays. InputError if a slope is steeper than its surface
     holds a ball on."""
     n = len(position)
-    slope = np.broadcast_to(np.asarray(slope_deg, dtype=float), (n,))
-    _check_slopes(slope, np.broadcast_to(np.asarray(surface.rolling_resistance, dtype=float), (n,)))
+    check_slope_held(slope_deg, surface.rolling_resistance)
     record = _Record(n, keep_path)
-    columns = (xp.columns(v) for v in (position, velocity, spin, plane_normals(slope, slope_dir_deg, n)))
+    columns = (xp.columns(v) for v in (position, velocity, spin, plane_normals(slope_deg, slope_dir_deg, n)))
     rest, hops, total = _to_rest(*columns, surface, record)
     return GroundPhase(xp.stack(rest), hops, total, record.paths())
 
 
 def plane_normal_one(surface: Surface, slope_deg: float, slope_dir_deg: float) -> tuple[float, float, float]:
-    """One plane's unit normal on floats (`plane_normals`' formula), after refusing a slope steeper than `surface`
-    holds a ball on (ValueError): where every one-ball phase on a plane starts."""
-    _check_slopes(np.float64(slope_deg), np.float64(surface.rolling_resistance))
-    phi, beta = math.radians(slope_deg), math.radians(slope_dir_deg)
-    return math.sin(phi) * math.sin(beta), math.sin(phi) * math.cos(beta), math.cos(phi)
+    """One plane's unit normal on floats (`plane_normal`), after refusing a slope steeper than `surface` holds a ball
+    on (InputError, `check_slope_held`): where every one-ball phase on a plane starts."""
+    check_slope_held(slope_deg, surface.rolling_resistance)
+    return plane_normal(slope_deg, slope_dir_deg)
 
 
 def ground_phase_one(

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from golfflight.errors import InputError
-from golfflight.flight.ground.surfaces import SURFACES, Surface, holding_slope_deg
+from golfflight.flight.ground.surfaces import SURFACES, Surface, check_slope_held
 from golfflight.flight.limits import SLOPE_DEG
 from golfflight.flight.per_shot import PerShot
 
@@ -15,7 +15,8 @@ from golfflight.flight.per_shot import PerShot
 class GroundSpec:
     """A plane `elevation_m` above the tee's ground (z = 0; the flight lands where it comes down through it), sloped
     by `slope_deg` towards `slope_dir_deg` around the landing point (`flight.ground.phase.plane_normals`), of
-    `surface`. ValueError for a slope steeper than the surface holds a ball still on, or than SLOPE_DEG."""
+    `surface`. InputError for a slope outside SLOPE_DEG or not below the steepest the surface holds a ball still on
+    (`check_slope_held`)."""
 
     surface: Surface = field(default_factory=lambda: SURFACES["fairway"])
     elevation_m: float = 0.0
@@ -23,10 +24,9 @@ class GroundSpec:
     slope_dir_deg: float = 0.0
 
     def __post_init__(self) -> None:
-        holding = float(holding_slope_deg(self.surface.rolling_resistance))
-        if not (0.0 <= self.slope_deg <= SLOPE_DEG.high and self.slope_deg < holding):
-            raise InputError(f"slope_deg {self.slope_deg:g} is outside {SLOPE_DEG.describe()} or not below "
-                             f"{holding:.2f} deg, the steepest slope this surface holds a ball still on")
+        if not 0.0 <= self.slope_deg <= SLOPE_DEG.high:
+            raise InputError(f"slope_deg: {self.slope_deg:g} is outside {SLOPE_DEG.describe()}")
+        check_slope_held(self.slope_deg, self.surface.rolling_resistance)
 
 
 LEVEL_FAIRWAY = GroundSpec()

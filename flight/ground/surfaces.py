@@ -124,3 +124,21 @@ def holding_slope_deg(rolling_resistance: float | np.ndarray) -> float | np.ndar
     """The steepest slope a surface holds a ball still on: (5/7) g sin(phi) < c_r g cos(phi). Steeper, a ball never
     comes to rest on an endless plane."""
     return np.degrees(np.arctan(np.asarray(rolling_resistance, dtype=float) / ROLLING_GRAVITY_FRACTION))
+
+
+def check_slope_held(
+    slope_deg: float | np.ndarray, rolling_resistance: float | np.ndarray, surface_name: str = "the surface"
+) -> None:
+    """InputError naming slope_deg, the steepest slope the surface holds and the range allowed, where a slope (one or
+    [N], each with its surface's rolling resistance) is not below `holding_slope_deg`: the one check of every place
+    that takes a slope (a shot's ground, the ground phase, a request)."""
+    limit = holding_slope_deg(rolling_resistance)
+    steep = np.asarray(slope_deg) >= limit
+    if not np.any(steep):
+        return
+    first = int(np.argmax(steep))
+    slope, held = (float(np.ravel(np.broadcast_to(v, np.shape(steep)))[first]) for v in (slope_deg, limit))
+    raise InputError(
+        f"slope_deg: {slope:g} is steeper than {surface_name} holds a ball still on ({held:.2f} deg: it would never "
+        f"come to rest); allowed 0 to {held - 0.005:.2f} deg on this surface"
+    )
