@@ -15,7 +15,7 @@ from functools import cached_property
 import numpy as np
 from golfflight.discovery.simulator import Correction
 from golfflight.errors import InputError
-from golfflight.flight.constants import BALL_AREA_M2, BALL_MASS_KG, BALL_RADIUS_M
+from golfflight.flight.physics import aerodynamics, spin_ratio
 from golfflight.flight.wind import Wind, wind_vector
 
 LOW_SPEED_DRAG = "low_speed_drag"
@@ -31,31 +31,27 @@ blows from (the report's wind convention)}."""
 OUTSIDE = (LOW_SPEED_DRAG, HIGH_SPIN_LIFT_LOSS, HEIGHT_GUST)
 
 
-def _pressure_over_mass(v: np.ndarray, density: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(|v| [N,1], q A / m [N,1]) of air-relative velocities v [N,3] in air of this density [N]."""
-    speed = np.linalg.norm(v, axis=1, keepdims=True)
-    return speed, 0.5 * density[:, None] * speed**2 * BALL_AREA_M2 / BALL_MASS_KG
+def _coefficient_acceleration(v: np.ndarray, w: np.ndarray, c_lift: np.ndarray, c_drag: np.ndarray,
+                               density: np.ndarray) -> np.ndarray:
+    """The acceleration [N,3] of extra lift and drag coefficients [N] at air-relative velocity and spin [N,3] in air
+    of this density [N]: `flight.physics.aerodynamics`' drag and Magnus lift at C_Q 0.5, the flight's own q A / m."""
+    no_moment, half = np.zeros(len(v)), np.full(len(v), 0.5)
+    return aerodynamics(v, w, np.stack([c_lift, c_drag, no_moment, half], axis=1), density)[0]
 
 
 def low_speed_drag(v: np.ndarray, w: np.ndarray, r: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """Extra drag [N,3] of C_D += rise x max(0, 1 - |v| / speed); weights [N,3] = (rise, speed, density)."""
     rise, fade, density = weights.T
-    speed, pressure = _pressure_over_mass(v, density)
-    extra_cd = rise[:, None] * np.clip(1.0 - speed / fade[:, None], 0.0, None)
-    return -extra_cd * pressure * v / np.maximum(speed, 1e-9)
+    extra_cd = rise * np.clip(1.0 - np.linalg.norm(v, axis=1) / fade, 0.0, None)
+    return _coefficient_acceleration(v, w, np.zeros(len(v)), extra_cd, density)
 
 
 def high_spin_lift_loss(v: np.ndarray, w: np.ndarray, r: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """Lift lost [N,3] of C_L -= loss x max(0, S - threshold), along the Magnus direction; weights [N,3] = (loss,
-    threshold, density)."""
+    """Lift lost [N,3] of C_L -= loss x max(0, S - threshold), along the Magnus direction (S `flight.physics.
+    spin_ratio`); weights [N,3] = (loss, threshold, density)."""
     loss, threshold, density = weights.T
-    speed, pressure = _pressure_over_mass(v, density)
-    spin = np.linalg.norm(w, axis=1, keepdims=True)
-    ratio = BALL_RADIUS_M * spin / np.maximum(speed, 1e-9)
-    lost_cl = loss[:, None] * np.clip(ratio - threshold[:, None], 0.0, None)
-    magnus = np.cross(w, v)
-    magnus /= np.maximum(np.linalg.norm(magnus, axis=1, keepdims=True), 1e-12)
-    return -lost_cl * pressure * magnus
+    lost_cl = loss * np.clip(spin_ratio(v, w) - threshold, 0.0, None)
+    return _coefficient_acceleration(v, w, -lost_cl, np.zeros(len(v)), density)
 
 
 TERMS = {
