@@ -12,7 +12,10 @@ import copy
 from dataclasses import dataclass
 
 import numpy as np
+from golfflight.flight import xp
 from golfflight.flight.constants import BALL_RADIUS_M
+from golfflight.flight.ground.vectors import norm
+from golfflight.flight.physics import spin_ratio_of
 
 BALL_DIAMETER_M = 2.0 * BALL_RADIUS_M
 
@@ -158,7 +161,5 @@ class ReferenceAerodynamics:
         return other
 
     def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
-        speed = np.sqrt(v_rel[:, 0] * v_rel[:, 0] + v_rel[:, 1] * v_rel[:, 1] + v_rel[:, 2] * v_rel[:, 2])
-        spin = np.sqrt(omega[:, 0] * omega[:, 0] + omega[:, 1] * omega[:, 1] + omega[:, 2] * omega[:, 2])
-        spin_ratio = BALL_RADIUS_M * spin / np.maximum(speed, 1e-9)
-        return self.coefficients(spin_ratio, speed * self.reynolds_per_speed)
+        speed = norm(xp.columns(v_rel))
+        return self.coefficients(spin_ratio_of(speed, norm(xp.columns(omega))), speed * self.reynolds_per_speed)
