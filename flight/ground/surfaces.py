@@ -133,8 +133,8 @@ def check_slope_held(
     [N], each with its surface's rolling resistance) is not below `holding_slope_deg`: the one check of every place
     that takes a slope (a shot's ground, the ground phase, a request)."""
     limit = holding_slope_deg(rolling_resistance)
-    steep = np.asarray(slope_deg) >= limit
-    if not np.any(steep):
+    steep = slope_deg >= limit  # NumPy's (limit is), so `any` is there for one slope too: the single shot's few us
+    if not steep.any():
         return
     first = int(np.argmax(steep))
     slope, held = (float(np.ravel(np.broadcast_to(v, np.shape(steep)))[first]) for v in (slope_deg, limit))
