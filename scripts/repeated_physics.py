@@ -205,20 +205,26 @@ def _calls(node: ast.AST) -> set[str]:
     return {_name(inner.func) for inner in ast.walk(node) if isinstance(inner, ast.Call)}
 
 
+def _passed_on(functions: dict[str, ast.AST], found: dict[str, set[str]]) -> None:
+    """Give each function the pieces of the private helpers of its module that it calls, until none changes."""
+    helpers = {name: name.rsplit(".", 1)[-1] for name in found if name.rsplit(".", 1)[-1].startswith("_")}
+    calls = {name: _calls(node) for name, node in functions.items()}
+    changed = True
+    while changed:
+        changed = False
+        for name in functions:
+            inherited = set().union(*(found[h] for h, short in helpers.items() if short in calls[name] and h != name))
+            changed |= not inherited <= found[name]
+            found[name] |= inherited
+
+
 def _module_findings(path: str, source: str) -> Iterator[Finding]:
     """The functions of one module that compute a piece outside its home, a private helper's pieces passed on to
     its callers."""
     functions = _functions(ast.parse(source))
-    found = {name: {p for p in _patterns(node) if f"{path}: {name}" not in HOMES[p]} for name, node in functions.items()}
-    helpers = {name: name.rsplit(".", 1)[-1] for name in found if name.rsplit(".", 1)[-1].startswith("_")}
-    changed = True
-    while changed:
-        changed = False
-        for name, node in functions.items():
-            inherited = set().union(*(found[h] for h, short in helpers.items() if short in _calls(node) and h != name))
-            if not inherited <= found[name]:
-                found[name] |= inherited
-                changed = True
+    found = {name: {p for p in _patterns(node) if f"{path}: {name}" not in HOMES[p]}
+             for name, node in functions.items()}
+    _passed_on(functions, found)
     for name, patterns in found.items():
         if patterns:
             yield Finding(path, name, tuple(p for p in PATTERNS if p in patterns), code_lines(source, functions[name]))
