@@ -105,7 +105,7 @@ def _exactly_one(model: BaseModel, quantity: str, *names: str) -> None:
 
 
 def _at_most_one(model: BaseModel, quantity: str, *names: str) -> str | None:
-    """The one of `names` that `model` gives, or None when it gives none; ValueError naming both when it gives two."""
+    """The one of `names` that `model` gives, or None when it gives none; InputError naming both when it gives two."""
     given = [name for name in names if getattr(model, name) is not None]
     if len(given) > 1:
         raise InputError(f"{quantity}: give {' or '.join(given)}, not both")

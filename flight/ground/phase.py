@@ -338,7 +338,7 @@ def ground_phase_one(
 ) -> OneRest:
     """`ground_phase` of one ball on plain floats (the same driver, `_to_rest`): from its landing (x, y, z) tuples
     to its rest, with the path `ground_phase` would record when `keep_path` (the served shot a screen draws).
-    ValueError if the slope is steeper than the surface holds a ball on."""
+    InputError if the slope is steeper than the surface holds a ball on (`check_slope_held`)."""
     normal = plane_normal_one(surface, slope_deg, slope_dir_deg)
     record = _Record(None, keep_path)
     rest, hops, time = _to_rest(position, velocity, spin, normal, surface, record)

@@ -69,7 +69,7 @@ def putt_phase(
     keep_path: bool = False,
 ) -> PuttPhase:
     """Skid and roll a putt launched from the origin to rest on a plane sloped by `slope_deg` towards `slope_dir_deg`
-    (`phase.plane_normals`), on plain floats. ValueError if the slope is steeper than the surface holds a ball on."""
+    (`phase.plane_normals`), on plain floats. InputError if the slope is steeper than the surface holds a ball on."""
     normal = plane_normal_one(surface, slope_deg, slope_dir_deg)
     gamma, heading, psi = (math.radians(a) for a in (launch_angle_deg, launch_direction_deg, spin_axis_deg))
     launch = times(ball_speed_mps, (math.cos(gamma) * math.sin(heading), math.cos(gamma) * math.cos(heading),
