@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 import torch
+from golfflight.errors import InputError
 from golfflight.evaluation.landing_network import LANDING_WEIGHTS_FILE
 from golfflight.model_export.joint import (
     JointConfig,
@@ -139,7 +140,7 @@ def landing_nn_from_checkpoint(path: str | os.PathLike) -> LandingNN:
     """The trained NN of a `train_landing_nn` run's last.pt, in eval mode. A checkpoint of another kind is refused."""
     payload = load_checkpoint(path)
     if payload.get("kind") != CHECKPOINT_KIND:
-        raise ValueError(f"{path} is not an NN run of train-real --variant nn (kind {payload.get('kind')!r})")
+        raise InputError(f"{path} is not an NN run of train-real --variant nn (kind {payload.get('kind')!r})")
     model = LandingNN(tuple(payload["hidden"]))
     model.load_state_dict(payload["model"])
     return model.eval()
