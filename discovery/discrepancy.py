@@ -32,9 +32,9 @@ MAX_SD_POINTS = 300
 """The SD is read from the process conditioned on the first this many of them: a triangular solve per shot costs
 their square, and fewer points only widen the SD (a new session's 100,000 shots in seconds)."""
 CHUNK = 10_000
+"""Shots whose kernel rows are built at once (a chunk of 10,000 against 1,000 points is 80 MB)."""
 CACHED = 4
 """Launch sets whose discrepancy means are kept: a fit's shots, its held-out shots and the whole set."""
-"""Shots whose kernel rows are built at once (a chunk of 10,000 against 1,000 points is 80 MB)."""
 
 
 def _kernel(a: np.ndarray, b: np.ndarray, lengthscale: float) -> np.ndarray:
