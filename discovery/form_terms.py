@@ -14,7 +14,7 @@ import numpy as np
 from golfflight.flight.constants import BALL_RADIUS_M
 from golfflight.flight.field import take
 from golfflight.flight.flyer import Flyer
-from golfflight.flight.physics import CoefficientModel
+from golfflight.flight.physics import CoefficientModel, at_least_tiny, spin_ratio_of
 
 SPIN_RATIO_REF = 0.2
 """The spin ratio at which the form's spin terms vanish (s = 0): between a driver's 0.08 and a wedge's 0.5."""
@@ -59,9 +59,8 @@ def log_multipliers(
 ) -> np.ndarray:
     """ln of the multipliers of (C_L, C_D, C_M) [N,3] at air-relative velocity and spin [N,3] in air of kinematic
     viscosity `viscosity` (one or per ball), for weights [K] or [N,K] in TERMS order."""
-    speed = np.maximum(np.linalg.norm(v_rel, axis=1), 1e-9)
-    spin_ratio = np.maximum(BALL_RADIUS_M * np.linalg.norm(omega, axis=1) / speed, SPIN_RATIO_FLOOR)
-    s = np.log(spin_ratio / SPIN_RATIO_REF)
+    speed = at_least_tiny(np.linalg.norm(v_rel, axis=1))
+    s = np.log(np.maximum(spin_ratio_of(speed, np.linalg.norm(omega, axis=1)), SPIN_RATIO_FLOOR) / SPIN_RATIO_REF)
     r = np.log(2.0 * BALL_RADIUS_M * speed / np.asarray(viscosity) / REYNOLDS_REF)
     s, r = np.clip(s, *SPIN_RANGE), np.clip(r, *REYNOLDS_RANGE)
     feature = {"1": np.ones_like(s), "s": s, "s^2": s**2, "r": r, "s r": s * r, "s^2 r": s**2 * r, "r^2": r**2,
