@@ -12,9 +12,6 @@ import sys
 import sysconfig
 from pathlib import Path
 
-from golfflight.flight.environment_variables import MODEL, given
-
-MODEL_ENV = MODEL
 CHECKOUT_MODEL = Path(__file__).resolve().parents[1] / "models" / "default"
 INSTALLED_MODEL = Path("share") / "golfflight" / "models" / "default"
 
@@ -29,16 +26,20 @@ def installed_model_dirs() -> list[Path]:
 
 
 def model_dir(explicit: str | os.PathLike | None = None) -> Path:
-    """The bundle directory to load; FileNotFoundError listing where it looked when there is none."""
+    """The bundle directory to load; FileNotFoundError listing where it looked when there is none. The environment's
+    reader (pydantic-settings) is imported here, not above, so that a command's help that shows CHECKOUT_MODEL stays
+    free of pydantic (tests/test_help_imports.py)."""
+    from golfflight.flight.environment_variables import MODEL, environment
+
     if explicit is not None:
         return Path(explicit)
-    named = given(MODEL_ENV)
+    named = environment().model
     if named:
-        return Path(named)
+        return named
     candidates = [CHECKOUT_MODEL, *installed_model_dirs()]
     for candidate in candidates:
         if (candidate / "model_card.json").is_file():
             return candidate
     raise FileNotFoundError(
-        f"no model bundle found (looked in {', '.join(str(c) for c in candidates)}); pass --model DIR or set {MODEL_ENV}"
+        f"no model bundle found (looked in {', '.join(str(c) for c in candidates)}); pass --model DIR or set {MODEL}"
     )

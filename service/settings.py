@@ -1,18 +1,17 @@
 """The service's settings, one object read once: `golfflight serve` builds it from its flags over the environment,
 checks it, and hands it whole to every worker process; `create_app` takes it and passes each part down (the API key
-to the HTTP guards, the bay file to the runtime, the connect address to Open Connect). The variables are read through
-`flight.environment_variables`, the one module that reads the environment: each setting `field` from
-GOLFFLIGHT_FIELD (its prefix), the bundle's own $GOLFFLIGHT_MODEL where every command finds its bundle
+to the HTTP guards, the bay file to the runtime, the connect address to Open Connect). The variables are read by
+`flight.environment_variables.Environment`, the one pydantic-settings object that reads the environment: each setting
+`field` from GOLFFLIGHT_FIELD (its prefix), the bundle's own $GOLFFLIGHT_MODEL where every command finds its bundle
 (`flight.bundle_location.model_dir`)."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from pathlib import Path
 
 from golfflight.errors import InputError
 from golfflight.flight.environment_variables import (
-    SERVICE_FIELDS, SERVICE_SETTINGS, given, prefixed, set_for_children, variable_of
+    SERVICE_FIELDS, SERVICE_SETTINGS, environment, set_for_children, variable_of
 )
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
@@ -24,15 +23,6 @@ API_KEY_ENV = variable_of("api_key")
 CORS_ORIGINS_ENV = variable_of("cors_origins")
 ALLOWED_HOSTS_ENV = variable_of("allowed_hosts")
 """The variables that messages name (`serve`'s warning, the guards' refusals)."""
-
-LISTS = frozenset({"cors_origins", "allowed_hosts"})
-"""The settings given as a comma-separated list."""
-
-
-def listed(text: str) -> tuple[str, ...]:
-    """The items of a comma-separated setting (origins, host names), blanks left out."""
-    return tuple(item.strip() for item in text.split(",") if item.strip())
-
 
 class ServiceSettings(BaseModel):
     """What a served bay is told: its model, who may call it, where its bay file is and whether GSPro connectors
@@ -49,19 +39,18 @@ class ServiceSettings(BaseModel):
     connect_host: str = Field("127.0.0.1", min_length=1, description="the address Open Connect listens on")
 
     @classmethod
-    def from_env(cls, environ: Mapping[str, str] | None = None) -> ServiceSettings:
-        """The settings a worker was handed (HANDED_DOWN_ENV), else those the GOLFFLIGHT_* variables of `environ`
-        (default: this process's) give (unset or empty: the default); InputError naming the variable for a value out
-        of range."""
-        handed = given(HANDED_DOWN_ENV, environ)
-        if handed:
-            return cls.model_validate_json(handed)
-        texts = prefixed(SERVICE_FIELDS, environ)
+    def from_env(cls) -> ServiceSettings:
+        """The settings a worker was handed (HANDED_DOWN_ENV), else those the GOLFFLIGHT_* variables give (unset or
+        empty: the default); InputError naming the variable for a value out of range."""
+        read = environment()
+        if read.service_settings:
+            return cls.model_validate_json(read.service_settings)
+        given = read.model_dump(include=set(SERVICE_FIELDS), exclude_none=True)
         try:
-            return cls(**{field: listed(text) if field in LISTS else text for field, text in texts.items()})
+            return cls(**given)
         except ValidationError as error:
             field = error.errors()[0]["loc"][0]
-            raise InputError(f"${variable_of(field)}: {error.errors()[0]['msg']}, got {texts[field]!r}") from None
+            raise InputError(f"${variable_of(field)}: {error.errors()[0]['msg']}, got {given[field]!r}") from None
 
     def hand_down(self) -> None:
         """Put these settings where the worker processes about to start will read them (`from_env`)."""

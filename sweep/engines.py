@@ -21,7 +21,7 @@ from contextlib import contextmanager
 from multiprocessing import forkserver
 
 from golfflight.errors import InputError
-from golfflight.flight.environment_variables import RAY_DATA_LOG_LEVEL, given
+from golfflight.flight.environment_variables import environment
 from golfflight.sweep.flyer import SweepWorker
 from golfflight.sweep.stopping import exit_with_driver, group_signals_held
 
@@ -202,7 +202,7 @@ def ray_tables(source, bundle_dir: str, sha256: str, workers: int | None, addres
     import ray
     import ray.data
 
-    if given(RAY_DATA_LOG_LEVEL) is None:  # Ray Data's INFO lines and its note that our tqdm replaced its bars
+    if environment().ray_data_log_level is None:  # Ray Data's INFO lines and its note that our tqdm replaced its bars
         logging.getLogger("ray.data").setLevel(logging.WARNING)
         logging.getLogger("ray.data._internal.progress").setLevel(logging.ERROR)
     with ray_noise_filtered():

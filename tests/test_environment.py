@@ -1,6 +1,7 @@
-"""One way in from the environment: `flight/environment_variables.py` is the only module of the package folders that
-reads (or sets) an environment variable, every variable it declares is in docs/service.md's table and the table
-lists no other, and each variable still reaches what it sets, read by a real process."""
+"""One way in from the environment: `flight/environment_variables.py` (one pydantic-settings object) is the only
+module of the package folders that reads (or sets) an environment variable, every variable it declares is in
+docs/service.md's table and the table lists no other, and each variable still reaches what it sets, read by a real
+process."""
 
 from __future__ import annotations
 
@@ -8,10 +9,12 @@ import ast
 import re
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import pytest
-from golfflight.flight.environment_variables import VARIABLES, given, prefixed
+from pydantic_settings import BaseSettings
+from golfflight.flight.environment_variables import VARIABLES, Environment, environment, set_for_children
 from tests.test_imports import FLOORS, ROOT
 
 THE_READER = ROOT / "flight" / "environment_variables.py"
@@ -55,19 +58,34 @@ def test_no_module_but_the_one_reader_touches_the_environment():
     assert environment_reads(THE_READER)
 
 
+def test_pyproject_lists_pydantic_settings_as_a_runtime_dependency():
+    dependencies = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["dependencies"]
+    assert any(re.match(r"pydantic-settings\b", dependency) for dependency in dependencies)
+    assert issubclass(Environment, BaseSettings)
+
+
 def test_every_variable_is_in_the_one_table_of_docs_service_md():
     documented = documented_variables()
     assert len(documented) == len(set(documented))
     assert set(documented) == set(VARIABLES)
 
 
-def test_ours_carry_the_prefix_and_empty_counts_as_unset():
+def test_ours_carry_the_prefix_and_empty_counts_as_unset(monkeypatch):
     assert [name for name in VARIABLES if not name.startswith("GOLFFLIGHT_")] == [
         "PROMETHEUS_MULTIPROC_DIR", "RAY_DATA_LOG_LEVEL"]  # their libraries' own names, read by them too
-    assert given("GOLFFLIGHT_MODEL", {"GOLFFLIGHT_MODEL": ""}) is None
-    assert prefixed(["api_key", "bay_file"], {"GOLFFLIGHT_API_KEY": "k", "GOLFFLIGHT_BAY_FILE": ""}) == {"api_key": "k"}
+    for name in VARIABLES:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("GOLFFLIGHT_MODEL", "")
+    monkeypatch.setenv("GOLFFLIGHT_API_KEY", "k")
+    monkeypatch.setenv("GOLFFLIGHT_METRICS_DIR", "/not/read")  # a field with its library's name takes no prefix
+    read = environment()
+    assert (read.model, read.api_key, read.metrics_dir, read.cors_origins) == (None, "k", None, ())
+    monkeypatch.setenv("PROMETHEUS_MULTIPROC_DIR", "/metrics")
+    monkeypatch.setenv("GOLFFLIGHT_CORS_ORIGINS", " https://a.example,, https://b.example ")
+    read = environment()
+    assert (str(read.metrics_dir), read.cors_origins) == ("/metrics", ("https://a.example", "https://b.example"))
     with pytest.raises(KeyError, match="GOLFFLIGHT_MODLE is not one of golfflight's environment variables"):
-        given("GOLFFLIGHT_MODLE")
+        set_for_children("GOLFFLIGHT_MODLE", "x")
 
 
 def test_each_existing_name_still_sets_what_it_did_in_a_real_process(tmp_path):

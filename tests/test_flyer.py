@@ -16,7 +16,8 @@ from golfflight.discovery.model import from_bundle, load_model
 from golfflight.discovery.simulator import Setup
 from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.flight.air import Air
-from golfflight.flight.bundle_location import MODEL_ENV, model_dir
+from golfflight.flight.bundle_location import model_dir
+from golfflight.flight.environment_variables import MODEL as MODEL_ENV
 from golfflight.flight.coefficients import QuadraticSpinRatio
 from golfflight.flight.constants import GRAVITY_MPS2
 from golfflight.flight.field import BallInAir

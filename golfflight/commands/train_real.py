@@ -8,7 +8,6 @@ import argparse
 from golfflight.commands import COMMANDS
 from golfflight.commands.train import COMPILE_HELP
 from golfflight.model_export.real_sources import DEFAULT_SOURCES, SOURCES
-from golfflight.shots.paths import shared_data_dir
 
 
 def _seeds(text: str) -> tuple[int, ...]:
@@ -68,6 +67,7 @@ def run(args: argparse.Namespace) -> int:
     from golfflight.model_export.joint import JointConfig
     from golfflight.model_export.real_data import BUILDERS
     from golfflight.model_export.real_training import SeedPlan, train_real
+    from golfflight.shots.paths import shared_data_dir
 
     names = tuple(n.strip() for n in args.sources.split(","))
     unknown = [n for n in names if n not in BUILDERS]

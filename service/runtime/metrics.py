@@ -24,7 +24,7 @@ from prometheus_client.exposition import CONTENT_TYPE_LATEST, generate_latest
 from prometheus_client.metrics_core import InfoMetricFamily
 from prometheus_client.multiprocess import MultiProcessCollector
 from golfflight.errors import InputError
-from golfflight.flight.environment_variables import METRICS_DIR, given, set_for_children
+from golfflight.flight.environment_variables import METRICS_DIR, environment, set_for_children
 
 MULTIPROC_ENV = METRICS_DIR
 """prometheus-client's switch to multiprocess mode: the directory the worker processes write their samples to."""
@@ -90,7 +90,7 @@ class ServiceMetrics:
         )
         self.registry.register(ModelInfoCollector(model_labels))
         self._scraped = self.registry
-        if given(MULTIPROC_ENV):
+        if environment().metrics_dir:
             self._scraped = CollectorRegistry()
             MultiProcessCollector(self._scraped)
             self._scraped.register(ModelInfoCollector(model_labels))
@@ -107,11 +107,10 @@ def shared_across_workers(workers: int) -> Iterator[Path | None]:
     With $PROMETHEUS_MULTIPROC_DIR set, that directory is used and the sample files an earlier run left in it are
     removed (they would be added to this run's counts). Otherwise several workers get a fresh temporary directory,
     removed when the server stops, and one worker keeps its metrics in memory (None)."""
-    named = given(MULTIPROC_ENV)
-    if named:
-        directory = Path(named)
+    directory = environment().metrics_dir
+    if directory:
         if not directory.is_dir():
-            raise InputError(f"${MULTIPROC_ENV} is {named!r}: no such directory")
+            raise InputError(f"${MULTIPROC_ENV} is {str(directory)!r}: no such directory")
         for stale in directory.glob("*.db"):
             stale.unlink()
         yield directory
