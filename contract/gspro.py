@@ -17,7 +17,7 @@ from golfflight.contract.bay import BayConditions, flown_in
 from golfflight.contract.flying import fly_request
 from golfflight.contract.inputs import spin_from_components
 from golfflight.contract.refusals import answer_to, describe_errors, encodable
-from golfflight.contract.requests import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotRequest
+from golfflight.contract.requests import BALL_SPEED_MPH, SIDE_SPIN_RPM, ShotRequest, total_spin_rpm
 from golfflight.contract.results import ShotResult
 from golfflight.errors import FlightError, InputError
 from golfflight.flight import limits
@@ -207,9 +207,8 @@ def launch_from_ball_data(ball: GSProBallData) -> Launch:
     if missing:
         raise InputError(f"BallData is missing {', '.join(missing)}")
     if uses_components:
+        total_spin_rpm(ball.BackSpin or 0.0, ball.SideSpin or 0.0)
         spin, axis = spin_from_components(ball.BackSpin or 0.0, ball.SideSpin or 0.0)
-        if spin > limits.SPIN_RPM.high:
-            raise InputError(f"BallData: BackSpin and SideSpin make {spin:.0f} rpm, over {limits.SPIN_RPM.describe()}")
     else:
         spin, axis = ball.TotalSpin or 0.0, ball.SpinAxis or 0.0
     return Launch(ball.Speed * MPH_TO_MPS, ball.VLA, ball.HLA or 0.0, spin, axis)

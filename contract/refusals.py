@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Sequence
 from typing import NamedTuple
 
 from golfflight.contract.requests import RANGES
-from golfflight.errors import FlightError, GolfflightError, InputError, ServiceError
+from golfflight.errors import FlightError, GolfflightError, InputError, ServiceError, refusal_text
 from golfflight.flight.limits import Range, limit_text
 
 NOT_JSON = "the body is not JSON text in UTF-8 (or UTF-16 or UTF-32, which are read too)"
@@ -77,26 +78,56 @@ def _msg(error: dict) -> str:
 def describe_error(error: dict, ranges: dict[str, Range] = RANGES) -> dict:
     """One 422 detail: FastAPI's own `loc` and `type` and its `msg` (a bound in it printed as every limit is), plus
     the field as a dotted path, the value sent, the allowed range (from `ranges`, by field name), the batch index of
-    the shot, and a `message` in plain words that says all of it."""
+    the shot, and a `message` in plain words that says all of it (`errors.refusal_text`). An InputError that names
+    its field, raised by a model's validator, gives its own field, value and range (`input_detail`)."""
+    raised = (error.get("ctx") or {}).get("error")
+    if isinstance(raised, InputError) and raised.field is not None:
+        return input_detail(raised, error["type"], error["loc"])
     path = [_shown(p) for p in error["loc"] if p != "body"]
     field = ".".join(str(p) for p in path) or "body"
     msg = _msg(error)
     entry: dict = {"loc": [_shown(p) for p in error["loc"]], "msg": msg, "type": error["type"], "field": field}
-    parts = [f"{field}: {msg}"]
-    if len(path) >= 2 and path[0] == "shots" and isinstance(path[1], int):
-        entry["shot"] = path[1]
-        parts[0] = f"shot {path[1]}: {'.'.join(str(p) for p in path[2:]) or 'shot'}: {msg}"
-    sent = error.get("input")
-    value = _plain(sent) if error["type"] != "missing" else None
-    if value is not None:
-        entry["value"] = value
-        parts.append(f"(got {_quoted(sent)!r})" if isinstance(sent, str) else f"(got {value!r})")
+    sent = error.get("input") if error["type"] != "missing" else None
+    if _plain(sent) is not None:
+        entry["value"] = _plain(sent)
     name = path[-1] if path else None
     if isinstance(name, str) and name in ranges and error["type"] != "extra_forbidden":
         entry["allowed"] = ranges[name].describe()
-        parts.append(f"; allowed {entry['allowed']}")
-    entry["message"] = " ".join(parts).replace(" ;", ";")
+    return _finished(entry, path, sent)
+
+
+def input_detail(error: InputError, kind: str, at: Sequence = ("body",)) -> dict:
+    """One 422 detail of an InputError that names its field (`error.field`): the field under `at` (the location of
+    the model whose validator raised it; the body by default), the value, the allowed range and the message, the same
+    parts and words as `describe_error`'s, so the 422 body, the Open Connect reply and the command line agree."""
+    loc = [_shown(p) for p in at] + [_shown(part) for part in error.field.split(".")]
+    path = [p for p in loc if p != "body"]
+    entry: dict = {"loc": loc, "msg": encodable(error.problem), "type": kind, "field": ".".join(str(p) for p in path)}
+    if _plain(error.value) is not None:
+        entry["value"] = _plain(error.value)
+    if error.allowed:
+        entry["allowed"] = error.allowed
+    return _finished(entry, path, error.value)
+
+
+def _finished(entry: dict, path: list, sent) -> dict:
+    """`entry` with its batch index (`shot`) where the path starts in a batch's shots, and its `message`
+    (`errors.refusal_text`: the field, the problem, the value sent, cut where long, and the allowed range)."""
+    named = entry["field"]
+    if len(path) >= 2 and path[0] == "shots" and isinstance(path[1], int):
+        entry["shot"] = path[1]
+        named = f"shot {path[1]}: {'.'.join(str(p) for p in path[2:]) or 'shot'}"
+    shown = None if "value" not in entry else _quoted(sent) if isinstance(sent, str) else entry["value"]
+    entry["message"] = refusal_text(named, entry["msg"], shown, entry.get("allowed"))
     return entry
+
+
+def failure_detail(error: GolfflightError, kind: str) -> dict:
+    """The 4xx detail of one of our failures: an InputError that names its field as `input_detail` writes it, any
+    other as the body's (`body_detail`)."""
+    if isinstance(error, InputError) and error.field is not None:
+        return input_detail(error, kind)
+    return body_detail(str(error), kind)
 
 
 class Answer(NamedTuple):

@@ -8,6 +8,7 @@ into the OpenAPI schema (oneOf / not), so a schema-driven client or fuzzer build
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Literal
 
 from golfflight.contract.clubs import ClubName
@@ -95,6 +96,16 @@ def _one_of(*forms: tuple[str, tuple[str, ...]]) -> dict:
 def _not_together(*pairs: tuple[str, str]) -> dict:
     """JSON Schema: no pair is given together."""
     return {"not": {"anyOf": [_given(*pair) for pair in pairs]}}
+
+
+def total_spin_rpm(back_spin_rpm: float, side_spin_rpm: float) -> float:
+    """The spin that back and side spin make; InputError naming `spin_rpm`, the total (whole rpm) and its range when
+    it is over `flight.limits.SPIN_RPM`: the one check of a request, a GSPro message and `golfflight fly`."""
+    total = math.hypot(back_spin_rpm, side_spin_rpm)
+    if total > limits.SPIN_RPM.high:
+        raise InputError("back and side spin make a total over the range", field="spin_rpm", value=round(total),
+                         allowed=limits.SPIN_RPM.describe())
+    return total
 
 
 def _exactly_one(model: BaseModel, quantity: str, *names: str) -> None:
@@ -286,9 +297,7 @@ class ShotRequest(Strict):
         if self.back_spin_rpm is not None and self.spin_axis_deg is not None:
             raise InputError("spin: spin_axis_deg goes with spin_rpm; with back_spin_rpm give side_spin_rpm")
         if self.back_spin_rpm is not None:
-            total = (self.back_spin_rpm**2 + (self.side_spin_rpm or 0.0) ** 2) ** 0.5
-            if total > limits.SPIN_RPM.high:
-                raise InputError(f"spin: back and side spin make {total:.0f} rpm, over {limits.SPIN_RPM.describe()}")
+            total_spin_rpm(self.back_spin_rpm, self.side_spin_rpm or 0.0)
         return self
 
 

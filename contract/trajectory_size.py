@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import math
 
-from golfflight.contract.refusals import RequestRefused
+from golfflight.contract.refusals import RequestRefused, input_detail
 from golfflight.contract.requests import TrajectoryRequest
+from golfflight.errors import InputError
 from golfflight.flight.engine import EulerStates
 
 MAX_TRAJECTORY_SAMPLES = 300_000
@@ -34,12 +35,8 @@ def refuse_long_trajectories(traced: list[tuple[TrajectoryRequest, EulerStates]]
     total = sum(sample_count(states, trajectory) for trajectory, states in traced)
     if total <= MAX_TRAJECTORY_SAMPLES:
         return
+    problem = (f"the trajectories asked for come to {total:,} points (rate_hz x each flight's time to rest, its "
+               "normalized replay's too): ask a lower rate_hz or fewer trajectories")
     allowed = f"at most {MAX_TRAJECTORY_SAMPLES:,} trajectory points per request"
-    message = (
-        f"trajectory.rate_hz: the trajectories asked for come to {total:,} points (rate_hz x each flight's time to "
-        f"rest, its normalized replay's too); allowed {allowed}: ask a lower rate_hz or fewer trajectories"
-    )
-    loc = ["body", "trajectory", "rate_hz"]
-    detail = {"loc": loc, "msg": message, "type": "too_many_points", "field": "trajectory.rate_hz",
-              "value": total, "allowed": allowed, "message": message}
-    raise RequestRefused([detail])
+    too_many = InputError(problem, field="trajectory.rate_hz", value=total, allowed=allowed)
+    raise RequestRefused([input_detail(too_many, "too_many_points")])

@@ -11,9 +11,26 @@ class GolfflightError(Exception):
     """Every failure golfflight raises on purpose; the message says what and why."""
 
 
+def refusal_text(field: str, problem: str, value: object = None, allowed: str | None = None) -> str:
+    """How every refusal of a field reads, on every surface (the HTTP 422 body's `message`, the Open Connect reply's
+    Message, the command line's line): `field: problem (got value); allowed range`, the value and the range where
+    known (a value of None is not shown: a field left out has none)."""
+    text = f"{field}: {problem}"
+    if value is not None:
+        text += f" (got {value!r})"
+    return text + (f"; allowed {allowed}" if allowed else "")
+
+
 class InputError(GolfflightError, ValueError):
     """The caller's input is wrong (a field, an option, a file or a bundle): the message names it and what is
-    allowed. A ValueError too, so pydantic validators may raise it and older callers that catch ValueError still do."""
+    allowed. Given a `field` (a dotted path such as `air.temperature_c`), it carries the field, the `value` sent and
+    the `allowed` range too, and reads as `refusal_text` writes them, so that every surface shows the same words and
+    the HTTP 422 body the same parts (`contract.refusals.input_detail`). A ValueError too, so pydantic validators may
+    raise it and older callers that catch ValueError still do."""
+
+    def __init__(self, problem: str, *, field: str | None = None, value: object = None, allowed: str | None = None):
+        super().__init__(problem if field is None else refusal_text(field, problem, value, allowed))
+        self.problem, self.field, self.value, self.allowed = problem, field, value, allowed
 
 
 class FlightError(GolfflightError):

@@ -7,6 +7,7 @@ to the HTTP guards, the bay file to the runtime, the connect address to Open Con
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 from golfflight.errors import InputError
@@ -23,6 +24,7 @@ API_KEY_ENV = variable_of("api_key")
 CORS_ORIGINS_ENV = variable_of("cors_origins")
 ALLOWED_HOSTS_ENV = variable_of("allowed_hosts")
 """The variables that messages name (`serve`'s warning, the guards' refusals)."""
+
 
 class ServiceSettings(BaseModel):
     """What a served bay is told: its model, who may call it, where its bay file is and whether GSPro connectors
@@ -46,12 +48,27 @@ class ServiceSettings(BaseModel):
         if read.service_settings:
             return cls.model_validate_json(read.service_settings)
         given = read.model_dump(include=set(SERVICE_FIELDS), exclude_none=True)
+        return cls.validated(given, {field: f"${variable_of(field)}" for field in SERVICE_FIELDS})
+
+    @classmethod
+    def validated(cls, values: Mapping[str, object], names: Mapping[str, str]) -> ServiceSettings:
+        """The settings `values` give; InputError naming a refused setting as it was given (`names`: its variable or
+        its flag), with the value given and the range the setting allows, where it has one."""
         try:
-            return cls(**given)
+            return cls.model_validate(values)
         except ValidationError as error:
-            field = error.errors()[0]["loc"][0]
-            raise InputError(f"${variable_of(field)}: {error.errors()[0]['msg']}, got {given[field]!r}") from None
+            problem = error.errors()[0]
+            field = problem["loc"][0]
+            raise InputError(problem["msg"], field=names.get(field, field), value=values[field],
+                             allowed=_range_of(field)) from None
 
     def hand_down(self) -> None:
         """Put these settings where the worker processes about to start will read them (`from_env`)."""
         set_for_children(HANDED_DOWN_ENV, self.model_dump_json())
+
+
+def _range_of(field: str) -> str | None:
+    """'LOW to HIGH' of a setting bounded both ways (the port: 1 to 65535), read from its Field; None otherwise."""
+    bounds = {name: getattr(rule, name) for rule in ServiceSettings.model_fields[field].metadata
+              for name in ("ge", "le") if hasattr(rule, name)}
+    return f"{bounds['ge']} to {bounds['le']}" if len(bounds) == 2 else None

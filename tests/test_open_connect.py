@@ -290,7 +290,8 @@ def test_out_of_range_values_name_the_field_and_its_range(connector):
         ({"Speed": 400.0}, "(got 400.0); allowed 1.119 to 223.6 mph"),
         ({"VLA": -45.0}, "BallData.VLA"),
         ({"TotalSpin": 20000.0}, "BallData.TotalSpin"),
-        ({"TotalSpin": None, "BackSpin": 14000.0, "SideSpin": 9000.0}, "BackSpin and SideSpin make 16643 rpm"),
+        ({"TotalSpin": None, "BackSpin": 14000.0, "SideSpin": 9000.0},
+         "spin_rpm: back and side spin make a total over the range (got 16643); allowed 0 to 15000 rpm"),
         ({"VLA": None}, "BallData is missing VLA"),
     ):
         reply, _, _ = connector.fly(shot(41, **ball))
@@ -491,7 +492,7 @@ def test_serve_refuses_tcp_with_several_workers_and_a_busy_port(capsys):
     assert main(["serve", "--connect-port", str(free_port()), "--workers", "2"]) == 2
     assert "--connect-port" in capsys.readouterr().err
     assert main(["serve", "--connect-port", "70000"]) == 2
-    assert "--connect-port: Input should be less than or equal to 65535, got 70000" in capsys.readouterr().err
+    assert "--connect-port: Input should be less than or equal to 65535 (got 70000); allowed 1 to 65535" in capsys.readouterr().err
     with socket.create_server(("127.0.0.1", 0)) as busy:
         taken = busy.getsockname()[1]
         assert main(["serve", "--port", str(free_port()), "--connect-port", str(taken)]) == 2

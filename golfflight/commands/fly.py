@@ -102,14 +102,24 @@ def _with_flags(text: str) -> str:
     return re.sub(r"\b(" + "|".join(names) + r")\b", lambda m: by_name[m.group(1)], text)
 
 
-def _refusal(errors: list[dict]) -> str:
+def _in_request(shot: dict, field: str) -> bool:
+    """Whether the request `shot` holds the dotted field `field` (`air.temperature_c`)."""
+    for part in field.split("."):
+        if not isinstance(shot, dict) or part not in shot:
+            return False
+        shot = shot[part]
+    return True
+
+
+def _refusal(errors: list[dict], shot: dict) -> str:
     """The API's 422 messages on one line (` | ` between them), each naming the option instead of the request
-    field."""
+    field where the request `shot` holds that field (a value worked out of others, such as the spin that back and
+    side spin make, keeps its field's name, as the API and Open Connect say it)."""
     problems = []
     for detail in errors:
         field, message = detail["field"], detail["message"]
         if field in FLAGS and message.startswith(f"{field}:"):
-            problems.append(FLAGS[field] + message.removeprefix(field))
+            problems.append(FLAGS[field] + message.removeprefix(field) if _in_request(shot, field) else message)
         elif field == "body" or detail["msg"].startswith(f"{field}:"):  # the message names what it is about
             problems.append(_with_flags(detail["msg"]))
         else:
@@ -133,7 +143,8 @@ def wind_speed_mps(args: argparse.Namespace) -> float | None:
         in_mph.model_validate({"wind_speed_mph": args.wind_speed_mph})
     except ValidationError as error:
         details = describe_errors(error.errors(), {"wind_speed_mph": bounds})
-        raise InputError(_refusal([{**d, "field": "wind_speed_mph"} for d in details])) from None
+        refused = [{**detail, "field": "wind_speed_mph"} for detail in details]
+        raise InputError(_refusal(refused, {"wind_speed_mph": args.wind_speed_mph})) from None
     return args.wind_speed_mph * MPH_TO_MPS
 
 
@@ -194,7 +205,7 @@ def checked(shot: dict):
     try:
         return ShotRequest.model_validate(shot)
     except ValidationError as error:
-        raise InputError(_refusal(describe_errors(error.errors()))) from None
+        raise InputError(_refusal(describe_errors(error.errors()), shot)) from None
 
 
 def fly_reference_shot(shot) -> dict:

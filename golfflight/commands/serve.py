@@ -159,7 +159,6 @@ def served_settings(args: argparse.Namespace, environment: ServiceSettings) -> S
     the bay file made absolute, so every worker reads the same ones. InputError naming the flag for a bad value."""
     from golfflight.flight.bundle_location import model_dir
     from golfflight.service.settings import ServiceSettings
-    from pydantic import ValidationError
 
     given = {field: getattr(args, flag[2:].replace("-", "_")) for field, flag in FLAGS.items()}
     given = {field: tuple(value) if isinstance(value, list) else value for field, value in given.items()
@@ -168,12 +167,7 @@ def served_settings(args: argparse.Namespace, environment: ServiceSettings) -> S
     values["model"] = model_dir(values["model"]).resolve()
     if values["bay_file"] is not None:
         values["bay_file"] = Path(values["bay_file"]).absolute()
-    try:
-        return ServiceSettings.model_validate(values)
-    except ValidationError as error:
-        problem = error.errors()[0]
-        field = problem["loc"][0]
-        raise InputError(f"{FLAGS.get(field, field)}: {problem['msg']}, got {values[field]!r}") from None
+    return ServiceSettings.validated(values, FLAGS)
 
 
 def run(args: argparse.Namespace) -> int:

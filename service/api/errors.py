@@ -18,6 +18,7 @@ from golfflight.contract.refusals import (
     RequestRefused,
     answer_to,
     body_detail,
+    failure_detail,
     listed_errors,
     not_json,
 )
@@ -87,7 +88,7 @@ def failure_response(path: str, error: GolfflightError) -> JSONResponse:
         return JSONResponse({"detail": str(error)}, answer.http_status)
     if isinstance(error, RequestRefused):
         return JSONResponse({"detail": error.details}, answer.http_status)
-    return JSONResponse({"detail": [body_detail(str(error), answer.kind)]}, answer.http_status)
+    return JSONResponse({"detail": [failure_detail(error, answer.kind)]}, answer.http_status)
 
 
 async def failed(request: Request, error: GolfflightError) -> JSONResponse:
