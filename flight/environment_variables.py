@@ -70,10 +70,9 @@ VARIABLES = tuple(variable_of(field) for field in Environment.model_fields)
 """Every variable golfflight reads."""
 
 MODEL = variable_of("model")
-SHARED_DATA = variable_of("shared_data")
 SERVICE_SETTINGS = variable_of("service_settings")
 METRICS_DIR = variable_of("metrics_dir")
-RAY_DATA_LOG_LEVEL = variable_of("ray_data_log_level")
+"""The variables other modules name (a message, a hand-down, a library's switch)."""
 
 
 def environment() -> Environment:
