@@ -3,6 +3,7 @@ applied inside a Flyer's coefficients (`formed_flyer`), so a learned form flies 
 
     C_L' = C_L exp(sum_k a_k f_k),  C_D' = C_D exp(sum_k b_k f_k),  f = 1, s, s^2, r, s r, s^2 r, r^2, s r^2
     C_M' = C_M exp(c0 + c1 s + c2 r)
+    each exponent held within LOG_MULTIPLIER_BOUND
     s = ln(S / 0.2), S = R |w| / |v| (spin ratio);  r = ln(Re / 1.5e5), Re = 2 R |v| / nu
 """
 
@@ -26,6 +27,14 @@ REYNOLDS_RANGE = (-1.5, 1.0)
 """r is held at these ends (Re from 33,000 to 410,000, about 11 to 140 m/s in ICAO air)."""
 SPIN_RATIO_FLOOR = 1e-3
 """The spin ratio below which s is held (a ball with no spin has no spin-ratio dependence to read)."""
+LOG_MULTIPLIER_BOUND = np.array([1.25, 1.25, 4.0])
+"""The largest |ln multiplier| of C_L, C_D and C_M the form's terms add up to anywhere (x 3.5 and x 55): beyond two
+flight models' difference, short of what a 0.25 s RK4 step cannot fly. Drag slows a 70 m/s drive in ICAO air at
+C_D rho A v / m = 0.8 /s (lift turns it alike), spin decays at about 0.07 /s: at their bounds 2.8 and 3.7 /s, a step
+takes 0.7 and 0.9 of them against RK4's stability limit of 2.8. At every corner of the bounds, conceal's bag flown at
+0.25 s lands within 3 m of 0.05 s; with lift and drag held at 1.5, lift x 4.5 and drag x 0.22 looped a shot 130 m
+off (tests/test_discovery_baseline.py). Unheld, 19 weights at their own bounds reach C_M x e^18 (a fitted form sat
+at e^13 on a wedge and flew it to NaN)."""
 
 
 @dataclass(frozen=True)
@@ -69,7 +78,7 @@ def log_multipliers(
     w = np.broadcast_to(weights, (len(speed), len(TERMS)))
     for k, term in enumerate(TERMS):
         out[:, term.column] += w[:, k] * feature[term.feature]
-    return out
+    return np.clip(out, -LOG_MULTIPLIER_BOUND, LOG_MULTIPLIER_BOUND)
 
 
 @dataclass(frozen=True)

@@ -11,8 +11,14 @@ from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import diagnose, library_for
 from golfflight.discovery.discrepancy import fit_discrepancy
 from golfflight.discovery.effects import BALL, EFFECTS
-from golfflight.discovery.form import FORM, accurately_flown, formed_model, learn_form
-from golfflight.discovery.form_terms import REYNOLDS_REF, SPIN_RATIO_REF, TERMS, log_multipliers
+from golfflight.discovery.form import FORM, RK4_STEP_S, accurately_flown, formed_model, learn_form
+from golfflight.discovery.form_terms import (
+    LOG_MULTIPLIER_BOUND,
+    REYNOLDS_REF,
+    SPIN_RATIO_REF,
+    TERMS,
+    log_multipliers,
+)
 from golfflight.discovery.model import load_model, reference
 from golfflight.discovery.noise import base_conditions
 from golfflight.discovery.prove import ferguson_world
@@ -46,6 +52,23 @@ def test_the_form_features_at_a_hand_worked_state():
     r = np.log(2 * BALL_RADIUS_M * 40 / 1.5e-5 / REYNOLDS_REF)
     assert s == pytest.approx(np.log(2.0), rel=1e-3) and r == pytest.approx(np.log(0.75858), rel=1e-3)
     assert out == pytest.approx([0.1 * s + 0.2 * r, 0.05, 0.3])
+
+
+def test_the_form_is_held_within_its_bound_and_the_coarse_step_flies_every_corner(served):
+    """Every weight at its own bound sums to ln C_M multipliers of about e^18 on a wedge (S = 1.5, Re = 33,000): the
+    sum is held at LOG_MULTIPLIER_BOUND, and at every corner of the bounds RK4 at RK4_STEP_S lands the shots a fine
+    step lands within 5 m (unheld, spin decay x e^13 flew two wedges to NaN; lift and drag held at 1.5, 130 m off)."""
+    v, w = np.array([[0.0, 12.0, 0.0]]), np.array([[-1500.0, 0.0, 0.0]])
+    top = np.array([term.bound for term in TERMS])
+    assert log_multipliers(v, w, 1.5e-5, top)[0] == pytest.approx(LOG_MULTIPLIER_BOUND)
+    assert log_multipliers(v, w, 1.5e-5, -top)[0] == pytest.approx(-LOG_MULTIPLIER_BOUND)
+    base = base_conditions(from_shot_set(conceal({}, 60, seed=8).shots), served)
+    fine = replace(served, flyer=served.flyer.replaced(rule=RUNGE_KUTTA_4, dt_s=0.05))
+    for sign in np.array(np.meshgrid(*[[-1.0, 1.0]] * 3)).T.reshape(-1, 3):
+        formed = FORM.apply(np.repeat((top * sign[[term.column for term in TERMS]])[None], len(base), 0), base)
+        coarse, close = accurately_flown(served).simulate(formed).outcomes(), fine.simulate(formed).outcomes()
+        assert np.array_equal(np.isfinite(coarse), np.isfinite(close)), sign
+        assert np.nanmax(np.abs(coarse - close)) < 5.0, sign
 
 
 def test_a_constant_drag_weight_flies_as_the_drag_scale():
@@ -175,15 +198,15 @@ def test_outcomes_the_baseline_never_recorded_are_not_compared(served):
         diagnose(carry_only, served, seed=5, progress=False, baseline=baseline)
 
 
-def test_discovery_flies_rk4_at_the_cards_step_within_centimetres_of_a_fine_one(served):
-    """RK4 at the card's step lands within 0.02 m and 0.02 deg of RK4 at 0.01 s, where the card's forward Euler misses
-    by metres: the accuracy a baseline's form is learned at."""
+def test_discovery_flies_rk4_at_a_step_within_centimetres_of_a_fine_one(served):
+    """RK4 at RK4_STEP_S lands within 0.1 m and 0.1 deg of RK4 at 0.01 s (the card's forward Euler misses by metres):
+    the accuracy a baseline's form is learned at, at 2.5x fewer network calls than RK4 at the card's 0.1 s."""
     base = base_conditions(from_shot_set(conceal({}, 120, seed=3).shots), served)
     flown = accurately_flown(served)
-    assert flown.flyer.rule is RUNGE_KUTTA_4 and flown.flyer.dt_s == served.flyer.dt_s
+    assert flown.flyer.rule is RUNGE_KUTTA_4 and flown.flyer.dt_s == RK4_STEP_S
     fine = replace(served, flyer=served.flyer.replaced(rule=RUNGE_KUTTA_4, dt_s=0.01)).simulate(base).outcomes()
     carry, angle = OBSERVABLES.index("carry_y_m"), OBSERVABLES.index("landing_angle_deg")
-    assert np.abs(flown.simulate(base).outcomes() - fine)[:, [carry, angle]].max() < 0.02
+    assert np.abs(flown.simulate(base).outcomes() - fine)[:, [carry, angle]].max() < 0.1
     assert np.abs(served.simulate(base).outcomes() - fine)[:, carry].max() > 0.5
 
 

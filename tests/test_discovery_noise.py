@@ -10,6 +10,7 @@ import pytest
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.diagnose import diagnose
 from golfflight.discovery.model import reference
+from golfflight.discovery import noise
 from golfflight.discovery.noise import RADAR_NOISE, recording_scatter
 from golfflight.discovery.recordings import OBSERVABLES, from_shot_set
 from golfflight.discovery.schema import Report
@@ -91,3 +92,24 @@ def test_an_effect_in_noisy_recordings_is_measured_against_their_scatter():
     assert [e.name for e in report.effects] == ["wind"]
     assert report.effects[0].parameters["speed_mps"] == pytest.approx(4.0, rel=0.1)
     assert report.heldout.after_error < 1.2 and report.heldout.explained_fraction > 0.9
+
+
+def test_a_large_session_flies_the_noise_responses_of_a_share_and_reads_the_rest_from_neighbours(monkeypatch):
+    """Above RESPONSE_SHOTS the launch-noise responses are flown for that many shots and read for the others from
+    their nearest flown ones: the flown shots' responses are exact, and the others' expected errors within a few per
+    cent of flying every shot (measured: 1,000 of 3,000 flown, median 0.2-1.2 %, 95th percentile 2-15 %)."""
+    recordings = from_shot_set(conceal({}, 600, seed=5).shots)
+    model = reference()
+    base = noise.base_conditions(recordings, model)
+    predicted = model.simulate(base).outcomes()
+    steps = noise.launch_noise_steps(base.launch, RADAR_NOISE)
+    every = noise.launch_responses(model, base, predicted, steps)
+    monkeypatch.setattr(noise, "RESPONSE_SHOTS", 250)
+    some = noise.launch_responses(model, base, predicted, steps)
+    flown = np.sort(np.random.default_rng(0).permutation(len(base))[:250])
+    for name in steps:
+        assert np.allclose(some[name][flown], every[name][flown], equal_nan=True)
+    sigma = {k: np.sqrt(np.nansum(np.stack(list(r.values())) ** 2, axis=0)) for k, r in (("every", every), ("some", some))}
+    relative = np.abs(sigma["some"] / sigma["every"] - 1.0)
+    assert np.nanmedian(relative) < 0.03 and np.nanpercentile(relative, 90) < 0.25
+    assert not np.isnan(sigma["some"]).any()
