@@ -3,8 +3,11 @@
 A batch is the Flyer's (`fly_batch`: NumPy [N] arrays through `flight.integrator`). One shot runs on
 plain Python floats with the network's inputs and output bound once to preallocated float32 buffers (IOBinding, one
 thread): per-call overheads, not arithmetic, decide single-shot latency (docs/benchmarks.md). It is the same forward
-Euler at the Flyer's step, fed v_rel and omega times the air's Reynolds scale, stopping at the same interpolated
-landing and failing at the same maximum flight time; tests/test_engine.py holds the two paths to each other.
+Euler at the Flyer's step, fed v_rel and omega times the air's Reynolds scale, landing and peaking by the batch's
+one rule (`flight.events`: asked only on a step that reaches the ground's height or ends a climb, so the loop pays
+for it nothing per step) and failing at the same maximum flight time; tests/test_engine.py and
+tests/test_landing_rule.py hold the paths to each other. It stays a loop of its own because flying one shot through
+`flight.integrator.integrate` costs several times more (`benchmarks/bench_single_path.py`, docs/benchmarks.md).
 """
 
 from __future__ import annotations
@@ -29,7 +32,8 @@ from golfflight.flight.flyer import (
     load_flyer,
 )
 from golfflight.flight.ground import GroundSpec, ground_phase_one, putt_phase
-from golfflight.flight.outcomes import BatchFlights, EulerStates, Rest, ShotFlight, landing_figures, parabola_apex
+from golfflight.flight.events import came_down, crossing_fraction, parabola_apex, rose_above
+from golfflight.flight.outcomes import BatchFlights, EulerStates, Rest, ShotFlight, landing_figures
 from golfflight.flight.physics import euler_step, initial_state, reynolds_scale
 from golfflight.flight.wind import log_profile_factor
 from golfflight.weights_schema.model_card import ModelCard
@@ -44,6 +48,10 @@ __all__ = [
     "Rest",
     "ShotFlight",
 ]
+
+
+BEFORE_LAUNCH = (math.nan,) * 9
+"""The single shot's state before its launch: none, so the launch state is never taken for a top it rose into."""
 
 
 class FlightEngine:
@@ -134,9 +142,10 @@ class FlightEngine:
         air_x, air_y = wind_x, wind_y
         dt = self.dt
         height = 0.0 if ground is None else ground.elevation_m
-        apex, apex_step, before_apex, after_apex = z, 0, math.nan, math.nan
+        peak, peak_step, before_peak, after_peak = z, 0, math.nan, math.nan
         history = [(x, y, z, vx, vy, vz)] if keep_states else None
         velocity_in, spin_in, out = self._velocity_in[0], self._spin_in[0], self._coefficients_out[0]
+        old = BEFORE_LAUNCH
         with self._single_lock:
             run, binding = self._single_session.run_with_iobinding, self._binding
             for step in range(1, self.max_steps + 1):
@@ -146,19 +155,17 @@ class FlightEngine:
                 velocity_in[0], velocity_in[1], velocity_in[2] = (vx - air_x) * k, (vy - air_y) * k, vz * k
                 spin_in[0], spin_in[1], spin_in[2] = wx * k, wy * k, wz * k
                 run(binding)
-                old = (x, y, z, vx, vy, vz, wx, wy, wz)
+                prior, old = old, (x, y, z, vx, vy, vz, wx, wy, wz)
                 x, y, z, vx, vy, vz, wx, wy, wz = euler_step(*old, out.tolist(), density, air_x, air_y, dt)
-                if z > apex:
-                    apex, apex_step, before_apex, after_apex = z, step, old[2], math.nan
-                elif apex_step == step - 1:
-                    after_apex = z
-                if z <= height < old[2]:
+                if old[5] <= 0.0 < prior[5] and rose_above(old[2], peak):  # old a top: rose into, not out of it
+                    peak, peak_step, before_peak, after_peak = old[2], step - 1, prior[2], z
+                if z <= height and came_down(old[2], z, height):
                     break
                 if history is not None:
                     history.append((x, y, z, vx, vy, vz))
             else:
-                raise FlightError(self.flyer.unlanded_message(apex, height))
-        frac = (old[2] - height) / (old[2] - z)
+                raise FlightError(self.flyer.unlanded_message(peak, height))
+        frac = crossing_fraction(old[2], z, height)
         land = [a + frac * (b - a) for a, b in zip(old, (x, y, z, vx, vy, vz, wx, wy, wz))]
         flight_time = (step - 1 + frac) * dt
         carry, angle, speed, spin = (float(v) for v in landing_figures(land[0], land[1], *land[3:]))
@@ -166,7 +173,7 @@ class FlightEngine:
         if history is not None:
             rows = np.array(history)
             states = EulerStates.to_landing(rows[:, :3], rows[:, 3:], land[:3], land[3:6], dt, flight_time)
-        apex, apex_time = parabola_apex(before_apex, apex, after_apex, apex_step * dt, dt)
+        apex, apex_time = parabola_apex(before_peak, peak, after_peak, peak_step * dt, dt)
         numbers = (land[0], land[1], carry, apex, apex_time, flight_time, angle, speed, spin)
         if not (all(map(math.isfinite, numbers)) and (states is None or states.finite)):
             raise FlightError(NON_FINITE)

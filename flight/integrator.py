@@ -13,7 +13,7 @@ torch engine's): a step rule x a vector field x an event x a record.
   states: the record marks them (`_Marks`: the apex and the landing as they happen), keeps what it keeps and says
   when the flight is finished; the loop never branches on which record it has.
 
-The apex is interpolated between steps (`flight.outcomes.parabola_apex`). A later phase (bounce and roll on the
+The landing and the apex are `flight.events`' one rule (the apex interpolated between steps, `parabola_apex`). A later phase (bounce and roll on the
 ground) starts from the landing state this returns, with its own field and event.
 """
 
@@ -27,7 +27,8 @@ from typing import Literal, Protocol
 import numpy as np
 from golfflight.flight import xp
 from golfflight.flight.field import VectorField
-from golfflight.flight.outcomes import Flight, parabola_apex
+from golfflight.flight.events import came_down, crossing_fraction, parabola_apex, rose_above
+from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import State
 
 
@@ -84,14 +85,13 @@ class GroundPlane:
     height_m: np.ndarray | float = 0.0
 
     def crossed(self, z_before: np.ndarray, z_after: np.ndarray) -> np.ndarray:
-        """Which balls came down through the plane during the step."""
-        return (z_before > self.height_m) & (z_after <= self.height_m)
+        """Which balls came down through the plane during the step (`flight.events.came_down`)."""
+        return came_down(z_before, z_after, self.height_m)
 
     def fraction(self, z_before: np.ndarray, z_after: np.ndarray, crossed: np.ndarray) -> np.ndarray:
-        """How far into the step (0..1) each ball met the plane, where it `crossed` it (elsewhere a finite value
-        of no meaning: no division by a zero drop, so no NaN reaches a gradient)."""
-        drop = xp.where(crossed, z_before - z_after, 1.0)
-        return (z_before - self.height_m) / drop
+        """How far into the step (0..1) each ball met the plane, where it `crossed` it
+        (`flight.events.crossing_fraction`)."""
+        return crossing_fraction(z_before, z_after, self.height_m, crossed)
 
     def take(self, index: np.ndarray) -> GroundPlane:
         return GroundPlane(xp.rows(self.height_m, index))
@@ -128,7 +128,7 @@ class _Marks:
         landing."""
         z_before, z_after = old.position[:, 2], new.position[:, 2]
         aloft = ~self.down  # a ball down flies on until it is set aside: a low, spinning one may rise again
-        higher = (z_after > self.peak) & aloft
+        higher = rose_above(z_after, self.peak) & aloft
         if self.rose:  # some ball's peak was the last step's state: its height after the peak is this step's
             self.after = xp.where((self.peak_step == step - 1) & ~higher, z_after, self.after)
         self.rose = xp.may_hold(higher)

@@ -25,19 +25,6 @@ def landing_angle_deg(vx, vy, vz):
     return xp.atan2(-vz, (vx * vx + vy * vy) ** 0.5) * DEGREES_PER_RADIAN
 
 
-def parabola_apex(before, peak, after, peak_time_s, dt: float, inside=True):
-    """(apex height, apex time) of the parabola through three heights one step apart, the middle one the highest
-    state: the integrator's apex between its steps rather than on them (about g dt^2 / 8 higher at most, up to dt / 2
-    earlier or later). Where a neighbour is missing (NaN: the launch state; or `inside` False: a differentiable
-    caller's peak at the first or last state) or the three do not bend down, the peak state itself. Floats, NumPy
-    arrays or torch tensors (`flight.xp`)."""
-    bend = before - 2.0 * peak + after
-    rise = before - after
-    down = (bend < 0.0) & inside
-    shift = xp.where(down, rise / (2.0 * xp.where(down, bend, -1.0)), 0.0)
-    return xp.where(down, peak - rise * shift / 4.0, peak), peak_time_s + shift * dt
-
-
 @dataclass
 class Flight:
     """Outcome of a batch of flights; landing values are NaN where `landed` is False.

@@ -3,8 +3,8 @@
 The equations of motion and the Euler step are the flight core's (`flight.field.BallInAir`, `flight.integrator`),
 written once over floats, NumPy and torch (`flight.xp`), and so is the loop: the rollout is the integrator with
 training's record (`TrajectoryRecord`, every state kept as one graph). This module adds what training alone needs:
-that record, the soft landing, and the landing and apex read back differentiably (the apex's parabola is
-`flight.outcomes.parabola_apex`'s, the landing's fraction the integrator's `GroundPlane.fraction`), batched over
+that record, the soft landing, and the landing and apex read back differentiably by the integrator's one rule
+(`flight.events`: `came_down`, `crossing_fraction`, `rose_above`, `parabola_apex`, over all steps at once), batched over
 shots and dtype-agnostic (float64 for the parity tests, float32 for training). Wind is uniform (one air velocity per
 shot): real-data training fits it as a per-group nuisance, where a uniform wind is the simplest stand-in for the
 profile. The landing and the apex are measured as `flight.integrator` measures them (`hard_landing`, `apex`), so
@@ -20,8 +20,8 @@ from functools import partial
 import torch
 from golfflight.flight import xp
 from golfflight.flight.field import BallInAir
+from golfflight.flight.events import came_down, crossing_fraction, parabola_apex, rose_above
 from golfflight.flight.integrator import FORWARD_EULER, GroundPlane, StepRule, integrate
-from golfflight.flight.outcomes import parabola_apex
 from golfflight.flight.physics import State
 from golfflight.flight.wind import CALM, WindAtBalls
 
@@ -193,9 +193,9 @@ def soft_landing(
 
 
 def _first_crossing(z: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """Per shot of heights z [T+1, N]: the step before the first downward crossing of r_z = 0 (z_i > 0 >= z_{i+1})
-    and whether there is one; where there is none, the step before the last."""
-    crossed = (z[:-1] > 0) & (z[1:] <= 0)
+    """Per shot of heights z [T+1, N]: the step before the first step that came down through r_z = 0
+    (`flight.events.came_down`) and whether there is one; where there is none, the step before the last."""
+    crossed = came_down(z[:-1], z[1:], 0.0)
     landed = crossed.any(dim=0)
     first = torch.argmax(crossed.to(torch.int8), dim=0)
     return torch.where(landed, first, z.shape[0] - 2), landed
@@ -209,7 +209,7 @@ def hard_landing(trajectory: Trajectory) -> Landing:
     before, landed = _first_crossing(z)
     shots = torch.arange(z.shape[1], device=z.device)
     z_before, z_after = z[before, shots], z[before + 1, shots]
-    frac = torch.where(landed, GroundPlane().fraction(z_before, z_after, landed), torch.ones_like(z_before))
+    frac = torch.where(landed, crossing_fraction(z_before, z_after, 0.0, landed), torch.ones_like(z_before))
 
     def interpolate(states: torch.Tensor) -> torch.Tensor:
         old, new = states[before, shots], states[before + 1, shots]
@@ -225,14 +225,17 @@ def hard_landing(trajectory: Trajectory) -> Landing:
 
 
 def apex(trajectory: Trajectory) -> Apex:
-    """Apex as `flight.integrator` measures it (`flight.outcomes.parabola_apex`): the highest state up to the first
-    downward crossing and the vertex of the parabola through it and its two neighbours; the highest state itself
-    where it is the first or last state or the three do not bend down. Differentiable in the three heights."""
+    """Apex as `flight.integrator` measures it (`flight.events`): the last state up to the landing that rose above
+    every state before it (`rose_above` against the running peak, all steps at once) and the vertex of the parabola
+    through it and its two neighbours (`parabola_apex`); that state itself where it is the first or last state or the
+    three do not bend down. Differentiable in the three heights."""
     z = trajectory.positions[:, :, 2]
     last = z.shape[0] - 1
     before, landed = _first_crossing(z)
-    in_flight = torch.arange(last + 1, device=z.device)[:, None] <= torch.where(landed, before + 1, last)
-    peak_step = torch.argmax(torch.where(in_flight, z, torch.full_like(z, -torch.inf)), dim=0)
+    steps = torch.arange(last + 1, device=z.device)[:, None]
+    flown = torch.where(steps <= torch.where(landed, before + 1, last), z.detach(), -torch.inf)
+    rose = rose_above(flown[1:], torch.cummax(flown, dim=0).values[:-1])
+    peak_step = torch.where(rose, steps[1:], 0).amax(dim=0)
     shots = torch.arange(z.shape[1], device=z.device)
     peak = z[peak_step, shots]
     earlier, later = z[(peak_step - 1).clamp_min(0), shots], z[(peak_step + 1).clamp_max(last), shots]

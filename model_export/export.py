@@ -88,8 +88,8 @@ LANDING = (
     "parabola through the highest step k up to the landing and its two neighbours, z_k - (z_{k-1} - z_{k+1})^2 / (8 "
     "(z_{k-1} - 2 z_k + z_{k+1})) at t_k + dt (z_{k-1} - z_{k+1}) / (2 (z_{k-1} - 2 z_k + z_{k+1})) (the highest step "
     "itself where it is the first or last or the three do not bend down): about g dt^2 / 8 (1.2 cm at 0.1 s) above it "
-    "at most. Training (flight.rollout) and the runtime (flight.integrator, flight.outcomes.parabola_apex) "
-    "measure both the same way. The soft-argmax landing of the L_p loss searches from landing_search_start_s on."
+    "at most. Training (flight.rollout) and the runtime (flight.engine, flight.integrator) measure both by one rule "
+    "(flight.events). The soft-argmax landing of the L_p loss searches from landing_search_start_s on."
 )
 
 

@@ -36,8 +36,8 @@ a formula to check it."""
 HOMES = {
     "force": {"flight/physics.py: accelerations"},
     "spin ratio": {"flight/physics.py: spin_ratio_of"},
-    "landing": {"flight/integrator.py: GroundPlane.crossed", "flight/integrator.py: GroundPlane.fraction"},
-    "apex": {"flight/integrator.py: _Marks.update", "flight/outcomes.py: parabola_apex"},
+    "landing": {"flight/events.py: came_down", "flight/events.py: crossing_fraction"},
+    "apex": {"flight/events.py: rose_above", "flight/events.py: parabola_apex"},
     "slope hold": {"flight/ground/surfaces.py: holding_slope_deg", "flight/ground/surfaces.py: check_slope_held"},
 }
 """The one home of each piece: the functions every other place calls."""

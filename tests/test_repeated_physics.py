@@ -1,8 +1,8 @@
 """Issues 44 and 58's line on repeated physics, held by the formulas (scripts/repeated_physics.py reads every package's
 syntax tree): a force, a spin ratio, a landing, an apex or a slope hold computed outside its one home comes to at
-most LINES_NOW code lines, a copy of a home pasted anywhere is found by what it computes, and the copies issue 58
+most LINES_NOW code lines, a copy of a home pasted anywhere is found by what it computes, the copies issue 58
 names (discovery's outside effects, the reference world's spin ratio, the ground's slope holds, the request's) are
-gone."""
+gone, and no landing or apex is told outside the one rule (`flight.events`)."""
 
 import ast
 import importlib.util
@@ -20,11 +20,11 @@ repeated_physics = importlib.util.module_from_spec(spec)
 sys.modules["repeated_physics"] = repeated_physics  # its dataclass looks its module up there
 spec.loader.exec_module(repeated_physics)
 
-LINES_NOW = 110
-"""The count today: the single shot's float loop (`FlightEngine.fly`, 68) and training's readers of a trajectory
-(`flight.rollout`, 32), which issue 58's one landing and apex rule takes away, plus `shots.tourcast`'s lift
-coefficient from an acceleration (q A / m inverted, 10). Issue 44's goal is 100; a new copy anywhere raises the count
-above this."""
+LINES_NOW = 10
+"""The count today: `shots.tourcast`'s lift coefficient from an acceleration (q A / m inverted, 10). Issue 58's one
+landing and apex rule (`flight.events`) took away the single shot's float loop (`FlightEngine.fly`, 68) and
+training's readers of a trajectory (`flight.rollout`, 32); issue 44's goal is 100; a new copy anywhere raises the
+count above this."""
 
 GONE = (
     "discovery/outside.py", "discovery/form_terms.py", "flight/reference_aero.py", "flight/ground/", "contract/requests.py"
@@ -90,6 +90,12 @@ def test_the_repeated_physics_stays_within_its_lines(findings):
 
 def test_the_repeats_issue_58_names_are_gone(findings):
     assert [f.place for f in findings if f.path.startswith(GONE)] == []
+
+
+def test_landings_and_apexes_are_found_by_the_one_rule_alone(findings):
+    """The single shot, the batch, the torch engine and training's rollout call `flight.events`: no other function
+    tells a landing or an apex itself."""
+    assert [(f.place, f.patterns) for f in findings if {"landing", "apex"} & set(f.patterns)] == []
 
 
 def test_a_new_copy_of_each_piece_is_found_by_its_formula(tmp_path):

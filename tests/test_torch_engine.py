@@ -12,14 +12,13 @@ import numpy as np
 import pytest
 import torch
 from conftest import random_launches
+from shared_network import numpy_flyer_of
 from golfflight.flight import torch_engine
 from golfflight.flight.air import Air
 from golfflight.flight.conditions import Conditions
 from golfflight.flight.devices import DeviceError, resolve_device
-from golfflight.flight.flyer import Flyer, load_flyer
+from golfflight.flight.flyer import load_flyer
 from golfflight.flight.ground import SURFACES, GroundSpec
-from golfflight.flight.physics import reynolds_scale
-from golfflight.flight.rollout import InAir
 from golfflight.flight.torch_engine import STAGES, TorchEngine
 from golfflight.flight.wind import Wind
 from golfflight.model_export.training import TrainConfig, load_checkpoint, train
@@ -108,36 +107,13 @@ def test_the_torch_engine_flies_mixed_shots_as_the_onnx_engine(engines, shots, o
     assert np.max(np.abs(got.rest.total_m[rolled] - onnx_flights.rest.total_m[rolled])) < 20 * carry_m
 
 
-class TorchNetwork:
-    """The torch engine's own network (float32, as it runs it) as a NumPy coefficient model for the Flyer, so that
-    the NumPy integrator and the torch engine fly the same coefficients and differ only in their arithmetic."""
-
-    def __init__(self, engine: TorchEngine, scale: float | np.ndarray = 1.0) -> None:
-        self.engine, self.scale = engine, scale
-
-    def in_air(self, kinematic_viscosity_m2_s: float | np.ndarray) -> TorchNetwork:
-        scale = reynolds_scale(np.asarray(kinematic_viscosity_m2_s), self.engine.flyer.kinematic_viscosity_m2_s)
-        return TorchNetwork(self.engine, scale[:, None] if scale.ndim else float(scale))
-
-    def take(self, index: np.ndarray) -> TorchNetwork:
-        return TorchNetwork(self.engine, self.scale[index] if isinstance(self.scale, np.ndarray) else self.scale)
-
-    @torch.no_grad()
-    def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray:
-        inputs = (torch.as_tensor(a * self.scale, dtype=torch.float64) for a in (v_rel, omega))
-        return InAir(self.engine.network, run_in=torch.float32)(*inputs).numpy()
-
-
 def test_in_float64_the_landing_and_apex_rules_are_the_integrators(engines, shots):
     """The same network flown by the NumPy integrator (the engine's Flyer) and by the torch engine in float64: every
     figure within 1e-6 (m, s, deg; the landing spin within 1e-5 rpm): the landing interpolated into the crossing
     step, the apex's parabola, each shot's ground, its air's Reynolds scale, the log profile at the ball's height,
     the failures. (An input a float64 rounding away from a float32 boundary can still move a coefficient by an ulp.)"""
     engine = engines["float64"]
-    onnx = engine.flyer
-    numpy_flyer = Flyer(TorchNetwork(engine), onnx.dt_s, onnx.max_flight_time_s, onnx.density_kg_m3,
-                        onnx.kinematic_viscosity_m2_s)
-    want, got = numpy_flyer.fly_batch(*shots), engine.fly_batch(*shots)
+    want, got = numpy_flyer_of(engine).fly_batch(*shots), engine.fly_batch(*shots)
     assert got.errors == want.errors
     landed = np.array([i not in got.errors for i in range(SHOTS)])
     for name in FIGURES:
