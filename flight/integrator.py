@@ -13,8 +13,9 @@ torch engine's): a step rule x a vector field x an event x a record.
   states: the record marks them (`_Marks`: the apex and the landing as they happen), keeps what it keeps and says
   when the flight is finished; the loop never branches on which record it has.
 
-The landing and the apex are `flight.events`' one rule (the apex interpolated between steps, `parabola_apex`). A later phase (bounce and roll on the
-ground) starts from the landing state this returns, with its own field and event.
+The landing and the apex are `flight.events`' one rule (the apex interpolated between steps, `parabola_apex`). A
+later phase (bounce and roll on the ground) starts from the landing state this returns, with its own field and
+event.
 """
 
 from __future__ import annotations

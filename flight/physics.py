@@ -28,10 +28,10 @@ from golfflight.flight.constants import (
     BALL_MASS_KG,
     BALL_RADIUS_M,
     GRAVITY_MPS2,
-    RPM_TO_RADPS,
     TEE_HEIGHT_M,
 )
 from golfflight.flight.ground.vectors import norm
+from golfflight.flight.launch_state import launch_state
 from golfflight.flight.wind import CALM, Wind
 
 TINY = 1e-12
@@ -74,19 +74,13 @@ def initial_state(
     spin_rpm: np.ndarray,
     spin_axis_deg: np.ndarray,
 ) -> State:
-    """State at impact from launch-monitor values (paper eq. 12; spin axis + tilts right, rifle spin zero)."""
-    speed = np.asarray(ball_speed_mps, dtype=float)
-    gamma = np.radians(launch_angle_deg)
-    phi = np.radians(launch_direction_deg)
-    psi = np.radians(spin_axis_deg)
-    spin = np.asarray(spin_rpm, dtype=float) * RPM_TO_RADPS
-    velocity = np.stack(
-        [speed * np.cos(gamma) * np.sin(phi), speed * np.cos(gamma) * np.cos(phi), speed * np.sin(gamma)], -1
-    )
-    omega = np.stack([spin * np.cos(psi), np.zeros_like(spin), -spin * np.sin(psi)], -1)
+    """State at impact from launch-monitor values (paper eq. 12, `flight.launch_state`), [N] arrays each."""
+    velocity, spin = launch_state(*(np.asarray(value, dtype=float) for value in (
+        ball_speed_mps, launch_angle_deg, launch_direction_deg, spin_rpm, spin_axis_deg)))
+    velocity = np.stack(velocity, -1)
     position = np.zeros_like(velocity)
     position[:, 2] = TEE_HEIGHT_M
-    return State(position, velocity, omega)
+    return State(position, velocity, np.stack(spin, -1))
 
 
 def spin_ratio(v_rel, omega):

@@ -12,6 +12,7 @@ from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.ground import SKID_FRICTION, GroundSpec, holding_slope_deg, putt_phase, surface
 from golfflight.flight.ground.phase import MAX_ROLL_TIME_S
 from golfflight.flight.ground.surfaces import STIMPMETER_EXIT_SPEED_MPS, green_rolling_resistance
+from golfflight.flight.physics import initial_state
 
 TOP_SPIN_AXIS_DEG = 180.0
 """omega = |omega| (cos psi, 0, -sin psi) is -x at psi = 180: top spin for a ball moving to +y."""
@@ -121,3 +122,20 @@ def test_a_putt_rolls_on_its_green_where_that_green_lies(engine: FlightEngine):
     np.testing.assert_allclose(below.states.positions[:, 2], -3.0)
     np.testing.assert_allclose(below.states.positions[:, :2], level.states.positions[:, :2])
     assert below.rest == level.rest
+
+
+def test_a_putt_starts_from_the_flights_launch_state():
+    """A putt's start is the launch state a flight starts from (`flight.launch_state`, as `initial_state` gives it),
+    projected onto level ground: the same velocity to the last bit, its vertical part dropped; and with the spin of
+    that state, a putt skids for |v + R e_z x omega| / (3.5 mu g)."""
+    rng = np.random.default_rng(58)
+    launches = np.stack([rng.uniform(0.5, 6.0, 40), rng.uniform(-3.0, 6.0, 40), rng.uniform(-15.0, 15.0, 40),
+                         rng.uniform(0.0, 400.0, 40), rng.uniform(-180.0, 180.0, 40)], -1)
+    start = initial_state(*launches.T)
+    green = surface("green", 11.0)
+    for launch, velocity, spin in zip(launches.tolist(), start.velocity, start.spin, strict=True):
+        putt = putt_phase(*launch, green, keep_path=True)
+        np.testing.assert_array_equal(putt.path.velocities[0], [velocity[0], velocity[1], 0.0])
+        slip = velocity[:2] + BALL_RADIUS_M * np.array([-spin[1], spin[0]])
+        skid_time = math.hypot(*slip.tolist()) / (3.5 * SKID_FRICTION * GRAVITY_MPS2)
+        assert putt.skid_time_s == pytest.approx(skid_time, rel=1e-12)

@@ -2,9 +2,9 @@
 
 Start: a putter launches the ball at a few degrees with little spin, a hop at most a few millimetres high and a few
 centimetres long (0.2 mm and 2 cm at 1.83 m/s and 2 degrees), too small to matter, so the launch velocity is
-projected onto the ground's plane through the origin (its vertical part dropped on level ground). The spin is the
-flight's, omega = |omega| (cos psi, 0, -sin psi): back spin (+x for a putt towards +y) makes the ball skid longer
-and roll off slower.
+projected onto the ground's plane through the origin (its vertical part dropped on level ground). The launch velocity
+and the spin are a flight's (`flight.launch_state`), omega = |omega| (cos psi, 0, -sin psi): back spin (+x for a putt
+towards +y) makes the ball skid longer and roll off slower.
 
 Skid: the contact point slips at s = v + R n x omega. Kinetic friction mu g cos(phi) against the slip slows the
 centre by mu g cos(phi) and spins the ball up by (5/2) mu g cos(phi) / R, so the slip falls at (7/2) mu g cos(phi)
@@ -20,10 +20,9 @@ level ground in closed form, slopes in ROLL_STEP_S steps, so a putt on a slope b
 
 from __future__ import annotations
 
-import math
 from typing import NamedTuple
 
-from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2, RPM_TO_RADPS
+from golfflight.flight.constants import BALL_RADIUS_M, GRAVITY_MPS2
 from golfflight.flight.ground.phase import (
     GroundPath,
     _Record,
@@ -34,6 +33,7 @@ from golfflight.flight.ground.phase import (
 )
 from golfflight.flight.ground.surfaces import Surface
 from golfflight.flight.ground.vectors import add, cross, dot, norm, times
+from golfflight.flight.launch_state import launch_state
 
 SKID_FRICTION = 0.3
 """Kinetic friction coefficient of a golf ball sliding on a green. It sets only where the skid ends, not the speed
@@ -71,12 +71,8 @@ def putt_phase(
     """Skid and roll a putt launched from the origin to rest on a plane sloped by `slope_deg` towards `slope_dir_deg`
     (`phase.plane_normals`), on plain floats. InputError if the slope is steeper than the surface holds a ball on."""
     normal = plane_normal_one(surface, slope_deg, slope_dir_deg)
-    gamma, heading, psi = (math.radians(a) for a in (launch_angle_deg, launch_direction_deg, spin_axis_deg))
-    launch = times(ball_speed_mps, (math.cos(gamma) * math.sin(heading), math.cos(gamma) * math.cos(heading),
-                                    math.sin(gamma)))
+    launch, spin = launch_state(ball_speed_mps, launch_angle_deg, launch_direction_deg, spin_rpm, spin_axis_deg)
     velocity = add(launch, normal, -dot(launch, normal))
-    omega = spin_rpm * RPM_TO_RADPS
-    spin = (omega * math.cos(psi), 0.0, -omega * math.sin(psi))
     slip = add(velocity, cross(normal, spin), BALL_RADIUS_M)
     skid_time = norm(slip) / (3.5 * SKID_FRICTION * GRAVITY_MPS2 * normal[2])
     downhill = downhill_acceleration(normal)
