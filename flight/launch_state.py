@@ -15,9 +15,9 @@ RADIANS_PER_DEGREE = math.pi / 180.0
 
 
 def launch_state(ball_speed_mps, launch_angle_deg, launch_direction_deg, spin_rpm, spin_axis_deg) -> tuple:
-    """((vx, vy, vz), (wx, wy, wz)) at impact: the speed along the launch angle above the horizontal and the
-    direction right of the target line (+y), the spin about a horizontal axis tilted right (+) by the spin axis,
-    rifle spin zero; floats, NumPy arrays or torch tensors, component by component."""
+    """((vx, vy, vz), (wx, wy, wz)) at impact: the speed at the launch angle above the horizontal, the launch
+    direction right (+) of the target line (+y); the spin about a horizontal axis tilted right (+) by the spin axis,
+    rifle spin zero. Floats, NumPy arrays or torch tensors, component by component."""
     gamma, phi, psi = (angle * RADIANS_PER_DEGREE for angle in (launch_angle_deg, launch_direction_deg, spin_axis_deg))
     along = ball_speed_mps * xp.cos(gamma)
     omega = spin_rpm * RPM_TO_RADPS
