@@ -44,6 +44,7 @@ from golfflight.flight.air import Air
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import load_flyer
 from golfflight.flight.ground import SURFACES, GroundSpec
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.torch_engine import STAGES, TorchEngine
 from golfflight.flight.wind import Wind
 from golfflight.shots.clubs import CLUBS
@@ -108,7 +109,7 @@ def timed(engine: TorchEngine, launches: np.ndarray, rounds: int) -> dict[str, f
     spent = {stage: [] for stage in STAGES}
     for _ in range(rounds):
         engine.seconds = dict.fromkeys(STAGES, 0.0)
-        engine.fly_batch(launches, STANDARD, GroundSpec(SURFACES["fairway"]))
+        engine.fly_batch(FlightProblem.of(launches, STANDARD, GroundSpec(SURFACES["fairway"])))
         for stage in STAGES:
             spent[stage].append(engine.seconds[stage])
     return {stage: statistics.median(values) for stage, values in spent.items()}
@@ -148,14 +149,14 @@ def parity(bundle: Path, device: str, shots: int, engines: dict[str, TorchEngine
     launches = launches_array(shots, seed=7)
     conditions, grounds = mixed_conditions(shots)
     started = time.perf_counter()
-    reference = load_flyer(bundle).fly_batch(launches, conditions, grounds)
+    reference = load_flyer(bundle).fly_batch(FlightProblem.of(launches, conditions, grounds))
     print(f"ONNX reference: {shots:,} mixed shots in {time.perf_counter() - started:.1f} s", flush=True)
     cases = [("float32", False, engines["eager"]), ("float64", False, TorchEngine(bundle, device, "float64"))]
     if "compiled" in engines:
         cases.append(("float32", True, engines["compiled"]))
     rows = []
     for dtype, compile_step, engine in cases:
-        got = engine.fly_batch(launches, conditions, grounds)
+        got = engine.fly_batch(FlightProblem.of(launches, conditions, grounds))
         landed = np.array([i not in reference.errors for i in range(shots)])
         rolled = got.rolled & reference.rolled
         row = {"dtype": dtype, "compiled": compile_step, "shots": shots, "errors_equal": got.errors == reference.errors,
@@ -296,11 +297,11 @@ def warmed_engines(bundle: Path, device: str, others: list[str]) -> tuple[dict[s
                                    lambda: TorchEngine(bundle, device, ground_on_device=not eager.ground_on_device)),
               "none-set-aside": ("none set aside", lambda: TorchEngine(bundle, device, set_aside_share=1.0))}
     engines, failed = {"eager": eager}, {}
-    eager.fly_batch(launches_array(1024), STANDARD, GroundSpec(SURFACES["fairway"]))
+    eager.fly_batch(FlightProblem.of(launches_array(1024), STANDARD, GroundSpec(SURFACES["fairway"])))
     for name, make in (makers[other] for other in others):
         try:
             engine = make()
-            engine.fly_batch(launches_array(1024), STANDARD, GroundSpec(SURFACES["fairway"]))
+            engine.fly_batch(FlightProblem.of(launches_array(1024), STANDARD, GroundSpec(SURFACES["fairway"])))
             engines[name] = engine
         except Exception as error:  # noqa: BLE001 - recorded in the results, the other engines still timed
             failed[name] = f"{type(error).__name__}: {error}"

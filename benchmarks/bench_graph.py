@@ -22,7 +22,7 @@ import onnxruntime as ort
 from common import SEVEN_IRON, add_results_flag, write_results
 from golfflight.flight.bundle_check import session_options
 from golfflight.flight.bundle_location import model_dir
-from golfflight.flight.engine import FlightEngine
+from golfflight.flight.engine import FlightEngine, FlightProblem
 from golfflight.flight.physics import euler_step
 from golfflight.weights_schema.bundle import load_bundle
 from onnx import TensorProto, helper
@@ -98,8 +98,8 @@ def main() -> None:
     rows.append({"name": "plain-float Euler step (flight.physics.euler_step)", "unit": "us",
                  "p50": median_us(lambda: euler_step(*state, (0.2, 0.25, 0.001, 0.5), 1.225, 0.0, 0.0, 0.1))})
     engine = FlightEngine(bundle)
-    steps = engine.fly(SEVEN_IRON).flight_time_s / card.physics.dt_s
-    shot_us = median_us(lambda: engine.fly(SEVEN_IRON), rounds=9, calls=300)
+    steps = engine.fly(FlightProblem.of([SEVEN_IRON]))[0].flight_time_s / card.physics.dt_s
+    shot_us = median_us(lambda: engine.fly(FlightProblem.of([SEVEN_IRON])), rounds=9, calls=300)
     rows.append({"name": f"whole 7-iron, per step ({steps:.0f} steps)", "unit": "us", "p50": shot_us / steps})
     print("| part of a step | nodes (after ORT) | time |")
     print("|---|---:|---:|")

@@ -24,7 +24,7 @@ from common import (
 )
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import RPM_TO_RADPS
-from golfflight.flight.engine import BATCH_THREADS, FlightEngine
+from golfflight.flight.engine import BATCH_THREADS, FlightEngine, FlightProblem
 from golfflight.flight.ground import LEVEL_FAIRWAY, GroundSpec, ground_phase_one, surface
 
 SLOPED_GREEN = GroundSpec(surface("green", 11.0), elevation_m=-2.0, slope_deg=1.5, slope_dir_deg=30.0)
@@ -53,7 +53,7 @@ def main() -> None:
     args = parser.parse_args()
     engine = FlightEngine(model_dir(args.model), BATCH_THREADS)
     launches = mixed_launches(1024)
-    landed = engine.fly_batch([DRIVER], keep_states=True).shots()[0]
+    landed = engine.fly_batch(FlightProblem.of([DRIVER], keep_states=True)).shots()[0]
     states, spin = landed.states, landed.landing_spin_rpm * RPM_TO_RADPS
     landing = (tuple(states.positions[-1]), tuple(states.velocities[-1]), (spin, 0.0, 0.0))
     single = {(shot, name): [] for shot in ("7-iron", "driver") for name in GROUNDS}
@@ -62,7 +62,7 @@ def main() -> None:
     for _ in range(args.rounds):
         for shot, launch in (("7-iron", SEVEN_IRON), ("driver", DRIVER)):
             for name, ground in GROUNDS.items():
-                call = lambda: engine.fly(launch, ground=ground)  # noqa: E731
+                call = lambda: engine.fly(FlightProblem.of([launch], grounds=ground))  # noqa: E731
                 single[shot, name].append(percentiles_ms(cpu_timed(call, 500, warmup=50)))
         for name in alone:
             g = GROUNDS[name]
@@ -70,7 +70,8 @@ def main() -> None:
             alone[name].append(percentiles_ms(cpu_timed(call, 500, warmup=50)))
         for name in batch:
             ground = GROUNDS[name]
-            batch[name].append(statistics.median(cpu_timed(lambda: engine.fly_batch(launches, grounds=ground).shots(), 5)))
+            call = lambda: engine.fly_batch(FlightProblem.of(launches, grounds=ground)).shots()  # noqa: E731
+            batch[name].append(statistics.median(cpu_timed(call, 5)))
     rows = []
     for shot in ("7-iron", "driver"):
         flight_only = median_of_rounds(single[shot, "flight alone"])

@@ -22,7 +22,7 @@ from common import (
     write_results,
 )
 from golfflight.flight.bundle_location import model_dir
-from golfflight.flight.engine import BATCH_THREADS, FlightEngine
+from golfflight.flight.engine import BATCH_THREADS, FlightEngine, FlightProblem
 
 
 def timed(call, repeats: int, warmup: int = 1) -> list[float]:
@@ -38,11 +38,11 @@ def timed(call, repeats: int, warmup: int = 1) -> list[float]:
 
 
 def time_single(engine: FlightEngine, launch, shots: int) -> dict:
-    return percentiles_ms(timed(lambda: engine.fly(launch), shots, warmup=100))
+    return percentiles_ms(timed(lambda: engine.fly(FlightProblem.of([launch])), shots, warmup=100))
 
 
 def time_batch(engine: FlightEngine, launches, repeats: int) -> list[float]:
-    return timed(lambda: engine.fly_batch(launches).shots(), repeats)
+    return timed(lambda: engine.fly_batch(FlightProblem.of(launches)).shots(), repeats)
 
 
 def main() -> None:

@@ -4,9 +4,11 @@
 
 Three ways to fly one shot, each timed in blocks of `--shots` calls (the block's median), the ways in turn and their
 order reversed every block, so each block of one way has a block of the others beside it in time:
-- float loop: `FlightEngine.fly(launch)`, the served single shot (floats, the graph bound once, one thread);
+- float loop: `FlightEngine.fly` of the launch's problem, the served single shot (floats, the graph bound once, one
+  thread);
 - integrate: `Flyer.flight` of the launch's [1]-row state, the integrator's Flight (landing, apex, times) alone;
-- Flyer batch of one: `Flyer.fly_batch([launch]).shots()[0]`, what the engine would serve through the batch path.
+- Flyer batch of one: `Flyer.fly_batch` of the launch's problem, `.shots()[0]`, what the engine would serve through
+  the batch path.
 The ratio of each block's median to the float loop's beside it is taken, and the median of the ratios reported.
 
 python benchmarks/bench_single_path.py [--blocks 20] [--shots 200] [--results FILE]
@@ -22,7 +24,7 @@ import time
 import numpy as np
 from common import DRIVER, SEVEN_IRON, add_results_flag, write_results
 from golfflight.flight.bundle_location import model_dir
-from golfflight.flight.engine import FlightEngine, Launch
+from golfflight.flight.engine import FlightEngine, FlightProblem, Launch
 from golfflight.flight.physics import initial_state
 
 WAYS = ("float loop", "integrate", "Flyer batch of one")
@@ -32,9 +34,9 @@ def ways_to_fly(engine: FlightEngine, launch: Launch) -> dict:
     """Each way to fly `launch` as a call of no arguments."""
     start = initial_state(*(np.array([value], dtype=float) for value in launch))
     return {
-        "float loop": lambda: engine.fly(launch),
-        "integrate": lambda: engine.flyer.flight(start),
-        "Flyer batch of one": lambda: engine.flyer.fly_batch([launch]).shots()[0],
+        "float loop": lambda: engine.fly(FlightProblem.of([launch]))[0],
+        "integrate": lambda: engine.flyer.flight(FlightProblem(start)),
+        "Flyer batch of one": lambda: engine.flyer.fly_batch(FlightProblem.of([launch])).shots()[0],
     }
 
 

@@ -36,19 +36,56 @@ import numpy as np
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.ground import GroundSpec
+from golfflight.contract.flying import fly_request
+from golfflight.contract.requests import ShotRequest
+
+try:
+    from golfflight.flight.problem import FlightProblem
+except ImportError:  # before issue 58's one flight problem: launches, conditions and grounds apart
+    FlightProblem = None
 
 engine, fairway = FlightEngine(model_dir()), GroundSpec()
 shots = {"7-iron": Launch(55.0, 16.0, 0.0, 7100.0, 0.0), "driver": Launch(76.5, 10.5, 0.0, 2550.0, 0.0)}
 torch_fly = launches = None
+requests = {
+    "plain": ShotRequest(ball_speed_mph=150.0, launch_angle_deg=10.4, back_spin_rpm=2545.0),
+    "full": ShotRequest(ball_speed_mph=150.0, launch_angle_deg=10.4, back_spin_rpm=2545.0, normalized=True,
+                        trajectory={"rate_hz": 30}, wind={"speed_mps": 4.0, "from_deg": 200.0, "profile": "log"},
+                        ground={"surface": "green", "elevation_m": 3.0, "slope_deg": 2.0, "slope_dir_deg": 45.0}),
+}
+
+
+def fly_one(launch):  # one shot to rest on the fairway on the engine's single-shot path
+    if FlightProblem is None:
+        return engine.fly(launch, ground=fairway)
+    return engine.fly(FlightProblem.of([launch], grounds=fairway))[0]
+
+
+def fly_many(launches, **given):  # the engine's batch path
+    return engine.fly_batch(*([FlightProblem.of(launches, **given)] if FlightProblem else [launches]),
+                            **({} if FlightProblem else given))
+
+
+def request(name, count):  # one request through contract.flying.fly_request (ms, median of count)
+    times = []
+    for _ in range(count):
+        started = time.perf_counter()
+        fly_request(engine, requests[name])
+        times.append(time.perf_counter() - started)
+    return sorted(times)[len(times) // 2] * 1e3
 
 
 def single(name, count):
     times = []
     for _ in range(count):
         started = time.perf_counter()
-        engine.fly(shots[name], ground=fairway)
+        fly_one(shots[name])
         times.append(time.perf_counter() - started)
     return sorted(times)[len(times) // 2] * 1e3
+
+
+def torch_problem(launches):  # what the torch engine takes, before and after issue 58
+    return [FlightProblem.of(launches)] if FlightProblem else [launches]
 
 
 def torch_batch(n):
@@ -65,9 +102,9 @@ def torch_batch(n):
                              rng.uniform(2000, 8000, n), rng.normal(0, 5, n)], -1)
         backend = TorchEngine(model_dir())
         torch_fly = getattr(backend, "fly_columns", None) or backend.fly_batch  # its name before one batch method
-        torch_fly(launches[:512])
+        torch_fly(*torch_problem(launches[:512]))
     started = time.perf_counter()
-    torch_fly(launches)
+    torch_fly(*torch_problem(launches))
     return n / (time.perf_counter() - started)
 
 
@@ -79,7 +116,7 @@ mixed = [Launch(*row) for row in np.stack([rng.uniform(30, 80, 1024), rng.unifor
 
 def objects_batch(n=1024):
     started = time.perf_counter()
-    flown = engine.fly_batch(mixed[:n], grounds=fairway)
+    flown = fly_many(mixed[:n], grounds=fairway)
     if hasattr(flown, "shots"):  # one batch method, columns, since issue 44's; a list of ShotFlight before
         flown.shots()
     return (time.perf_counter() - started) * 1e3
@@ -134,12 +171,14 @@ def rollout(training):  # training's rollout of 256 mixed launches, float32, one
 
 for name in shots:
     single(name, 100)
+for name in requests:
+    request(name, 100)
 objects_batch()
 print("ready", flush=True)
 for line in sys.stdin:
     kind, *args = line.split()
     runs = {"single": lambda: single(args[0], int(args[1])), "torch": lambda: torch_batch(int(args[0])),
-            "objects": lambda: objects_batch(int(args[0])),
+            "objects": lambda: objects_batch(int(args[0])), "request": lambda: request(args[0], int(args[1])),
             "ground-one": lambda: ground_one(float(args[0]), int(args[1])),
             "ground-batch": lambda: ground_batch(float(args[0])), "rollout": lambda: rollout(args[0] == "training")}
     print(json.dumps(runs[kind]()), flush=True)
@@ -148,6 +187,8 @@ for line in sys.stdin:
 BLOCKS = {
     "single shot, 7-iron (ms, median of 50)": "single 7-iron 50",
     "single shot, driver (ms, median of 50)": "single driver 50",
+    "one request, driver, plain (fly_request, ms, median of 50)": "request plain 50",
+    "one request, normalized, sloped green, trajectory, log wind (fly_request, ms, median of 50)": "request full 50",
     "torch engine in process, 8,192 mixed shots (shots/s)": "torch 8192",
     "engine batch of 1,024 mixed shots to rest, one ShotFlight a shot (ms)": "objects 1024",
     "engine batch of 16 mixed shots to rest, one ShotFlight a shot (ms)": "objects 16",

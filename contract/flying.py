@@ -22,9 +22,10 @@ from golfflight.contract.trajectory import resample
 from golfflight.contract.trajectory_size import refuse_long_trajectories
 from golfflight.errors import FlightError
 from golfflight.flight.conditions import Conditions
-from golfflight.flight.engine import BatchFlights, FlightEngine, Launch, ShotFlight
+from golfflight.flight.engine import BatchFlights, FlightEngine, ShotFlight
 from golfflight.flight.ground import GroundSpec
 from golfflight.flight.per_shot import PerShot
+from golfflight.flight.problem import LAUNCH_WIDTH, FlightProblem
 from golfflight.flight.wind import CALM
 
 
@@ -82,22 +83,16 @@ def result_of(
 def fly_request(
     engine: FlightEngine, shot: ShotRequest, *, keep_states: bool = False, putt: bool = False, flat: bool = True
 ) -> tuple[ShotResult, ShotFlight]:
-    """One request on the engine's single-shot path (`FlightEngine.fly`: the shot, its normalized replay, its flat
-    flight): its result and the flight it was read from (its states through the ground phase to rest when
-    `keep_states`, for a renderer: the numbers and the picture of one flight). A `putt` rolls on the shot's ground
-    from the start (`FlightEngine.putt`: no flight, so no normalized or flat flight); `flat` False leaves the flat
-    flight out (a GSPro reply has no field for it). FlightError if it cannot land."""
-    launch, ground = launch_of(shot), ground_of(shot.ground)
-    keep = keep_states or shot.trajectory is not None
+    """One request on the engine's single-shot path (`FlightEngine.fly` of its one problem, `batch_of`: the shot, its
+    normalized replay, its flat flight): its result and the flight it was read from (its states through the ground
+    phase to rest when `keep_states`, for a renderer: the numbers and the picture of one flight). A `putt` rolls on
+    the shot's ground from the start (`FlightEngine.putt`: no flight, so no normalized or flat flight); `flat` False
+    leaves the flat flight out (a GSPro reply has no field for it). FlightError if it cannot land."""
     if putt:
-        flight = engine.putt(launch, ground, keep)
+        flight = engine.putt(launch_of(shot), ground_of(shot.ground), keep_states or shot.trajectory is not None)
         return result_of(shot, flight), flight
-    flight = engine.fly(launch, conditions_of(shot), keep, ground)
-    reference = reference_of(shot)
-    normalized = None
-    if reference is not None:
-        normalized = engine.fly(launch, Conditions(air_of(reference), CALM), shot.trajectory is not None, ground)
-    flat_flight = engine.fly(launch, conditions_of(shot)) if flat and lands_off_the_flat(shot) else None
+    batch = batch_of([shot], keep_states, flat)
+    flight, normalized, flat_flight = batch.read(engine.fly(batch.problem))[0]
     if shot.trajectory is not None:
         refuse_long_trajectories([(shot.trajectory, own.states) for own in (flight, normalized) if own is not None])
     return result_of(shot, flight, normalized, flat_flight), flight
@@ -105,31 +100,63 @@ def fly_request(
 
 @dataclass(frozen=True)
 class Batch:
-    """One engine batch for `n` shots: their launches, conditions and grounds, then those of their normalized
-    replays and of their flat flights appended; `replays` and `flats` say which shots those are, in the order
-    appended. Made from requests (`batch_of`) or from a sweep's columns (`sweep.rows`); its flights go back into
-    results (`fly_requests`) or columns (`columns_of`)."""
+    """One engine problem for `n` shots: their own flights, then their normalized replays' and their flat flights'
+    appended; `replays` and `flats` say which shots those are, in the order appended. Made from requests
+    (`batch_of`) or from a sweep's columns (`sweep.rows`), each through `of`; its flights go back by `read` (each
+    shot's own, replay and flat flight) or into columns (`columns_of`)."""
 
-    launches: list[Launch] | np.ndarray
-    conditions: list[Conditions] | PerShot
-    grounds: list[GroundSpec | None] | PerShot
+    problem: FlightProblem
     n: int
     replays: np.ndarray
     flats: np.ndarray
 
+    @classmethod
+    def of(
+        cls,
+        launches: np.ndarray,
+        conditions: PerShot[Conditions],
+        grounds: PerShot[GroundSpec | None],
+        replays: PerShot[Conditions | None],
+        flats: np.ndarray,
+        keep: np.ndarray | bool = False,
+    ) -> Batch:
+        """The batch of n shots' launches [n, LAUNCH_WIDTH], conditions and grounds: each shot whose `replays` entry
+        is a reference's conditions replayed in them on its ground, each of `flats` flown alone to z = 0; `keep`
+        (one flag, or [own flags n, replay flags]) says whose states are kept, never a flat flight's."""
+        n = len(launches)
+        replayed = np.flatnonzero(replays.column(lambda c: c is not None, bool))
+        flats = np.asarray(flats, dtype=np.intp)
+        keep = np.broadcast_to(np.asarray(keep, dtype=bool), (n + len(replayed),))
+        problem = FlightProblem.of(
+            launches[np.concatenate([np.arange(n), replayed, flats])],
+            conditions.plus(replays.take(replayed), conditions.take(flats)),
+            grounds.plus(grounds.take(replayed), PerShot([None], np.zeros(len(flats), dtype=np.intp))),
+            np.concatenate([keep, np.zeros(len(flats), dtype=bool)]),
+        )
+        return cls(problem, n, replayed, flats)
 
-def batch_of(shots: list[ShotRequest]) -> Batch:
-    """The engine batch of `shots` (`Batch`)."""
-    launches = [launch_of(shot) for shot in shots]
-    conditions = [conditions_of(shot) for shot in shots]
-    grounds: list[GroundSpec | None] = [ground_of(shot.ground) for shot in shots]
-    replays = [i for i, shot in enumerate(shots) if reference_of(shot) is not None]
-    flats = [i for i, shot in enumerate(shots) if lands_off_the_flat(shot)]
-    launches += [launches[i] for i in replays + flats]
-    conditions += [Conditions(air_of(reference_of(shots[i])), CALM) for i in replays] + [conditions[i] for i in flats]
-    grounds += [grounds[i] for i in replays] + [None] * len(flats)
-    return Batch(launches, conditions, grounds, len(shots), np.array(replays, dtype=np.intp),
-                 np.array(flats, dtype=np.intp))
+    def read(self, flights: list) -> list[tuple]:
+        """Each shot's (own, normalized replay or None, flat or None) of the problem's flights, in order (a flight is
+        a ShotFlight, or a FlightError from a batch)."""
+        n, replays = self.n, len(self.replays)
+        replayed = dict(zip(self.replays.tolist(), flights[n : n + replays], strict=True))
+        flat = dict(zip(self.flats.tolist(), flights[n + replays :], strict=True))
+        return [(flights[i], replayed.get(i), flat.get(i)) for i in range(n)]
+
+
+def batch_of(shots: list[ShotRequest], keep: bool = False, flat: bool = True) -> Batch:
+    """The engine batch of `shots` (`Batch`), each request read once: its own states kept where `keep` or it asks
+    for a trajectory, its replay's where it asks for one; flat flights of shots off the flat unless `flat` is False."""
+    n = len(shots)
+    launches = np.array([launch_of(shot) for shot in shots], dtype=float).reshape(n, LAUNCH_WIDTH)
+    conditions = PerShot([conditions_of(shot) for shot in shots], np.arange(n))
+    grounds = PerShot([ground_of(shot.ground) for shot in shots], np.arange(n))
+    references = [reference_of(shot) for shot in shots]
+    replays = PerShot([None if r is None else Conditions(air_of(r), CALM) for r in references], np.arange(n))
+    flats = [i for i, shot in enumerate(shots) if flat and lands_off_the_flat(shot)]
+    traced = [shot.trajectory is not None for shot in shots]
+    keep_rows = [keep or t for t in traced] + [t for t, r in zip(traced, references, strict=True) if r is not None]
+    return Batch.of(launches, conditions, grounds, replays, np.array(flats, dtype=np.intp), np.array(keep_rows, bool))
 
 
 def _fly_group(
@@ -137,21 +164,17 @@ def _fly_group(
 ) -> tuple[list[ShotResult | ShotFailure], list[ShotFlight | FlightError]]:
     """One engine batch for `shots`, their normalized replays and their flat flights; results in order, and each
     shot's own flight."""
-    batch = batch_of(shots)
-    flights = engine.fly_batch(batch.launches, batch.conditions, batch.grounds, keep).shots()
-    replays, flats = batch.replays.tolist(), batch.flats.tolist()
-    replayed = dict(zip(replays, flights[len(shots) : len(shots) + len(replays)], strict=True))
-    flat = dict(zip(flats, flights[len(shots) + len(replays) :], strict=True))
+    batch = batch_of(shots, keep)
+    flights = batch.read(engine.fly_batch(batch.problem).shots())
     refuse_long_trajectories([
-        (shot.trajectory, own.states) for i, shot in enumerate(shots) if shot.trajectory is not None
-        for own in (flights[i], replayed.get(i)) if isinstance(own, ShotFlight)
+        (shot.trajectory, own.states) for shot, shot_flights in zip(shots, flights, strict=True)
+        if shot.trajectory is not None for own in shot_flights[:2] if isinstance(own, ShotFlight)
     ])
     results: list[ShotResult | ShotFailure] = []
-    for i, shot in enumerate(shots):
-        own = (flights[i], replayed.get(i), flat.get(i))
+    for shot, own in zip(shots, flights, strict=True):
         failure = next((f for f in own if isinstance(f, FlightError)), None)
         results.append(ShotFailure(error=str(failure)) if failure else result_of(shot, *own))
-    return results, flights[: len(shots)]
+    return results, [own[0] for own in flights]
 
 
 @dataclass(frozen=True)
@@ -193,7 +216,7 @@ def columns_of(flights: BatchFlights, batch: Batch) -> ShotColumns:
             full = np.zeros(n, dtype=column.dtype)
             full[own] = column
             values[prefix + name], present[prefix + name] = full, mask
-    conditions = PerShot.of(batch.conditions, len(owner), "conditions").take(np.arange(n))
+    conditions = batch.problem.air.take(np.arange(n))
     values[AIR_DENSITY], present[AIR_DENSITY] = conditions.column(lambda c: c.air.density_kg_m3), np.ones(n, bool)
     return ShotColumns(values, present, errors)
 

@@ -8,8 +8,8 @@ from golfflight.contract.requests import AirRequest, GroundRequest, ReferenceAir
 from golfflight.flight.air import Air
 from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.constants import FOOT_M, MPH_TO_MPS
-from golfflight.flight.flyer import Launch
 from golfflight.flight.ground import LEVEL_FAIRWAY, GroundSpec, surface
+from golfflight.flight.problem import Launch
 from golfflight.flight.wind import CALM, Wind
 
 

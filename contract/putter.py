@@ -7,7 +7,7 @@ the numbers' sources).
 from __future__ import annotations
 
 from golfflight.flight.constants import MPH_TO_MPS
-from golfflight.flight.flyer import Launch
+from golfflight.flight.problem import Launch
 
 PUTT_MAX_SPEED_MPH = 30.0
 """The fastest ball rolled as a putt: on the slowest green the bay takes (stimp 4) 30 mph rolls about as far as the

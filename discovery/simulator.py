@@ -12,10 +12,12 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 from golfflight.discovery.form_terms import formed_flyer
+from golfflight.flight.conditions import BatchAir
 from golfflight.flight.field import WeightedCorrection
 from golfflight.flight.flyer import Flyer
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import initial_state
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.wind import Wind
 
 CHUNK_SHOTS = 25_000
@@ -136,9 +138,9 @@ def setup_flight(
     if setup.form_weights is not None:
         flyer = formed_flyer(flyer, setup.form_weights)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        return flyer.flight(initial_state(**setup.launch), density, setup.viscosity(flyer.kinematic_viscosity_m2_s),
-                            wind, setup.ground_height_m, keep_states, coefficient_scale=setup.coefficient_scale,
-                            correction=extra)
+        air_columns = BatchAir(density, setup.viscosity(flyer.kinematic_viscosity_m2_s), wind)
+        return flyer.flight(FlightProblem(initial_state(**setup.launch), air_columns, setup.ground_height_m,
+                                          setup.coefficient_scale, extra, keep_states))
 
 
 def simulate_setup(

@@ -11,9 +11,10 @@ import numpy as np
 from golfflight.flight import flyer as core
 from golfflight.flight.air import Air
 from golfflight.flight.coefficients import FERGUSON_2022, QuadraticSpinRatio
-from golfflight.flight.conditions import STANDARD
+from golfflight.flight.conditions import STANDARD, BatchAir
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import CoefficientModel, initial_state
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.wind import CALM, Wind
 
 STANDARD_DENSITY_KG_M3 = 1.225
@@ -59,8 +60,8 @@ class EvaluatedModel:
     ) -> Flight:
         """Fly launches (the canonical launch columns, arrays) in `air` (default: the flyer's own) and `wind`."""
         density, viscosity = (None, None) if air is None else (air.density_kg_m3, air.kinematic_viscosity_m2_s)
-        return self.flyer.flight(initial_state(**launch), density, viscosity, wind, ground_height_m, keep_states,
-                                 t_max_s)
+        return self.flyer.flight(FlightProblem(initial_state(**launch), BatchAir(density, viscosity, wind),
+                                               ground_height_m, keep_states=keep_states, max_time_s=t_max_s))
 
 
 class ModelFlyer(EvaluatedModel):

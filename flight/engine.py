@@ -1,6 +1,7 @@
 """The served engine: a bundle's `flight.flyer.Flyer` and its single-shot latency twin.
 
-A batch is the Flyer's (`fly_batch`: NumPy [N] arrays through `flight.integrator`). One shot runs on
+Both take a `flight.problem.FlightProblem`. A batch is the Flyer's (`fly_batch`: NumPy [N] arrays through
+`flight.integrator`). A single shot (`fly`: each shot of a small problem in turn) runs on
 plain Python floats with the network's inputs and output bound once to preallocated float32 buffers (IOBinding, one
 thread): per-call overheads, not arithmetic, decide single-shot latency (docs/benchmarks.md). It is the same forward
 Euler at the Flyer's step, fed v_rel and omega times the air's Reynolds scale, landing and peaking by the batch's
@@ -16,25 +17,18 @@ import math
 import os
 import threading
 import time
-from collections.abc import Sequence
 
 import numpy as np
 from golfflight.errors import FlightError, InputError
 from golfflight.flight.bundle_check import open_session, session_options
-from golfflight.flight.conditions import STANDARD, Conditions
-from golfflight.flight.flyer import (
-    BATCH_THREADS,
-    MAX_FLIGHT_TIME_S,
-    NON_FINITE,
-    Flyer,
-    Launch,
-    air_inputs,
-    load_flyer,
-)
+from golfflight.flight.conditions import Conditions, air_inputs
+from golfflight.flight.flyer import BATCH_THREADS, MAX_FLIGHT_TIME_S, NON_FINITE, Flyer, load_flyer
 from golfflight.flight.ground import GroundSpec, ground_phase_one, putt_phase
 from golfflight.flight.events import came_down, crossing_fraction, parabola_apex, rose_above
 from golfflight.flight.outcomes import BatchFlights, EulerStates, Rest, ShotFlight, landing_figures
-from golfflight.flight.physics import euler_step, initial_state, reynolds_scale
+from golfflight.flight.per_shot import PerShot
+from golfflight.flight.physics import State, euler_step, reynolds_scale
+from golfflight.flight.problem import FlightProblem, Launch
 from golfflight.flight.wind import log_profile_factor
 from golfflight.weights_schema.model_card import ModelCard
 
@@ -44,6 +38,7 @@ __all__ = [
     "BatchFlights",
     "EulerStates",
     "FlightEngine",
+    "FlightProblem",
     "Launch",
     "Rest",
     "ShotFlight",
@@ -85,8 +80,8 @@ class FlightEngine:
             list(self._coefficients_out.shape),
             self._coefficients_out.ctypes.data,
         )
-        self.fly(Launch(60.0, 12.0, 0.0, 3000.0, 0.0))  # first runs allocate inside ORT: keep them off the clock
-        self.fly_batch([Launch(60.0, 12.0, 0.0, 3000.0, 0.0)] * 8)
+        self.fly(FlightProblem.of([Launch(60.0, 12.0, 0.0, 3000.0, 0.0)]))  # first runs allocate inside ORT
+        self.fly_batch(FlightProblem.of([Launch(60.0, 12.0, 0.0, 3000.0, 0.0)] * 8))
         self.load_seconds = time.perf_counter() - started
 
     @property
@@ -120,21 +115,24 @@ class FlightEngine:
         """SHA-256 of the ONNX graph (checked against the card at load)."""
         return self.card.onnx.sha256
 
-    def fly(
-        self,
-        launch: Launch,
-        conditions: Conditions = STANDARD,
-        keep_states: bool = False,
-        ground: GroundSpec | None = None,
+    def fly(self, problem: FlightProblem) -> list[ShotFlight]:
+        """Each shot of `problem` on Python floats, down to its ground and rolled to rest there on floats too
+        (`flight.ground.ground_phase_one`, which records the ground's path too where states are kept); a shot with
+        no GroundSpec: the flight alone, down to z = 0 (InputError for what only a batch flies: `_check_single`).
+        Raises FlightError for the first shot that has not landed by the Flyer's maximum flight time (or, from a
+        broken model, any number of whose flight is not finite)."""
+        _check_single(problem)
+        grounds = problem.ground_specs
+        return [self._fly_one(problem.start, shot, problem.air[shot], problem.keeps(shot), grounds[shot])
+                for shot in range(len(problem))]
+
+    def _fly_one(
+        self, start: State, shot: int, conditions: Conditions, keep_states: bool, ground: GroundSpec | None
     ) -> ShotFlight:
-        """Fly one shot on Python floats down to its ground and roll it to rest there on floats too
-        (`flight.ground.ground_phase_one`, which records the ground's path too when states are kept); ground
-        None: the flight alone, down to z = 0. Raises FlightError if it has not landed by the Flyer's maximum flight
-        time (or, from a broken model, if any number of its flight is not finite)."""
-        start = initial_state(*(np.array([value], dtype=float) for value in launch))
-        x, y, z = start.position[0].tolist()
-        vx, vy, vz = start.velocity[0].tolist()
-        wx, wy, wz = start.spin[0].tolist()
+        """Shot `shot` of a start state flown on floats (`fly`)."""
+        x, y, z = start.position[shot].tolist()
+        vx, vy, vz = start.velocity[shot].tolist()
+        wx, wy, wz = start.spin[shot].tolist()
         air = air_inputs(conditions)
         density, wind_x, wind_y, log_wind = air.density_kg_m3, air.wind_x_mps, air.wind_y_mps, air.log_profile
         reference_height, roughness = air.reference_height_m, air.roughness_m
@@ -211,13 +209,22 @@ class FlightEngine:
             landing_spin_rpm=launch.spin_rpm, states=states, rest=Rest.at(x, y, 0.0, 0, rolled.time_s),
         )
 
-    def fly_batch(
-        self,
-        launches: Sequence[Launch] | np.ndarray,
-        conditions: Sequence[Conditions] | Conditions = STANDARD,
-        grounds: Sequence[GroundSpec | None] | GroundSpec | None = None,
-        keep_states: bool = False,
-    ) -> BatchFlights:
+    def fly_batch(self, problem: FlightProblem) -> BatchFlights:
         """Many shots through the Flyer (`Flyer.fly_batch`): their figures, rests and errors as columns (one
         ShotFlight or FlightError a shot, in order, from `.shots()`)."""
-        return self.flyer.fly_batch(launches, conditions, grounds, keep_states)
+        return self.flyer.fly_batch(problem)
+
+
+def _check_single(problem: FlightProblem) -> None:
+    """InputError unless the single shot can fly `problem`: one Conditions a shot and its grounds as GroundSpecs,
+    no coefficient scales, extra acceleration or time of its own (a batch, `fly_batch`, flies those)."""
+    batch_only = {
+        "air as columns": not isinstance(problem.air, PerShot),
+        "grounds as heights": not isinstance(problem.grounds, PerShot),
+        "coefficient_scale": problem.coefficient_scale is not None,
+        "correction": problem.correction is not None,
+        "max_time_s": problem.max_time_s is not None,
+    }
+    given = [name for name, present in batch_only.items() if present]
+    if given:
+        raise InputError(f"problem: the single shot does not fly {', '.join(given)}; fly_batch does")

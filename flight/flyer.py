@@ -3,10 +3,10 @@
 `load_flyer` is the only code that finds and assembles a model bundle: the lookup (`flight.bundle_location`), the
 card's step, maximum flight time (its t_sim, or the shot records' limit if longer), air and ball, checked against
 `flight.constants`. A Flyer puts its model in a given air (`in_air`: the graph fed at that air's Reynolds scale).
-`Flyer.flight` is the one batch flight: a state through `flight.integrator.integrate` in given air and wind, down to
-ground planes. `fly_batch` plans launches [N, LAUNCH_WIDTH] x conditions x grounds into it: each shot down to its
+`Flyer.flight` is the one batch flight: a `flight.problem.FlightProblem` through `flight.integrator.integrate`, down
+to its ground planes. `fly_batch` (the `flight.problem.Engine` protocol) adds the rest: each shot down to its
 ground's plane (the state interpolated linearly to it), failing alone if it is still in the air at the maximum
-flight time, then bounced and rolled to rest on that ground (`flight.ground`) unless the flight alone was asked for.
+flight time, then bounced and rolled to rest on its ground (`flight.ground`) where the problem gives one.
 The engine's batches (`flight.engine`), discovery, accuracy, evaluation, the reference world and the ground fit all
 fly through it, so every one of them flies the same shot to the same numbers.
 """
@@ -15,15 +15,14 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
-from functools import lru_cache, partial
+from collections.abc import Callable
+from dataclasses import replace
+from functools import partial
 from pathlib import Path
 from typing import NamedTuple, Protocol
 
 import numpy as np
 from golfflight.flight.bundle_location import model_dir
-from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.constants import BALL_MASS_KG, BALL_RADIUS_M
 from golfflight.flight.field import BallInAir, ScaledCoefficients
 from golfflight.flight.ground import GroundPhase, GroundSpec, batch_surface, elevations, ground_phase
@@ -38,8 +37,8 @@ from golfflight.flight.outcomes import (
     landing_figures,
 )
 from golfflight.flight.per_shot import PerShot
-from golfflight.flight.physics import CoefficientModel, ExtraAcceleration, State, initial_state
-from golfflight.flight.wind import CALM, Wind
+from golfflight.flight.physics import CoefficientModel
+from golfflight.flight.problem import FlightProblem
 from golfflight.weights_schema.bundle import CARD_FILE, BundleError
 from golfflight.weights_schema.model_card import ModelCard
 
@@ -55,57 +54,12 @@ about 1.5x from a second thread, so pass batch_threads=2 where the cores are the
 NON_FINITE = "the model gave a non-finite flight for this launch"
 
 
-class Launch(NamedTuple):
-    """Launch-monitor values of one shot, SI (paper eq. 12's inputs)."""
-
-    ball_speed_mps: float
-    launch_angle_deg: float
-    launch_direction_deg: float
-    spin_rpm: float
-    spin_axis_deg: float
-
-
-LAUNCH_WIDTH = len(Launch._fields)
-"""The width of a launches array [N, LAUNCH_WIDTH], its columns in Launch's order (`shots.records.LAUNCH_COLUMNS`
-and `contract.columns.LAUNCH_COLUMNS` name the columns of files)."""
-
-
 class ModelInAir(Protocol):
     """A coefficient model that can be put in air of another kinematic viscosity (its Reynolds numbers)."""
 
     def __call__(self, v_rel: np.ndarray, omega: np.ndarray) -> np.ndarray: ...
 
     def in_air(self, kinematic_viscosity_m2_s: float | np.ndarray) -> CoefficientModel: ...
-
-
-@dataclass(frozen=True)
-class AirInputs:
-    """What the equations need of a shot's conditions: density, the wind at its reference height, whether it follows
-    the log profile (and the profile's reference height and roughness), and the kinematic viscosity."""
-
-    density_kg_m3: float
-    wind_x_mps: float
-    wind_y_mps: float
-    log_profile: bool
-    reference_height_m: float
-    roughness_m: float
-    kinematic_viscosity_m2_s: float
-
-
-@lru_cache(maxsize=1024)
-def air_inputs(conditions: Conditions) -> AirInputs:
-    """The AirInputs of a shot's conditions; cached because a batch or a stream of shots mostly shares a few."""
-    wind_x, wind_y = conditions.wind_at_reference_mps
-    wind, air = conditions.wind, conditions.air
-    return AirInputs(
-        density_kg_m3=air.density_kg_m3,
-        wind_x_mps=wind_x,
-        wind_y_mps=wind_y,
-        log_profile=wind.profile == "log" and (wind_x != 0.0 or wind_y != 0.0),
-        reference_height_m=wind.reference_height_m,
-        roughness_m=wind.roughness_m,
-        kinematic_viscosity_m2_s=air.kinematic_viscosity_m2_s,
-    )
 
 
 def step_count(max_time_s: float, dt_s: float) -> int:
@@ -161,30 +115,20 @@ class Flyer:
         viscosity = self.kinematic_viscosity_m2_s if kinematic_viscosity_m2_s is None else kinematic_viscosity_m2_s
         return self.model.in_air(viscosity)
 
-    def flight(
-        self,
-        state: State,
-        density_kg_m3: float | np.ndarray | None = None,
-        kinematic_viscosity_m2_s: float | np.ndarray | None = None,
-        wind: Wind = CALM,
-        ground_height_m: float | np.ndarray = 0.0,
-        keep_states: bool = False,
-        max_time_s: float | None = None,
-        coefficient_scale: np.ndarray | None = None,
-        correction: ExtraAcceleration | None = None,
-    ) -> Flight:
-        """THE batch flight: the integrator's Flight from `state` in this air (None: the nominal) and wind down to
-        ground planes, for the maximum flight time (or `max_time_s`, for a caller that compares states at fixed
-        times); the coefficients times `coefficient_scale` [N,3] and an extra acceleration where given (discovery's
-        effects and corrections). `fly_batch` plans launches and conditions into this call."""
-        density = self.density_kg_m3 if density_kg_m3 is None else density_kg_m3
-        model = self.in_air(kinematic_viscosity_m2_s)
-        if coefficient_scale is not None:
-            model = ScaledCoefficients(model, coefficient_scale)
-        field = BallInAir(model, density, wind, correction)
-        steps = self.max_steps if max_time_s is None else step_count(max_time_s, self.dt_s)
-        event = GroundPlane(np.asarray(ground_height_m, dtype=float))
-        return integrate(state, field, self.dt_s, steps, self.rule, event, record_for(keep_states))
+    def flight(self, problem: FlightProblem) -> Flight:
+        """THE batch flight: the integrator's Flight of `problem`'s balls in their air (None: this Flyer's nominal)
+        and wind down to their ground planes, for the maximum flight time or the problem's `max_time_s` (a caller that
+        compares states at fixed times), its coefficients times the problem's scales and its extra acceleration where
+        given (discovery's effects and corrections); no ground phase (`fly_batch` adds it)."""
+        air = problem.columns
+        density = self.density_kg_m3 if air.density_kg_m3 is None else air.density_kg_m3
+        model = self.in_air(air.kinematic_viscosity_m2_s)
+        if problem.coefficient_scale is not None:
+            model = ScaledCoefficients(model, problem.coefficient_scale)
+        field = BallInAir(model, density, air.wind, problem.correction)
+        steps = self.max_steps if problem.max_time_s is None else step_count(problem.max_time_s, self.dt_s)
+        event = GroundPlane(np.asarray(problem.heights, dtype=float))
+        return integrate(problem.start, field, self.dt_s, steps, self.rule, event, record_for(problem.keeps()))
 
     def unlanded_message(self, apex_m: float, height_m: float) -> str:
         """Why a shot never came down through its ground's plane: it never rose above it, or it was still in the air
@@ -193,19 +137,12 @@ class Flyer:
             return f"the ball never rose to its landing ground: apex {apex_m:.1f} m, ground.elevation_m {height_m:g} m"
         return f"the ball was still in the air after {self.max_steps * self.dt_s:g} s (the simulation cap)"
 
-    def fly_batch(
-        self,
-        launches: Sequence[Launch] | np.ndarray,
-        conditions: Sequence[Conditions] | Conditions = STANDARD,
-        grounds: Sequence[GroundSpec | None] | GroundSpec | None = None,
-        keep_states: bool = False,
-    ) -> BatchFlights:
-        """Shots (launches an [N, LAUNCH_WIDTH] array or a sequence of Launch), each in its conditions, down to its
-        ground and rolled to rest there (grounds None: the flights alone, down to z = 0), as columns; a shot that has
-        not landed by the maximum flight time, or whose flight is not finite, fails (`errors`). With `keep_states`,
-        each shot's states through its bounces and roll (`BatchFlights.states`). `.shots()` gives one ShotFlight a
-        shot."""
-        columns, flight, phase = self._fly(launches, conditions, keep_states, grounds)
+    def fly_batch(self, problem: FlightProblem) -> BatchFlights:
+        """`problem`'s shots down to their grounds and rolled to rest there (a shot with no GroundSpec: the flight
+        alone), as columns; a shot that has not landed by the maximum flight time, or whose flight is not finite,
+        fails (`errors`). Where states are kept, each shot's through its bounces and roll (`BatchFlights.states`).
+        `.shots()` gives one ShotFlight a shot."""
+        columns, flight, phase = self._fly(problem)
         if flight.states is None:
             return columns
         history = (np.stack([s.position for s in flight.states]), np.stack([s.velocity for s in flight.states]))
@@ -213,7 +150,7 @@ class Flyer:
         states: list[EulerStates | None] = [None] * len(columns.rolled)
         errors = dict(columns.errors)
         for i in range(len(states)):
-            if i in errors:
+            if i in errors or not problem.keeps(i):
                 continue
             kept = self._shot_states(history, flight, i)
             if columns.rolled[i]:
@@ -224,23 +161,11 @@ class Flyer:
                 errors[i] = NON_FINITE
         return replace(columns, states=states, errors=errors)
 
-    def _fly(
-        self,
-        launches: Sequence[Launch] | np.ndarray,
-        conditions: Sequence[Conditions] | Conditions,
-        keep_states: bool,
-        grounds: Sequence[GroundSpec | None] | GroundSpec | None,
-    ) -> _FlownBatch:
+    def _fly(self, problem: FlightProblem) -> _FlownBatch:
         """The batch flight behind `fly_batch`."""
-        n = len(launches)
-        per_shot = PerShot.of(conditions, n, "conditions")
-        shot_grounds = PerShot.of(grounds, n, "grounds")
-        heights = elevations(shot_grounds)
-        start = initial_state(*np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH).T)
-        air = batch_air(per_shot)
-        flight = self.flight(start, air.density_kg_m3, air.kinematic_viscosity_m2_s, air.wind, heights, keep_states)
-        roll = partial(ground_phase, keep_path=keep_states)
-        columns, phase = landed_columns(flight, shot_grounds, self.unlanded_message, roll)
+        flight = self.flight(problem)
+        roll = partial(ground_phase, keep_path=problem.keeps())
+        columns, phase = landed_columns(flight, problem.ground_specs, self.unlanded_message, roll)
         return _FlownBatch(columns, flight, phase)
 
     def _shot_states(self, history: tuple[np.ndarray, np.ndarray], flight: Flight, shot: int) -> EulerStates:
@@ -250,28 +175,6 @@ class Flyer:
         return EulerStates.to_landing(history[0][: last + 1, shot], history[1][: last + 1, shot],
                                       flight.landing_position[shot], flight.landing_velocity[shot], self.dt_s,
                                       flight.flight_time_s[shot])
-
-
-class BatchAir(NamedTuple):
-    """A batch's air as the equations take it: density and kinematic viscosity [N], the wind of every shot."""
-
-    density_kg_m3: np.ndarray
-    kinematic_viscosity_m2_s: np.ndarray
-    wind: Wind
-
-
-def batch_air(per_shot: PerShot[Conditions]) -> BatchAir:
-    """Each shot's air and wind as [N] columns, read once for each distinct conditions (`air_inputs`)."""
-    inputs = PerShot([air_inputs(c) for c in per_shot.objects], per_shot.index)
-    wind = Wind(
-        per_shot.column(lambda c: c.wind.speed_mps),
-        per_shot.column(lambda c: c.wind.from_deg),
-        per_shot.column(lambda c: c.wind.profile, None),
-        inputs.column(lambda a: a.reference_height_m),
-        inputs.column(lambda a: a.roughness_m),
-    )
-    return BatchAir(inputs.column(lambda a: a.density_kg_m3), inputs.column(lambda a: a.kinematic_viscosity_m2_s),
-                    wind)
 
 
 Roll = Callable[..., GroundPhase]

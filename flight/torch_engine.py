@@ -6,7 +6,7 @@ The coefficient network is the bundle's ONNX graph run by torch (`flight.torch_n
 on the bundle checker's probes), in float32 as the graph runs; the flight is the flight core's own, on the device's
 tensors: the equations (`flight.physics`), the vector field (`flight.field.BallInAir`), forward Euler and the
 integrator (`flight.integrator.integrate`: its landing interpolated into the crossing step, its apex's parabola), in
-float32 or float64. What the engine takes, this takes: every shot's air (`flight.flyer.batch_air`: density, and its
+float32 or float64. What the engine takes, this takes: every shot's air (`flight.conditions.batch_air`: density, and its
 kinematic viscosity as the Reynolds scale of the network's inputs), its wind (uniform, or the log profile at the
 ball's height each step) and its ground's elevation, down to the engine's maximum flight time. A part's shots fly
 together; every LANDING_CHECK_STEPS steps those that have come down are set aside once they are SET_ASIDE_SHARE of
@@ -37,16 +37,16 @@ from functools import partial
 import numpy as np
 import torch
 from golfflight.errors import InputError
-from golfflight.flight.conditions import STANDARD, Conditions
+from golfflight.flight.conditions import BatchAir
 from golfflight.flight.devices import keep_freed_memory, resolve_device
 from golfflight.flight.field import BallInAir
-from golfflight.flight.flyer import LAUNCH_WIDTH, BatchAir, Launch, batch_air, landed_columns, load_flyer
-from golfflight.flight.ground import GroundPhase, GroundSpec, Surface, elevations, ground_phase
+from golfflight.flight.flyer import landed_columns, load_flyer
+from golfflight.flight.ground import GroundPhase, Surface, ground_phase
 from golfflight.flight.ground.phase import plane_normals, roll_to_rest
 from golfflight.flight.integrator import GroundPlane, SetAside, SummaryRecord, integrate
 from golfflight.flight.outcomes import BatchFlights, Flight
-from golfflight.flight.per_shot import PerShot
-from golfflight.flight.physics import State, initial_state, reynolds_scale
+from golfflight.flight.physics import State, reynolds_scale
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.rollout import LANDING_CHECK_STEPS, InAir, step_rule
 from golfflight.flight.torch_network import network_from_bundle
 
@@ -123,33 +123,22 @@ class TorchEngine:
         free += torch.cuda.memory_reserved(self.device) - torch.cuda.memory_allocated(self.device)  # torch's own cache
         return max(1024, int(free * DEVICE_MEMORY_SHARE / self.parts_at_once / BYTES_PER_SHOT))
 
-    def fly_batch(
-        self,
-        launches: Sequence[Launch] | np.ndarray,
-        conditions: Sequence[Conditions] | Conditions = STANDARD,
-        grounds: Sequence[GroundSpec | None] | GroundSpec | None = None,
-        keep_states: bool = False,
-    ) -> BatchFlights:
-        """Shots (an [N, LAUNCH_WIDTH] array or Launches), each in its conditions, down to its ground and rolled to
-        rest there (grounds None: down to z = 0, the flight alone), as `FlightEngine.fly_batch` gives them, without
-        states (InputError for `keep_states`: the sweep's engine keeps none). One Conditions or GroundSpec for every
-        shot is spread without a Python step a shot (a benchmark's millions)."""
-        if keep_states:
-            raise InputError("keep_states: the torch engine keeps no states (FlightEngine.fly_batch does)")
-        n = len(launches)
-        if n == 0:
-            raise InputError("no shots to fly")
-        per_shot, shot_grounds = PerShot.of(conditions, n, "conditions"), PerShot.of(grounds, n, "grounds")
+    def fly_batch(self, problem: FlightProblem) -> BatchFlights:
+        """`problem`'s shots down to their grounds and rolled to rest there (a shot with no GroundSpec: down to its
+        plane, the flight alone), as `FlightEngine.fly_batch` gives them, without states (InputError for what this
+        engine does not fly: `_check_torch`). One Conditions or GroundSpec for every shot is spread without a Python
+        step a shot (a benchmark's millions)."""
+        _check_torch(problem)
+        n = len(problem)
         started = time.perf_counter()
-        start = initial_state(*np.asarray(launches, dtype=float).reshape(n, LAUNCH_WIDTH).T)
-        air, heights = batch_air(per_shot), elevations(shot_grounds)
+        air, heights = problem.columns, np.zeros(n) + problem.heights  # [N], writable
         prepared = self._spent("prepare", started)
         size = self.part_shots()
-        parts = [self._fly_part(start.take(rows), air, heights, rows)
+        parts = [self._fly_part(problem.start.take(rows), air, heights, rows)
                  for rows in (slice(first, min(first + size, n)) for first in range(0, n, size))]
         flight = Flight(*(np.concatenate([getattr(part, name) for part in parts]) for name in LANDING_FIELDS))
         flown = self._spent("flight", prepared)
-        columns = landed_columns(flight, shot_grounds, self.flyer.unlanded_message, self._roll())[0]
+        columns = landed_columns(flight, problem.ground_specs, self.flyer.unlanded_message, self._roll())[0]
         self._spent("ground", flown)
         return columns
 
@@ -195,6 +184,24 @@ class TorchEngine:
                            GroundPlane(tensor(heights[rows])), self.record)
         return Flight(*(getattr(flight, name).to(device="cpu", dtype=torch.float64 if name != "landed" else None)
                         .numpy() for name in LANDING_FIELDS))
+
+
+def _check_torch(problem: FlightProblem) -> None:
+    """InputError for a problem this engine does not fly: no shots, kept states (the sweep's engine keeps none),
+    coefficient scales, an extra acceleration, a time of its own, or air without a density and viscosity a shot."""
+    if len(problem) == 0:
+        raise InputError("no shots to fly")
+    air = problem.columns
+    unflown = {
+        "keep_states": problem.keeps(),
+        "coefficient_scale": problem.coefficient_scale is not None,
+        "correction": problem.correction is not None,
+        "max_time_s": problem.max_time_s is not None,
+        "nominal air (density or viscosity None)": air.density_kg_m3 is None or air.kinematic_viscosity_m2_s is None,
+    }
+    given = [name for name, present in unflown.items() if present]
+    if given:
+        raise InputError(f"problem: the torch engine does not fly {', '.join(given)} (FlightEngine.fly_batch does)")
 
 
 @dataclass(frozen=True)

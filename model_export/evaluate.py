@@ -20,9 +20,11 @@ from golfflight.evaluation.noise_floor import Floor, noise_floors, nominal_condi
 from golfflight.evaluation.report import metres_yards
 from golfflight.evaluation.validation import Errors, Prediction, errors_of, gap
 from golfflight.flight.air import Air
+from golfflight.flight.conditions import BatchAir
 from golfflight.flight.flyer import load_flyer
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import initial_state, spin_ratio
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics
 from golfflight.flight.rollout import euler_rollout, hard_landing
 from golfflight.model_export.training import (
@@ -153,7 +155,8 @@ def runtime_flight(bundle_dir: str | os.PathLike | None, launch: dict[str, np.nd
     """Launches (the canonical launch columns) flown in `air` by a bundle's Flyer: the runtime path of
     `check_bundle`."""
     flyer = load_flyer(bundle_dir)
-    return flyer.flight(initial_state(**launch), air.density_kg_m3, air.kinematic_viscosity_m2_s)
+    air_columns = BatchAir(air.density_kg_m3, air.kinematic_viscosity_m2_s)
+    return flyer.flight(FlightProblem(initial_state(**launch), air_columns))
 
 
 def check_bundle(bundle_dir: str | os.PathLike, val: ValidationSet) -> BundleCheck:

@@ -26,6 +26,7 @@ from golfflight.flight.flyer import FixedCoefficients, Flyer  # noqa: E402
 from golfflight.flight.integrator import RUNGE_KUTTA_4  # noqa: E402
 from golfflight.flight.outcomes import Flight  # noqa: E402
 from golfflight.flight.physics import initial_state  # noqa: E402
+from golfflight.flight.problem import FlightProblem  # noqa: E402
 from golfflight.flight.reference_aero import REFERENCE_DT_S, REFERENCE_T_MAX_S  # noqa: E402
 from golfflight.shots.markdown import table  # noqa: E402
 from golfflight.shots.paths import shared_data_dir  # noqa: E402
@@ -60,7 +61,7 @@ def ferguson(state) -> Flight:
     standard = Air.standard()
     flyer = Flyer(FixedCoefficients(QuadraticSpinRatio(FERGUSON_2022)), REFERENCE_DT_S, REFERENCE_T_MAX_S,
                   DENSITY_KG_M3, standard.kinematic_viscosity_m2_s, RUNGE_KUTTA_4)
-    return flyer.flight(state, keep_states=True)
+    return flyer.flight(FlightProblem(state, keep_states=True))
 
 
 def reference(state) -> Flight:

@@ -22,6 +22,7 @@ from golfflight.flight.conditions import Conditions  # noqa: E402
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M  # noqa: E402
 from golfflight.flight.engine import FlightEngine, Launch  # noqa: E402
 from golfflight.flight.ground import SURFACES, GroundSpec, Surface, surface  # noqa: E402
+from golfflight.flight.problem import FlightProblem  # noqa: E402
 from golfflight.flight.wind import CALM, Wind  # noqa: E402
 from golfflight.shots.clubs import CLUBS, ClubLaunch  # noqa: E402
 from golfflight.shots.markdown import table  # noqa: E402
@@ -87,7 +88,7 @@ def fly(engine: FlightEngine, clubs: Sequence[ClubLaunch], wind: Wind, ground: S
     """`clubs` flown straight (launch direction and spin axis 0) through `engine` in ICAO air and `wind`, rolled to
     rest on a level `ground` at the tee's height."""
     launches = [Launch(c.ball_speed_mps, c.launch_angle_deg, 0.0, c.spin_rpm, 0.0) for c in clubs]
-    flights = engine.fly_batch(launches, Conditions(wind=wind), GroundSpec(ground)).shots()
+    flights = engine.fly_batch(FlightProblem.of(launches, Conditions(wind=wind), GroundSpec(ground))).shots()
     return [AnchorRun(f.carry_m / YARD_M, f.rest.roll_m / YARD_M) for f in flights]
 
 

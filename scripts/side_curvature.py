@@ -20,6 +20,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from golfflight.evaluation.accuracy_flyers import EvaluatedModel, ModelFlyer, ferguson_flyer
 from golfflight.evaluation.accuracy_sets import outcome_errors
 from golfflight.flight.physics import initial_state
+from golfflight.flight.problem import FlightProblem
 from golfflight.model_export.real_data import trackman_outdoor
 from golfflight.shots.markdown import table
 from golfflight.shots.paths import shared_data_dir
@@ -77,7 +78,7 @@ def scale_rows(flyer: ModelFlyer, shots: ShotSet, lift_scales: tuple[float, ...]
     for lift in lift_scales:
         for drag in drag_scales:
             scale = np.tile([lift, drag, 1.0], (len(shots), 1))
-            flight = flyer.flyer.flight(initial_state(**launch), coefficient_scale=scale)
+            flight = flyer.flyer.flight(FlightProblem(initial_state(**launch), coefficient_scale=scale))
             errors = outcome_errors(flight, shots)
             slope, _ = axis_slope(errors["side_m"], launch)
             rows.append([f"{lift:.2f}", f"{drag:.2f}", f"{np.mean(errors['landing_m']):.2f}",

@@ -22,6 +22,7 @@ from golfflight.flight.flyer import FixedCoefficients, Flyer
 from golfflight.flight.integrator import RUNGE_KUTTA_4
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import State, initial_state
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.reference_aero import (
     CALIBRATED,
     FREE_PARAMETERS,
@@ -339,7 +340,7 @@ def evaluate_clubs_ferguson(clubs: list[ClubAverage], air: Air = CALIBRATION_AIR
     """The same shots with Ferguson 2022's quadratics (the open-model baseline), same integrator and air."""
     flyer = Flyer(FixedCoefficients(QuadraticSpinRatio()), REFERENCE_DT_S, REFERENCE_T_MAX_S, air.density_kg_m3,
                   air.kinematic_viscosity_m2_s, RUNGE_KUTTA_4)
-    return _club_check(flyer.flight(club_launch_state(clubs)), clubs)
+    return _club_check(flyer.flight(FlightProblem(club_launch_state(clubs))), clubs)
 
 
 def parameters_literal(params: ReferenceParameters) -> str:

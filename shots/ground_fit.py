@@ -18,10 +18,11 @@ from pathlib import Path
 
 import numpy as np
 from golfflight.flight.constants import YARD_M
-from golfflight.flight.flyer import LAUNCH_WIDTH, Flyer
+from golfflight.flight.flyer import Flyer
 from golfflight.flight.ground import SURFACES, Surface, ground_phase
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import initial_state
+from golfflight.flight.problem import LAUNCH_WIDTH, FlightProblem
 from golfflight.shots.markdown import table
 from golfflight.shots.pbp import load_pbp, recorded_apex, rest_positions
 from golfflight.shots.progress import progress_bar, progress_step
@@ -86,7 +87,7 @@ def fairway_shots(event: str, path: str | os.PathLike) -> RestShots:
 def landings(shots: RestShots, flyer: Flyer) -> Flight:
     """The shots flown by the bundle's Flyer (its step, maximum flight time and air) down to planes at their rest
     elevations."""
-    return flyer.flight(initial_state(*shots.launches.T), ground_height_m=shots.rest_dz_m)
+    return flyer.flight(FlightProblem(initial_state(*shots.launches.T), grounds=shots.rest_dz_m))
 
 
 def totals(flight: Flight, surface: Surface) -> np.ndarray:

@@ -14,11 +14,13 @@ from pathlib import Path
 import numpy as np
 from golfflight.errors import InputError
 from golfflight.flight.air import Air
+from golfflight.flight.conditions import BatchAir
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
 from golfflight.flight.flyer import Flyer
 from golfflight.flight.integrator import RUNGE_KUTTA_4
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import State
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.reference_aero import (
     CALIBRATED,
     REFERENCE_DT_S,
@@ -64,7 +66,8 @@ def fly_reference(
     """Fly a batch through the reference world (`reference_flyer`) in `air` (per shot or shared) until every ball
     has landed."""
     flyer = reference_flyer(params)
-    return flyer.flight(state, air.density_kg_m3, air.kinematic_viscosity_m2_s, wind, ground_height_m, keep_states)
+    air_columns = BatchAir(air.density_kg_m3, air.kinematic_viscosity_m2_s, wind)
+    return flyer.flight(FlightProblem(state, air_columns, ground_height_m, keep_states=keep_states))
 
 
 class ClubAverage(BaseModel):

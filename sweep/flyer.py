@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING, Protocol
+from typing import Protocol
 
 from golfflight.contract.columns import (
     AIR_DENSITY,
@@ -23,9 +23,7 @@ from golfflight.contract.columns import (
     result_columns,
 )
 from golfflight.errors import InputError
-
-if TYPE_CHECKING:
-    from golfflight.flight.outcomes import BatchFlights
+from golfflight.flight.problem import Engine
 
 PROBLEM = "problem"
 """Column of a worker's table: why the request model refused the row (lines), null for a row that flew."""
@@ -86,13 +84,12 @@ def echo(column: str, value):
     return _number(value)
 
 
-class ColumnsEngine(Protocol):
-    """What a worker flies its rows with: `FlightEngine`, or another engine with its batch path (`fly_batch`) and the
-    SHA-256 of the bundle's graph (`flight.torch_engine.TorchEngine`, given by the command line)."""
+class ColumnsEngine(Engine, Protocol):
+    """What a worker flies its rows with: `FlightEngine`, or another engine of the one protocol
+    (`flight.problem.Engine`: `flight.torch_engine.TorchEngine`, given by the command line) with the SHA-256 of the
+    bundle's graph."""
 
     sha256: str
-
-    def fly_batch(self, launches, conditions, grounds) -> BatchFlights: ...
 
 
 class SweepWorker:

@@ -19,8 +19,8 @@ Flying. The valid rows' launches are converted as `contract.inputs.launch_of` co
 spin by `spin_from_components` itself); their conditions, grounds and normalized replays come from the contract's own
 functions (`air_of`, `wind_of`, `ground_of`, `reference_of`, `lands_off_the_flat`) on one validated request part for
 each distinct combination of those columns' cells. The batch (the rows, their normalized replays, then their flat
-flights) is a `contract.flying.Batch`, as `batch_of` makes one from requests, and its flights go back into columns
-through the same `contract.flying.columns_of`.
+flights) is a `contract.flying.Batch`, made by `Batch.of` as `batch_of` makes one from requests (its one
+`flight.problem.FlightProblem`), and its flights go back into columns through the same `contract.flying.columns_of`.
 """
 
 from __future__ import annotations
@@ -381,18 +381,9 @@ def fly_checked(engine, checked: Checked) -> ShotColumns:
     off_flat = np.array(
         [lands_off_the_flat(ShotRequest.model_construct(ground=g)) for g in grounds.objects], dtype=bool
     )
-    has_reference = np.array([r is not None for r in references.objects], dtype=bool)
-    replays = np.flatnonzero(has_reference[references.index])
-    flats = np.flatnonzero(off_flat[grounds.index])
+    replays = PerShot([None if r is None else Conditions(air_of(r), CALM) for r in references.objects],
+                      references.index)
     own_grounds = PerShot([ground_of(g) for g in grounds.objects], grounds.index)
-    replay_air = PerShot(
-        [None if r is None else Conditions(air_of(r), CALM) for r in references.objects], references.index[replays]
-    )
-    launches = _launches(checked.columns, rows)
-    batch = Batch(
-        np.concatenate([launches, launches[replays], launches[flats]]),
-        conditions.plus(replay_air, conditions.take(flats)),
-        own_grounds.plus(own_grounds.take(replays), PerShot([None], np.zeros(len(flats), dtype=np.intp))),
-        n, replays, flats,
-    )
-    return columns_of(engine.fly_batch(batch.launches, batch.conditions, batch.grounds), batch)
+    batch = Batch.of(_launches(checked.columns, rows), conditions, own_grounds, replays,
+                     np.flatnonzero(off_flat[grounds.index]))
+    return columns_of(engine.fly_batch(batch.problem), batch)

@@ -17,6 +17,7 @@ from golfflight.flight.constants import MPH_TO_MPS
 from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.flyer import Flyer
 from golfflight.flight.physics import initial_state
+from golfflight.flight.problem import FlightProblem
 from golfflight.service.app import create_app
 from golfflight.service.settings import ServiceSettings
 from golfflight.service.viewer.page import ASSETS
@@ -48,7 +49,7 @@ def test_fly_flies_the_served_model_as_post_v1_shots_does(api, capsys):
     launch = Launch(driver.ball_speed_mps, driver.launch_angle_deg, 0.0, driver.spin_rpm, 0.0)
     engine = FlightEngine(model_dir())
     assert out["club"] == "Driver" and out["model"]["sha256"] == engine.sha256
-    assert out["flight"]["carry_m"] == pytest.approx(engine.fly(launch).carry_m, abs=1e-9)
+    assert out["flight"]["carry_m"] == pytest.approx(engine.fly(FlightProblem.of([launch]))[0].carry_m, abs=1e-9)
     served = api.post("/v1/shots", json=out["request"])
     assert served.status_code == 200
     answered = served.json()

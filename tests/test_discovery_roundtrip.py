@@ -14,6 +14,7 @@ from golfflight.discovery.model import load_model
 from golfflight.discovery.schema import Report
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine, Launch
+from golfflight.flight.problem import FlightProblem
 from golfflight.shots.records import LAUNCH_COLUMNS, write_shots
 
 from golfflight.cli import main
@@ -29,7 +30,7 @@ def _service_rms(engine: FlightEngine, records, settings: dict | None) -> np.nda
         request = ShotRequest.model_validate({**launch, **({"wind": settings["wind"]} if settings else {})})
         launches.append(Launch(*launch.values()))
         conditions.append(conditions_of(request))
-    flights = engine.fly_batch(launches, conditions).shots()
+    flights = engine.fly_batch(FlightProblem.of(launches, conditions=conditions)).shots()
     residual = np.array([[r.carry_y_m - f.landing_y_m, r.carry_x_m - f.landing_x_m] for r, f in zip(records, flights)])
     return np.sqrt(np.mean(residual**2, axis=0))
 

@@ -20,6 +20,7 @@ from golfflight.discovery.recordings import from_shot_set
 from golfflight.discovery.simulator import Setup
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine, Launch
+from golfflight.flight.problem import FlightProblem
 from golfflight.shots.paths import REPO_ROOT
 from golfflight.shots.records import ShotRecord, ShotSet
 from golfflight.cli import main
@@ -42,7 +43,7 @@ def _diagnose(model, hidden, seed, noise=RADAR_NOISE, correction=False):
 def test_discovery_flies_the_launches_as_the_engine_does(served):
     """Same integrator, coefficients and air: discovery's prediction is the engine's batch flight."""
     launches = [Launch(70.0, 11.0, 1.0, 2600.0, 4.0), Launch(45.0, 20.0, -2.0, 7000.0, -8.0)]
-    flights = FlightEngine(model_dir()).fly_batch(launches).shots()
+    flights = FlightEngine(model_dir()).fly_batch(FlightProblem.of(launches)).shots()
     columns = {name: np.array(values, dtype=float) for name, values in zip(Launch._fields, zip(*launches))}
     setup = Setup(columns, np.ones(2), np.full(2, served.density_kg_m3), np.zeros((2, 2)), np.zeros(2), np.ones((2, 3)))
     flown = served.simulate(setup).outcomes()

@@ -16,6 +16,7 @@ from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.engine import Launch, ShotFlight
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
 from golfflight.flight.physics import initial_state, reynolds_scale
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.wind import Wind
 
 from flights import simulate
@@ -61,7 +62,7 @@ def test_flights_match_the_torch_simulator_within_a_centimetre(engine, air):
             scale,
         )
         landing = hard_landing(trajectory)
-    flights = engine.fly_batch(shots, Conditions(air)).shots()
+    flights = engine.fly_batch(FlightProblem.of(shots, conditions=Conditions(air))).shots()
     assert landing.landed.all()
     got = np.array([[f.landing_x_m, f.landing_y_m] for f in flights])
     assert np.hypot(*(got - landing.position[:, :2].numpy()).T).max() < 0.01
@@ -80,9 +81,9 @@ def test_single_shots_equal_the_batch(engine):
         )
         for i in range(len(shots))
     ]
-    batch = engine.fly_batch(shots, conditions).shots()
+    batch = engine.fly_batch(FlightProblem.of(shots, conditions=conditions)).shots()
     for shot, condition, flown in zip(shots, conditions, batch, strict=True):
-        single = engine.fly(shot, condition)
+        single = engine.fly(FlightProblem.of([shot], conditions=condition))[0]
         assert single.carry_m == pytest.approx(flown.carry_m, abs=1e-6)
         assert single.apex_m == pytest.approx(flown.apex_m, abs=1e-6)
         assert single.flight_time_s == pytest.approx(flown.flight_time_s, abs=1e-9)
@@ -97,9 +98,9 @@ def test_the_single_shot_latency_path_is_the_flight_core(engine):
         Conditions(Air.from_conditions(temperature_c=30.0 - i), Wind(0.5 * i, 15.0 * i, "log" if i % 3 else "uniform"))
         for i in range(len(shots))
     ]
-    core = engine.fly_batch(shots, conditions, keep_states=True).shots()
+    core = engine.fly_batch(FlightProblem.of(shots, conditions=conditions, keep_states=True)).shots()
     for shot, condition, flown in zip(shots, conditions, core, strict=True):
-        single = engine.fly(shot, condition, keep_states=True)
+        single = engine.fly(FlightProblem.of([shot], conditions=condition, keep_states=True))[0]
         for name in ShotFlight.__dataclass_fields__:
             if name != "states":
                 assert getattr(single, name) == pytest.approx(getattr(flown, name), abs=1e-9), name
@@ -109,19 +110,20 @@ def test_the_single_shot_latency_path_is_the_flight_core(engine):
 
 def test_a_long_flight_goes_on_past_t_sim_and_the_cap_fails_only_that_shot(engine):
     sky_ball = Launch(75.0, 70.0, 0.0, 3000.0, 0.0)
-    flight = engine.fly(sky_ball)
+    flight = engine.fly(FlightProblem.of([sky_ball]))[0]
     assert flight.flight_time_s > engine.t_sim
     capped = copy.copy(engine)
     capped.flyer = copy.copy(engine.flyer)
     capped.flyer.max_steps = int(engine.t_sim / engine.dt)
     with pytest.raises(FlightError, match="still in the air"):
-        capped.fly(sky_ball)
-    first, second = capped.fly_batch([sky_ball, SEVEN_IRON]).shots()
-    assert isinstance(first, FlightError) and second.carry_m == pytest.approx(engine.fly(SEVEN_IRON).carry_m)
+        capped.fly(FlightProblem.of([sky_ball]))[0]
+    first, second = capped.fly_batch(FlightProblem.of([sky_ball, SEVEN_IRON])).shots()
+    alone = engine.fly(FlightProblem.of([SEVEN_IRON]))[0]
+    assert isinstance(first, FlightError) and second.carry_m == pytest.approx(alone.carry_m)
 
 
 def test_the_landing_is_on_the_ground_between_two_steps(engine):
-    flight = engine.fly(SEVEN_IRON, keep_states=True)
+    flight = engine.fly(FlightProblem.of([SEVEN_IRON], keep_states=True))[0]
     states = flight.states
     assert states.positions[-1, 2] == pytest.approx(0.0, abs=1e-9)
     assert (states.positions[:-1, 2] > 0).all()
@@ -135,7 +137,7 @@ def test_the_landing_is_on_the_ground_between_two_steps(engine):
 
 
 def test_resampled_trajectory_passes_through_the_states_with_their_velocities(engine):
-    flight = engine.fly(Launch(70.0, 12.0, 2.0, 3000.0, 10.0), keep_states=True)
+    flight = engine.fly(FlightProblem.of([Launch(70.0, 12.0, 2.0, 3000.0, 10.0)], keep_states=True))[0]
     times, positions = resample(flight.states, 60.0)
     assert np.allclose(np.diff(times[:-1]), 1 / 60) and times[-1] == flight.flight_time_s
     np.testing.assert_allclose(positions[-1], flight.states.positions[-1], atol=1e-9)
@@ -148,16 +150,16 @@ def test_resampled_trajectory_passes_through_the_states_with_their_velocities(en
 
 
 def test_headwind_shortens_crosswind_from_the_right_moves_left_altitude_lengthens(engine):
-    calm = engine.fly(SEVEN_IRON)
-    headwind = engine.fly(SEVEN_IRON, Conditions(wind=Wind(5.0, 0.0)))
-    from_right = engine.fly(SEVEN_IRON, Conditions(wind=Wind(5.0, 90.0)))
-    denver = engine.fly(SEVEN_IRON, Conditions(Air.from_conditions(altitude_m=1600.0)))
+    calm = engine.fly(FlightProblem.of([SEVEN_IRON]))[0]
+    headwind = engine.fly(FlightProblem.of([SEVEN_IRON], conditions=Conditions(wind=Wind(5.0, 0.0))))[0]
+    from_right = engine.fly(FlightProblem.of([SEVEN_IRON], conditions=Conditions(wind=Wind(5.0, 90.0))))[0]
+    denver = engine.fly(FlightProblem.of([SEVEN_IRON], Conditions(Air.from_conditions(altitude_m=1600.0))))[0]
     assert headwind.carry_m < calm.carry_m - 3
     assert from_right.lateral_m < -1.0 and calm.lateral_m == pytest.approx(0.0, abs=1e-9)
     assert denver.carry_m > calm.carry_m + 5
     punch = Launch(40.0, 6.0, 0.0, 3000.0, 0.0)  # stays below the 10 m where the log profile's wind is weaker
     low_calm, low_uniform, low_log = (
-        engine.fly(punch, Conditions(wind=w)) for w in (Wind(), Wind(5.0), Wind(5.0, 0.0, "log"))
+        engine.fly(FlightProblem.of([punch], Conditions(wind=w)))[0] for w in (Wind(), Wind(5.0), Wind(5.0, 0.0, "log"))
     )
     assert 0 < abs(low_log.carry_m - low_calm.carry_m) < abs(low_uniform.carry_m - low_calm.carry_m)
 
@@ -174,7 +176,7 @@ def test_thin_warm_air_lowers_the_reynolds_number_the_network_sees(engine):
         simulate(start, model, denver.density_kg_m3, dt=engine.dt, t_max=engine.t_sim)
         for model in (coefficients.in_air(denver.kinematic_viscosity_m2_s), coefficients)
     )
-    flight = engine.fly(SEVEN_IRON, Conditions(denver))
+    flight = engine.fly(FlightProblem.of([SEVEN_IRON], conditions=Conditions(denver)))[0]
     assert flight.carry_m == pytest.approx(float(scaled.carry_m[0]), abs=0.01)
     assert abs(flight.carry_m - float(density_only.carry_m[0])) > 1.0
 
@@ -184,7 +186,8 @@ def test_a_drive_at_7800_ft_gains_about_what_is_published(engine):
     and a land angle 9 degrees shallower. The default model: +9.0 %, apex -7 yd, land -10 deg (the reference world:
     +14.8 %, docs/reference_world.md)."""
     drive = Launch(76.4, 10.4, 0.0, 2545.0, 0.0)
-    sea_level, high = (engine.fly(drive, Conditions(Air.from_conditions(altitude_m=h))) for h in (0.0, 2377.0))
+    sea_level, high = (engine.fly(FlightProblem.of([drive], Conditions(Air.from_conditions(altitude_m=h))))[0]
+                       for h in (0.0, 2377.0))
     assert high.carry_m / sea_level.carry_m == pytest.approx(306 / 282, abs=0.035)
     assert high.apex_m < sea_level.apex_m and high.landing_angle_deg < sea_level.landing_angle_deg - 3
 
@@ -193,7 +196,7 @@ def test_one_shot_is_far_faster_than_the_paper(engine):
     timings = []
     for _ in range(200):
         started = time.perf_counter()
-        engine.fly(SEVEN_IRON, STANDARD)
+        engine.fly(FlightProblem.of([SEVEN_IRON], conditions=STANDARD))[0]
         timings.append(time.perf_counter() - started)
     p50_ms = float(np.median(timings)) * 1e3
     print(

@@ -23,6 +23,7 @@ from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import YARD_M
 from golfflight.flight.engine import BatchFlights, FlightEngine, Launch, Rest, ShotFlight
 from golfflight.flight.ground import LEVEL_FAIRWAY
+from golfflight.flight.problem import FlightProblem
 
 from golfflight.cli import main
 
@@ -79,7 +80,8 @@ def test_every_figure_is_a_field_of_the_http_result_a_column_and_a_row_of_the_fl
 
 
 def test_the_numbers_of_a_flight_are_its_figures_with_their_twins():
-    flight = FlightEngine(model_dir()).fly(Launch(55.0, 16.0, 0.0, 7100.0, 0.0), ground=LEVEL_FAIRWAY)
+    seven_iron = FlightProblem.of([Launch(55.0, 16.0, 0.0, 7100.0, 0.0)], grounds=LEVEL_FAIRWAY)
+    flight = FlightEngine(model_dir()).fly(seven_iron)[0]
     numbers = flight_numbers(flight)
     assert list(numbers) == [name for figure in FIGURES for name in (figure.name, figure.twin) if name]
     assert numbers["carry_m"] == flight.carry_m and numbers["total_m"] == flight.rest.total_m

@@ -21,7 +21,7 @@ from golfflight.flight.environment_variables import MODEL as MODEL_ENV
 from golfflight.flight.coefficients import QuadraticSpinRatio
 from golfflight.flight.constants import GRAVITY_MPS2
 from golfflight.flight.field import BallInAir
-from golfflight.flight.flyer import MAX_FLIGHT_TIME_S, FixedCoefficients, Flyer, Launch, load_flyer
+from golfflight.flight.flyer import MAX_FLIGHT_TIME_S, FixedCoefficients, Flyer, load_flyer
 from golfflight.flight.integrator import (
     FORWARD_EULER,
     RUNGE_KUTTA_4,
@@ -32,6 +32,7 @@ from golfflight.flight.integrator import (
     integrate,
 )
 from golfflight.flight.physics import initial_state
+from golfflight.flight.problem import FlightProblem, Launch
 from golfflight.shots.ground_fit import RestShots, landings
 from golfflight.weights_schema.bundle import CARD_FILE, BundleError
 from test_readme import venv_with_these_packages
@@ -50,7 +51,7 @@ def launch_columns(launch: Launch) -> dict[str, np.ndarray]:
 
 def test_every_caller_flies_the_shot_to_the_engines_carry_for_the_same_time(engine):
     flyer = engine.flyer
-    single = engine.fly(SKY_BALL)
+    single = engine.fly(FlightProblem.of([SKY_BALL]))[0]
     assert single.flight_time_s > flyer.card.physics.t_sim_s
     calm_air = Air(flyer.density_kg_m3, flyer.kinematic_viscosity_m2_s)
     discovery = from_bundle()
@@ -60,8 +61,8 @@ def test_every_caller_flies_the_shot_to_the_engines_carry_for_the_same_time(engi
     level = RestShots("one", np.array([SKY_BALL]), np.full(1, np.nan), np.zeros(1), np.full(1, np.nan))
     evaluate = pytest.importorskip("golfflight.model_export.evaluate")
     carries = {
-        "engine.fly_batch": engine.fly_batch([SKY_BALL]).shots()[0].carry_m,
-        "engine.fly_batch, columns (sweep)": engine.fly_batch(np.array([SKY_BALL])).carry_m[0],
+        "engine.fly_batch": engine.fly_batch(FlightProblem.of([SKY_BALL])).shots()[0].carry_m,
+        "engine.fly_batch, columns (sweep)": engine.fly_batch(FlightProblem.of(np.array([SKY_BALL]))).carry_m[0],
         "discovery from_bundle": discovery.fly(setup).carry_m[0],
         "accuracy ModelFlyer": accuracy.simulate(launch_columns(SKY_BALL)).carry_m[0],
         "evaluate runtime path": evaluate.runtime_flight(None, launch_columns(SKY_BALL), calm_air).carry_m[0],
@@ -122,13 +123,15 @@ def test_the_batch_flight_scales_coefficients_and_adds_an_acceleration_per_ball(
     the right moves a flight in a vacuum 0.5 a t^2 right."""
     flyer = Flyer(FixedCoefficients(QuadraticSpinRatio()), 0.01, 15.0, 1.225, 1.5e-5, RUNGE_KUTTA_4)
     state = initial_state(np.full(3, 70.0), np.full(3, 11.0), np.zeros(3), np.full(3, 2500.0), np.zeros(3))
-    plain = flyer.flight(state)
-    ones = flyer.flight(state, coefficient_scale=np.ones((3, 3)), correction=lambda v, w, r: np.zeros_like(v))
+    plain = flyer.flight(FlightProblem(state))
+    ones = flyer.flight(FlightProblem(state, coefficient_scale=np.ones((3, 3)),
+                                      correction=lambda v, w, r: np.zeros_like(v)))
     np.testing.assert_array_equal(ones.landing_position, plain.landing_position)
-    draggy = flyer.flight(state, coefficient_scale=np.array([[1.0, 1.0, 1.0], [1.0, 1.2, 1.0], [1.0, 1.0, 1.0]]))
+    scale = np.array([[1.0, 1.0, 1.0], [1.0, 1.2, 1.0], [1.0, 1.0, 1.0]])
+    draggy = flyer.flight(FlightProblem(state, coefficient_scale=scale))
     assert draggy.carry_m[1] < plain.carry_m[1] - 5 and draggy.carry_m[[0, 2]] == pytest.approx(plain.carry_m[[0, 2]])
     vacuum = Flyer(FixedCoefficients(lambda v, w: np.zeros((len(v), 4))), 0.01, 15.0, 1.225, 1.5e-5, RUNGE_KUTTA_4)
-    pushed = vacuum.flight(state, correction=lambda v, w, r: np.tile([1.0, 0.0, 0.0], (len(v), 1)))
+    pushed = vacuum.flight(FlightProblem(state, correction=lambda v, w, r: np.tile([1.0, 0.0, 0.0], (len(v), 1))))
     vz, z0 = 70.0 * np.sin(np.radians(11.0)), state.position[0, 2]
     time_s = (vz + np.sqrt(vz**2 + 2 * GRAVITY_MPS2 * z0)) / GRAVITY_MPS2
     assert pushed.flight_time_s == pytest.approx(time_s, abs=1e-4)  # the landing interpolated across a 0.01 s step
@@ -141,10 +144,10 @@ def test_a_ball_that_rises_again_below_its_ground_keeps_its_first_landing_and_ap
     record of states flies every ball to the batch's last landing, so the ball flies on below its ground meanwhile:
     it must keep the landing and apex of its first crossing, as the single shot (which stops there) does."""
     low, drive = Launch(64.0, -1.0, 0.0, 6500.0, 0.0), Launch(60.0, 12.0, 0.0, 3000.0, 0.0)
-    single = engine.fly(low)
+    single = engine.fly(FlightProblem.of([low]))[0]
     assert single.flight_time_s < engine.dt
     for keep_states in (False, True):
-        flown = engine.fly_batch([low, drive], keep_states=keep_states).shots()[0]
+        flown = engine.fly_batch(FlightProblem.of([low, drive], keep_states=keep_states)).shots()[0]
         for name in ("carry_m", "flight_time_s", "apex_m", "apex_time_s", "landing_speed_mps"):
             assert getattr(flown, name) == pytest.approx(getattr(single, name), abs=1e-9), (keep_states, name)
 

@@ -15,6 +15,7 @@ from golfflight.flight.constants import YARD_M
 from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.ground import SURFACES, GroundSpec, holding_slope_deg
 from golfflight.flight.limits import SLOPE_DEG
+from golfflight.flight.problem import FlightProblem
 from golfflight.service.app import create_app
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -157,8 +158,8 @@ def test_every_shot_comes_to_rest_finite_and_the_batch_agrees(engine, launch, na
     where = SURFACES[name]
     steepest = min(float(holding_slope_deg(where.rolling_resistance)), SLOPE_DEG.high)
     ground = GroundSpec(where, elevation, slope_share * steepest, slope_dir)
-    one = engine.fly(Launch(*launch), ground=ground)
-    batch = engine.fly_batch([Launch(*launch)] * 2, grounds=ground).shots()[1]
+    one = engine.fly(FlightProblem.of([Launch(*launch)], grounds=ground))[0]
+    batch = engine.fly_batch(FlightProblem.of([Launch(*launch)] * 2, grounds=ground)).shots()[1]
     rest = one.rest
     assert all(math.isfinite(v) for v in (rest.x_m, rest.y_m, rest.total_m, rest.roll_m, rest.ground_time_s))
     assert rest.bounces >= 0 and rest.ground_time_s >= 0.0

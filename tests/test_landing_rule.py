@@ -13,6 +13,7 @@ import torch
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.engine import FlightEngine, Launch
 from golfflight.flight.physics import initial_state
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.rollout import InAir, apex, euler_rollout, hard_landing
 from golfflight.flight.torch_engine import TorchEngine
 from shared_network import numpy_flyer_of
@@ -63,7 +64,7 @@ def _rollout_figures(network, density: float, dt: float, t_sim: float) -> dict[s
 
 
 def test_the_grid_holds_a_shot_whose_apex_is_its_launch_and_shots_that_climb(engine):
-    flights = [engine.fly(launch) for launch in GRID]
+    flights = engine.fly(FlightProblem.of(GRID))
     tee = initial_state(*np.asarray(GRID[:1], dtype=float).T).position[0, 2]
     assert sum(f.apex_m == tee for f in flights) >= 1 and sum(f.apex_m > 10.0 for f in flights) >= 10
 
@@ -71,7 +72,8 @@ def test_the_grid_holds_a_shot_whose_apex_is_its_launch_and_shots_that_climb(eng
 def test_the_single_shot_lands_and_peaks_as_the_numpy_batch(engine):
     """The float loop (the rule asked at a climb's top and at the ground) against the batch's marks (asked every
     step): the same ONNX graph, so the figures agree to its float32 rounding (one ulp of a coefficient)."""
-    single, batch = _columns(engine.fly(launch) for launch in GRID), _columns(engine.fly_batch(GRID).shots())
+    problem = FlightProblem.of(GRID)
+    single, batch = _columns(engine.fly(problem)), _columns(engine.fly_batch(problem).shots())
     for name in FIGURES:
         np.testing.assert_allclose(single[name], batch[name], rtol=0, atol=1e-9, err_msg=name)
 
@@ -82,8 +84,8 @@ def test_the_numpy_batch_the_torch_engine_and_training_land_and_peak_alike(torch
     runs in float32 in each, so an input a float64 rounding away from a float32 boundary moves a coefficient by an
     ulp (up to 1.2e-6 m here); a landing or apex told one step apart would differ by centimetres to metres."""
     onnx = torch_engine.flyer
-    numpy_batch = _columns(numpy_flyer_of(torch_engine).fly_batch(GRID).shots())
-    on_torch = _columns(torch_engine.fly_batch(GRID).shots())
+    numpy_batch = _columns(numpy_flyer_of(torch_engine).fly_batch(FlightProblem.of(GRID)).shots())
+    on_torch = _columns(torch_engine.fly_batch(FlightProblem.of(GRID)).shots())
     trained = _rollout_figures(torch_engine.network, onnx.density_kg_m3, onnx.dt_s, onnx.max_flight_time_s)
     for name in FIGURES:
         np.testing.assert_allclose(on_torch[name], numpy_batch[name], rtol=0, atol=2e-6, err_msg=name)

@@ -58,13 +58,13 @@ def test_the_wheel_installs_beside_a_package_called_service_and_flies_a_shot(tmp
         (others / name / "__init__.py").write_text(f"WHO = 'somebody else\\'s {name}'\n")
     code = (
         "import service, flight\n"
-        "from golfflight.flight.engine import FlightEngine, Launch\n"
+        "from golfflight.flight.engine import FlightEngine, FlightProblem, Launch\n"
         "from golfflight.flight.bundle_location import model_dir\n"
         "assert service.WHO.endswith('service') and flight.WHO.endswith('flight')\n"
         f"engine = FlightEngine(model_dir({str(target / 'share/golfflight/models/default')!r}))\n"
         "import golfflight.flight.engine as engine_module\n"
         f"assert engine_module.__file__.startswith({str(target)!r}), engine_module.__file__\n"
-        "print(engine.fly(Launch(55.0, 16.0, 0.0, 7100.0, 0.0)).carry_m)\n"
+        "print(engine.fly(FlightProblem.of([Launch(55.0, 16.0, 0.0, 7100.0, 0.0)]))[0].carry_m)\n"
     )
     env = {"PYTHONPATH": f"{target}:{others}", "PATH": "/usr/bin:/bin"}
     flown = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True)

@@ -10,6 +10,7 @@ from golfflight.flight.conditions import STANDARD, Conditions
 from golfflight.flight.flyer import load_flyer
 from golfflight.flight.ground import SURFACES, GroundSpec, Surface, batch_surface
 from golfflight.flight.per_shot import PerShot
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.wind import Wind
 
 
@@ -61,8 +62,8 @@ def test_the_engine_flies_a_per_shot_batch_to_the_numbers_of_the_same_objects_gi
     grounds = [None, GroundSpec(SURFACES["green"], -3.0, 1.5, 40.0), GroundSpec(SURFACES["rough"], 2.0)]
     conditions = PerShot(airs, rng.integers(0, 3, n))
     shot_grounds = PerShot(grounds, rng.integers(0, 3, n))
-    shared = flyer.fly_batch(launches, conditions, shot_grounds)
-    listed = flyer.fly_batch(launches, list(conditions), list(shot_grounds))
+    shared = flyer.fly_batch(FlightProblem.of(launches, conditions=conditions, grounds=shot_grounds))
+    listed = flyer.fly_batch(FlightProblem.of(launches, conditions=list(conditions), grounds=list(shot_grounds)))
     assert shared.errors == listed.errors
     np.testing.assert_array_equal(shared.rolled, listed.rolled)
     for name in ("carry_m", "apex_m", "landing_angle_deg", "flight_time_s"):

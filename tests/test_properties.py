@@ -16,6 +16,7 @@ from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.conditions import Conditions
 from golfflight.flight.engine import MAX_FLIGHT_TIME_S, Launch, ShotFlight
 from golfflight.flight.onnx_coefficients import OnnxCoefficients
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.wind import CALM, Wind
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -95,7 +96,7 @@ def assert_sound(flight: ShotFlight) -> None:
 @PROPERTY
 @given(launch=launches, where=conditions)
 def test_every_valid_shot_lands_with_finite_numbers(engine, launch, where):
-    flight = engine.fly(launch, where, keep_states=True)
+    flight = engine.fly(FlightProblem.of([launch], conditions=where, keep_states=True))[0]
     assert_sound(flight)
     assert flight.states.positions[-1][2] == pytest.approx(0.0, abs=1e-9)
 
@@ -103,10 +104,10 @@ def test_every_valid_shot_lands_with_finite_numbers(engine, launch, where):
 @PROPERTY
 @given(shots=st.lists(st.tuples(launches, conditions), min_size=1, max_size=12))
 def test_batch_flights_are_the_single_shot_flights(engine, shots):
-    batch = engine.fly_batch([launch for launch, _ in shots], [where for _, where in shots]).shots()
+    batch = engine.fly_batch(FlightProblem.of([launch for launch, _ in shots], [where for _, where in shots])).shots()
     for (launch, where), flight in zip(shots, batch, strict=True):
         assert_sound(flight)
-        single = engine.fly(launch, where)
+        single = engine.fly(FlightProblem.of([launch], conditions=where))[0]
         assert flight.carry_m == pytest.approx(single.carry_m, abs=1e-6)
         assert flight.apex_m == pytest.approx(single.apex_m, abs=1e-6)
 
@@ -123,7 +124,8 @@ def test_carry_grows_with_ball_speed_for_a_fixed_launch_in_calm_air(engine, spee
     the faster 0.1 mm shorter (and 81 and 87 m/s 1 cm apart at 160.38 m), so the carry may stay level within PLATEAU_M
     but never fall further."""
     speeds = sorted(speeds)
-    carries = [f.carry_m for f in engine.fly_batch([Launch(v, angle, 0.0, spin, 0.0) for v in speeds]).shots()]
+    problem = FlightProblem.of([Launch(v, angle, 0.0, spin, 0.0) for v in speeds])
+    carries = [f.carry_m for f in engine.fly_batch(problem).shots()]
     assert all(b >= a - PLATEAU_M for a, b in zip(carries, carries[1:])), list(zip(speeds, carries))
 
 
@@ -135,8 +137,8 @@ def mirrored(launch: Launch) -> Launch:
 @given(launch=launches, where=conditions)
 def test_mirrored_launch_and_wind_land_mirrored(engine, launch, where):
     wind = dataclasses.replace(where.wind, from_deg=(360.0 - where.wind.from_deg) % 360.0)
-    flight = engine.fly(launch, where)
-    mirror = engine.fly(mirrored(launch), Conditions(where.air, wind))
+    flight = engine.fly(FlightProblem.of([launch], conditions=where))[0]
+    mirror = engine.fly(FlightProblem.of([mirrored(launch)], conditions=Conditions(where.air, wind)))[0]
     assert mirror.landing_x_m == pytest.approx(-flight.landing_x_m, abs=1e-6)
     for name in ("landing_y_m", "carry_m", "apex_m", "flight_time_s", "landing_angle_deg", "landing_spin_rpm"):
         assert getattr(mirror, name) == pytest.approx(getattr(flight, name), abs=1e-6), name

@@ -155,7 +155,7 @@ def requested_columns(engine, shots):
     from golfflight.contract.flying import batch_of, columns_of
 
     batch = batch_of(shots)
-    return columns_of(engine.fly_batch(np.array(batch.launches, dtype=float), batch.conditions, batch.grounds), batch)
+    return columns_of(engine.fly_batch(batch.problem), batch)
 
 
 def test_the_column_path_gives_fly_requests_numbers_bit_for_bit():

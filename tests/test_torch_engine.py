@@ -19,6 +19,7 @@ from golfflight.flight.conditions import Conditions
 from golfflight.flight.devices import DeviceError, resolve_device
 from golfflight.flight.flyer import load_flyer
 from golfflight.flight.ground import SURFACES, GroundSpec
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.torch_engine import STAGES, TorchEngine
 from golfflight.flight.wind import Wind
 from golfflight.model_export.training import TrainConfig, load_checkpoint, train
@@ -68,7 +69,7 @@ def shots():
 
 @pytest.fixture(scope="module")
 def onnx_flights(shots):
-    return load_flyer(None).fly_batch(*shots)
+    return load_flyer(None).fly_batch(FlightProblem.of(*shots))
 
 
 @pytest.fixture(scope="module")
@@ -94,7 +95,7 @@ def test_the_torch_engine_flies_mixed_shots_as_the_onnx_engine(engines, shots, o
     what is left is the network's float32 arithmetic (torch's and ONNX Runtime's sums differ by an ulp: about 1e-7
     in a coefficient), some 10 um of carry (the rules themselves are held to 1e-6 m below), with the ground phase in
     NumPy or in torch. The other figures (degrees, rpm, s) and the rests after the ground phase follow."""
-    got = engines[dtype].fly_batch(*shots)
+    got = engines[dtype].fly_batch(FlightProblem.of(*shots))
     assert got.errors == onnx_flights.errors and {1, 2} <= set(got.errors)
     assert "never rose to its landing ground" in got.errors[1]
     np.testing.assert_array_equal(got.rolled, onnx_flights.rolled)
@@ -113,7 +114,8 @@ def test_in_float64_the_landing_and_apex_rules_are_the_integrators(engines, shot
     step, the apex's parabola, each shot's ground, its air's Reynolds scale, the log profile at the ball's height,
     the failures. (An input a float64 rounding away from a float32 boundary can still move a coefficient by an ulp.)"""
     engine = engines["float64"]
-    want, got = numpy_flyer_of(engine).fly_batch(*shots), engine.fly_batch(*shots)
+    problem = FlightProblem.of(*shots)
+    want, got = numpy_flyer_of(engine).fly_batch(problem), engine.fly_batch(problem)
     assert got.errors == want.errors
     landed = np.array([i not in got.errors for i in range(SHOTS)])
     for name in FIGURES:
@@ -128,7 +130,8 @@ def test_a_batch_split_into_parts_flies_the_same_numbers(shots):
     small = TorchEngine(load_flyer(None).bundle_dir, "cpu", "float64", part_shots=64)
     whole = TorchEngine(load_flyer(None).bundle_dir, "cpu", "float64")
     launches, conditions, grounds = (part[:150] for part in shots)
-    split, joined = small.fly_batch(launches, conditions, grounds), whole.fly_batch(launches, conditions, grounds)
+    problem = FlightProblem.of(launches, conditions, grounds)
+    split, joined = small.fly_batch(problem), whole.fly_batch(problem)
     assert split.errors == joined.errors
     for name in FIGURES:
         np.testing.assert_allclose(getattr(split, name), getattr(joined, name), rtol=1e-8, atol=1e-6)
@@ -156,7 +159,8 @@ def test_shots_set_aside_as_they_land_fly_the_same_numbers(shots):
     aside_engine = TorchEngine(bundle, "cpu", "float64")
     together_engine = TorchEngine(bundle, "cpu", "float64", set_aside_share=1.0)
     aside_flown, together_flown = counted(aside_engine), counted(together_engine)
-    aside, together = aside_engine.fly_batch(*shots), together_engine.fly_batch(*shots)
+    problem = FlightProblem.of(*shots)
+    aside, together = aside_engine.fly_batch(problem), together_engine.fly_batch(problem)
     assert aside.errors == together.errors and {1, 2} <= set(aside.errors)
     for name in FIGURES:
         np.testing.assert_allclose(getattr(aside, name), getattr(together, name), rtol=1e-8, atol=1e-6, err_msg=name)
@@ -310,9 +314,10 @@ def test_marks_kept_as_on_a_gpu_give_the_same_figures(shots, monkeypatch):
 
     bundle = load_flyer(None).bundle_dir
     launches, conditions, grounds = (part[:120] for part in shots)
-    asked = TorchEngine(bundle, "cpu", "float64").fly_batch(launches, conditions, grounds)
+    problem = FlightProblem.of(launches, conditions, grounds)
+    asked = TorchEngine(bundle, "cpu", "float64").fly_batch(problem)
     monkeypatch.setattr(xp, "answers_now", lambda flags: isinstance(flags, np.ndarray))
-    merged = TorchEngine(bundle, "cpu", "float64").fly_batch(launches, conditions, grounds)
+    merged = TorchEngine(bundle, "cpu", "float64").fly_batch(problem)
     assert merged.errors == asked.errors
     for name in FIGURES:
         np.testing.assert_array_equal(getattr(merged, name), getattr(asked, name), err_msg=name)

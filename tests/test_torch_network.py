@@ -13,6 +13,7 @@ onnx = pytest.importorskip("onnx")
 from golfflight.errors import InputError
 from golfflight.flight.bundle_check import open_verified
 from golfflight.flight.engine import FlightEngine, Launch
+from golfflight.flight.problem import FlightProblem
 from golfflight.flight.torch_engine import TorchEngine
 from golfflight.flight.torch_network import GraphNetwork, network_from_bundle
 from golfflight.weights_schema.bundle import BundleError
@@ -57,7 +58,7 @@ def test_from_bundle_picks_the_backend():
     assert type(onnx_engine) is FlightEngine and isinstance(torch_engine, TorchEngine)
     assert onnx_engine.sha256 == torch_engine.sha256
     launches = np.array([Launch(55.0, 16.0, 0.0, 7100.0, 0.0), Launch(76.5, 10.5, 1.0, 2550.0, -3.0)])
-    want, got = onnx_engine.fly_batch(launches), torch_engine.fly_batch(launches)
+    want, got = onnx_engine.fly_batch(FlightProblem.of(launches)), torch_engine.fly_batch(FlightProblem.of(launches))
     np.testing.assert_allclose(got.carry_m, want.carry_m, rtol=0, atol=1e-3)  # torch CPU parity: 1 mm
     with pytest.raises(InputError, match="backend 'jax': choose onnx or torch"):
         FlightEngine.from_bundle(bundle, backend="jax")

@@ -215,9 +215,11 @@ def fly_reference_shot(shot) -> dict:
     from golfflight.contract.inputs import conditions_of, launch_of
     from golfflight.errors import FlightError
     from golfflight.flight.ground import LEVEL_FAIRWAY
+    from golfflight.flight.problem import FlightProblem
     from golfflight.shots.reference_world import reference_flyer
 
-    flown = reference_flyer().fly_batch([launch_of(shot)], conditions_of(shot), LEVEL_FAIRWAY).shots()[0]
+    problem = FlightProblem.of([launch_of(shot)], conditions_of(shot), LEVEL_FAIRWAY)
+    flown = reference_flyer().fly_batch(problem).shots()[0]
     if isinstance(flown, FlightError):
         raise InputError(f"the reference world could not fly the shot: {flown}")
     fields = flight_fields(flown, None)
