@@ -126,6 +126,8 @@ class Batch:
         n = len(launches)
         replayed = np.flatnonzero(replays.column(lambda c: c is not None, bool))
         flats = np.asarray(flats, dtype=np.intp)
+        if not len(replayed) and not len(flats):  # their own flights alone (most requests): nothing to append
+            return cls(FlightProblem.of(launches, conditions, grounds, keep), n, replayed, flats)
         keep = np.broadcast_to(np.asarray(keep, dtype=bool), (n + len(replayed),))
         problem = FlightProblem.of(
             launches[np.concatenate([np.arange(n), replayed, flats])],
@@ -149,10 +151,10 @@ def batch_of(shots: list[ShotRequest], keep: bool = False, flat: bool = True) ->
     for a trajectory, its replay's where it asks for one; flat flights of shots off the flat unless `flat` is False."""
     n = len(shots)
     launches = np.array([launch_of(shot) for shot in shots], dtype=float).reshape(n, LAUNCH_WIDTH)
-    conditions = PerShot([conditions_of(shot) for shot in shots], np.arange(n))
-    grounds = PerShot([ground_of(shot.ground) for shot in shots], np.arange(n))
+    conditions = PerShot.each([conditions_of(shot) for shot in shots])
+    grounds = PerShot.each([ground_of(shot.ground) for shot in shots])
     references = [reference_of(shot) for shot in shots]
-    replays = PerShot([None if r is None else Conditions(air_of(r), CALM) for r in references], np.arange(n))
+    replays = PerShot.each([None if r is None else Conditions(air_of(r), CALM) for r in references])
     flats = [i for i, shot in enumerate(shots) if flat and lands_off_the_flat(shot)]
     traced = [shot.trajectory is not None for shot in shots]
     keep_rows = [keep or t for t in traced] + [t for t, r in zip(traced, references, strict=True) if r is not None]

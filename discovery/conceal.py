@@ -19,7 +19,7 @@ from golfflight.discovery.effects import NOMINAL_CONTEXT as NOMINAL_CONTEXT
 from golfflight.discovery.model import FlightModel
 from golfflight.discovery.noise import RADAR_NOISE
 from golfflight.discovery.outside import OUTSIDE, air_motion, term_and_weights
-from golfflight.discovery.simulator import Setup
+from golfflight.discovery.simulator import Setup, setup_flight
 from golfflight.errors import InputError
 from golfflight.flight.outcomes import Flight
 from golfflight.flight.physics import initial_state
@@ -148,13 +148,13 @@ def _fly_model(
         raise InputError(f"a model's own flights take library effects, uniform wind and discovery.outside: {unknown}")
     n = len(true.club)
     setup = Setup(
-        true.launch(), np.ones(n), np.full(n, model.density_kg_m3), np.zeros((n, 2)), np.zeros(n), np.ones((n, 3))
+        true.launch(), np.ones(n), np.full(n, model.flyer.density_kg_m3), np.zeros((n, 2)), np.zeros(n), np.ones((n, 3))
     )
     for effect in library:
         setup = effect.hiding.model(np.repeat(effect.internal(hidden[effect.name])[None], n, axis=0), setup)
     term, setup.correction_weights = term_and_weights(hidden, setup.density_kg_m3 * setup.density_ratio)
     air = air_motion(hidden, Wind.from_components(setup.wind_xy_mps[:, 0], setup.wind_xy_mps[:, 1]))
-    return model.fly(setup, term, keep_states=trajectories, air=air)
+    return setup_flight(setup, model.flyer, term, trajectories, air)
 
 
 def _mean_wind_factor(flight: Flight, wind: Wind, shots: np.ndarray) -> float:

@@ -203,8 +203,8 @@ def model_info(model: FlightModel, context: Context, start: AsIs, estimate_scatt
     expected, scatter = start.expected, start.scatter
     return ModelInfo(
         name=model.name,
-        dt_s=model.dt_s,
-        integrator=model.method,
+        dt_s=model.flyer.dt_s,
+        integrator=model.flyer.rule.name,
         density_kg_m3=context.density_kg_m3,
         model_error=expected.model,
         model_error_source=expected.model_source,

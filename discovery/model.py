@@ -13,18 +13,14 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Literal
-
 from golfflight.discovery.choices import REFERENCE
 from golfflight.discovery.discrepancy import Discrepancy
 from golfflight.discovery.recordings import OBSERVABLES
-from golfflight.discovery.simulator import Correction, Outcomes, Setup, setup_flight, simulate_setup
+from golfflight.discovery.simulator import Correction, Outcomes, Setup, simulate_setup
 from golfflight.flight.air import Air
 from golfflight.flight.flyer import Flyer, load_flyer
 from golfflight.flight.integrator import RUNGE_KUTTA_4
-from golfflight.flight.outcomes import Flight
 from golfflight.flight.reference_aero import CALIBRATED, ReferenceAerodynamics, ReferenceParameters
-from golfflight.flight.wind import Wind
 
 MIN_T_MAX_S = 15.0
 """Flights are integrated for at least this long, so a shot the effects lengthen still lands."""
@@ -50,31 +46,11 @@ class FlightModel:
     """What a baseline session taught beyond the form held in `flyer` (`discovery.form`): its mean at the launches
     flown is added to every prediction (`simulate`) and its SD to every shot's expected error."""
 
-    @property
-    def density_kg_m3(self) -> float:
-        """Air density the model assumes when a shot has no recorded conditions."""
-        return self.flyer.density_kg_m3
-
-    @property
-    def dt_s(self) -> float:
-        return self.flyer.dt_s
-
-    @property
-    def method(self) -> Literal["euler", "rk4"]:
-        return self.flyer.rule.name
-
     def simulate(self, setup: Setup, correction: Correction | None = None, keep_positions: bool = False) -> Outcomes:
         """A setup's outcomes through this model (`discovery.simulator.simulate_setup`), with the discrepancy's mean at
         the launches flown where a baseline taught one."""
         flown = simulate_setup(setup, self.flyer, correction, keep_positions)
         return flown if self.discrepancy is None else self.discrepancy.shifted(flown, setup.launch)
-
-    def fly(
-        self, setup: Setup, correction: Correction | None = None, keep_states: bool = False, air: Wind | None = None
-    ) -> Flight:
-        """The flight core's own `Flight` of a setup through this model (`discovery.simulator.setup_flight`; `air`
-        replaces the setup's uniform wind)."""
-        return setup_flight(setup, self.flyer, correction, keep_states, air)
 
 
 def from_bundle(directory: str | os.PathLike | None = None, control: bool = False) -> FlightModel:

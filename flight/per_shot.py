@@ -35,11 +35,23 @@ class PerShot(Sequence, Generic[T]):
         if isinstance(given, PerShot):
             shared = given
         elif isinstance(given, Sequence):
-            shared = cls(given, np.arange(len(given)))
+            shared = cls.each(given)
         else:
-            return cls([given], np.zeros(n, dtype=np.intp))
+            return cls._used([given], np.zeros(n, dtype=np.intp)) if n else cls([given], np.zeros(0, dtype=np.intp))
         if len(shared) != n:
             raise InputError(f"{len(shared)} {name} for {n} launches")
+        return shared
+
+    @classmethod
+    def each(cls, objects: Sequence[T]) -> PerShot[T]:
+        """One object a shot, in order (every one used: no search for unused ones, which a single shot would pay)."""
+        return cls._used(list(objects), np.arange(len(objects)))
+
+    @classmethod
+    def _used(cls, objects: list[T], index: np.ndarray) -> PerShot[T]:
+        """A PerShot of objects that `index` uses every one of, as given."""
+        shared = cls.__new__(cls)
+        shared.objects, shared.index = objects, index
         return shared
 
     def __len__(self) -> int:

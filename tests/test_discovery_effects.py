@@ -31,7 +31,7 @@ def base() -> Setup:
     launch = launches()
     n = len(launch["spin_rpm"])
     return Setup(
-        launch, np.ones(n), np.full(n, MODEL.density_kg_m3), np.zeros((n, 2)), np.zeros(n), np.ones((n, 3))
+        launch, np.ones(n), np.full(n, MODEL.flyer.density_kg_m3), np.zeros((n, 2)), np.zeros(n), np.ones((n, 3))
     )
 
 

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from built_wheel import PIP, build_wheel
 from golfflight.discovery.model import from_bundle, load_model
-from golfflight.discovery.simulator import Setup
+from golfflight.discovery.simulator import Setup, setup_flight
 from golfflight.evaluation.accuracy_flyers import ModelFlyer
 from golfflight.flight.air import Air
 from golfflight.flight.bundle_location import model_dir
@@ -63,7 +63,7 @@ def test_every_caller_flies_the_shot_to_the_engines_carry_for_the_same_time(engi
     carries = {
         "engine.fly_batch": engine.fly_batch(FlightProblem.of([SKY_BALL])).shots()[0].carry_m,
         "engine.fly_batch, columns (sweep)": engine.fly_batch(FlightProblem.of(np.array([SKY_BALL]))).carry_m[0],
-        "discovery from_bundle": discovery.fly(setup).carry_m[0],
+        "discovery from_bundle": setup_flight(setup, discovery.flyer).carry_m[0],
         "accuracy ModelFlyer": accuracy.simulate(launch_columns(SKY_BALL)).carry_m[0],
         "evaluate runtime path": evaluate.runtime_flight(None, launch_columns(SKY_BALL), calm_air).carry_m[0],
         "ground fit landings": landings(level, load_flyer()).carry_m[0],
