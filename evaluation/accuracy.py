@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import TypeVar
 
 import numpy as np
+from golfflight.contract.problems import launch_problem
 from golfflight.evaluation.accuracy_finetune import (
     MEASURED_ROUNDS,
     TRAIN_ROUNDS,
@@ -30,7 +31,7 @@ from golfflight.evaluation.accuracy_finetune import (
     FinetuneStudy,
     finetune_study,
 )
-from golfflight.evaluation.accuracy_flyers import CoefficientFlyer, EvaluatedModel, ModelFlyer, ferguson_flyer
+from golfflight.evaluation.accuracy_flyers import ferguson_flyer, is_bundle, model_flyer
 from golfflight.evaluation.accuracy_sets import (
     APEX_MAE_YD,
     APEX_METRICS,
@@ -75,6 +76,7 @@ from golfflight.evaluation.accuracy_winds import (
     training_winds,
 )
 from golfflight.flight.constants import YARD_M
+from golfflight.flight.flyer import Flyer
 from golfflight.shots.markdown import table, write_generated_section
 from golfflight.shots.paths import shared_data_dir
 from golfflight.shots.pbp import hole_pars
@@ -87,8 +89,8 @@ from golfflight.shots.trackman import ConversionReport
 
 __all__ = [
     "COMMAND", "DRIVER_FILE", "OUTCOMES", "PATH_FIGURE", "PGA_TARGETS", "TOURCAST_PBP", "TOURCAST_TRAJECTORIES",
-    "AccuracyReport", "CoefficientFlyer", "EvaluatedModel", "ModelFlyer", "ball_types", "compare_clubs", "ferguson_flyer",
-    "outcome_errors", "path_errors", "per_model", "run_accuracy",
+    "AccuracyReport", "ball_types", "compare_clubs", "ferguson_flyer", "model_flyer", "outcome_errors",
+    "path_errors", "per_model", "run_accuracy",
 ]
 
 COMMAND = "accuracy"
@@ -123,15 +125,16 @@ class AccuracyReport:
     study: FinetuneStudy | None = None
 
 
-def _key(flyer: EvaluatedModel) -> tuple:
+def _key(flyer: Flyer) -> tuple:
     """What makes two flyers fly alike: the graph and the card's step and air, or the closed-form model."""
-    if isinstance(flyer, ModelFlyer):
+    if is_bundle(flyer):
         physics = flyer.card.physics
         return ("onnx", flyer.card.onnx.sha256, physics.dt_s, physics.t_sim_s, physics.air_density_kg_m3)
-    return ("model", repr(getattr(flyer, "model", flyer)), flyer.dt_s, flyer.t_sim_s, flyer.density_kg_m3)
+    closed_form = getattr(flyer.model, "model", flyer.model)  # a FixedCoefficients' own model
+    return ("model", repr(closed_form), flyer.dt_s, flyer.max_flight_time_s, flyer.density_kg_m3)
 
 
-def per_model(flyers: Sequence[EvaluatedModel], work: Callable[[EvaluatedModel], T]) -> dict[str, T]:
+def per_model(flyers: Sequence[Flyer], work: Callable[[Flyer], T]) -> dict[str, T]:
     """`work` for each model, by label; a model that flies exactly like an earlier one reuses its result."""
     done: dict[tuple, T] = {}
     results = {}
@@ -173,27 +176,27 @@ def _verdict(name: str, value: float, limit: float, unit: str) -> str:
     return f"{name} {_cell(value)} {unit} (target <= {limit:g}): **{'met' if met else 'not met'}**"
 
 
-def _header(flyers: Sequence[EvaluatedModel], rho_note: str) -> list[str]:
+def _header(flyers: Sequence[Flyer], rho_note: str) -> list[str]:
     rows = []
     for flyer in flyers:
-        if isinstance(flyer, ModelFlyer):
+        if is_bundle(flyer):
             card = flyer.card
             sources = getattr(card.training_data, "sources", None) or []
             trained = f"`{card.training_data.file}`" + (f" ({', '.join(s.name for s in sources)})" if sources else "")
-            what = (f"`{flyer.bundle}`: {card.variant}, trained on {trained}, ONNX {card.onnx.sha256[:12]}, card air "
-                    f"rho {flyer.density_kg_m3:.3f} kg/m^3")
+            what = (f"`{flyer.bundle_dir}`: {card.variant}, trained on {trained}, ONNX {card.onnx.sha256[:12]}, "
+                    f"card air rho {flyer.density_kg_m3:.3f} kg/m^3")
         else:
             what = (f"C_L, C_D quadratic in spin ratio, C_M = 0.011 S (`flight.coefficients.FERGUSON_2022`), "
                     f"rho {flyer.density_kg_m3:.3f} kg/m^3")
         rows.append((flyer.label, what))
-    models = [f for f in flyers if isinstance(f, ModelFlyer)]
+    models = [f for f in flyers if is_bundle(f)]
     same = len({f.card.onnx.sha256 for f in models}) < len(models)
     lines = [
         *table(("column", "model"), rows, align="ll"),
         "",
         (
             f"Every model is flown through `flight.flyer.Flyer` (NumPy physics, forward Euler, dt "
-            f"{flyers[0].dt_s:g} s, up to {flyers[0].t_sim_s:g} s), calm, in the air named above: {rho_note}"
+            f"{flyers[0].dt_s:g} s, up to {flyers[0].max_flight_time_s:g} s), calm, in the air named above: {rho_note}"
         ),
     ]
     if same:
@@ -201,7 +204,7 @@ def _header(flyers: Sequence[EvaluatedModel], rho_note: str) -> list[str]:
     return lines
 
 
-def _drivers(data_dir: Path, flyers: Sequence[EvaluatedModel], report: AccuracyReport) -> list[str]:
+def _drivers(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
     lines = ["### TrackMan outdoor drivers (held out: lines 2943 on)", ""]
     path = data_dir / DRIVER_FILE
     if not path.is_file():
@@ -209,7 +212,7 @@ def _drivers(data_dir: Path, flyers: Sequence[EvaluatedModel], report: AccuracyR
     shots, note = held_out_driver_shots(path)
     report.driver_shots = shots
     labels = [f.label for f in flyers]
-    report.driver = per_model(flyers, lambda flyer: outcome_errors(flyer.simulate(shots.launch()), shots))
+    report.driver = per_model(flyers, lambda flyer: outcome_errors(flyer.flight(launch_problem(shots.launch())), shots))
     balls = ball_types(path)
     kinds = np.array([r.ball or balls.get(r.shot_id or "", "") for r in shots.records], dtype=object)
     premium = kinds == PREMIUM
@@ -266,7 +269,7 @@ def _tee_group_rows(errors: dict[str, dict[str, np.ndarray]], labels: Sequence[s
     return rows
 
 
-def _tour_championship(data_dir: Path, flyers: Sequence[EvaluatedModel], report: AccuracyReport) -> list[str]:
+def _tour_championship(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
     held = TOUR_CHAMPIONSHIP_HELD_OUT
     lines = [f"### TOUR Championship 2020, East Lake (held out: {held.rows()})", ""]
     path = data_dir / TOUR_CHAMPIONSHIP_PBP
@@ -276,11 +279,11 @@ def _tour_championship(data_dir: Path, flyers: Sequence[EvaluatedModel], report:
     labels = [f.label for f in flyers]
     air = TOUR_CHAMPIONSHIP_2020.air()
     report.tour_championship = per_model(
-        flyers, lambda flyer: outcome_errors(flyer.simulate(shots.launch(), air), shots))
+        flyers, lambda flyer: outcome_errors(flyer.flight(launch_problem(shots.launch(), air)), shots))
     pars = hole_pars(path)
     rows = _tee_group_rows(report.tour_championship, labels, tee_groups(shots, pars))
     par_three = ", ".join(str(hole) for hole, par in pars.items() if par == 3)
-    ferguson = next(f.label for f in flyers if not isinstance(f, ModelFlyer))
+    ferguson = next(f.label for f in flyers if not is_bundle(f))
     lines += [
         (
             f"`{TOUR_CHAMPIONSHIP_PBP.name}`: {note}. Every model flown in the event's air "
@@ -316,7 +319,7 @@ def _pga_outcome(index: int, comparisons: dict[str, ClubComparison], labels: Seq
             *table(("club", "TrackMan", *labels, "target"), rows), ""]
 
 
-def _pga(data_dir: Path, flyers: Sequence[EvaluatedModel], report: AccuracyReport):
+def _pga(data_dir: Path, flyers: Sequence[Flyer], report: AccuracyReport):
     lines = ["### PGA TOUR 2023 TrackMan averages per club (a TRAINING set: a fit, not a check)", ""]
     path = data_dir / TOUR_AVERAGES_FILE
     if not path.is_file():
@@ -359,7 +362,7 @@ def _paper() -> list[str]:
     ]
 
 
-def _slow(flyers: Sequence[EvaluatedModel], report: AccuracyReport) -> list[str]:
+def _slow(flyers: Sequence[Flyer], report: AccuracyReport) -> list[str]:
     labels = [f.label for f in flyers]
     report.slow = per_model(flyers, fly_slow)
     rows = []
@@ -384,7 +387,7 @@ def _slow(flyers: Sequence[EvaluatedModel], report: AccuracyReport) -> list[str]
     return lines
 
 
-def _sentry(data_dir: Path, flyers: Sequence[EvaluatedModel], out: Path, figures_dir: Path, report: AccuracyReport) -> list[str]:
+def _sentry(data_dir: Path, flyers: Sequence[Flyer], out: Path, figures_dir: Path, report: AccuracyReport) -> list[str]:
     from golfflight.evaluation import figures
 
     lines = ["### PGA TOUR trajectories, 2022 Sentry at Kapalua (a TRAINING set of the real-data model)", ""]
@@ -396,8 +399,8 @@ def _sentry(data_dir: Path, flyers: Sequence[EvaluatedModel], out: Path, figures
     trajectories = [conversion.trajectories[s] for s in shots.column("shot_id")]
     labels = [f.label for f in flyers]
 
-    def evaluate(flyer: EvaluatedModel):
-        flight = flyer.simulate(shots.launch(), keep_states=True)
+    def evaluate(flyer: Flyer):
+        flight = flyer.flight(launch_problem(shots.launch(), keep_states=True))
         return outcome_errors(flight, shots), path_errors(flight, trajectories)
 
     results = per_model(flyers, evaluate)
@@ -439,14 +442,14 @@ def _anova_cells(result: Anova) -> tuple[str, ...]:
             "–" if not math.isfinite(result.f) else f"{result.f:.1f} ({p})", _cell(result.between_fraction))
 
 
-def _winds(trajectory_file: Path, conversion, shots: ShotSet, flyers: Sequence[EvaluatedModel],
+def _winds(trajectory_file: Path, conversion, shots: ShotSet, flyers: Sequence[Flyer],
            report: AccuracyReport) -> list[str]:
     flights = read_flights(trajectory_file, ConversionReport(str(trajectory_file)))
     tracked = {f.shot_id: f.measured_time_s for f in flights}
     ids = list(shots.column("shot_id"))
     labels = [f.label for f in flyers]
 
-    def fit(flyer: EvaluatedModel) -> WindFit:
+    def fit(flyer: Flyer) -> WindFit:
         return fit_winds(flyer, measured_paths(ids, shots.launch(), conversion.trajectories, tracked, flyer.dt_s))
 
     report.winds = per_model(flyers, fit)
@@ -526,18 +529,18 @@ def _wind_answer(results: dict[str, Consistency], labels: Sequence[str]) -> str:
     return "In numbers: " + "; ".join(parts) + "."
 
 
-def _training_wind_lines(flyer: EvaluatedModel, fitted: dict[str, GroupWind], report: AccuracyReport) -> list[str]:
-    if not isinstance(flyer, ModelFlyer):
+def _training_wind_lines(flyer: Flyer, fitted: dict[str, GroupWind], report: AccuracyReport) -> list[str]:
+    if not is_bundle(flyer):
         return []
-    entries = training_winds(flyer.bundle)
+    entries = training_winds(flyer.bundle_dir)
     if entries is None:
-        return [f"_No `training_conditions.json` beside `{flyer.bundle}`: the comparison with the winds the model was "
-                "trained with is skipped._"]
+        return [f"_No `training_conditions.json` beside `{flyer.bundle_dir}`: the comparison with the winds the model "
+                "was trained with is skipped._"]
     comparison = compare_training_winds(entries, list(fitted.values()))
     report.training_winds = comparison
     return [
         (
-            f"`{flyer.bundle}/training_conditions.json` holds {comparison.n_training_groups} group winds; "
+            f"`{flyer.bundle_dir}/training_conditions.json` holds {comparison.n_training_groups} group winds; "
             f"{comparison.n_groups} of them are Sentry holes fitted here. Correlation of the training winds with the "
             f"fitted group means: x {_cell(comparison.correlation_x)}, y {_cell(comparison.correlation_y)} (NaN with "
             f"fewer than 3 groups); mean difference (training - fitted) x "
@@ -562,7 +565,7 @@ def _summary_rows(errors: dict[str, np.ndarray]) -> list[tuple[str, ...]]:
     return rows
 
 
-def _study(data_dir: Path, flyer: ModelFlyer, clubs, epochs: int, finetune: Finetune | None,
+def _study(data_dir: Path, flyer: Flyer, clubs, epochs: int, finetune: Finetune | None,
            report: AccuracyReport, progress: bool) -> list[str]:
     lines = ["### Fine-tuning on a tour event's early rounds (Sony Open 2022)", ""]
     path = data_dir / SONY_TRAJECTORIES
@@ -625,11 +628,11 @@ def run_accuracy(
     (`model_export.finetune.finetune`; None skips it), and write OUT's generated section and the path-error figure;
     missing sets are announced. With `progress`, each set's step goes to standard error as it starts."""
     data_dir = Path(data_dir) if data_dir is not None else shared_data_dir()
-    real = ModelFlyer(bundle, "real-data model")
-    flyers: list[EvaluatedModel] = [
+    real = model_flyer(bundle, "real-data model")
+    flyers: list[Flyer] = [
         real,
-        ModelFlyer(synthetic if synthetic is not None else bundle, "synthetic model"),
-        ferguson_flyer(real.dt_s, real.t_sim_s),
+        model_flyer(synthetic if synthetic is not None else bundle, "synthetic model"),
+        ferguson_flyer(real.dt_s, real.max_flight_time_s),
     ]
     report = AccuracyReport("", labels=[f.label for f in flyers])
     lines = _header(flyers, "none of these sets records its weather; the TOUR Championship and the PGA table are "

@@ -15,9 +15,11 @@ from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
+from golfflight.contract.problems import launch_problem
 from golfflight.errors import InputError
-from golfflight.evaluation.accuracy_flyers import ModelFlyer
+from golfflight.evaluation.accuracy_flyers import model_flyer
 from golfflight.evaluation.accuracy_sets import ClubComparison, compare_clubs, outcome_errors
+from golfflight.flight.flyer import Flyer
 from golfflight.shots.progress import progress_bar
 from golfflight.shots.records import ShotSet, write_shots
 from golfflight.shots.reference_world import ClubAverage
@@ -71,7 +73,7 @@ class FinetuneStudy:
 
 
 def finetune_study(
-    flyer: ModelFlyer,
+    flyer: Flyer,
     shots: ShotSet,
     clubs: Sequence[ClubAverage] | None,
     finetune: Finetune,
@@ -93,21 +95,21 @@ def finetune_study(
         raise InputError(f"needs shots in rounds {list(train_rounds)} and {list(measured_rounds)}; "
                          f"found {len(train)} and {len(measured)}")
     launch = measured.launch()
-    before = outcome_errors(flyer.simulate(launch), measured)
+    before = outcome_errors(flyer.flight(launch_problem(launch)), measured)
     with tempfile.TemporaryDirectory(prefix="golfflight-finetune-") as work:
         train_file = Path(work) / "train_rounds.csv"
         write_shots(train_file, [r.model_copy(update={"split": None}) for r in train.records])
         results = {}
         for index, lr in enumerate(progress_bar(lrs, "fine-tuning, learning rates", unit="rate", shown=progress)):
-            results[lr] = (Path(work) / f"bundle-{index}",
-                           finetune(flyer.bundle, train_file, Path(work) / f"bundle-{index}", epochs, lr, batch_size,
-                                    val_fraction=val_fraction, progress=False))
+            out = Path(work) / f"bundle-{index}"
+            results[lr] = (out, finetune(flyer.bundle_dir, train_file, out, epochs, lr, batch_size,
+                                         val_fraction=val_fraction, progress=False))
         validation = {lr: (float(r.run.best["landing_error_m"]) if r.run.best else float("inf"),
                            None if r.run.best is None else int(r.run.best["epoch"])) for lr, (_, r) in results.items()}
         lr = min(validation, key=lambda rate: validation[rate][0])
         out, result = results[lr]
-        tuned = ModelFlyer(out) if result.improved else flyer
-        after = outcome_errors(tuned.simulate(launch), measured)
+        tuned = model_flyer(out) if result.improved else flyer
+        after = outcome_errors(tuned.flight(launch_problem(launch)), measured)
         pga_after = compare_clubs(tuned, clubs, PGA_2023_TABLE.air()) if clubs and result.improved else None
     return FinetuneStudy(
         n_shots=len(shots),

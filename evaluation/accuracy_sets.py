@@ -13,10 +13,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from golfflight.contract.problems import launch_problem
 from golfflight.errors import InputError
-from golfflight.evaluation.accuracy_flyers import EvaluatedModel
 from golfflight.flight.air import Air
 from golfflight.flight.constants import FOOT_M, YARD_M
+from golfflight.flight.flyer import Flyer
 from golfflight.flight.outcomes import Flight
 from golfflight.shots.clubs import straight_launches
 from golfflight.shots.heldout import HELD_OUT, held_out_rounds, shot_round
@@ -70,11 +71,11 @@ class ClubComparison:
         return np.mean(self.model - self.targets, axis=0)
 
 
-def compare_clubs(flyer: EvaluatedModel, clubs: Sequence[ClubAverage], air: Air | None = None) -> ClubComparison:
+def compare_clubs(flyer: Flyer, clubs: Sequence[ClubAverage], air: Air | None = None) -> ClubComparison:
     """Fly each club's average launch (launch direction and spin axis 0) and compare with TrackMan's averages."""
     launch = straight_launches(clubs)
     density = flyer.density_kg_m3 if air is None else float(air.density_kg_m3)
-    flight = flyer.simulate(launch, air)
+    flight = flyer.flight(launch_problem(launch, air))
     model = np.stack([flight.carry_m / YARD_M, flight.apex_m / YARD_M, flight.landing_angle_deg], axis=1)
     return ClubComparison(list(clubs), model, density)
 

@@ -11,8 +11,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from golfflight.evaluation.accuracy_flyers import EvaluatedModel
+from golfflight.contract.problems import launch_problem
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
+from golfflight.flight.flyer import Flyer
 
 
 @dataclass(frozen=True)
@@ -95,7 +96,7 @@ def launch_of(shots: Sequence[SlowShot]) -> dict[str, np.ndarray]:
     }
 
 
-def fly_slow(flyer: EvaluatedModel, shots: Sequence[SlowShot] = SLOW_SHOTS) -> dict[str, np.ndarray]:
+def fly_slow(flyer: Flyer, shots: Sequence[SlowShot] = SLOW_SHOTS) -> dict[str, np.ndarray]:
     """Carry (yd), max height (yd) and land angle (deg) of each slow shot, calm, in the flyer's own air."""
-    flight = flyer.simulate(launch_of(shots))
+    flight = flyer.flight(launch_problem(launch_of(shots)))
     return {"carry": flight.carry_m / YARD_M, "apex": flight.apex_m / YARD_M, "land": flight.landing_angle_deg}

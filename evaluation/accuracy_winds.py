@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from golfflight.evaluation.accuracy_flyers import EvaluatedModel
+from golfflight.contract.problems import launch_problem
+from golfflight.flight.flyer import Flyer
 from golfflight.flight.wind import Wind
 from scipy import sparse
 from scipy.optimize import least_squares
@@ -84,10 +85,11 @@ def measured_paths(
     return MeasuredPaths(list(shot_ids), launch, dt_s, positions)
 
 
-def _model_positions(flyer: EvaluatedModel, paths: MeasuredPaths, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def _model_positions(flyer: Flyer, paths: MeasuredPaths, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     steps = paths.positions.shape[0]
-    flight = flyer.simulate(paths.launch, keep_states=True, wind=Wind.from_components(x, y),
-                       t_max_s=steps * paths.dt_s, ground_height_m=NEVER_LANDS_M)
+    wind = Wind.from_components(x, y)
+    flight = flyer.flight(launch_problem(paths.launch, wind=wind, keep_states=True, max_time_s=steps * paths.dt_s,
+                                         ground_height_m=NEVER_LANDS_M))
     start = flight.states[0].position
     return np.stack([s.position for s in flight.states[1 : steps + 1]]) - start[None]
 
@@ -112,7 +114,7 @@ def _rms(residual: np.ndarray, counts: np.ndarray) -> np.ndarray:
     return np.sqrt(np.nansum(residual**2, axis=(0, 2)) / np.maximum(3 * counts, 1))
 
 
-def fit_winds(flyer: EvaluatedModel, paths: MeasuredPaths, max_evaluations: int = 60, step_mps: float = 0.01) -> WindFit:
+def fit_winds(flyer: Flyer, paths: MeasuredPaths, max_evaluations: int = 60, step_mps: float = 0.01) -> WindFit:
     """Each shot's uniform wind minimising its squared position errors over its measured steps, the model fixed.
 
     The Jacobian is taken by forward differences of `step_mps` (all shots' x components at once, then all y): a

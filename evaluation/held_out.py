@@ -9,7 +9,8 @@ import os
 from pathlib import Path
 
 import numpy as np
-from golfflight.evaluation.accuracy_flyers import ModelFlyer
+from golfflight.contract.problems import launch_problem
+from golfflight.evaluation.accuracy_flyers import model_flyer
 from golfflight.evaluation.accuracy_sets import (
     TOUR_CHAMPIONSHIP_HELD_OUT,
     TRACKMAN_HELD_OUT,
@@ -18,6 +19,7 @@ from golfflight.evaluation.accuracy_sets import (
     tee_groups,
     tour_championship_shots,
 )
+from golfflight.flight.flyer import Flyer
 from golfflight.shots.files import write_text_atomic
 from golfflight.shots.heldout import HeldOutSet
 from golfflight.shots.pbp import hole_pars
@@ -45,18 +47,18 @@ def _result(held: HeldOutSet, path: Path, n: int, errors: dict[str, float], note
                          errors=errors, note=note)
 
 
-def _drivers(flyer: ModelFlyer, path: Path) -> HeldOutResult:
+def _drivers(flyer: Flyer, path: Path) -> HeldOutResult:
     """TrackMan's held-out lines, in the card's air (the range sessions recorded none)."""
     shots, note = held_out_driver_shots(path)
-    errors = _mae(outcome_errors(flyer.simulate(shots.launch()), shots), FLIGHT_ERRORS)
+    errors = _mae(outcome_errors(flyer.flight(launch_problem(shots.launch())), shots), FLIGHT_ERRORS)
     return _result(TRACKMAN_HELD_OUT, path, len(shots), errors, f"all ball types; in the card's air; {note}")
 
 
-def _tour_championship(flyer: ModelFlyer, path: Path) -> HeldOutResult:
+def _tour_championship(flyer: Flyer, path: Path) -> HeldOutResult:
     """The TOUR Championship's held-out rounds in the event's air: apex MAE of all tee shots and of each group of
     `accuracy_sets.TEE_GROUPS` ('par3_apex_m', 'par4_5_apex_m')."""
     shots, note = tour_championship_shots(path)
-    errors = outcome_errors(flyer.simulate(shots.launch(), TOUR_CHAMPIONSHIP_2020.air()), shots)
+    errors = outcome_errors(flyer.flight(launch_problem(shots.launch(), TOUR_CHAMPIONSHIP_2020.air())), shots)
     measured = _mae(errors, {"apex_m": "apex_m"})
     for name, mask in tee_groups(shots, hole_pars(path)).items():
         measured |= _mae(errors, {"apex_m": f"{name}_apex_m"}, mask)
@@ -66,7 +68,7 @@ def _tour_championship(flyer: ModelFlyer, path: Path) -> HeldOutResult:
 
 def held_out_results(bundle: str | os.PathLike, data_dir: str | os.PathLike) -> list[HeldOutResult]:
     """The bundle's errors on every held-out set present under `data_dir` (sets that are absent are left out)."""
-    flyer, data_dir = ModelFlyer(bundle), Path(data_dir)
+    flyer, data_dir = model_flyer(bundle), Path(data_dir)
     sets = ((TRACKMAN_HELD_OUT, _drivers), (TOUR_CHAMPIONSHIP_HELD_OUT, _tour_championship))
     return [measure(flyer, data_dir / held.path) for held, measure in sets if (data_dir / held.path).is_file()]
 

@@ -1,7 +1,7 @@
 """`golfflight physics-check`: a model bundle's aerodynamics along real flights, held against the literature.
 
 Torch-free (NumPy and ONNX Runtime only), so it runs in the serving install. Each club of `shots.clubs.CLUBS` is
-flown through the runtime path (`evaluation.accuracy_flyers.ModelFlyer`: the bundle's ONNX graph in
+flown through the runtime path (`evaluation.accuracy_flyers.model_flyer`: the bundle's ONNX graph in
 `flight.flyer.Flyer.flight`, forward Euler at the card's step) in ICAO standard air, calm. At every step above the
 ground it records the Reynolds number Re = |v_rel| d / nu and spin ratio S = R |omega| / |v_rel| the ball meets, and
 the coefficients the graph gives there, converted to the literature's convention (below). Two checks:
@@ -30,10 +30,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from golfflight.contract.problems import launch_problem
 from golfflight.errors import InputError
-from golfflight.evaluation.accuracy_flyers import EvaluatedModel, ModelFlyer
+from golfflight.evaluation.accuracy_flyers import model_flyer
 from golfflight.flight.air import Air
 from golfflight.flight.constants import BALL_RADIUS_M
+from golfflight.flight.flyer import Flyer
 from golfflight.flight.physics import spin_ratio
 from golfflight.shots.clubs import CLUBS, ClubLaunch, straight_launches
 from golfflight.shots.markdown import table
@@ -298,11 +300,11 @@ class FlightPoints:
     coefficients: dict[str, np.ndarray]
 
 
-def flight_points(flyer: EvaluatedModel, clubs: list[ClubLaunch], air: Air) -> list[FlightPoints]:
+def flight_points(flyer: Flyer, clubs: list[ClubLaunch], air: Air) -> list[FlightPoints]:
     """Fly the clubs through `flyer` in `air` (calm) and read back what each flight meets at each step above the
     ground. The coefficients are the model's at those states, the very values the integrator stepped with."""
-    flight = flyer.simulate(straight_launches(clubs), air, keep_states=True)
-    model = flyer.coefficients_in(air)
+    flight = flyer.flight(launch_problem(straight_launches(clubs), air, keep_states=True))
+    model = flyer.in_air(air.kinematic_viscosity_m2_s)
     result = []
     for i, club in enumerate(clubs):
         last = int(flight.last_step[i]) if flight.landed[i] else len(flight.states) - 1
@@ -315,12 +317,13 @@ def flight_points(flyer: EvaluatedModel, clubs: list[ClubLaunch], air: Air) -> l
     return result
 
 
-def spin_lost(flyer: EvaluatedModel, clubs: list[ClubLaunch], air: Air, times_s: tuple[float, ...]) -> np.ndarray:
+def spin_lost(flyer: Flyer, clubs: list[ClubLaunch], air: Air, times_s: tuple[float, ...]) -> np.ndarray:
     """Share (0-1) of its launch spin each club's ball has lost at each time [clubs, times], flown through `flyer`
     in `air` (the spin magnitude interpolated linearly between steps). A ball is followed past its landing (the
     measurement is of the decay law, not of a flight's length), so the flight is run for the longest time asked."""
-    flight = flyer.simulate(straight_launches(clubs), air, keep_states=True, t_max_s=max(flyer.t_sim_s, max(times_s)),
-                            ground_height_m=-1e9)
+    longest = max(flyer.max_flight_time_s, max(times_s))
+    problem = launch_problem(straight_launches(clubs), air, keep_states=True, max_time_s=longest, ground_height_m=-1e9)
+    flight = flyer.flight(problem)
     spin = np.stack([np.linalg.norm(state.spin, axis=-1) for state in flight.states])
     return np.stack([1.0 - np.interp(times_s, flight.times_s, spin[:, i]) / spin[0, i] for i in range(len(clubs))])
 
@@ -402,7 +405,7 @@ def club_launch(name: str, spin_rpm: float | None = None) -> ClubLaunch:
     return match if spin_rpm is None else match._replace(spin_rpm=spin_rpm)
 
 
-def check_spin(flyer: EvaluatedModel, measurements: list[SpinDecayMeasurement], air: Air) -> list[SpinCheck]:
+def check_spin(flyer: Flyer, measurements: list[SpinDecayMeasurement], air: Air) -> list[SpinCheck]:
     """Each TrackMan club flown with its tour-average speed and launch angle and TrackMan's launch spin: for a
     C_M = p_M S model the share lost depends on the speed history alone, and the launch spin changes that history
     only through the flight's lift."""
@@ -417,7 +420,7 @@ def check_spin(flyer: EvaluatedModel, measurements: list[SpinDecayMeasurement], 
 class PhysicsReport:
     """Everything `golfflight physics-check` found about one bundle."""
 
-    flyer: ModelFlyer
+    flyer: Flyer
     air: Air
     literature: list[LiteraturePoint]
     measured: dict[str, MeasuredSet]
@@ -432,7 +435,7 @@ def run_physics_checks(model_dir: str | os.PathLike | None, data_dir: str | os.P
         if not path.is_file():
             raise FileNotFoundError(f"{path} not found (set GOLFFLIGHT_SHARED_DATA or put the shared data beside the "
                                     "repository)")
-    flyer, air = ModelFlyer(model_dir), Air.standard()
+    flyer, air = model_flyer(model_dir), Air.standard()
     literature = read_aero_literature(aero)
     measured = {name: measured_set(literature, name) for name in COEFFICIENTS}
     if not all(len(m.value) for m in measured.values()):

@@ -15,11 +15,12 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
-from golfflight.evaluation.accuracy_flyers import EvaluatedModel
+from golfflight.contract.problems import launch_problem
 from golfflight.evaluation.accuracy_sets import outcome_errors
 from golfflight.evaluation.landing_network import LandingNetwork
 from golfflight.flight.air import Air
 from golfflight.flight.constants import YARD_M
+from golfflight.flight.flyer import Flyer
 from golfflight.shots.markdown import table
 from golfflight.shots.records import ShotSet
 
@@ -69,11 +70,11 @@ def _carry_where_only_distance(errors: dict[str, np.ndarray], carry_m: np.ndarra
     return errors | {"carry_m": np.where(only_distance, carry_m - y, errors["carry_m"])}
 
 
-def flown(model: EvaluatedModel) -> Predictor:
+def flown(model: Flyer) -> Predictor:
     """A physics model's errors: each shot flown calm in `air` (None: the model's own)."""
 
     def errors(shots: ShotSet, air: Air | None) -> dict[str, np.ndarray]:
-        flight = model.simulate(shots.launch(), air)
+        flight = model.flight(launch_problem(shots.launch(), air))
         return _carry_where_only_distance(outcome_errors(flight, shots), flight.carry_m, shots)
     return errors
 

@@ -8,7 +8,7 @@ import os
 from pathlib import Path
 
 from golfflight.errors import InputError
-from golfflight.evaluation.accuracy_flyers import ModelFlyer, ferguson_flyer
+from golfflight.evaluation.accuracy_flyers import ferguson_flyer, model_flyer
 from golfflight.evaluation.landing_network import LandingNetwork
 from golfflight.evaluation.variant_comparison import (
     BOOTSTRAP_DRAWS,
@@ -36,7 +36,7 @@ def parse_variant(text: str) -> tuple[str, list[str]]:
 def _run(path: str) -> Predictor:
     """A bundle flies its shots; a folder of `train-real --variant nn` predicts their landing points."""
     if (Path(path) / "model_card.json").is_file():
-        return flown(ModelFlyer(path))
+        return flown(model_flyer(path))
     return predicted_landing(LandingNetwork(path))
 
 
@@ -45,8 +45,8 @@ def comparands(variants: list[str], synthetic: str | os.PathLike) -> list[Compar
     Euler step, as `golfflight accuracy` flies Ferguson)."""
     parsed = [parse_variant(text) for text in variants]
     compared = [Comparand(label, [_run(path) for path in paths]) for label, paths in parsed]
-    synthetic_model = ModelFlyer(synthetic, "synthetic model")
-    ferguson = ferguson_flyer(synthetic_model.dt_s, synthetic_model.t_sim_s)
+    synthetic_model = model_flyer(synthetic, "synthetic model")
+    ferguson = ferguson_flyer(synthetic_model.dt_s, synthetic_model.max_flight_time_s)
     return [*compared, Comparand("Ferguson 2022 published", [flown(ferguson)]),
             Comparand("synthetic model", [flown(synthetic_model)])]
 

@@ -77,7 +77,8 @@ class _FlownBatch(NamedTuple):
 
 class Flyer:
     """A coefficient model flown by one step rule at one step, for at most one flight time, in its nominal air unless
-    told otherwise. `card` and `bundle_dir` are a bundle's (None for a closed-form model)."""
+    told otherwise. `card` and `bundle_dir` are a bundle's (None for a closed-form model); `label` names it in reports
+    (default: the bundle's directory, or the model's class)."""
 
     def __init__(
         self,
@@ -89,8 +90,10 @@ class Flyer:
         rule: StepRule = FORWARD_EULER,
         card: ModelCard | None = None,
         bundle_dir: Path | None = None,
+        label: str | None = None,
     ) -> None:
         self.model, self.rule, self.card, self.bundle_dir = model, rule, card, bundle_dir
+        self.label = label or (f"`{bundle_dir}`" if bundle_dir is not None else type(model).__name__)
         self.dt_s, self.max_flight_time_s = float(dt_s), float(max_flight_time_s)
         self.density_kg_m3, self.kinematic_viscosity_m2_s = float(density_kg_m3), float(kinematic_viscosity_m2_s)
         self.max_steps = step_count(self.max_flight_time_s, self.dt_s)
@@ -108,6 +111,7 @@ class Flyer:
             self.rule if rule is None else rule,
             self.card,
             self.bundle_dir,
+            self.label,
         )
 
     def in_air(self, kinematic_viscosity_m2_s: float | np.ndarray | None = None) -> CoefficientModel:

@@ -18,7 +18,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from golfflight.evaluation.accuracy_flyers import ModelFlyer
+from golfflight.contract.problems import launch_problem
+from golfflight.evaluation.accuracy_flyers import model_flyer
 from golfflight.flight.air import Air
 from golfflight.flight.constants import YARD_M
 from golfflight.model_export.real_data import trackman_outdoor
@@ -59,9 +60,9 @@ def main() -> int:
                           [[b["ball"], str(b["n_shots"]), f"{b['lift_scale']:.3f}", f"{b['drag_scale']:.3f}"]
                            for b in conditions["ball"]])))
     launch, recorded, n = median_premium_drive(args.data)
-    flyer, standard = ModelFlyer(args.bundle), Air.standard()
+    flyer, standard = model_flyer(args.bundle), Air.standard()
     fitted = Air(standard.density_kg_m3 * mean, standard.kinematic_viscosity_m2_s / mean)
-    rows = [[name, f"{float(flyer.simulate(launch, air).carry_m[0]) / YARD_M:.1f}"]
+    rows = [[name, f"{float(flyer.flight(launch_problem(launch, air)).carry_m[0]) / YARD_M:.1f}"]
             for name, air in (("ICAO standard air", standard), (f"the range source's fitted air (x {mean:.3f})", fitted))]
     rows.append([f"recorded: the median carry of the {n} Premium drives", f"{recorded / YARD_M:.1f}"])
     speed, angle, spin = (float(launch[k][0]) for k in ("ball_speed_mps", "launch_angle_deg", "spin_rpm"))

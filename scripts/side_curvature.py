@@ -17,8 +17,10 @@ from scipy.optimize import least_squares
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from golfflight.evaluation.accuracy_flyers import EvaluatedModel, ModelFlyer, ferguson_flyer
+from golfflight.contract.problems import launch_problem
+from golfflight.evaluation.accuracy_flyers import ferguson_flyer, model_flyer
 from golfflight.evaluation.accuracy_sets import outcome_errors
+from golfflight.flight.flyer import Flyer
 from golfflight.flight.physics import initial_state
 from golfflight.flight.problem import FlightProblem
 from golfflight.model_export.real_data import trackman_outdoor
@@ -46,21 +48,21 @@ def axis_slope(errors: np.ndarray, launch: dict[str, np.ndarray],
     return float(coef[0]), float(np.sqrt(covariance[0, 0]))
 
 
-def side_per_degree(flyer: EvaluatedModel, launch: dict[str, np.ndarray]) -> float:
+def side_per_degree(flyer: Flyer, launch: dict[str, np.ndarray]) -> float:
     """The model's own mean change of the landing side (m) per degree of spin axis."""
     sides = []
     for step in (-AXIS_STEP_DEG, AXIS_STEP_DEG):
         tilted = dict(launch, spin_axis_deg=launch["spin_axis_deg"] + step)
-        sides.append(flyer.simulate(tilted).lateral_m)
+        sides.append(flyer.flight(launch_problem(tilted)).lateral_m)
     return float(np.mean((sides[1] - sides[0]) / (2 * AXIS_STEP_DEG)))
 
 
-def model_rows(flyers: list[EvaluatedModel], shots: ShotSet, groups: np.ndarray) -> list[list[str]]:
+def model_rows(flyers: list[Flyer], shots: ShotSet, groups: np.ndarray) -> list[list[str]]:
     """Per model: side MAE and bias, the side error's slope on the axis (over all shots, and within groups), the
     model's own slope, their ratio."""
     rows = []
     for flyer in flyers:
-        errors = outcome_errors(flyer.simulate(shots.launch()), shots)["side_m"]
+        errors = outcome_errors(flyer.flight(launch_problem(shots.launch())), shots)["side_m"]
         slope, se = axis_slope(errors, shots.launch())
         within, within_se = axis_slope(errors, shots.launch(), groups)
         own = side_per_degree(flyer, shots.launch())
@@ -70,7 +72,7 @@ def model_rows(flyers: list[EvaluatedModel], shots: ShotSet, groups: np.ndarray)
     return rows
 
 
-def scale_rows(flyer: ModelFlyer, shots: ShotSet, lift_scales: tuple[float, ...],
+def scale_rows(flyer: Flyer, shots: ShotSet, lift_scales: tuple[float, ...],
                drag_scales: tuple[float, ...]) -> list[list[str]]:
     """The bundle with its C_L and C_D scaled: side, carry, apex and landing-angle errors."""
     rows = []
@@ -88,7 +90,7 @@ def scale_rows(flyer: ModelFlyer, shots: ShotSet, lift_scales: tuple[float, ...]
     return rows
 
 
-def axis_scale_rows(flyers: list[EvaluatedModel], sets: dict[str, ShotSet], scales: tuple[float, ...]) -> list[list[str]]:
+def axis_scale_rows(flyers: list[Flyer], sets: dict[str, ShotSet], scales: tuple[float, ...]) -> list[list[str]]:
     """Landing error and side MAE with the recorded spin axis multiplied by each scale (a launch-monitor reading
     error, if that is what the missing curvature is)."""
     rows = []
@@ -97,7 +99,7 @@ def axis_scale_rows(flyers: list[EvaluatedModel], sets: dict[str, ShotSet], scal
             cells = []
             for scale in scales:
                 launch = dict(shots.launch(), spin_axis_deg=shots.launch()["spin_axis_deg"] * scale)
-                errors = outcome_errors(flyer.simulate(launch), shots)
+                errors = outcome_errors(flyer.flight(launch_problem(launch)), shots)
                 cells.append(f"{np.mean(errors['landing_m']):.2f} / {np.mean(np.abs(errors['side_m'])):.2f}")
             rows.append([name, flyer.label, *cells])
     return rows
@@ -120,7 +122,7 @@ def monitor_profile(launch: dict[str, np.ndarray], profile: np.ndarray) -> dict[
                 launch_direction_deg=launch["launch_direction_deg"] + profile[3])
 
 
-def fit_monitor_profile(flyer: EvaluatedModel, shots: ShotSet, free: list[int]) -> np.ndarray:
+def fit_monitor_profile(flyer: Flyer, shots: ShotSet, free: list[int]) -> np.ndarray:
     """The profile whose `free` entries (the others as recorded) bring the flyer's carry, side and apex closest to
     the recordings (bounded least squares)."""
 
@@ -130,7 +132,8 @@ def fit_monitor_profile(flyer: EvaluatedModel, shots: ShotSet, free: list[int]) 
         return profile
 
     def residuals(values: np.ndarray) -> np.ndarray:
-        errors = outcome_errors(flyer.simulate(monitor_profile(shots.launch(), profile_of(values))), shots)
+        profiled = monitor_profile(shots.launch(), profile_of(values))
+        errors = outcome_errors(flyer.flight(launch_problem(profiled)), shots)
         return np.concatenate([errors[k] / scale for k, scale in PROFILE_SCALES_M.items()])
 
     fit = least_squares(residuals, AS_RECORDED[free], diff_step=1e-2,
@@ -143,7 +146,7 @@ PROFILES = ([0, 1, 2], [0, 1, 2, 3])
 first three, then all four)."""
 
 
-def profile_rows(flyers: list[EvaluatedModel], fit_on: ShotSet, check_on: ShotSet) -> list[list[str]]:
+def profile_rows(flyers: list[Flyer], fit_on: ShotSet, check_on: ShotSet) -> list[list[str]]:
     """Per flyer and profile: the profile fitted on `fit_on`, and the landing error / side MAE without and with it
     on both sets."""
     rows = []
@@ -153,12 +156,12 @@ def profile_rows(flyers: list[EvaluatedModel], fit_on: ShotSet, check_on: ShotSe
     return rows
 
 
-def _profile_row(flyer: EvaluatedModel, profile: np.ndarray, fit_on: ShotSet, check_on: ShotSet) -> list[str]:
+def _profile_row(flyer: Flyer, profile: np.ndarray, fit_on: ShotSet, check_on: ShotSet) -> list[str]:
     """One flyer and profile: the profile, and the landing error / side MAE without and with it on both sets."""
     cells = []
     for shots in (fit_on, check_on):
         for p in (AS_RECORDED, profile):
-            errors = outcome_errors(flyer.simulate(monitor_profile(shots.launch(), p)), shots)
+            errors = outcome_errors(flyer.flight(launch_problem(monitor_profile(shots.launch(), p))), shots)
             cells.append(f"{np.mean(errors['landing_m']):.2f} / {np.mean(np.abs(errors['side_m'])):.2f}")
     named = f"axis x {profile[0]:.2f}, launch {profile[1]:+.2f}°, spin x {profile[2]:.2f}, direction {profile[3]:+.2f}°"
     return [flyer.label, named, *cells]
@@ -173,8 +176,8 @@ def main() -> int:
     records = trackman_outdoor(args.data).records
     premium = ShotSet([r for r in records if r.ball == "Premium"])
     range_balls = ShotSet([r for r in records if r.ball != "Premium"])
-    model = ModelFlyer(args.model)
-    flyers = [model, ModelFlyer(args.synthetic), ferguson_flyer(model.dt_s, model.t_sim_s)]
+    model = model_flyer(args.model)
+    flyers = [model, model_flyer(args.synthetic), ferguson_flyer(model.dt_s, model.max_flight_time_s)]
     print(f"TrackMan outdoor drivers, training lines, Premium balls: {len(premium)} shots (train and validation "
           "splits; every model calm, in its own air)\n")
     blocks = np.array([r.group for r in records if r.ball == "Premium"])

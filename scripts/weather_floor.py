@@ -18,7 +18,9 @@ from scipy.optimize import least_squares
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from golfflight.evaluation.accuracy_flyers import EvaluatedModel, ModelFlyer, ferguson_flyer
+from golfflight.contract.problems import launch_problem
+from golfflight.evaluation.accuracy_flyers import ferguson_flyer, model_flyer
+from golfflight.flight.flyer import Flyer
 from golfflight.flight.wind import Wind
 from golfflight.model_export.real_data import trackman_outdoor
 from golfflight.shots.markdown import table
@@ -33,14 +35,15 @@ WIND_STEP_MPS = 0.05
 """The finite-difference step of the wind fit (m/s): the ONNX graph computes in float32."""
 
 
-def landing_errors(flyer: EvaluatedModel, shots: ShotSet, wind_xy: np.ndarray) -> np.ndarray:
+def landing_errors(flyer: Flyer, shots: ShotSet, wind_xy: np.ndarray) -> np.ndarray:
     """Per-shot (x, y) landing-point error (model - recorded, m) with one uniform wind (x, y m/s) for all."""
     n = len(shots)
-    flight = flyer.simulate(shots.launch(), wind=Wind.from_components(np.full(n, wind_xy[0]), np.full(n, wind_xy[1])))
+    wind = Wind.from_components(np.full(n, wind_xy[0]), np.full(n, wind_xy[1]))
+    flight = flyer.flight(launch_problem(shots.launch(), wind=wind))
     return flight.landing_position[:, :2] - np.column_stack([shots.column("carry_x_m"), shots.column("carry_y_m")])
 
 
-def fitted_wind(flyer: EvaluatedModel, shots: ShotSet) -> np.ndarray:
+def fitted_wind(flyer: Flyer, shots: ShotSet) -> np.ndarray:
     """The uniform wind (x, y m/s) that lands these shots closest to their recorded landing points."""
     def residuals(wind_xy: np.ndarray) -> np.ndarray:
         return landing_errors(flyer, shots, wind_xy).ravel()
@@ -49,12 +52,12 @@ def fitted_wind(flyer: EvaluatedModel, shots: ShotSet) -> np.ndarray:
                          diff_step=WIND_STEP_MPS).x
 
 
-def calm_errors(flyer: EvaluatedModel, shots: ShotSet) -> np.ndarray:
+def calm_errors(flyer: Flyer, shots: ShotSet) -> np.ndarray:
     """Per-shot landing error (m) flown calm."""
     return np.linalg.norm(landing_errors(flyer, shots, np.zeros(2)), axis=1)
 
 
-def leave_one_out(flyer: EvaluatedModel, shots: ShotSet, blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def leave_one_out(flyer: Flyer, shots: ShotSet, blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per shot with enough block neighbours: its landing error with the wind of the other shots of its block, and
     that wind; NaN for a shot whose block is too small."""
     windy = np.full(len(shots), np.nan)
@@ -71,7 +74,7 @@ def leave_one_out(flyer: EvaluatedModel, shots: ShotSet, blocks: np.ndarray) -> 
     return windy, winds
 
 
-def block_spread_rows(flyers: list[EvaluatedModel], shots: ShotSet) -> list[list[str]]:
+def block_spread_rows(flyers: list[Flyer], shots: ShotSet) -> list[list[str]]:
     """Per model: the calm landing error of each range block (mean over its Premium shots, blocks of at least
     MIN_OTHERS + 1 shots), summarised as median and 10th-90th percentile: how much a held-out set of a few blocks
     can differ from another by its sessions alone."""
@@ -88,7 +91,7 @@ def block_spread_rows(flyers: list[EvaluatedModel], shots: ShotSet) -> list[list
     return out
 
 
-def rows(flyers: list[EvaluatedModel], splits: dict[str, ShotSet]) -> list[list[str]]:
+def rows(flyers: list[Flyer], splits: dict[str, ShotSet]) -> list[list[str]]:
     """Per split and model: shots counted, landing error calm and with the block's leave-one-out wind, the share of
     the calm error that wind takes away, and the median fitted wind speed."""
     out = []
@@ -112,8 +115,8 @@ def main() -> int:
     args = parser.parse_args()
     records = [r for r in trackman_outdoor(args.data).records if r.ball == "Premium"]
     splits = {split: ShotSet([r for r in records if r.split == split]) for split in ("train", "val")}
-    model = ModelFlyer(args.model)
-    flyers = [model, ModelFlyer(args.synthetic), ferguson_flyer(model.dt_s, model.t_sim_s)]
+    model = model_flyer(args.model)
+    flyers = [model, model_flyer(args.synthetic), ferguson_flyer(model.dt_s, model.max_flight_time_s)]
     print(f"TrackMan outdoor drivers, training lines, Premium balls, by range block; a shot counts where its block "
           f"has at least {MIN_OTHERS} other Premium shots\n")
     columns = ["split", "model", "shots", "landing error calm, m", "with the block's wind (leave one out), m",

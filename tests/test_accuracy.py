@@ -17,15 +17,16 @@ from golfflight.evaluation.accuracy import (
     PATH_FIGURE,
     TOURCAST_PBP,
     TOURCAST_TRAJECTORIES,
-    ModelFlyer,
     ball_types,
     compare_clubs,
     ferguson_flyer,
+    model_flyer,
     outcome_errors,
     path_errors,
     per_model,
     run_accuracy,
 )
+from golfflight.contract.problems import launch_problem
 from golfflight.evaluation.accuracy_finetune import finetune_study, round_number
 from golfflight.evaluation.accuracy_sets import (
     SONY_TRAJECTORIES,
@@ -195,7 +196,7 @@ def test_path_errors_compare_positions_at_the_same_time():
 
 
 def test_clubs_are_compared_in_the_stated_air(bundle):
-    flyer = ModelFlyer(bundle)
+    flyer = model_flyer(bundle)
     standard, thin = compare_clubs(flyer, CLUBS), compare_clubs(flyer, CLUBS, Air.from_conditions(25.0, 2000.0))
     assert standard.density_kg_m3 == pytest.approx(Air.standard().density_kg_m3)
     assert standard.model.shape == (2, 3) and np.all(thin.model[:, 0] > standard.model[:, 0]), (
@@ -210,7 +211,7 @@ def test_the_ferguson_flyer_is_quadratic_spin_ratio_through_the_same_simulate_ca
     launch = _launches(5)
     flyer = ferguson_flyer(dt_s=0.1, t_sim_s=10.0)
     direct = simulate(initial_state(**launch), QuadraticSpinRatio(FERGUSON_2022), density=1.225, dt=0.1, t_max=10.0)
-    flown = flyer.simulate(launch)
+    flown = flyer.flight(launch_problem(launch))
     assert flyer.density_kg_m3 == 1.225 and flyer.label == "Ferguson 2022"
     assert flown.carry_m == pytest.approx(direct.carry_m, rel=1e-12)
     assert flown.apex_m == pytest.approx(direct.apex_m, rel=1e-12)
@@ -218,12 +219,12 @@ def test_the_ferguson_flyer_is_quadratic_spin_ratio_through_the_same_simulate_ca
     assert np.all((direct.carry_m > 150) & (direct.carry_m < 300)), "plausible drives"
     thin = Air.from_conditions(25.0, 2000.0)
     in_thin = simulate(initial_state(**launch), QuadraticSpinRatio(), density=thin.density_kg_m3, dt=0.1, t_max=10.0)
-    assert flyer.simulate(launch, thin).carry_m == pytest.approx(in_thin.carry_m, rel=1e-12)
+    assert flyer.flight(launch_problem(launch, thin)).carry_m == pytest.approx(in_thin.carry_m, rel=1e-12)
 
 
 def test_models_that_fly_alike_are_flown_once(bundle):
     calls = []
-    flyers = [ModelFlyer(bundle, "real"), ModelFlyer(bundle, "synthetic"), ferguson_flyer()]
+    flyers = [model_flyer(bundle, "real"), model_flyer(bundle, "synthetic"), ferguson_flyer()]
     results = per_model(flyers, lambda flyer: calls.append(flyer.label) or len(calls))
     assert calls == ["real", "Ferguson 2022"] and results == {"real": 1, "synthetic": 1, "Ferguson 2022": 2}
 
@@ -354,7 +355,7 @@ def test_hole_pars_come_from_strokes_and_scores_of_the_trainable_rounds_only(tmp
 def _fly_with_wind(flyer, launch: dict[str, np.ndarray], x: np.ndarray, y: np.ndarray):
     """Trajectories [T, 4] (t, x, y, z relative to the start) of launches flown in a known uniform wind per shot,
     and a radar-tracked time of 90 % of each flight."""
-    flight = flyer.simulate(launch, keep_states=True, wind=Wind.from_components(x, y))
+    flight = flyer.flight(launch_problem(launch, keep_states=True, wind=Wind.from_components(x, y)))
     start = flight.states[0].position
     positions = np.stack([s.position for s in flight.states]) - start[None]
     ids = [f"901-R1-H{1 + i % 2}-P{i}-S1" for i in range(len(x))]
@@ -370,7 +371,7 @@ def _fly_with_wind(flyer, launch: dict[str, np.ndarray], x: np.ndarray, y: np.nd
 def test_the_wind_fit_recovers_a_known_wind(bundle, which):
     """Flown in a known uniform wind per shot (cross, head and tail), the fit with the same model finds it again;
     through a bundle too, whose float32 graph inputs would hide scipy's default finite-difference step."""
-    flyer = ferguson_flyer() if which == "ferguson" else ModelFlyer(bundle)
+    flyer = ferguson_flyer() if which == "ferguson" else model_flyer(bundle)
     launch = _launches(4, seed=11)
     x, y = np.array([2.0, -3.0, 0.5, 0.0]), np.array([-4.0, 1.5, 3.0, 0.0])
     ids, trajectories, tracked = _fly_with_wind(flyer, launch, x, y)
@@ -444,7 +445,7 @@ def test_the_finetune_study_tunes_early_rounds_and_measures_later_ones(bundle, t
                                           "shot_id": f"901-R{1 + i * 4 // len(records)}-H1-P{i}-S1"})
                      for i, r in enumerate(records)])
     assert round_number("006-R3", None) == 3 and round_number(None, "006-R12-H1-P1-S1") == 12
-    study = finetune_study(ModelFlyer(bundle), shots, CLUBS, finetune, epochs=2, lrs=(3e-3,), batch_size=32)
+    study = finetune_study(model_flyer(bundle), shots, CLUBS, finetune, epochs=2, lrs=(3e-3,), batch_size=32)
     assert study.n_measured == 60 and study.n_train + study.n_val <= 60
     assert len(study.before["carry_m"]) == 60 and set(study.validation) == {3e-3}
     assert study.improved == (study.validation[3e-3][0] < study.base_validation_m)
@@ -492,8 +493,8 @@ def test_accuracy_report_on_hand_made_data(bundle, tmp_path):
     assert "No `training_conditions.json`" in text and f"](figures/{PATH_FIGURE})" in text
     assert len(report.tour_championship["real-data model"]["apex_m"]) == 4
     shots, _ = tour_championship_shots(data / TOUR_CHAMPIONSHIP_PBP)
-    ferguson = ferguson_flyer(ModelFlyer(bundle).dt_s, ModelFlyer(bundle).t_sim_s)
-    in_event_air = outcome_errors(ferguson.simulate(shots.launch(), TOUR_CHAMPIONSHIP_2020.air()), shots)
+    ferguson = ferguson_flyer(model_flyer(bundle).dt_s, model_flyer(bundle).max_flight_time_s)
+    in_event_air = outcome_errors(ferguson.flight(launch_problem(shots.launch(), TOUR_CHAMPIONSHIP_2020.air())), shots)
     assert report.tour_championship["Ferguson 2022"]["apex_m"] == pytest.approx(in_event_air["apex_m"], rel=1e-12)
     assert {c.density_kg_m3 for c in report.pga.values()} == {PGA_2023_TABLE.air().density_kg_m3}
     assert "(held out: rounds 3-4)" in text and "| all tee shots: apex MAE, ft |" in text

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 from golfflight.contract.requests import MAX_BATCH_SHOTS
-from golfflight.evaluation.accuracy_flyers import ModelFlyer
+from golfflight.evaluation.accuracy_flyers import model_flyer
 from golfflight.evaluation.accuracy_sets import compare_clubs
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.constants import MPH_TO_MPS, YARD_M
@@ -78,7 +78,7 @@ def test_pga_tour_launches_answer_what_docs_accuracy_reports(client):
     if not path.is_file():
         pytest.skip(f"no {path}")
     clubs = read_tour_averages(path)
-    expected = compare_clubs(ModelFlyer(model_dir()), clubs).model
+    expected = compare_clubs(model_flyer(model_dir()), clubs).model
     for club, (carry_yd, apex_yd, land_deg) in zip(clubs, expected):
         launch = {"launch_angle_deg": club.launch_angle_deg}
         si = shot(client, **launch, ball_speed_mps=club.ball_speed_mps, spin_rpm=club.spin_rpm)

@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 from built_wheel import PIP, build_wheel
+from golfflight.contract.problems import launch_problem
 from golfflight.discovery.model import from_bundle, load_model
 from golfflight.discovery.simulator import Setup, setup_flight
-from golfflight.evaluation.accuracy_flyers import ModelFlyer
+from golfflight.evaluation.accuracy_flyers import model_flyer
 from golfflight.flight.air import Air
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.environment_variables import MODEL as MODEL_ENV
@@ -55,16 +56,16 @@ def test_every_caller_flies_the_shot_to_the_engines_carry_for_the_same_time(engi
     assert single.flight_time_s > flyer.card.physics.t_sim_s
     calm_air = Air(flyer.density_kg_m3, flyer.kinematic_viscosity_m2_s)
     discovery = from_bundle()
-    setup = Setup(launch_columns(SKY_BALL), np.ones(1), np.full(1, discovery.density_kg_m3), np.zeros((1, 2)),
+    setup = Setup(launch_columns(SKY_BALL), np.ones(1), np.full(1, discovery.flyer.density_kg_m3), np.zeros((1, 2)),
                   np.zeros(1), np.ones((1, 3)))
-    accuracy = ModelFlyer(None)
+    accuracy = model_flyer(None)
     level = RestShots("one", np.array([SKY_BALL]), np.full(1, np.nan), np.zeros(1), np.full(1, np.nan))
     evaluate = pytest.importorskip("golfflight.model_export.evaluate")
     carries = {
         "engine.fly_batch": engine.fly_batch(FlightProblem.of([SKY_BALL])).shots()[0].carry_m,
         "engine.fly_batch, columns (sweep)": engine.fly_batch(FlightProblem.of(np.array([SKY_BALL]))).carry_m[0],
         "discovery from_bundle": setup_flight(setup, discovery.flyer).carry_m[0],
-        "accuracy ModelFlyer": accuracy.simulate(launch_columns(SKY_BALL)).carry_m[0],
+        "accuracy model_flyer": accuracy.flight(launch_problem(launch_columns(SKY_BALL))).carry_m[0],
         "evaluate runtime path": evaluate.runtime_flight(None, launch_columns(SKY_BALL), calm_air).carry_m[0],
         "ground fit landings": landings(level, load_flyer()).carry_m[0],
     }
@@ -75,7 +76,7 @@ def test_every_caller_flies_the_shot_to_the_engines_carry_for_the_same_time(engi
         "engine": engine.max_steps * engine.dt,
         "flyer": flyer.max_flight_time_s,
         "discovery": discovery.flyer.max_flight_time_s,
-        "accuracy": accuracy.t_sim_s,
+        "accuracy": accuracy.max_flight_time_s,
         "ground fit and evaluate (load_flyer)": load_flyer().max_flight_time_s,
     }
     for caller, seconds in times.items():
@@ -157,13 +158,13 @@ from golfflight.cli import build_parser
 from golfflight.discovery.model import load_model
 from golfflight.flight.bundle_location import model_dir
 from golfflight.flight.flyer import load_flyer
-from golfflight.evaluation.accuracy_flyers import ModelFlyer
+from golfflight.evaluation.accuracy_flyers import model_flyer
 
 parser = build_parser()
 found = {
     "diagnose": load_model(parser.parse_args(["diagnose", "shots.csv", "--out", "x"]).model).flyer.bundle_dir,
-    "accuracy": ModelFlyer(parser.parse_args(["accuracy"]).model).bundle,
-    "physics-check": ModelFlyer(parser.parse_args(["physics-check"]).model).bundle,
+    "accuracy": model_flyer(parser.parse_args(["accuracy"]).model).bundle_dir,
+    "physics-check": model_flyer(parser.parse_args(["physics-check"]).model).bundle_dir,
     "evaluate": model_dir(parser.parse_args(["evaluate", "--data", "d", "--runs", "r", "--out", "o"]).bundle),
     "ground-fit": load_flyer(parser.parse_args(["ground-fit"]).model).bundle_dir,
 }

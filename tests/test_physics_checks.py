@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from golfflight.evaluation.accuracy_flyers import CoefficientFlyer
+from golfflight.evaluation.accuracy_flyers import coefficient_flyer
 from golfflight.evaluation.physics_checks import (
     AERO_FILE,
     COEFFICIENTS,
@@ -88,7 +88,7 @@ def test_reynolds_number_and_spin_ratio_of_a_state_by_hand(tmp_path):
     assert reynolds_number(np.array([[3.0, 4.0, 0.0]]), 1.5e-5)[0] == pytest.approx(14223.333, rel=1e-6)
     # a 50 m/s horizontal launch with 3000 rpm back spin: Re = 50 * 0.04267 / 1.5e-5 = 142,233;
     # S = 0.021335 * 314.159 / 50 = 6.70259 / 50 = 0.134052
-    flyer = CoefficientFlyer(ConstantCoefficients(0.2, 0.25, 0.0, 0.5), "toy")
+    flyer = coefficient_flyer(ConstantCoefficients(0.2, 0.25, 0.0, 0.5), "toy")
     points = flight_points(flyer, [ClubLaunch("toy", 50.0, 0.0, 3000.0)], AIR)[0]
     assert points.reynolds[0] == pytest.approx(142233.33, rel=1e-6)
     assert points.spin_ratio[0] == pytest.approx(0.134052, rel=1e-5) and points.time_s[0] == 0.0
@@ -157,7 +157,7 @@ def test_spin_loss_of_a_constant_moment_coefficient_against_the_closed_form():
     constant C_M, d|w|/dt = -C_M C_Q rho d A |v|^2 / I integrates to |w0| - K (v0^2 t + g^2 t^3 / 3),
     K = C_M C_Q rho d A / I. Forward Euler sums the same at the steps' starts: K dt sum_n (v0^2 + g^2 n^2 dt^2)."""
     c_m, c_q, v0, rpm, dt = 4e-4, 0.5, 50.0, 3000.0, 0.1
-    flyer = CoefficientFlyer(ConstantCoefficients(0.0, 0.0, c_m, c_q), "toy", dt_s=dt, density_kg_m3=AIR.density_kg_m3)
+    flyer = coefficient_flyer(ConstantCoefficients(0.0, 0.0, c_m, c_q), "toy", dt_s=dt, density_kg_m3=AIR.density_kg_m3)
     times = (1.0, 3.0, 5.0)
     lost = spin_lost(flyer, [ClubLaunch("toy", v0, 0.0, rpm)], AIR, times)[0]
     k = c_m * c_q * AIR.density_kg_m3 * 2 * BALL_RADIUS_M * BALL_AREA_M2 / BALL_INERTIA_KG_M2

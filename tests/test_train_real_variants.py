@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
+from golfflight.contract.problems import launch_problem
 from golfflight.evaluation.landing_network import LandingNetwork
 from golfflight.evaluation.accuracy_flyers import ferguson_flyer
 from golfflight.evaluation.variant_comparison import block_bootstrap, flown
@@ -180,7 +181,7 @@ def test_a_shot_that_records_only_its_carry_distance_is_compared_on_carry():
     shots = ShotSet([record])
     ferguson = ferguson_flyer()
     errors = flown(ferguson)(shots, None)
-    carry = ferguson.simulate(shots.launch()).carry_m
+    carry = ferguson.flight(launch_problem(shots.launch())).carry_m
     np.testing.assert_allclose(errors["carry_m"], carry - 200.0)
     assert np.isnan(errors["landing_m"]).all() and np.isnan(errors["side_m"]).all()
 
