@@ -146,18 +146,25 @@ class Batch:
         return [(flights[i], replayed.get(i), flat.get(i)) for i in range(n)]
 
 
+_NONE = np.zeros(0, dtype=np.intp)
+"""No shots: a batch's replays or flats where it has none."""
+
+
 def batch_of(shots: list[ShotRequest], keep: bool = False, flat: bool = True) -> Batch:
     """The engine batch of `shots` (`Batch`), each request read once: its own states kept where `keep` or it asks
     for a trajectory, its replay's where it asks for one; flat flights of shots off the flat unless `flat` is False."""
     n = len(shots)
-    launches = np.array([launch_of(shot) for shot in shots], dtype=float).reshape(n, LAUNCH_WIDTH)
+    launches = [launch_of(shot) for shot in shots]
     conditions = PerShot.each([conditions_of(shot) for shot in shots])
     grounds = PerShot.each([ground_of(shot.ground) for shot in shots])
     references = [reference_of(shot) for shot in shots]
-    replays = PerShot.each([None if r is None else Conditions(air_of(r), CALM) for r in references])
     flats = [i for i, shot in enumerate(shots) if flat and lands_off_the_flat(shot)]
     traced = [shot.trajectory is not None for shot in shots]
     keep_rows = [keep or t for t in traced] + [t for t, r in zip(traced, references, strict=True) if r is not None]
+    if not flats and len(keep_rows) == n:  # their own flights alone (most requests): the problem as it is
+        return Batch(FlightProblem.of(launches, conditions, grounds, np.array(keep_rows, bool)), n, _NONE, _NONE)
+    replays = PerShot.each([None if r is None else Conditions(air_of(r), CALM) for r in references])
+    launches = np.array(launches, dtype=float).reshape(n, LAUNCH_WIDTH)
     return Batch.of(launches, conditions, grounds, replays, np.array(flats, dtype=np.intp), np.array(keep_rows, bool))
 
 

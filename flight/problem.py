@@ -95,7 +95,7 @@ class FlightProblem:
 
     def keeps(self, shot: int | None = None) -> bool:
         """Whether `shot`'s states are kept (None: any shot's)."""
-        if np.ndim(self.keep_states) == 0:
+        if isinstance(self.keep_states, (bool, np.bool_)):
             return bool(self.keep_states)
         return bool(np.any(self.keep_states) if shot is None else self.keep_states[shot])
 
