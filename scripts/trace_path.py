@@ -329,33 +329,41 @@ class Journey:
                 "calls": [dataclasses.asdict(call) for call in self.calls], "answer": self.answer}
 
 
-def shot_body(mph: float) -> dict:
-    """The single-shot request: a driver in launch-monitor units (tests/test_api.py's DRIVER_MPH at `mph`)."""
-    return {"ball_speed_mph": mph, "launch_angle_deg": 10.4, "back_spin_rpm": 2545.0}
+def shot_body(mph: float, full: bool = False) -> dict:
+    """The single-shot request: a driver in launch-monitor units (tests/test_api.py's DRIVER_MPH at `mph`); `full`
+    adds every branch a request can take: a normalized replay, a sloped green above the tee (so a flat flight too),
+    a trajectory and a log-profile wind."""
+    body = {"ball_speed_mph": mph, "launch_angle_deg": 10.4, "back_spin_rpm": 2545.0}
+    if full:
+        body |= {"normalized": True, "trajectory": {"rate_hz": 30},
+                 "ground": {"surface": "green", "elevation_m": 3.0, "slope_deg": 2.0, "slope_dir_deg": 45.0},
+                 "wind": {"speed_mps": 4.0, "from_deg": 200.0, "profile": "log"}}
+    return body
 
 
-async def _post_one(app, mph: float, tracer: Tracer) -> dict:
+async def _post_one(app, mph: float, tracer: Tracer, full: bool) -> dict:
     import httpx
 
     async with app.router.lifespan_context(app):  # the model loads here, before tracing
         transport = httpx.ASGITransport(app=app)
         async with httpx.AsyncClient(transport=transport, base_url="http://127.0.0.1") as client:
-            warm = await client.post("/v1/shots", json=shot_body(120.0))  # first-request work, at another speed
+            warm = await client.post("/v1/shots", json=shot_body(120.0, full))  # first-request work, at another speed
             warm.raise_for_status()
             with tracer:
-                response = await client.post("/v1/shots", json=shot_body(mph))
+                response = await client.post("/v1/shots", json=shot_body(mph, full))
     response.raise_for_status()
     return response.json()
 
 
-def http_journey(mph: float = BALL_SPEED_MPH) -> Journey:
-    """One POST /v1/shots through the app `create_app` assembles (default settings, no API key), in process."""
+def http_journey(mph: float = BALL_SPEED_MPH, full: bool = False) -> Journey:
+    """One POST /v1/shots through the app `create_app` assembles (default settings, no API key), in process; `full`:
+    the request with every branch (`shot_body`)."""
     from golfflight.service.app import create_app
     from golfflight.service.settings import ServiceSettings
 
     tracer = Tracer(mph)
-    answer = asyncio.run(_post_one(create_app(ServiceSettings()), mph, tracer))
-    return Journey("http", tracer.calls, {"carry_m": answer.get("carry_m")})
+    answer = asyncio.run(_post_one(create_app(ServiceSettings()), mph, tracer, full))
+    return Journey("http-full" if full else "http", tracer.calls, {"carry_m": answer.get("carry_m")})
 
 
 def _write_row(folder: Path, mph: float, kind: str) -> Path:
@@ -415,19 +423,20 @@ def table(journey: Journey, every_call: bool = False) -> str:
 
 JOURNEYS: dict[str, Callable[[argparse.Namespace], Journey]] = {
     "http": lambda args: http_journey(args.mph),
+    "http-full": lambda args: http_journey(args.mph, full=True),
     "sweep": lambda args: sweep_journey(args.mph, args.sweep_input),
 }
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--journey", choices=("http", "sweep", "both"), default="both")
+    parser.add_argument("--journey", choices=("http", "http-full", "sweep", "both", "all"), default="both")
     parser.add_argument("--mph", type=float, default=BALL_SPEED_MPH, help="the ball speed carried (mph)")
     parser.add_argument("--sweep-input", choices=("parquet", "csv"), default="parquet")
     parser.add_argument("--calls", action="store_true", help="also print every counted call")
     parser.add_argument("--out", help="write the journeys as JSON here")
     args = parser.parse_args(argv)
-    names = ("http", "sweep") if args.journey == "both" else (args.journey,)
+    names = {"both": ("http", "sweep"), "all": tuple(JOURNEYS)}.get(args.journey, (args.journey,))
     journeys = [JOURNEYS[name](args) for name in names]
     for journey in journeys:
         print(table(journey, args.calls), end="\n\n")
