@@ -47,7 +47,9 @@ def base_conditions(recordings: Recordings, model: FlightModel) -> Setup:
     """The conditions the model assumes for the recordings: recorded air (its density and kinematic viscosity, as the
     service flies it) and wind where present, else its own air."""
     n = len(recordings)
-    density = recordings.density_kg_m3 if recordings.density_kg_m3 is not None else np.full(n, model.flyer.density_kg_m3)
+    density = recordings.density_kg_m3
+    if density is None:
+        density = np.full(n, model.flyer.density_kg_m3)
     viscosity = recordings.kinematic_viscosity_m2_s
     if viscosity is None:
         viscosity = np.full(n, model.flyer.kinematic_viscosity_m2_s)

@@ -44,8 +44,9 @@ z = 0), or only the heights of the planes they are flown down to (no ground phas
 @dataclass(frozen=True)
 class FlightProblem:
     """N balls to fly: their launch state, air and wind (one Conditions a shot, or the equations' columns), ground,
-    per-ball coefficient scales [N, 3] and an extra acceleration where given, and what to keep: every state (`keep_states`, one
-    flag for all or one a shot) and the time flown (`max_time_s`; None: the engine's maximum flight time)."""
+    per-ball coefficient scales [N, 3] and an extra acceleration where given, and what to keep: every state
+    (`keep_states`, one flag for all or one a shot) and the time flown (`max_time_s`; None: the engine's maximum
+    flight time)."""
 
     start: State
     air: PerShot[Conditions] | BatchAir = NOMINAL_AIR
@@ -70,7 +71,8 @@ class FlightProblem:
         if array.size != n * LAUNCH_WIDTH:
             raise InputError(f"launches: an array [N, {LAUNCH_WIDTH}] of {', '.join(Launch._fields)}")
         start = initial_state(*array.reshape(n, LAUNCH_WIDTH).T)
-        return cls(start, PerShot.of(conditions, n, "conditions"), PerShot.of(grounds, n, "grounds"), keep_states=keep_states)
+        air, on = PerShot.of(conditions, n, "conditions"), PerShot.of(grounds, n, "grounds")
+        return cls(start, air, on, keep_states=keep_states)
 
     def __len__(self) -> int:
         return len(self.start.position)

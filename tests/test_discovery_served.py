@@ -45,7 +45,8 @@ def test_discovery_flies_the_launches_as_the_engine_does(served):
     launches = [Launch(70.0, 11.0, 1.0, 2600.0, 4.0), Launch(45.0, 20.0, -2.0, 7000.0, -8.0)]
     flights = FlightEngine(model_dir()).fly_batch(FlightProblem.of(launches)).shots()
     columns = {name: np.array(values, dtype=float) for name, values in zip(Launch._fields, zip(*launches))}
-    setup = Setup(columns, np.ones(2), np.full(2, served.flyer.density_kg_m3), np.zeros((2, 2)), np.zeros(2), np.ones((2, 3)))
+    density = np.full(2, served.flyer.density_kg_m3)
+    setup = Setup(columns, np.ones(2), density, np.zeros((2, 2)), np.zeros(2), np.ones((2, 3)))
     flown = served.simulate(setup).outcomes()
     for column, field in enumerate(("landing_y_m", "landing_x_m", "apex_m", "flight_time_s", "landing_angle_deg")):
         assert flown[:, column] == pytest.approx([getattr(f, field) for f in flights], abs=1e-9)
