@@ -146,14 +146,28 @@ def learning_curve(shots: dict[str, np.ndarray], errors: dict[str, np.ndarray], 
                    path: str | os.PathLike, ylabel: str) -> Path:
     """Error against training shots, a line per model: `errors[label]` at `shots[label]` (log axis), with the range
     over seeds `spans[label]` [n, 2] as bars."""
-    figure, axis = plt.subplots(figsize=(6.5, 4.2))
-    for label, n in shots.items():
-        low, high = spans[label][:, 0], spans[label][:, 1]
-        axis.errorbar(n, errors[label], yerr=[errors[label] - low, high - errors[label]], marker="o", capsize=3,
-                      label=label)
-    axis.set_xscale("log")
-    axis.set_xlabel("training shots")
-    axis.set_ylabel(ylabel)
-    axis.grid(alpha=0.3)
-    axis.legend()
+    return learning_curves([(ylabel, shots, errors, spans)], path)
+
+
+LearningPanel = tuple[str, dict[str, np.ndarray], dict[str, np.ndarray], dict[str, np.ndarray]]
+"""One panel of `learning_curves`: (y label, shots, errors, spans) as `learning_curve` takes them."""
+
+
+def learning_curves(panels: Sequence[LearningPanel], path: str | os.PathLike,
+                    floors: dict[int, tuple[str, float]] | None = None) -> Path:
+    """`learning_curve`'s plot for each panel, side by side; `floors[i]` = (label, value) draws a dashed horizontal
+    line on panel i (a reference level, such as a noise floor)."""
+    figure, axes = plt.subplots(1, len(panels), figsize=(6.5 * len(panels), 4.2), squeeze=False)
+    for index, (axis, (ylabel, shots, errors, spans)) in enumerate(zip(axes[0], panels)):
+        for label, n in shots.items():
+            low, high = spans[label][:, 0], spans[label][:, 1]
+            axis.errorbar(n, errors[label], yerr=[errors[label] - low, high - errors[label]], marker="o",
+                          capsize=3, label=label)
+        if floors and index in floors:
+            axis.axhline(floors[index][1], color="grey", linestyle="--", label=floors[index][0])
+        axis.set_xscale("log")
+        axis.set_xlabel("training shots")
+        axis.set_ylabel(ylabel)
+        axis.grid(alpha=0.3)
+        axis.legend()
     return _save(figure, path)
