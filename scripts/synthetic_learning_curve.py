@@ -32,8 +32,10 @@ from golfflight.model_export.validation import ValidationSet, load_validation
 from golfflight.shots.markdown import table
 from golfflight.shots.records import read_shots
 
-HEADERS = ["variant", "training shots", "epochs (best)", "seeds", "validation landing error m (bias)",
-           "model-form error m (bias)", "seed range, validation / form m"]
+HEADERS = ["variant", "training shots", "epochs × batch (best epoch)", "seeds", "validation landing error m (bias)",
+           "model-form error m (bias)", "seed range, validation / form m", "train time min"]
+ORDER = ("phys-nn+", "phys-q", "nn")
+"""The table's and the figure's order of the issue's three variants (any other variant after them)."""
 
 
 def subset(data: Path, train_shots: int, out: Path) -> int:
@@ -60,7 +62,8 @@ def run_point(run: Path, val: ValidationSet, world: Prediction) -> dict:
     return {
         "run": str(run), "variant": evaluation.variant, "seed": evaluation.config.seed,
         "n_train": json.loads((run / "history.json").read_text())["data"]["n_train"],
-        "epochs": evaluation.epochs_trained, "best_epoch": evaluation.best_epoch,
+        "epochs": evaluation.epochs_trained, "batch_size": evaluation.config.batch_size,
+        "best_epoch": evaluation.best_epoch, "train_seconds": evaluation.train_seconds,
         "val_landing_m": errors.mean_landing_m, "val_length_bias_m": float(np.nanmean(errors.length_m)),
         "val_side_bias_m": float(np.nanmean(errors.side_m)),
         "form_landing_m": float(np.nanmean(np.linalg.norm(against_world, axis=-1))),
@@ -68,16 +71,20 @@ def run_point(run: Path, val: ValidationSet, world: Prediction) -> dict:
     }
 
 
+def _rank(variant: str) -> int:
+    return ORDER.index(variant) if variant in ORDER else len(ORDER)
+
+
 def summarise(points: list[dict]) -> list[dict]:
-    """Mean over seeds of each (variant, training shots), with the seeds' range; in variant, then n order."""
+    """Mean over seeds of each (variant, training shots), with the seeds' range; in ORDER, then n order."""
     groups = defaultdict(list)
     for point in points:
         groups[point["variant"], point["n_train"]].append(point)
     rows = []
-    for (variant, n_train), group in sorted(groups.items()):
-        row = {"variant": variant, "n_train": n_train, "seeds": len(group),
-               "epochs": group[0]["epochs"], "best_epochs": [p["best_epoch"] for p in group]}
-        for key in ("val_landing_m", "val_length_bias_m", "form_landing_m", "form_length_bias_m"):
+    for (variant, n_train), group in sorted(groups.items(), key=lambda item: (_rank(item[0][0]), item[0][1])):
+        row = {"variant": variant, "n_train": n_train, "seeds": len(group), "epochs": group[0]["epochs"],
+               "batch_size": group[0]["batch_size"], "best_epochs": [p["best_epoch"] for p in group]}
+        for key in ("val_landing_m", "val_length_bias_m", "form_landing_m", "form_length_bias_m", "train_seconds"):
             values = [p[key] for p in group]
             row[key], row[f"{key}_range"] = float(np.mean(values)), [min(values), max(values)]
         rows.append(row)
@@ -87,9 +94,11 @@ def summarise(points: list[dict]) -> list[dict]:
 def _cells(row: dict) -> list[str]:
     val, form = row["val_landing_m_range"], row["form_landing_m_range"]
     spread = "–" if row["seeds"] == 1 else f"{val[0]:.2f}–{val[1]:.2f} / {form[0]:.2f}–{form[1]:.2f}"
-    return [DISPLAY[row["variant"]], f"{row['n_train']:,}", f"{row['epochs']} ({', '.join(map(str, row['best_epochs']))})",
+    best = ", ".join(map(str, row["best_epochs"]))
+    return [DISPLAY[row["variant"]], f"{row['n_train']:,}", f"{row['epochs']} × {row['batch_size']} ({best})",
             str(row["seeds"]), f"{row['val_landing_m']:.2f} ({row['val_length_bias_m']:+.2f})",
-            f"{row['form_landing_m']:.2f} ({row['form_length_bias_m']:+.2f})", spread]
+            f"{row['form_landing_m']:.2f} ({row['form_length_bias_m']:+.2f})", spread,
+            f"{row['train_seconds'] / 60:.1f}"]
 
 
 def figure(rows: list[dict], floor_m: float, path: Path) -> Path:
