@@ -23,8 +23,6 @@ torch.set_num_threads(1)
 SCRIPT = REPO_ROOT / "scripts" / "synthetic_learning_curve.py"
 ENV = {**os.environ, "PYTHONPATH": str(REPO_ROOT)}
 VARIANTS = ("phys-nn+", "phys-q", "nn")
-
-
 SPEC = importlib.util.spec_from_file_location("synthetic_learning_curve", SCRIPT)
 curve = importlib.util.module_from_spec(SPEC)
 SPEC.loader.exec_module(curve)
