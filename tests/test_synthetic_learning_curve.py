@@ -1,13 +1,15 @@
 """`scripts/synthetic_learning_curve.py` (issue 57's learning curve on the synthetic world): a subset keeps n training
 shots and every validation shot, nested in a larger one; Phys-NN+, Phys-Q and NN trained an epoch on it are reported
 with their validation error and their model-form error against the reference world, each within the triangle the
-world's own error allows; the results file and the figure are written only when asked."""
+world's own error allows, each error and bias with a 95 % interval that draws whole sessions; the results file and
+the figure are written only when asked."""
 
 from __future__ import annotations
 
 import importlib.util
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -72,7 +74,10 @@ def test_each_variant_is_reported_against_the_records_and_the_world_within_the_w
     printed = capsys.readouterr().out
     assert not list(tmp_path.iterdir()), "nothing written without --results or --png"
     for label in ("Phys-NN+", "Phys-Q", "NN"):
-        assert any(line.startswith(f"| {label} | ") for line in printed.splitlines()), printed
+        line = next(line for line in printed.splitlines() if line.startswith(f"| {label} | "))
+        assert len(re.findall(r"\d\.\d\d \[\d+\.\d\d, \d+\.\d\d\] \([+-]\d+\.\d\d \[[+-]\d+\.\d\d, [+-]\d+\.\d\d\]\)",
+                              line)) == 2, line
+    assert re.search(r"Nominal floor .*: \d+\.\d\d m \[\d+\.\d\d, \d+\.\d\d\] \(bias [+-]", printed), printed
     curve.report(synthetic, runs, tmp_path / "c.png", tmp_path / "r.json")
     results = json.loads((tmp_path / "r.json").read_text())
     assert {row["variant"] for row in results["rows"]} == set(VARIANTS)
@@ -83,4 +88,22 @@ def test_each_variant_is_reported_against_the_records_and_the_world_within_the_w
         assert 0 < row["form_landing_m"], row
         # per shot |model - record| lies within |world - record| +- |model - world|, so the means do too
         assert floor - row["form_landing_m"] - 1e-9 <= row["val_landing_m"] <= floor + row["form_landing_m"] + 1e-9
+        for key in curve.PER_SHOT:
+            low, high = row[f"{key}_interval"]
+            assert low - 1e-9 <= row[key] <= high + 1e-9, (key, row)
     assert (tmp_path / "c.png").stat().st_size > 1000
+
+
+def test_the_interval_draws_whole_sessions_of_the_seeds_mean_not_shots():
+    sessions = np.array(["S1"] * 50 + ["S2"] * 50, dtype=object)
+    zeros_then_tens = np.repeat([0.0, 10.0], 50)
+    point = {"variant": "phys-q", "n_train": 1000, "epochs": 1, "batch_size": 256, "best_epoch": 1,
+             "train_seconds": 1.0, **{key: 5.0 for key in curve.PER_SHOT},
+             "per_shot": {key: zeros_then_tens for key in curve.PER_SHOT}}
+    (row,) = curve.summarise([point], sessions)
+    assert all(row[f"{key}_interval"] == [0.0, 10.0] for key in curve.PER_SHOT), row
+    (by_shot,) = curve.summarise([point], np.arange(100))
+    assert 3 < by_shot["val_landing_m_interval"][0] < by_shot["val_landing_m_interval"][1] < 7, by_shot
+    other_seed = point | {"per_shot": {key: 10.0 - zeros_then_tens for key in curve.PER_SHOT}}
+    (two_seeds,) = curve.summarise([point, other_seed], sessions)
+    assert two_seeds["seeds"] == 2 and two_seeds["val_landing_m_interval"] == [5.0, 5.0], two_seeds
