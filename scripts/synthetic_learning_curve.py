@@ -80,9 +80,7 @@ def _rank(variant: str) -> int:
 def session_interval(per_seed: list[np.ndarray], sessions: np.ndarray) -> list[float]:
     """The 95 % interval of the seeds' mean of a per-shot statistic, drawing whole sessions (shots of one session
     share their hidden weather and player, so they are not independent)."""
-    with np.errstate(invalid="ignore"):
-        per_shot = np.nanmean(np.stack(per_seed), axis=0) if len(per_seed) > 1 else per_seed[0]
-    return list(block_bootstrap(per_shot, sessions))
+    return list(block_bootstrap(np.mean(np.stack(per_seed), axis=0), sessions))
 
 
 def summarise(points: list[dict], sessions: np.ndarray) -> list[dict]:
