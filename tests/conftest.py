@@ -92,3 +92,15 @@ def trainable_copy(root: Path, out: Path) -> Path:
 def engine() -> FlightEngine:
     """The shipped model's engine, loaded once a test module."""
     return FlightEngine(model_dir())
+
+
+@pytest.fixture(scope="module")
+def one_torch_thread():
+    """One torch thread for a module: the 2-core test machines run other work, where a second thread waits more than
+    it helps."""
+    import torch  # here, not at the top: most tests must run without torch imported
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(threads)

@@ -18,21 +18,14 @@ from golfflight.flight.rollout import InAir, apex, euler_rollout, hard_landing
 from golfflight.flight.torch_engine import TorchEngine
 from shared_network import numpy_flyer_of
 
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
+
 GRID = [Launch(*values) for values in itertools.product(
     (18.0, 45.0, 72.0), (-3.0, 9.0, 24.0, 45.0), (0.0,), (0.0, 2800.0, 9000.0), (-20.0, 0.0, 15.0)
 )]
 """108 shots: speeds x launch angles x spins x spin axes."""
 
 FIGURES = ("landing_x_m", "landing_y_m", "flight_time_s", "apex_m", "apex_time_s")
-
-
-@pytest.fixture(scope="module", autouse=True)
-def one_thread():
-    """One torch thread: the 2-core test machines run other work, where a second thread waits more than it helps."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
 
 
 @pytest.fixture(scope="module")

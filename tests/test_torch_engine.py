@@ -26,20 +26,13 @@ from golfflight.model_export.training import TrainConfig, load_checkpoint, train
 
 from golfflight.cli import main
 
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
+
 pq = pytest.importorskip("pyarrow.parquet")
 
 SHOTS = 300
 FIGURES = ("landing_x_m", "landing_y_m", "carry_m", "apex_m", "apex_time_s", "flight_time_s", "landing_angle_deg",
            "landing_speed_mps", "landing_spin_rpm")
-
-
-@pytest.fixture(scope="module", autouse=True)
-def one_thread():
-    """One torch thread: the 2-core test machines run other work, where a second thread waits more than it helps."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
 
 
 def mixed_shots(n: int, seed: int = 0) -> tuple[np.ndarray, list[Conditions], list[GroundSpec | None]]:
