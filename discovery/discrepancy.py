@@ -35,6 +35,9 @@ CHUNK = 10_000
 """Shots whose kernel rows are built at once (a chunk of 10,000 against 1,000 points is 80 MB)."""
 CACHED = 4
 """Launch sets whose discrepancy means are kept: a fit's shots, its held-out shots and the whole set."""
+SHARED_POINTS = 2000
+"""At most this many shots (a random share) estimate how the discrepancy's error is shared between shots
+(`Discrepancy.shared_information`): the pairs cost their square."""
 
 
 def _kernel(a: np.ndarray, b: np.ndarray, lengthscale: float) -> np.ndarray:
@@ -75,6 +78,18 @@ class Process:
             return np.sqrt(np.maximum(self.amplitude**2 - (solved**2).sum(axis=0), 0.0))
 
         return _chunked(z, read)
+
+    def shared(self, z: np.ndarray, weights: np.ndarray) -> np.ndarray:
+        """sum over pairs i != j of weights_i' C_ij weights_j [k, k], C the process's posterior covariance between
+        the shots at standardized launches z [n, 4] (weights [n, k]): what the error the shots share adds."""
+        if not len(self.points):
+            return np.zeros((weights.shape[1],) * 2)
+        cross = self.amplitude**2 * _kernel(z, self.points[: len(self.sd_cholesky)], self.lengthscale)
+        solved = solve_triangular(self.sd_cholesky, cross.T, lower=True)
+        projected = solved @ weights
+        every = self.amplitude**2 * weights.T @ _kernel(z, z, self.lengthscale) @ weights - projected.T @ projected
+        own_sd2 = np.maximum(self.amplitude**2 - (solved**2).sum(axis=0), 0.0)
+        return every - (weights * own_sd2[:, None]).T @ weights
 
 
 def _likelihood(points: np.ndarray, y: np.ndarray, noise: np.ndarray, lengthscale: float, amplitude: float) -> float:
@@ -143,6 +158,22 @@ class Discrepancy:
         """Mean and SD [N,5] of the discrepancy at launches."""
         z = self.standardized(launch)
         return self.mean(launch), np.stack([process.sd(z) for process in self.processes], axis=1)
+
+    def shared_information(
+        self, launch: dict[str, np.ndarray], weights: np.ndarray, rng: np.random.Generator
+    ) -> np.ndarray:
+        """What the discrepancy's error, shared by shots at nearby launches, adds to J'J [k, k] beyond independent
+        errors: sum over observables and pairs of shots of weights_i' C_ij weights_j, weights [N, 5, k] the Jacobian
+        over each shot's expected error (zero where unused), C the posterior covariance between the two shots'
+        discrepancies. A shot's own error is already in its expected error; counting it once per shot, as if shots
+        erred independently, made the baseline's parameters 2-4 times too sure (docs/discovery.md). Above
+        SHARED_POINTS shots, the pairs of a random share, scaled to all pairs."""
+        n = len(weights)
+        rows = np.arange(n) if n <= SHARED_POINTS else np.sort(rng.choice(n, SHARED_POINTS, replace=False))
+        m = len(rows)
+        z = self.standardized({k: v[rows] for k, v in launch.items()})
+        total = sum(process.shared(z, weights[rows, j]) for j, process in enumerate(self.processes))
+        return total * (n * (n - 1)) / max(m * (m - 1), 1)
 
     def shifted(self, flown: Outcomes, launch: dict[str, np.ndarray]) -> Outcomes:
         """A batch's outcomes with the discrepancy's mean at its flown launches added (positions left as flown)."""

@@ -83,6 +83,15 @@ class Problem:
             self.offset[rows],
         )
 
+    def shared_information(self, z: np.ndarray, jacobian: np.ndarray) -> np.ndarray | None:
+        """What the model's error shared between shots adds to J'J (`Discrepancy.shared_information`): only a model
+        with a baseline's discrepancy says how its error is shared; None otherwise."""
+        discrepancy = self.model.discrepancy
+        if discrepancy is None or jacobian.shape[-1] == 0:
+            return None
+        weights = np.where(np.isfinite(z)[..., None], jacobian / self.sigma[..., None], 0.0)
+        return discrepancy.shared_information(self.recordings.launch, weights, np.random.default_rng(5))
+
     def standardize(self, predicted: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """(recorded - predicted) / sigma [..., len(rows), 5]; NaN where unused, a large value where not landed."""
         z = (self.observed[rows] - predicted) / self.sigma[rows]
@@ -161,9 +170,13 @@ def residuals_and_jacobian(
     return z[0], jacobian
 
 
-def covariance(z: np.ndarray, jacobian: np.ndarray, groups: np.ndarray) -> np.ndarray:
-    """Parameter covariance from the Jacobian: s^2 (J'J)^-1, or the session-clustered sandwich (5+ sessions) when
-    that is larger on average (shots of a session share conditions, so they may not be independent)."""
+def covariance(
+    z: np.ndarray, jacobian: np.ndarray, groups: np.ndarray, shared: np.ndarray | None = None
+) -> np.ndarray:
+    """Parameter covariance from the Jacobian: s^2 (J'J)^-1, or s^2 (J'J)^-1 (J'J + shared) (J'J)^-1 where the model's
+    error is shared between shots (`shared`, `Problem.shared_information`), or the session-clustered sandwich (5+
+    sessions) when that is larger on average (shots of a session share conditions, so they may not be
+    independent)."""
     used = np.isfinite(z)
     k = jacobian.shape[-1]
     if k == 0:
@@ -176,6 +189,8 @@ def covariance(z: np.ndarray, jacobian: np.ndarray, groups: np.ndarray) -> np.nd
     codes = np.unique(groups, return_inverse=True)[1]
     g = codes.max() + 1
     classical = bread * float(np.sum(r**2) / max(m - k, 1))
+    if shared is not None:
+        classical = classical @ (flat_j.T @ flat_j + shared) @ bread
     if g < 5:
         return classical
     scores = np.zeros((g, k))
@@ -261,7 +276,8 @@ def fit(problem: Problem, effects: tuple[Effect, ...], start: np.ndarray, rows: 
         theta = result.x
     every_shot = len(rows) == len(everyone) and theta.tobytes() in flown
     z, jacobian = flown[theta.tobytes()] if every_shot else residuals_and_jacobian(problem, effects, theta, everyone)
-    return Fit(effects, theta, z, jacobian, covariance(z, jacobian, problem.recordings.session))
+    shared = problem.shared_information(z, jacobian)
+    return Fit(effects, theta, z, jacobian, covariance(z, jacobian, problem.recordings.session, shared))
 
 
 def folds(groups: np.ndarray, n_folds: int = 5) -> tuple[np.ndarray, str]:

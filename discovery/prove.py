@@ -387,12 +387,29 @@ def _air_within(run: Run, tolerance: float = 0.03) -> bool:
     return found is not None and abs(fitted[found]["ratio"] - run.hidden[DENSITY_ONLY]["ratio"]) <= tolerance
 
 
+def _covered(run: Run, widths: float = 2.0) -> list[bool]:
+    """For each parameter of each hidden effect that was fitted: whether the hidden value lies within `widths` of the
+    reported ± of the fitted one (the ± tells the truth about the error: 95 % for a calibrated one at 2)."""
+    fitted = run.fitted if run.systematic else {}
+    out = []
+    for name, hidden in run.hidden.items():
+        found = fitted_as(name, fitted)
+        if found is None:
+            continue
+        for key, value in hidden.items():
+            sd = run.uncertainty.get(found, {}).get(key)
+            if key in fitted[found] and sd is not None:
+                out.append(abs(fitted[found][key] - value) <= widths * sd)
+    return out
+
+
 def _baseline_rows(runs: list[Run]) -> list[str]:
     """The baseline campaign's headline rows: no-change sessions, the change named within 10 %, the high venue."""
     clean = [r for r in runs if r.case == "clean"]
     changed = [r for r in runs if r.case not in ("clean", HIGH_VENUE)]
     venue = [r for r in runs if r.case == HIGH_VENUE]
     errors = [e for r in changed for e in r.parameter_error.values()]
+    covered = [c for r in changed + venue for c in _covered(r)]
     rows = []
     if clean:
         rows.append(
@@ -406,6 +423,8 @@ def _baseline_rows(runs: list[Run]) -> list[str]:
             f"| the change named alone | {_share([r.correct for r in changed])} | - |",
             f"| parameters within 10 % of the change's size | {sum(e <= 0.1 for e in errors)} of {len(errors)} "
             f"(median error {np.median(errors):.1%}) | - |" if errors else "",
+            f"| hidden values within 2 ± of the fitted ones (each parameter) | {_share(covered)} | - |"
+            if covered else "",
         ]
     if venue:
         rows.append(f"| {HIGH_VENUE}: air named within 0.03 | {_share([_air_within(r) for r in venue])} | all |")
