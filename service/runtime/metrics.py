@@ -39,6 +39,27 @@ a second, a request waits at most the 30 s drain."""
 BATCH_SHOTS_BUCKETS = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000)
 """Histogram buckets for shots per batch, up to the 10,000 a batch may hold."""
 
+
+def started(path: Path) -> bool:
+    """Whether a worker's sample file has its header: prometheus-client creates it empty and sizes it an instant
+    later, and cannot read it in between (a scrape as a worker starts was answered 500, tests/test_metrics.py)."""
+    try:
+        return path.stat().st_size > 0
+    except OSError:  # removed since it was listed
+        return False
+
+
+class StartedWorkersCollector(MultiProcessCollector):
+    """prometheus-client's sum over the worker processes' sample files, leaving out a file its worker has not yet
+    sized (it holds no sample)."""
+
+    def __init__(self, registry: CollectorRegistry, directory: Path) -> None:
+        super().__init__(registry, str(directory))
+        self.directory = directory
+
+    def collect(self):
+        return self.merge([str(path) for path in self.directory.glob("*.db") if started(path)], accumulate=True)
+
 ModelLabels = Callable[[], dict[str, str] | None]
 """The loaded model's info labels (variant, sha256, version), or None while it loads or after it failed to."""
 
@@ -92,7 +113,7 @@ class ServiceMetrics:
         self._scraped = self.registry
         if environment().metrics_dir:
             self._scraped = CollectorRegistry()
-            MultiProcessCollector(self._scraped)
+            StartedWorkersCollector(self._scraped, Path(environment().metrics_dir))
             self._scraped.register(ModelInfoCollector(model_labels))
 
     def exposition(self) -> bytes:
