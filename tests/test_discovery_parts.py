@@ -25,6 +25,7 @@ from golfflight.discovery.outside import HEIGHT_GUST, OUTSIDE, HeightGust, air_m
 from golfflight.discovery.prove import (
     TRIPLES,
     Run,
+    hidden_within_uncertainty,
     cases,
     draw_effect,
     expected_label,
@@ -326,3 +327,40 @@ def test_prove_triples_conceals_three_effects_and_scores_them(tmp_path):
     text = tables([named, missed], "test model", campaign="triples")
     assert "| three effects: all three among those named | 1 of 2 (50%) | ≥ 80 % |" in text
     assert "| three effects: all three fitted within 10 % of their sizes | 1 of 2 (50%) | ≥ 60 % |" in text
+
+
+def test_the_campaign_counts_hidden_values_within_two_of_their_reported_uncertainty():
+    """Each fitted parameter of a hidden effect counts once: within 2 ± of the hidden value or not (air named in its
+    other variant is the same air); an effect not named counts nothing."""
+    hidden = {"wind": {"speed_mps": 4.0, "from_deg": 10.0}}
+    fitted = {"wind": {"speed_mps": 4.3, "from_deg": 11.0}}
+    sure = {"wind": {"speed_mps": 0.1, "from_deg": 1.0}}
+    run = Run("wind", 0, hidden, 300, 4, True, "wind", True, fitted, sure, {}, 2.0, 1.0, 1.0, False, {}, {}, [], 1.0)
+    assert hidden_within_uncertainty(run) == [False, True]  # 0.3 m/s off at +-0.1; 1 deg off at +-1
+    air = {"air_density": {"ratio": 0.85}}
+    named = {"air_density_only": {"ratio": 0.86, "equivalent_altitude_m": 1300.0}}
+    sd = {"air_density_only": {"ratio": 0.006, "equivalent_altitude_m": 50.0}}
+    as_other = Run("air", 0, air, 300, 4, True, "air_density_only", False, named, sd, {}, 2.0, 1.0, 1.0, False, {}, {},
+                   [], 1.0)
+    assert hidden_within_uncertainty(as_other) == [True]
+    missed = Run("air", 0, air, 300, 4, False, "none", False, {}, {}, {}, 2.0, 2.0, None, False, {}, {}, [], 1.0)
+    assert hidden_within_uncertainty(missed) == []
+
+
+def test_a_baseline_at_three_lower_venues_keeps_the_players_and_records_each_venues_air():
+    """The real-air venue case's baseline: the ICAO baseline's sessions (the same players and clubs), one in three at
+    each lower venue, flown and recorded in that venue's real air."""
+    from golfflight.discovery.prove import HIGH_VENUE_REAL, HIGH_VENUES, LOWER_VENUES, baseline_cases, venue_baseline
+    from golfflight.discovery.recordings import from_shot_set
+    from golfflight.flight.air import Air
+
+    assert (HIGH_VENUE_REAL, (HIGH_VENUES[HIGH_VENUE_REAL][0],)) in baseline_cases("reference")
+    assert not any(case in HIGH_VENUES for case, _ in baseline_cases("density-only"))
+    icao = venue_baseline(None, 60, 3, (1.0,))
+    venues = venue_baseline(None, 60, 3, LOWER_VENUES)
+    assert sorted(r.session for r in venues.records) == sorted(r.session for r in icao.records)
+    recordings = from_shot_set(venues)
+    sessions = sorted(set(recordings.session))
+    for k, session in enumerate(sessions):
+        density = recordings.density_kg_m3[recordings.session == session]
+        assert np.allclose(density, LOWER_VENUES[k % 3] * Air.standard().density_kg_m3, rtol=2e-3)
