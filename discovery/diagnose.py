@@ -49,7 +49,7 @@ from golfflight.discovery.fit import (
     per_shot,
     stratified_rows,
 )
-from golfflight.discovery.form import LearnedForm, formed_model
+from golfflight.discovery.form import LearnedForm, formed_model, read_along_speed
 from golfflight.discovery.headline import headline
 from golfflight.discovery.invariance import Halves, halves, set_aside_sentence
 from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
@@ -279,6 +279,9 @@ class Diagnoser:
             self.rows = stratified_rows(self.problem.recordings, MAX_FIT_SHOTS, self.rng)
         self.scored_fold = self.fold[self.scored]
         self._response_errors: dict[tuple[str, bytes], float] = {}  # memo: asked up to three times
+        self.other_reading = model.control
+        if baseline is not None:  # the form the baseline cannot tell from its own in another air
+            self.other_reading = read_along_speed(model, baseline)
         self.set_aside: list[Halves] = []  # the conditions set aside as changing with the launch (`model_form`)
 
     def run(self) -> Diagnosis:
@@ -466,13 +469,15 @@ class Diagnoser:
     def response_error(self, candidate: Scored) -> float:
         """How much of the candidate's remaining error is the model's own: the mean squared standardized
         difference between the model (plus its known error at the assumed conditions) and its control, both
-        flown with the candidate's effects. Zero without a control or without effects.
+        flown with the candidate's effects; against a baseline, between the form read along the Reynolds number
+        and along the speed (`form.read_along_speed`). Zero without either or without effects.
 
         The control takes out the model's error at the assumed conditions only; once an effect changes them, the
         model responds to it a little differently from the physics it imitates (e.g. the bundle gains more carry
-        in thin air than the reference world). A richer explanation that removes no more than that difference is
-        fitting the model's error, not left-out physics."""
-        control, result = self.model.control, candidate.fit
+        in thin air than the reference world). A baseline teaches the form in its own airs only: in another air the
+        two readings it cannot tell apart differ. A richer explanation that removes no more than that difference
+        is fitting the model's error, not left-out physics."""
+        control, result = self.other_reading, candidate.fit
         if control is None or result.k == 0:
             return 0.0
         key = (result.name, result.theta.tobytes())
@@ -620,9 +625,14 @@ class Diagnoser:
     ) -> tuple[Scored, list[Scored]]:
         """The choice without its effects `within` the model's form (`model_form`; refitted), or an explanation of
         the model's form alone (coefficient scales), whichever scores best among those that beat the model as is; the
-        model as is where none does (the learned correction, the model's form too, is tried after). (choice, the
-        refit)."""
+        model as is where none does (the learned correction, the model's form too, is tried after). Against a
+        baseline, whose form is held, also every explanation fitted without an effect set aside (air, say, where
+        another ball was set aside for a spin decay that changes with the launch): it is then judged the same way.
+        (choice, the refit)."""
         options = [s for s in scored if s.fit.k and all(e.kind == "form" for e in s.fit.effects)]
+        if self.baseline is not None:
+            aside = set(within) | {h.effect for h in self.set_aside}
+            options += [s for s in scored if s.fit.k and not aside & {e.name for e in s.fit.effects}]
         kept = [(e, block) for e, block in blocks(chosen.fit) if e.name not in within]
         refitted = []
         if kept:

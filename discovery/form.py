@@ -79,6 +79,9 @@ class LearnedForm:
     """The baseline's recorded launch values."""
     density_kg_m3: np.ndarray
     """The air density each baseline shot flew in (recorded, else the model's): the airs it was learned in."""
+    kinematic_viscosity_m2_s: float
+    """The median kinematic viscosity of the airs it was learned in: where the form read along the speed
+    (`read_along_speed`) is read."""
 
     def weights(self) -> dict[str, float]:
         """The form's weights by term name."""
@@ -144,6 +147,7 @@ def learn_form(
         float(np.nanmean(after**2)),
         {k: v.copy() for k, v in recordings.launch.items()},
         start.base.density_kg_m3.copy(),
+        float(np.median(start.base.viscosity(model.flyer.kinematic_viscosity_m2_s))),
     )
 
 
@@ -196,3 +200,12 @@ def formed_model(model: FlightModel, form: LearnedForm) -> FlightModel:
         model.temperature_c,
         discrepancy=form.discrepancy,
     )
+
+
+def read_along_speed(formed: FlightModel, form: LearnedForm) -> FlightModel:
+    """The formed model (`formed_model`) with its form read along the speed, at the viscosity of the airs the
+    baseline was learned in, instead of along the Reynolds number: the same flights in those airs, and in another
+    air the other reading the baseline cannot rule out (at one air the Reynolds number and the speed are one
+    variable). The two differ by what the baseline cannot inform of the new air (`Diagnoser.response_error`)."""
+    flyer = formed.flyer.replaced(model=replace(formed.flyer.model, read_at=form.kinematic_viscosity_m2_s))
+    return replace(formed, name=f"{formed.name}, its form read along the speed", flyer=flyer)

@@ -102,13 +102,17 @@ class FormedCoefficients:
 
 @dataclass(frozen=True)
 class FormedModel:
-    """A Flyer's model in air (`flight.flyer.ModelInAir`) with the form applied in any air."""
+    """A Flyer's model in air (`flight.flyer.ModelInAir`) with the form applied in any air: read at the Reynolds
+    number that air gives, or, with `read_at`, at one kinematic viscosity whatever the air (the form along the
+    speed: at the air it was learned in the two readings agree)."""
 
     base: object
     weights: np.ndarray
+    read_at: float | None = None
 
     def in_air(self, kinematic_viscosity_m2_s: float | np.ndarray) -> CoefficientModel:
-        return FormedCoefficients(self.base.in_air(kinematic_viscosity_m2_s), kinematic_viscosity_m2_s, self.weights)
+        reading = kinematic_viscosity_m2_s if self.read_at is None else self.read_at
+        return FormedCoefficients(self.base.in_air(kinematic_viscosity_m2_s), reading, self.weights)
 
 
 def formed_flyer(flyer: Flyer, weights: np.ndarray) -> Flyer:
