@@ -466,6 +466,13 @@ class Diagnoser:
         material = gain >= max(MIN_RELATIVE_IMPROVEMENT * against, tolerance)
         return bool(low > 0 and material and rich.score < simple.score), gain, float(low), float(high)
 
+    def claims_more(self, rich: Scored, simple: Scored) -> bool:
+        """Whether `rich` adds a venue condition, monitor bias or ball to `simple`; against a baseline, one that adds
+        only the model's form (the Reynolds scale that reads recorded air) does not: fitting the model's own error is
+        what such a term is for, so the model's error of response does not hold it back."""
+        added = [e for e in rich.fit.effects if e not in simple.fit.effects]
+        return self.baseline is None or any(e.kind != "form" for e in added)
+
     def response_error(self, candidate: Scored) -> float:
         """How much of the candidate's remaining error is the model's own: the mean squared standardized
         difference between the model (plus its known error at the assumed conditions) and its control, both
@@ -540,7 +547,7 @@ class Diagnoser:
             extended = [e for e in extended if inside(e)]
             if not extended:
                 break
-            tolerance = self.response_error(chosen)
+            tolerance = self.response_error(chosen) if self.claims_more(extended[0], chosen) else 0.0
             flag, gain, low, _ = self.better(extended[0], chosen, COMBINATION_LEVEL, tolerance)
             test.update(
                 {
