@@ -203,9 +203,10 @@ def formed_model(model: FlightModel, form: LearnedForm) -> FlightModel:
 
 
 def read_along_speed(formed: FlightModel, form: LearnedForm) -> FlightModel:
-    """The formed model (`formed_model`) with its form read along the speed, at the viscosity of the airs the
-    baseline was learned in, instead of along the Reynolds number: the same flights in those airs, and in another
-    air the other reading the baseline cannot rule out (at one air the Reynolds number and the speed are one
-    variable). The two differ by what the baseline cannot inform of the new air (`Diagnoser.response_error`)."""
+    """The formed model (`formed_model`) with its form read along the speed, at the median viscosity of the airs the
+    baseline was learned in, instead of along the Reynolds number: the same flights in that air, and in another air
+    the other reading the baseline cannot rule out (at one air the Reynolds number and the speed are one variable;
+    airs within 10 % of each other barely part them). The two differ by what the baseline cannot inform of the new
+    air (`Diagnoser.response_error`)."""
     flyer = formed.flyer.replaced(model=replace(formed.flyer.model, read_at=form.kinematic_viscosity_m2_s))
     return replace(formed, name=f"{formed.name}, its form read along the speed", flyer=flyer)
