@@ -37,8 +37,8 @@ CACHED = 4
 """Launch sets whose discrepancy means are kept: a fit's shots, its held-out shots and the whole set."""
 SHARED_POINTS = 1000
 """At most this many shots (a random share) estimate how the discrepancy's error is shared between shots
-(`Discrepancy.shared_information`): the pairs cost their square (0.08 s a fit at 1,000, 0.44 s at 2,000, about 70 fits
-in a diagnosis: 2,000 took a 100,000-shot diagnosis from 175 to 218 s)."""
+(`Discrepancy.shared_information`), about 70 times a diagnosis: the pairs cost their square, and a random 1,000 of
+a larger set's shots estimate them without bias (tests/test_shared_error.py)."""
 
 
 def _kernel(a: np.ndarray, b: np.ndarray, lengthscale: float) -> np.ndarray:
