@@ -188,9 +188,15 @@ def venue_baseline(world: FlightModel | None, n_shots: int, seed: int, venues: t
         flown = conceal(hidden, n_shots, seed, model=world, launch_seed=BASELINE_LAUNCHES).shots
         sessions = sorted({r.session for r in flown.records})
         here = set(sessions[k :: len(venues)])
-        air = {"temperature_c": 15.0, "altitude_m": equivalent_altitude_m(ratio, NOMINAL_CONTEXT), "humidity_pct": 0.0}
-        records += [r.model_copy(update=air) for r in flown.records if r.session in here]
+        records += recorded_in([r for r in flown.records if r.session in here], ratio)
     return ShotSet(records)
+
+
+def recorded_in(records: list, ratio: float) -> list:
+    """The shot records with a venue's air written on them: dry air at 15 degC at the standard-atmosphere height whose
+    density is `ratio` x ICAO (what the service reads back as that density and its viscosity)."""
+    air = {"temperature_c": 15.0, "altitude_m": equivalent_altitude_m(ratio, NOMINAL_CONTEXT), "humidity_pct": 0.0}
+    return [r.model_copy(update=air) for r in records]
 
 
 def _outside(effects: tuple[str, ...] | dict) -> bool:
@@ -304,9 +310,7 @@ def run_case(
     concealed = conceal({**hidden, **venue}, n_shots, seed, wind_profile=profile, model=world)
     shots = concealed.shots
     if venue:  # the venue's air recorded with every shot
-        altitude = equivalent_altitude_m(venue[DENSITY_ONLY]["ratio"], NOMINAL_CONTEXT)
-        air = {"temperature_c": 15.0, "altitude_m": altitude, "humidity_pct": 0.0}
-        shots = ShotSet([r.model_copy(update=air) for r in shots.records])
+        shots = ShotSet(recorded_in(shots.records, venue[DENSITY_ONLY]["ratio"]))
     recordings = from_shot_set(shots, source=f"concealed {case} seed {seed}")
     baseline = baseline_form(model, truth, n_shots, seed, venues) if against_baseline else None
     started = time.perf_counter()
