@@ -26,7 +26,7 @@ named is what changed since the baseline.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from golfflight.discovery import correction as learned
@@ -49,7 +49,7 @@ from golfflight.discovery.fit import (
     per_shot,
     stratified_rows,
 )
-from golfflight.discovery.form import LearnedForm, formed_model, read_along_speed
+from golfflight.discovery.form import LearnedForm, formed_model, read_along_speed, with_form_uncertainty
 from golfflight.discovery.headline import headline
 from golfflight.discovery.invariance import Halves, halves, set_aside_sentence
 from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
@@ -290,6 +290,8 @@ class Diagnoser:
         self.step("locating the mismatch...")
         located = located_mismatch(self.recordings, start)
         selection = self.select(has_structure(located))
+        if self.baseline is not None and selection.systematic:
+            selection = self.counting_the_form(selection)
         chosen = selection.chosen
         self.step("the chosen explanation's flights and held-out errors...")
         trajectories = bool(self.recordings.trajectories)
@@ -444,6 +446,14 @@ class Diagnoser:
         if not systematic:
             return Selection(null, scored, null, False, test, None, [])
         return Selection(null, scored, chosen, True, test, unlisted, unexplained)
+
+    def counting_the_form(self, selection: Selection) -> Selection:
+        """The selection with its choice's ± counting the baseline form's own uncertainty
+        (`form.with_form_uncertainty`): the ± the report quotes. The choice was made before, on the fits."""
+        chosen = selection.chosen
+        counted = replace(chosen, fit=with_form_uncertainty(self.problem, chosen.fit, self.baseline))
+        scored = [counted if s is chosen else s for s in selection.scored]
+        return replace(selection, chosen=counted, scored=scored)
 
     def score(self, result: Fit) -> Scored:
         z = heldout(self.problem, result, self.scored_fold)

@@ -200,6 +200,20 @@ def covariance(
     return sandwich if inflation >= 1.0 else classical
 
 
+def held_nuisance_covariance(
+    z: np.ndarray, jacobian: np.ndarray, nuisance_jacobian: np.ndarray, nuisance_covariance: np.ndarray
+) -> np.ndarray:
+    """What a nuisance estimated first, on other data, and then held adds to a least-squares fit's covariance: the
+    fit moves with the nuisance's error as G = -(J'J)^-1 J'J_n (J, J_n: dz/dtheta [N,5,k], dz/dnuisance [N,5,m]), so
+    it adds G Cov_n G' (Murphy & Topel 1985; no cross term, the two data sets being independent)."""
+    used = np.isfinite(z)
+    k, m = jacobian.shape[-1], nuisance_jacobian.shape[-1]
+    J = np.where(used[..., None], jacobian, 0.0).reshape(-1, k)
+    J_n = np.where(used[..., None], nuisance_jacobian, 0.0).reshape(-1, m)
+    moves = -np.linalg.pinv(J.T @ J) @ (J.T @ J_n)
+    return moves @ nuisance_covariance @ moves.T
+
+
 def linear_starts(
     problem: Problem, base: Fit | None, additions: tuple[Effect, ...], rows: np.ndarray
 ) -> list[tuple[np.ndarray, float]]:

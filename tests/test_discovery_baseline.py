@@ -8,10 +8,18 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from golfflight.discovery.conceal import conceal
-from golfflight.discovery.diagnose import diagnose, library_for
+from golfflight.discovery.diagnose import Diagnoser, diagnose, library_for
 from golfflight.discovery.discrepancy import fit_discrepancy
 from golfflight.discovery.effects import BALL, EFFECTS
-from golfflight.discovery.form import FORM, RK4_STEP_S, accurately_flown, formed_model, learn_form
+from golfflight.discovery.fit import fit, linear_starts
+from golfflight.discovery.form import (
+    FORM,
+    RK4_STEP_S,
+    accurately_flown,
+    formed_model,
+    learn_form,
+    with_form_uncertainty,
+)
 from golfflight.discovery.form_terms import (
     LOG_MULTIPLIER_BOUND,
     REYNOLDS_REF,
@@ -23,7 +31,7 @@ from golfflight.discovery.model import load_model, reference
 from golfflight.discovery.noise import base_conditions
 from golfflight.discovery.prove import ferguson_world
 from golfflight.discovery.recordings import OBSERVABLES, UNKNOWN_CLUB, from_shot_set
-from golfflight.discovery.reach import baseline_info, needed_words, outside_baseline
+from golfflight.discovery.reach import baseline_info, comparable, needed_words, outside_baseline
 from golfflight.discovery.schema import Report
 from golfflight.flight.constants import BALL_RADIUS_M
 from golfflight.flight.integrator import RUNGE_KUTTA_4
@@ -250,3 +258,19 @@ def test_a_ball_set_aside_as_the_form_gives_way_to_the_air_fitted_without_it(ser
     assert run.systematic and set(run.fitted) <= {"air_density", "air_density_only"}
     (air,) = run.fitted.values()
     assert abs(air["ratio"] - 0.776) < 0.03
+
+
+def test_the_choices_plus_minus_counts_the_held_forms_own_error(served, ferguson_baseline):
+    """The form the baseline taught is held while the wind is fitted; its covariance moves the wind's fit too, so
+    the quoted ± is the fit's own widened by it, and a form known exactly would add nothing."""
+    hidden = {"wind": {"speed_mps": 4.0, "from_deg": 20.0}}
+    new = comparable(from_shot_set(conceal(hidden, 200, seed=4, model=ferguson_world()).shots), ferguson_baseline)
+    formed = formed_model(served, ferguson_baseline)
+    diagnoser = Diagnoser(new, formed, seed=4, progress=False, baseline=ferguson_baseline)
+    start = linear_starts(diagnoser.problem, None, (EFFECTS["wind"],), diagnoser.rows)[0][0]
+    wind = fit(diagnoser.problem, (EFFECTS["wind"],), start, diagnoser.rows)
+    counted = with_form_uncertainty(diagnoser.problem, wind, ferguson_baseline)
+    assert np.all(np.diag(counted.covariance) > np.diag(wind.covariance))
+    np.testing.assert_array_equal(counted.theta, wind.theta)
+    exact = replace(ferguson_baseline, covariance=np.zeros_like(ferguson_baseline.covariance))
+    np.testing.assert_allclose(with_form_uncertainty(diagnoser.problem, wind, exact).covariance, wind.covariance)
