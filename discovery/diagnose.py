@@ -49,7 +49,13 @@ from golfflight.discovery.fit import (
     per_shot,
     stratified_rows,
 )
-from golfflight.discovery.form import LearnedForm, formed_model, read_along_speed, with_form_uncertainty
+from golfflight.discovery.form import (
+    LearnedForm,
+    formed_model,
+    read_along_speed,
+    with_form_uncertainty,
+    with_reading_uncertainty,
+)
 from golfflight.discovery.headline import headline
 from golfflight.discovery.invariance import Halves, halves, set_aside_sentence
 from golfflight.discovery.locate import has_structure, locate, trajectory_residuals, trajectory_stats
@@ -291,7 +297,7 @@ class Diagnoser:
         located = located_mismatch(self.recordings, start)
         selection = self.select(has_structure(located))
         if self.baseline is not None and selection.systematic:
-            selection = self.counting_the_form(selection)
+            selection = self.counting_the_baseline(selection)
         chosen = selection.chosen
         self.step("the chosen explanation's flights and held-out errors...")
         trajectories = bool(self.recordings.trajectories)
@@ -447,11 +453,16 @@ class Diagnoser:
             return Selection(null, scored, null, False, test, None, [])
         return Selection(null, scored, chosen, True, test, unlisted, unexplained)
 
-    def counting_the_form(self, selection: Selection) -> Selection:
-        """The selection with its choice's ± counting the baseline form's own uncertainty
-        (`form.with_form_uncertainty`): the ± the report quotes. The choice was made before, on the fits."""
+    def counting_the_baseline(self, selection: Selection) -> Selection:
+        """The selection with its choice's ± counting what the baseline leaves unsure: its form's own error
+        (`form.with_form_uncertainty`) and, where the two readings of the form part (another air than the
+        baseline's), the reading it cannot rule out (`form.with_reading_uncertainty`). The ± the report quotes; the
+        choice was made before, on the fits."""
         chosen = selection.chosen
-        counted = replace(chosen, fit=with_form_uncertainty(self.problem, chosen.fit, self.baseline))
+        counted = with_form_uncertainty(self.problem, chosen.fit, self.baseline)
+        if self.response_error(chosen) > 0.0:
+            counted = with_reading_uncertainty(self.problem, counted, self.other_reading, self.rows)
+        counted = replace(chosen, fit=counted)
         scored = [counted if s is chosen else s for s in selection.scored]
         return replace(selection, chosen=counted, scored=scored)
 

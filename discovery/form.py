@@ -226,6 +226,18 @@ def with_form_uncertainty(problem: Problem, result: Fit, form: LearnedForm) -> F
     return replace(result, covariance=result.covariance + added)
 
 
+def with_reading_uncertainty(problem: Problem, result: Fit, other_reading: FlightModel, rows: np.ndarray) -> Fit:
+    """`result` with the reading of the form the baseline cannot rule out in its covariance: refitted from where it
+    stands against the form read along the speed (`read_along_speed`), half the move is one ± more. In another air
+    than the baseline's the truth's response lay between the two readings in every world the docs measure
+    (docs/discovery.md, "How far a sea-level form carries into other air"); in the baseline's air they agree."""
+    if not result.k:
+        return result
+    refit = fit(replace(problem, model=other_reading), result.effects, result.theta, rows)
+    half = (refit.theta - result.theta) / 2.0
+    return replace(result, covariance=result.covariance + np.outer(half, half))
+
+
 def read_along_speed(formed: FlightModel, form: LearnedForm) -> FlightModel:
     """The formed model (`formed_model`) with its form read along the speed, at the median viscosity of the airs the
     baseline was learned in, instead of along the Reynolds number: the same flights in that air, and in another air

@@ -18,7 +18,9 @@ from golfflight.discovery.form import (
     accurately_flown,
     formed_model,
     learn_form,
+    read_along_speed,
     with_form_uncertainty,
+    with_reading_uncertainty,
 )
 from golfflight.discovery.form_terms import (
     LOG_MULTIPLIER_BOUND,
@@ -274,3 +276,31 @@ def test_the_choices_plus_minus_counts_the_held_forms_own_error(served, ferguson
     np.testing.assert_array_equal(counted.theta, wind.theta)
     exact = replace(ferguson_baseline, covariance=np.zeros_like(ferguson_baseline.covariance))
     np.testing.assert_allclose(with_form_uncertainty(diagnoser.problem, wind, exact).covariance, wind.covariance)
+
+
+@pytest.mark.parametrize(
+    ("hidden", "same_air"),
+    [({"wind": {"speed_mps": 4.0, "from_deg": 20.0}}, True), ({"air_density": {"ratio": 0.85}}, False)],
+)
+def test_the_reading_the_baseline_cannot_rule_out_widens_the_plus_minus_in_other_air(
+    served, ferguson_baseline, hidden, same_air
+):
+    """In the baseline's air the two readings of the form fly alike and add nothing; in real air 0.85 x as dense (its
+    viscosity, so its Reynolds numbers, moved) they part: refitted against the form read along the speed, the air
+    moves (0.866 -> 0.863 here), and half that move is one ± more."""
+    formed = formed_model(served, ferguson_baseline)
+    (name,) = hidden
+    new = comparable(from_shot_set(conceal(hidden, 200, seed=4, model=ferguson_world()).shots), ferguson_baseline)
+    diagnoser = Diagnoser(new, formed, seed=4, progress=False, baseline=ferguson_baseline)
+    start = linear_starts(diagnoser.problem, None, (EFFECTS[name],), diagnoser.rows)[0][0]
+    fitted = fit(diagnoser.problem, (EFFECTS[name],), start, diagnoser.rows)
+    result = with_form_uncertainty(diagnoser.problem, fitted, ferguson_baseline)
+    other = read_along_speed(formed, ferguson_baseline)
+    read = with_reading_uncertainty(diagnoser.problem, result, other, diagnoser.rows)
+    added = np.diag(read.covariance) - np.diag(result.covariance)
+    if same_air:
+        np.testing.assert_allclose(added, 0.0, atol=1e-6 * np.diag(result.covariance).max())
+    else:
+        refit = fit(replace(diagnoser.problem, model=other), (EFFECTS[name],), fitted.theta, diagnoser.rows)
+        assert abs(refit.theta[0] - fitted.theta[0]) > 1e-3
+        assert np.sqrt(added[0]) == pytest.approx(abs(refit.theta[0] - fitted.theta[0]) / 2, rel=1e-6)
