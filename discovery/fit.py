@@ -260,36 +260,57 @@ def stratified_rows(recordings: Recordings, size: int, rng: np.random.Generator)
     return np.sort(order[np.minimum(picks, n - 1)])
 
 
+def fitted_parameters(
+    problem: Problem, effects: tuple[Effect, ...], start: np.ndarray, rows: np.ndarray
+) -> tuple[np.ndarray, dict[bytes, tuple[np.ndarray, np.ndarray]]]:
+    """Least-squares parameters of the effects on `rows` from `start`, within their bounds, and the (z, Jacobian) on
+    `rows` at each parameter set tried."""
+    low, high, typical, _ = _bounds(effects)
+    theta = np.clip(start, low, high)
+    flown: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+    if not len(theta):
+        return theta, flown
+
+    def evaluate(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        key = x.tobytes()
+        if key not in flown:
+            flown[key] = residuals_and_jacobian(problem, effects, x, rows)
+        z, jac = flown[key]
+        used = np.isfinite(z)
+        return z[used], jac[used]
+
+    result = least_squares(
+        lambda x: evaluate(x)[0],
+        theta,
+        jac=lambda x: evaluate(x)[1],
+        bounds=(low, high),
+        x_scale=typical,
+        method="trf",
+        max_nfev=MAX_EVALUATIONS,
+        xtol=1e-3,
+        ftol=1e-4,
+    )
+    return result.x, flown
+
+
 def fit(problem: Problem, effects: tuple[Effect, ...], start: np.ndarray, rows: np.ndarray) -> Fit:
     """Least-squares fit of the effects' parameters on `rows`, then residuals and Jacobian on every shot."""
-    low, high, typical, _ = _bounds(effects)
+    theta, flown = fitted_parameters(problem, effects, start, rows)
+    if len(rows) == len(problem.recordings) and theta.tobytes() in flown:
+        return fit_at(problem, effects, theta, flown[theta.tobytes()])
+    return fit_at(problem, effects, theta)
+
+
+def fit_at(
+    problem: Problem,
+    effects: tuple[Effect, ...],
+    theta: np.ndarray,
+    flown: tuple[np.ndarray, np.ndarray] | None = None,
+) -> Fit:
+    """The effects at `theta` as a Fit: residuals, Jacobian and covariance on every shot (`flown`: the residuals and
+    Jacobian on every shot where already flown)."""
     everyone = np.arange(len(problem.recordings))
-    theta = np.clip(start, low, high)
-    flown: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}  # (z, Jacobian) on `rows` at each theta tried
-    if len(theta):
-
-        def evaluate(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            key = x.tobytes()
-            if key not in flown:
-                flown[key] = residuals_and_jacobian(problem, effects, x, rows)
-            z, jac = flown[key]
-            used = np.isfinite(z)
-            return z[used], jac[used]
-
-        result = least_squares(
-            lambda x: evaluate(x)[0],
-            theta,
-            jac=lambda x: evaluate(x)[1],
-            bounds=(low, high),
-            x_scale=typical,
-            method="trf",
-            max_nfev=MAX_EVALUATIONS,
-            xtol=1e-3,
-            ftol=1e-4,
-        )
-        theta = result.x
-    every_shot = len(rows) == len(everyone) and theta.tobytes() in flown
-    z, jacobian = flown[theta.tobytes()] if every_shot else residuals_and_jacobian(problem, effects, theta, everyone)
+    z, jacobian = flown if flown is not None else residuals_and_jacobian(problem, effects, theta, everyone)
     shared = problem.shared_information(z, jacobian)
     return Fit(effects, theta, z, jacobian, covariance(z, jacobian, problem.recordings.session, shared))
 

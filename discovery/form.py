@@ -20,8 +20,9 @@ from golfflight.discovery.effects import Context, Effect, Parameter, Reported
 from golfflight.discovery.fit import (
     Fit,
     Problem,
-    fit,
+    fit_at,
     fit_rows,
+    fitted_parameters,
     folds,
     held_nuisance_covariance,
     linear_starts,
@@ -171,14 +172,25 @@ def _discrepancy(
 
 def converged(problem: Problem, start: np.ndarray, rows: np.ndarray, rounds: int = FIT_ROUNDS) -> Fit:
     """The form fitted from `start`, restarted from where each fit stopped (a fit stops after a fixed number of
-    evaluations; the form's many weights may need more) until its error stops falling by 1 %."""
-    result = fit(problem, (FORM,), start, rows)
+    evaluations; the form's many weights may need more) until its error on every shot stops falling by 1 %; only the
+    last one's Jacobian is flown on every shot (for its covariance): 19 weights' worth of flights of every baseline
+    shot a round."""
+    theta = fitted_parameters(problem, (FORM,), start, rows)[0]
+    error = _error(problem, theta)
     for _ in range(rounds - 1):
-        again = fit(problem, (FORM,), result.theta, rows)
-        if np.nanmean(again.z**2) > 0.99 * np.nanmean(result.z**2):
-            return again
-        result = again
-    return result
+        again = fitted_parameters(problem, (FORM,), theta, rows)[0]
+        again_error = _error(problem, again)
+        stalled = again_error > 0.99 * error
+        theta, error = again, again_error
+        if stalled:
+            break
+    return fit_at(problem, (FORM,), theta)
+
+
+def _error(problem: Problem, theta: np.ndarray) -> float:
+    """Mean squared standardized residual of every shot flown with the form's weights `theta`."""
+    everyone = np.arange(len(problem.recordings))
+    return float(np.nanmean(problem.standardize(problem.predict((FORM,), theta, everyone)[0], everyone) ** 2))
 
 
 def heldout_with_discrepancy(problem: Problem, formed: np.ndarray, whole: Discrepancy, seed: int) -> np.ndarray:
@@ -214,8 +226,8 @@ def formed_model(model: FlightModel, form: LearnedForm) -> FlightModel:
 def with_form_uncertainty(problem: Problem, result: Fit, form: LearnedForm) -> Fit:
     """`result` (a fit against the model with `form` held) with the form's own uncertainty in its covariance: the
     form was estimated on the baseline and then held, and its error moves the fit as much as the new shots' noise
-    may (`fit.held_nuisance_covariance`). Fitted on the new shots alone, a launch-angle bias of -1.18 +- 0.019 deg came
-    out for the hidden -1.25 (3.8 +-); with the form's error counted, +- 0.040 (1.8 +-; reference world, seed 0)."""
+    may (`fit.held_nuisance_covariance`). Fitted on the new shots alone, a launch-angle bias of -1.18 ± 0.019 deg came
+    out for the hidden -1.25 (3.8 ± off); with the form's error counted, ± 0.040 (1.8 ± off; reference world, seed 0)."""
     if not result.k:
         return result
     everyone = np.arange(len(problem.recordings))
@@ -233,8 +245,8 @@ def with_reading_uncertainty(problem: Problem, result: Fit, other_reading: Fligh
     (docs/discovery.md, "How far a sea-level form carries into other air"); in the baseline's air they agree."""
     if not result.k:
         return result
-    refit = fit(replace(problem, model=other_reading), result.effects, result.theta, rows)
-    half = (refit.theta - result.theta) / 2.0
+    refit = fitted_parameters(replace(problem, model=other_reading), result.effects, result.theta, rows)[0]
+    half = (refit - result.theta) / 2.0
     return replace(result, covariance=result.covariance + np.outer(half, half))
 
 
