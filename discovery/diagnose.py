@@ -459,7 +459,7 @@ class Diagnoser:
         baseline's), the reading it cannot rule out (`form.with_reading_uncertainty`). The ± the report quotes; the
         choice was made before, on the fits."""
         chosen = selection.chosen
-        counted = with_form_uncertainty(self.problem, chosen.fit, self.baseline)
+        counted = with_form_uncertainty(self.problem, chosen.fit, self.baseline, self.rows)
         if self.response_error(chosen) > 0.0:
             counted = with_reading_uncertainty(self.problem, counted, self.other_reading, self.rows)
         counted = replace(chosen, fit=counted)
