@@ -11,11 +11,15 @@ REFERENCE = "reference"
 CLEAN_SETS = 40
 """Clean sets per campaign, whatever the seeds per case: false alarms are counted on at least this many."""
 
-Truth = Literal["model", "reference", "ferguson", "density-only"]
-TRUTHS: tuple[Truth, ...] = ("model", "reference", "ferguson", "density-only")
+Truth = Literal["model", "reference", "ferguson", "density-only", "density-only-rk4"]
+TRUTHS: tuple[Truth, ...] = ("model", "reference", "ferguson", "density-only", "density-only-rk4")
 """The worlds effects are hidden in: the diagnosed model's own flights, and those that differ from it in form (the
 model-form campaign): the reference world, Ferguson 2022's closed-form coefficients, and the model itself in venue
-air that scales density only (recorded, so the model flies it with the Reynolds change real air has)."""
+air that scales density only (recorded, so the model flies it with the Reynolds change real air has), as the service
+flies it (forward Euler at the card's step) or by RK4 at 0.01 s (`density-only-rk4`: without the step error)."""
+
+DENSITY_ONLY_WORLDS: tuple[Truth, ...] = ("density-only", "density-only-rk4")
+"""The worlds whose venue air scales density only and is recorded with every shot."""
 
 Campaign = Literal["library", "pairs", "triples", "baseline"]
 CAMPAIGNS: tuple[Campaign, ...] = ("library", "pairs", "triples", "baseline")

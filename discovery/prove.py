@@ -18,11 +18,11 @@ import json
 import re
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
-from golfflight.discovery.choices import CAMPAIGNS, CLEAN_SETS, TRUTHS, Campaign, Truth
+from golfflight.discovery.choices import CAMPAIGNS, CLEAN_SETS, DENSITY_ONLY_WORLDS, TRUTHS, Campaign, Truth
 from golfflight.discovery.conceal import NOMINAL_AIR, NOMINAL_CONTEXT, OUTSIDE_EFFECT, conceal
 from golfflight.discovery.diagnose import diagnose
 from golfflight.discovery.effects import AIR_VARIANTS, BALL, DENSITY_ONLY, EFFECTS, LIBRARY, Draw, equivalent_altitude_m
@@ -135,7 +135,7 @@ def cases(truth: Truth = "model", campaign: Campaign = "library") -> list[tuple[
     if campaign == "baseline":
         return baseline_cases(truth)
     library = [(e.name, (e.name,)) for e in LIBRARY]
-    if truth == "density-only":  # the air is recorded there: an air finding is wrong by construction
+    if truth in DENSITY_ONLY_WORLDS:  # the air is recorded there: an air finding is wrong by construction
         library = [(name, effects) for name, effects in library if name not in AIR_VARIANTS]
     if truth == "reference":
         library.append((LOG_WIND, ("wind",)))
@@ -152,9 +152,9 @@ def baseline_cases(truth: Truth) -> list[tuple[str, tuple[str, ...]]]:
     """The baseline campaign's cases: no change, each venue condition and monitor bias, another ball, and a high
     venue flown as density alone (none of the air cases where the world's venue air is recorded)."""
     changes = [e.name for e in LIBRARY if e.kind in ("venue", "monitor")] + [BALL.name]
-    if truth == "density-only":
+    if truth in DENSITY_ONLY_WORLDS:
         changes = [name for name in changes if name not in AIR_VARIANTS]
-    venues = [] if truth == "density-only" else [(case, (variant,)) for case, (variant, _) in HIGH_VENUES.items()]
+    venues = [] if truth in DENSITY_ONLY_WORLDS else [(case, (variant,)) for case, (variant, _) in HIGH_VENUES.items()]
     return [("clean", ())] + [(name, (name,)) for name in changes] + venues
 
 
@@ -209,13 +209,24 @@ def internal(name: str, parameters: dict[str, float]) -> np.ndarray:
 
 
 def truth_world(truth: Truth, model: FlightModel) -> FlightModel | None:
-    """The world the effects are hidden in: the diagnosed model (its own flights, or in density-only venue air),
-    Ferguson 2022's closed-form coefficients (RK4 at 0.01 s), or None for the reference world."""
+    """The world the effects are hidden in: the diagnosed model (its own flights, or in density-only venue air, as
+    the service flies it or by RK4 at 0.01 s), Ferguson 2022's closed-form coefficients (RK4 at 0.01 s), or None for
+    the reference world."""
     if truth == "reference":
         return None
     if truth == "ferguson":
         return ferguson_world()
+    if truth == "density-only-rk4":
+        return finely_flown(model)
     return model
+
+
+def finely_flown(model: FlightModel) -> FlightModel:
+    """The model's coefficients flown by RK4 at 0.01 s, as Ferguson's world is: its physics without the forward-Euler
+    step error of the service's 0.1 s, which a form learned from a baseline carries only in the baseline's air
+    (`form.accurately_flown`)."""
+    flyer = model.flyer.replaced(rule=RUNGE_KUTTA_4, dt_s=0.01)
+    return replace(model, name=f"{model.name}, flown by RK4 at 0.01 s", flyer=flyer)
 
 
 def ferguson_world() -> FlightModel:
@@ -305,7 +316,7 @@ def run_case(
         hidden = {variant: {"ratio": HIGH_VENUE_RATIO}}
     profile = "log" if case == LOG_WIND else "uniform"
     world, venue = truth_world(truth, model), {}
-    if truth == "density-only":
+    if truth in DENSITY_ONLY_WORLDS:
         venue = {DENSITY_ONLY: {"ratio": float(rng.uniform(*VENUE_RATIOS))}}
     concealed = conceal({**hidden, **venue}, n_shots, seed, wind_profile=profile, model=world)
     shots = concealed.shots
@@ -625,6 +636,8 @@ def tables(runs: list[Run], model_name: str, truth: Truth = "model", campaign: C
         "ferguson": "flights with Ferguson 2022's coefficients (RK4, 0.01 s)",
         "density-only": "the diagnosed model's own flights in venue air that scales density only (0.75-0.95 x ICAO, "
         "recorded)",
+        "density-only-rk4": "the diagnosed model's coefficients flown by RK4 at 0.01 s in venue air that scales "
+        "density only (0.75-0.95 x ICAO, recorded)",
     }[truth]
     opening = (
         f"Model diagnosed: {model_name}; effects hidden in {flown}. {len(runs)} concealed sets, "

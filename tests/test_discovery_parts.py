@@ -364,3 +364,19 @@ def test_a_baseline_at_three_lower_venues_keeps_the_players_and_records_each_ven
     for k, session in enumerate(sessions):
         density = recordings.density_kg_m3[recordings.session == session]
         assert np.allclose(density, LOWER_VENUES[k % 3] * Air.standard().density_kg_m3, rtol=2e-3)
+
+
+def test_the_density_only_world_flown_finely_is_the_model_by_rk4_at_a_hundredth_of_a_second():
+    """`density-only-rk4` is the density-only world without the service's forward-Euler step: the model's own
+    coefficients and air, flown by RK4 at 0.01 s; its cases are the density-only world's."""
+    from golfflight.discovery.model import load_model
+    from golfflight.discovery.prove import baseline_cases, cases, truth_world
+    from golfflight.flight.integrator import RUNGE_KUTTA_4
+
+    served = load_model(None)
+    fine = truth_world("density-only-rk4", served)
+    assert fine.flyer.rule is RUNGE_KUTTA_4 and fine.flyer.dt_s == 0.01
+    assert fine.flyer.model is served.flyer.model and fine.flyer.density_kg_m3 == served.flyer.density_kg_m3
+    assert truth_world("density-only", served) is served
+    assert baseline_cases("density-only-rk4") == baseline_cases("density-only")
+    assert cases("density-only-rk4") == cases("density-only")
