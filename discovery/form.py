@@ -172,9 +172,8 @@ def _discrepancy(
 
 def converged(problem: Problem, start: np.ndarray, rows: np.ndarray, rounds: int = FIT_ROUNDS) -> Fit:
     """The form fitted from `start`, restarted from where each fit stopped (a fit stops after a fixed number of
-    evaluations; the form's many weights may need more) until its error on every shot stops falling by 1 %; only the
-    last one's Jacobian is flown on every shot (for its covariance): 19 weights' worth of flights of every baseline
-    shot a round."""
+    evaluations; the form's many weights may need more) until its error on every shot stops falling by 1 %. A restart
+    flies its fit and every shot once; the Jacobian on every shot, for the covariance, is flown for the last alone."""
     theta = fitted_parameters(problem, (FORM,), start, rows)[0]
     error = _error(problem, theta)
     for _ in range(rounds - 1):
@@ -225,8 +224,8 @@ def formed_model(model: FlightModel, form: LearnedForm) -> FlightModel:
 
 def with_form_uncertainty(problem: Problem, result: Fit, form: LearnedForm, rows: np.ndarray) -> Fit:
     """`result` (a fit against the model with `form` held) with the form's own uncertainty in its covariance: the
-    form was estimated on the baseline and then held, and its error moves the fit as much as the new shots' noise
-    may (`fit.held_nuisance_covariance`). How far the fit moves per unit of the form's weights is a ratio of sums over
+    form was estimated on the baseline and then held, so its error moves the new fit too, alike for every new shot,
+    which their scatter cannot show (`fit.held_nuisance_covariance`). How far the fit moves per unit of the form's weights is a ratio of sums over
     the shots, read on the fit's `rows` (every shot up to `fit.MAX_FIT_SHOTS`). Fitted on the new shots alone, a
     launch-angle bias of -1.18 ± 0.019 deg came out for the hidden -1.25 (3.8 ± off); with the form's error counted,
     ± 0.040 (1.8 ± off; reference world, seed 0)."""
