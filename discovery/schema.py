@@ -93,7 +93,12 @@ class EffectResult(_ReportModel):
         "differs from the model's in form)",
     )
     parameters: dict[str, float]
-    uncertainty: dict[str, float]
+    uncertainty: dict[str, float] = Field(
+        description="1 standard deviation of each parameter, from the fit's Jacobian; against a baseline session it "
+        "counts the model's error shared between shots once, and for the chosen explanation also the error of the "
+        "form the baseline taught (held while fitting) and, in another air than the baseline's, half the move to the "
+        "form's other reading (docs/discovery.md, 'The ± counts what the baseline leaves unsure')"
+    )
 
 
 class Candidate(_ReportModel):
