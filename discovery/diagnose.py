@@ -285,9 +285,9 @@ class Diagnoser:
             self.rows = stratified_rows(self.problem.recordings, MAX_FIT_SHOTS, self.rng)
         self.scored_fold = self.fold[self.scored]
         self._response_errors: dict[tuple[str, bytes], float] = {}  # memo: asked up to three times
-        self.other_reading = model.control
-        if baseline is not None:  # the form the baseline cannot tell from its own in another air
-            self.other_reading = read_along_speed(model, baseline)
+        # what the model's response is measured against: its control, or the form the baseline cannot tell from its
+        # own in another air
+        self.other_reading = model.control if baseline is None else read_along_speed(model, baseline)
         self.set_aside: list[Halves] = []  # the conditions set aside as changing with the launch (`model_form`)
 
     def run(self) -> Diagnosis:

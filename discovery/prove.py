@@ -18,7 +18,7 @@ import json
 import re
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +27,7 @@ from golfflight.discovery.conceal import NOMINAL_AIR, NOMINAL_CONTEXT, OUTSIDE_E
 from golfflight.discovery.diagnose import diagnose
 from golfflight.discovery.effects import AIR_VARIANTS, BALL, DENSITY_ONLY, EFFECTS, LIBRARY, Draw, equivalent_altitude_m
 from golfflight.discovery.effects.parts import sign, uniform
-from golfflight.discovery.form import LearnedForm, learn_form
+from golfflight.discovery.form import LearnedForm, flown_by_rk4, learn_form
 from golfflight.discovery.model import MIN_T_MAX_S, FlightModel
 from golfflight.discovery.outside import HEIGHT_GUST, HIGH_SPIN_LIFT_LOSS, LOW_SPEED_DRAG, OUTSIDE
 from golfflight.discovery.recordings import from_shot_set
@@ -73,6 +73,8 @@ HIGH_VENUE = "1,900 m air, density only"
 """The baseline campaign's fixed case: a venue at about 1,900 m (0.776 x ICAO) flown as density alone, against a
 sea-level baseline: the air must be named, within 0.03."""
 HIGH_VENUE_RATIO = 0.776
+FINE_STEP_S = 0.01
+"""The RK4 step of the worlds not flown as the service flies (Ferguson 2022's, `density-only-rk4`)."""
 HIGH_VENUE_REAL = "1,900 m real air, against three lower venues"
 """The baseline campaign's case of a launch monitor taken up a mountain: the same 0.776 x ICAO as real air (the
 Reynolds number with the density), against a baseline recorded at three lower venues (`LOWER_VENUES`, their air
@@ -216,17 +218,9 @@ def truth_world(truth: Truth, model: FlightModel) -> FlightModel | None:
         return None
     if truth == "ferguson":
         return ferguson_world()
-    if truth == "density-only-rk4":
-        return finely_flown(model)
+    if truth == "density-only-rk4":  # without the service's forward-Euler step error (`form.accurately_flown`)
+        return flown_by_rk4(model, FINE_STEP_S)
     return model
-
-
-def finely_flown(model: FlightModel) -> FlightModel:
-    """The model's coefficients flown by RK4 at 0.01 s, as Ferguson's world is: its physics without the forward-Euler
-    step error of the service's 0.1 s, which a form learned from a baseline carries only in the baseline's air
-    (`form.accurately_flown`)."""
-    flyer = model.flyer.replaced(rule=RUNGE_KUTTA_4, dt_s=0.01)
-    return replace(model, name=f"{model.name}, flown by RK4 at 0.01 s", flyer=flyer)
 
 
 def ferguson_world() -> FlightModel:
@@ -235,7 +229,7 @@ def ferguson_world() -> FlightModel:
     air = NOMINAL_AIR
     flyer = Flyer(
         FixedCoefficients(QuadraticSpinRatio()),
-        dt_s=0.01,
+        dt_s=FINE_STEP_S,
         max_flight_time_s=MIN_T_MAX_S,
         density_kg_m3=float(air.density_kg_m3),
         kinematic_viscosity_m2_s=float(air.kinematic_viscosity_m2_s),

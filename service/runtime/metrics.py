@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import shutil
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from prometheus_client import CollectorRegistry, Counter, Histogram
 from prometheus_client.exposition import CONTENT_TYPE_LATEST, generate_latest
-from prometheus_client.metrics_core import InfoMetricFamily
+from prometheus_client.metrics_core import InfoMetricFamily, Metric
 from prometheus_client.multiprocess import MultiProcessCollector
 from golfflight.errors import InputError
 from golfflight.flight.environment_variables import METRICS_DIR, environment, set_for_children
@@ -57,8 +57,9 @@ class StartedWorkersCollector(MultiProcessCollector):
         super().__init__(registry, str(directory))
         self.directory = directory
 
-    def collect(self):
+    def collect(self) -> Iterable[Metric]:
         return self.merge([str(path) for path in self.directory.glob("*.db") if started(path)], accumulate=True)
+
 
 ModelLabels = Callable[[], dict[str, str] | None]
 """The loaded model's info labels (variant, sha256, version), or None while it loads or after it failed to."""
