@@ -10,6 +10,9 @@ REFERENCE = "reference"
 
 CLEAN_SETS = 40
 """Clean sets per campaign, whatever the seeds per case: false alarms are counted on at least this many."""
+SHOTS = 300
+"""Shots per concealed set (and per baseline session), unless a campaign is told otherwise."""
+
 
 Truth = Literal["model", "reference", "ferguson", "density-only", "density-only-rk4"]
 TRUTHS: tuple[Truth, ...] = ("model", "reference", "ferguson", "density-only", "density-only-rk4")

@@ -22,10 +22,11 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
-from golfflight.discovery.choices import CAMPAIGNS, CLEAN_SETS, DENSITY_ONLY_WORLDS, TRUTHS, Campaign, Truth
+from golfflight.discovery.choices import CAMPAIGNS, CLEAN_SETS, DENSITY_ONLY_WORLDS, SHOTS, TRUTHS, Campaign, Truth
 from golfflight.discovery.conceal import NOMINAL_AIR, NOMINAL_CONTEXT, OUTSIDE_EFFECT, conceal
 from golfflight.discovery.diagnose import diagnose
 from golfflight.discovery.effects import AIR_VARIANTS, BALL, DENSITY_ONLY, EFFECTS, LIBRARY, Draw, equivalent_altitude_m
+from golfflight.discovery.effects.ball import DRAG_AND_LIFT
 from golfflight.discovery.effects.parts import sign, uniform
 from golfflight.discovery.form import LearnedForm, flown_by_rk4, learn_form
 from golfflight.discovery.model import MIN_T_MAX_S, FlightModel
@@ -85,6 +86,11 @@ other, about 250 to 1,000 m at 15 degC."""
 HIGH_VENUES = {HIGH_VENUE: (DENSITY_ONLY, (1.0,)), HIGH_VENUE_REAL: ("air_density", LOWER_VENUES)}
 """Each high-venue case: its air variant (ratio HIGH_VENUE_RATIO) and the airs of its baseline's venues."""
 
+BALL_AT_VENUE = "another ball, the air recorded"
+"""The baseline campaign's case of two balls compared at one venue: another ball, the new session's air recorded
+with its shots (the baseline's calm ICAO air), so that air cannot stand in for a ball whose drag and lift move alike.
+Scored apart from the concealed changes, since its air is not concealed."""
+
 BASELINE_LAUNCHES = 1
 """The baseline session's launch stream (`conceal`'s launch_seed): the new session's players and clubs, other
 launches and noise, in the truth world's calm ICAO air."""
@@ -96,12 +102,14 @@ def command(
     only: str | None = None,
     seeds: int | None = None,
     campaign: Campaign = "library",
+    shots: int = SHOTS,
 ) -> str:
     """The `golfflight` command whose generated section the tables go to: one per model and campaign (and case
-    filter), so such sections coexist."""
+    filter and session size), so such sections coexist."""
     extra = "" if campaign == "library" else f" --campaign {campaign}"
     extra += "" if only is None else f" --cases '{only}'"
     extra += f" --seeds {seeds}" if extra else ""
+    extra += f" --shots {shots}" if shots != SHOTS else ""
     return f"prove --model {model_spec} --truth {truth}{extra}"
 
 
@@ -157,7 +165,8 @@ def baseline_cases(truth: Truth) -> list[tuple[str, tuple[str, ...]]]:
     if truth in DENSITY_ONLY_WORLDS:
         changes = [name for name in changes if name not in AIR_VARIANTS]
     venues = [] if truth in DENSITY_ONLY_WORLDS else [(case, (variant,)) for case, (variant, _) in HIGH_VENUES.items()]
-    return [("clean", ())] + [(name, (name,)) for name in changes] + venues
+    at_venue = [] if truth in DENSITY_ONLY_WORLDS else [(BALL_AT_VENUE, (BALL.name,))]
+    return [("clean", ())] + [(name, (name,)) for name in changes] + venues + at_venue
 
 
 _LEARNED: dict[tuple[str, str, int, int, tuple[float, ...]], LearnedForm] = {}
@@ -199,6 +208,14 @@ def recorded_in(records: list, ratio: float) -> list:
     density is `ratio` x ICAO (what the service reads back as that density and its viscosity)."""
     air = {"temperature_c": 15.0, "altitude_m": equivalent_altitude_m(ratio, NOMINAL_CONTEXT), "humidity_pct": 0.0}
     return [r.model_copy(update=air) for r in records]
+
+
+def recorded_air(case: str, venue: dict[str, dict[str, float]]) -> float | None:
+    """The air (x ICAO) written on a new session's shots: the density-only world's venue air, the baseline's ICAO
+    air where two balls are compared at one venue (`BALL_AT_VENUE`), else none (the air left blank)."""
+    if venue:
+        return venue[DENSITY_ONLY]["ratio"]
+    return 1.0 if case == BALL_AT_VENUE else None
 
 
 def _outside(effects: tuple[str, ...] | dict) -> bool:
@@ -314,8 +331,9 @@ def run_case(
         venue = {DENSITY_ONLY: {"ratio": float(rng.uniform(*VENUE_RATIOS))}}
     concealed = conceal({**hidden, **venue}, n_shots, seed, wind_profile=profile, model=world)
     shots = concealed.shots
-    if venue:  # the venue's air recorded with every shot
-        shots = ShotSet(recorded_in(shots.records, venue[DENSITY_ONLY]["ratio"]))
+    recorded = recorded_air(case, venue)
+    if recorded is not None:
+        shots = ShotSet(recorded_in(shots.records, recorded))
     recordings = from_shot_set(shots, source=f"concealed {case} seed {seed}")
     baseline = baseline_form(model, truth, n_shots, seed, venues) if against_baseline else None
     started = time.perf_counter()
@@ -364,7 +382,7 @@ def run_case(
 def prove(
     model: FlightModel,
     seeds: int = 4,
-    n_shots: int = 300,
+    n_shots: int = SHOTS,
     report: Callable[[str], None] | None = None,
     only: str | None = None,
     truth: Truth = "model",
@@ -416,6 +434,17 @@ def _within(run: Run, tolerance: float = 0.1) -> bool:
     return set(run.parameter_error) == set(run.hidden) and all(e <= tolerance for e in run.parameter_error.values())
 
 
+def _ball_drag_and_lift_within(run: Run, tolerance: float = 0.1) -> bool:
+    """Another ball named with its drag and lift scales within `tolerance` of their part of its size: how it scores
+    with its spin decay, which the outcomes cannot measure, left to its ± (`ball.DRAG_AND_LIFT`)."""
+    fitted = run.fitted.get(BALL.name) if run.systematic else None
+    if fitted is None:
+        return False
+    hidden = np.array([run.hidden[BALL.name][k] for k in DRAG_AND_LIFT])
+    got = np.array([fitted[k] for k in DRAG_AND_LIFT])
+    return bool(np.linalg.norm(got - hidden) <= tolerance * np.linalg.norm(hidden - 1.0))
+
+
 def _acted_on(run: Run) -> bool:
     """A venue condition, a launch-monitor bias or another ball was named: the findings a user acts on."""
     return run.systematic and any(kind in ("venue", "monitor", "ball") for kind in run.named_kinds)
@@ -448,7 +477,7 @@ def hidden_within_uncertainty(run: Run, widths: float = 2.0) -> list[bool]:
 def _baseline_rows(runs: list[Run]) -> list[str]:
     """The baseline campaign's headline rows: no-change sessions, the change named within 10 %, the high venue."""
     clean = [r for r in runs if r.case == "clean"]
-    changed = [r for r in runs if r.case != "clean" and r.case not in HIGH_VENUES]
+    changed = [r for r in runs if r.case not in ("clean", BALL_AT_VENUE, *HIGH_VENUES)]
     errors = [e for r in changed for e in r.parameter_error.values()]
     covered = [c for r in runs if r.case != "clean" for c in hidden_within_uncertainty(r)]
     rows = []
@@ -467,6 +496,16 @@ def _baseline_rows(runs: list[Run]) -> list[str]:
             f"| hidden values within 2 ± of the fitted ones (each parameter) | {_share(covered)} | - |"
             if covered else "",
         ]
+    for case, where in ((BALL.name, ""), (BALL_AT_VENUE, ", the air recorded")):
+        balls = [r for r in runs if r.case == case]
+        if case == BALL_AT_VENUE and balls:
+            rows.append(f"| another ball{where}: named within 10 % of its size | "
+                        f"{_share([_among(r) and _within(r) for r in balls])} | - |")
+        if balls:
+            rows.append(
+                f"| another ball{where}: named, its drag and lift within 10 % of their size (spin decay left to its ±) "
+                f"| {_share([_ball_drag_and_lift_within(r) for r in balls])} | - |"
+            )
     for case in HIGH_VENUES:
         venue = [r for r in runs if r.case == case]
         if venue:

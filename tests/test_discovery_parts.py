@@ -347,15 +347,58 @@ def test_the_campaign_counts_hidden_values_within_two_of_their_reported_uncertai
     assert hidden_within_uncertainty(missed) == []
 
 
+def test_a_campaign_of_another_session_size_writes_its_own_section():
+    """The section's command names the shots per set where they are not the default 300."""
+    from golfflight.discovery.prove import command
+
+    base = "prove --model models/default --truth model --campaign baseline --cases '^ball$' --seeds 6"
+    assert command("models/default", "model", "^ball$", 6, "baseline") == base
+    assert command("models/default", "model", "^ball$", 6, "baseline", 3000) == base + " --shots 3000"
+
+
+def test_the_baseline_campaign_scores_another_balls_drag_and_lift_beside_its_whole_size():
+    """The drag-and-lift row reads the ball's drag and lift against their part of its size, the whole-size row all
+    three scales against the whole: one ball passes each, and a ball read as air neither."""
+    hidden = {"ball": {"drag_scale": 0.94, "lift_scale": 1.08, "spin_decay_scale": 1.2}}
+    # sizes: drag and lift |(-0.06, 0.08)| = 0.1; all three |(-0.06, 0.08, 0.2)| = 0.224
+    spin_decay_off = {"ball": {"drag_scale": 0.945, "lift_scale": 1.073, "spin_decay_scale": 0.9}}  # 0.0086 of 0.1
+    drag_off = {"ball": {"drag_scale": 0.9505, "lift_scale": 1.08, "spin_decay_scale": 1.2}}  # 0.0105: 10.5 %, 4.7 %
+    as_air = {"air_density_only": {"ratio": 0.95, "equivalent_altitude_m": 430.0}}
+
+    def run(fitted: dict, named: str) -> Run:
+        errors = {"ball": relative_error("ball", fitted["ball"], hidden["ball"])} if "ball" in fitted else {}
+        return Run("ball", 0, hidden, 300, 4, True, named, named == "ball", fitted, {}, errors, 8.0, 1.1, 0.97, False,
+                   {}, {}, [], 1.0)
+
+    runs = [run(spin_decay_off, "ball"), run(drag_off, "ball"), run(as_air, "air_density_only")]
+    text = tables(runs, "test model", campaign="baseline")
+    assert "| the change named (beside others or not), within 10 % of its size | 1 of 3 (33%) | ≥ 90 % |" in text
+    assert ("| another ball: named, its drag and lift within 10 % of their size (spin decay left to its ±) | "
+            "1 of 3 (33%) | - |") in text
+
+
 def test_a_baseline_at_three_lower_venues_keeps_the_players_and_records_each_venues_air():
     """The real-air venue case's baseline: the ICAO baseline's sessions (the same players and clubs), one in three at
-    each lower venue, flown and recorded in that venue's real air."""
-    from golfflight.discovery.prove import HIGH_VENUE_REAL, HIGH_VENUES, LOWER_VENUES, baseline_cases, venue_baseline
+    each lower venue, flown and recorded in that venue's real air; the two-ball case's new session records the
+    baseline's air, the density-only world's its venue's."""
+    from golfflight.discovery.prove import (
+        BALL_AT_VENUE,
+        HIGH_VENUE_REAL,
+        HIGH_VENUES,
+        LOWER_VENUES,
+        baseline_cases,
+        recorded_air,
+        venue_baseline,
+    )
     from golfflight.discovery.recordings import from_shot_set
     from golfflight.flight.air import Air
 
     assert (HIGH_VENUE_REAL, (HIGH_VENUES[HIGH_VENUE_REAL][0],)) in baseline_cases("reference")
     assert not any(case in HIGH_VENUES for case, _ in baseline_cases("density-only"))
+    assert (BALL_AT_VENUE, ("ball",)) in baseline_cases("ferguson")
+    assert BALL_AT_VENUE not in dict(baseline_cases("density-only"))  # its air is recorded in every case there
+    assert recorded_air(BALL_AT_VENUE, {}) == 1.0 and recorded_air("ball", {}) is None
+    assert recorded_air("ball", {"air_density_only": {"ratio": 0.8}}) == 0.8
     icao = venue_baseline(None, 60, 3, (1.0,))
     venues = venue_baseline(None, 60, 3, LOWER_VENUES)
     assert sorted(r.session for r in venues.records) == sorted(r.session for r in icao.records)

@@ -24,6 +24,10 @@ from golfflight.discovery.schema import CorrectionSettings
 KNOBS = ("drag_scale", "lift_scale", "spin_decay_scale")
 """The ball's parameters: the reference world's knobs it turns, multipliers of C_D, C_L and C_M's spin decay."""
 
+DRAG_AND_LIFT = KNOBS[:2]
+"""The two scales the recorded outcomes measure to a few per cent against a baseline; the spin decay they do not
+(docs/discovery.md, "Another ball: what these outcomes tell of it")."""
+
 _apply = scale_columns(KNOBS)
 
 

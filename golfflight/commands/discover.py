@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 from golfflight.commands import COMMANDS
-from golfflight.discovery.choices import CAMPAIGNS, CLEAN_SETS, REFERENCE, TRUTHS
+from golfflight.discovery.choices import CAMPAIGNS, CLEAN_SETS, REFERENCE, SHOTS, TRUTHS
 from golfflight.errors import InputError
 from golfflight.shots.progress import print_line, progress_step
 
@@ -76,7 +76,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     prove.add_argument("--seeds", type=int, default=4, help="concealed sets per case")
     prove.add_argument("--clean-sets", type=int, default=CLEAN_SETS, help="clean sets (false-alarm count)")
-    prove.add_argument("--shots", type=int, default=300, help="shots per concealed set")
+    prove.add_argument("--shots", type=int, default=SHOTS, help="shots per concealed set")
     prove.add_argument("--out", default="docs/discovery.md", help="markdown file whose generated section is replaced")
     prove.add_argument("--json", help="also write every run's truth and findings to this JSON file")
     prove.add_argument(
@@ -164,7 +164,7 @@ def run_prove(args: argparse.Namespace) -> int:
         names = ", ".join(name for name, _ in cases(args.truth, args.campaign))
         raise InputError(f"--cases {args.cases!r} matches none of: {names}")
     spec = args.model or "models/default"
-    section = command(spec, args.truth, args.cases, args.seeds, args.campaign)
+    section = command(spec, args.truth, args.cases, args.seeds, args.campaign, args.shots)
     json_path = Path(args.json) if args.json else None
     write_tables(results, Path(args.out), json_path, model.name, section, args.truth, args.campaign)
     print(f"wrote the tables to {args.out}")
