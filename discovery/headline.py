@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 from golfflight.discovery.effects import AIR_VARIANTS, DENSITY_ONLY
+from golfflight.discovery.effects.ball import DRAG_AND_LIFT
 from golfflight.discovery.schema import Ambiguity, EffectResult, Report
 from golfflight.discovery.verdict import Flagged, candidate, flagged, ruled_out, strongest_trend
 from golfflight.discovery.words import COVARIATE_WORDS, DIRECTIONS, OBSERVABLE_WORDS, UNITS, effect_words, key_words
@@ -222,14 +223,15 @@ def _scale(name: str, scale: float, sd: float | None) -> str:
 
 
 def _ball_scales(effect: EffectResult, full: bool) -> str:
-    """The ball's coefficient scales that depart from 1 beyond 2 sigma (the furthest one where none does), furthest
-    first, the first with its ± where `full`."""
+    """The ball's drag and lift scales that depart from 1 beyond 2 sigma (the further one where neither does),
+    furthest first, the first with its ± where `full`; not its spin decay, which these outcomes do not measure
+    (`ball.DRAG_AND_LIFT`)."""
     p, u = effect.parameters, effect.uncertainty
 
     def departure(key: str) -> float:
         return abs(p[key] - 1) / u[key] if u.get(key, 0) > 0 else abs(p[key] - 1)
 
-    keys = sorted(p, key=departure, reverse=True)
+    keys = sorted((k for k in p if k in DRAG_AND_LIFT), key=departure, reverse=True)
     shown = [k for k in keys if departure(k) > 2] or keys[:1]
     return ", ".join(_scale(k, p[k], u.get(k) if full and i == 0 else None) for i, k in enumerate(shown))
 

@@ -38,7 +38,8 @@ def _describe(theta: np.ndarray, covariance: np.ndarray, context: Context) -> Re
 
 def _phrase(p: dict[str, float], u: dict[str, float]) -> str:
     drag, lift, decay = (plus_minus(p[k], u[k]) for k in KNOBS)
-    return f"another ball: drag scaled by {drag}, lift by {lift} and spin decay by {decay}"
+    unmeasured = f"its spin decay, {decay}, these outcomes do not measure"
+    return f"another ball: drag scaled by {drag} and lift by {lift} ({unmeasured})"
 
 
 def _scales(p: dict[str, float]) -> dict[str, float]:
