@@ -15,6 +15,7 @@ import argparse
 from pathlib import Path
 
 import numpy as np
+from golfflight.discovery.choices import SHOTS
 from golfflight.discovery.conceal import conceal
 from golfflight.discovery.effects import BALL
 from golfflight.discovery.effects.ball import KNOBS
@@ -29,7 +30,6 @@ from golfflight.shots.files import write_text_atomic
 from golfflight.shots.markdown import replace_section, table
 from golfflight.shots.synth import MeasurementNoise
 
-SHOTS = 300
 CHANGES = (("spin decay x 1.3", {"spin_decay_scale": 1.3}), ("lift x 0.97", {"lift_scale": 0.97}))
 """A large spin-decay change of another ball and a small lift change, each alone."""
 NO_NOISE = MeasurementNoise(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)

@@ -111,7 +111,7 @@ def test_the_ball_reports_its_three_scales():
     assert uncertainty == pytest.approx({"drag_scale": 0.01, "lift_scale": 0.02, "spin_decay_scale": 0.1})
     result = EffectResult(name="ball", kind="ball", parameters=parameters, uncertainty=uncertainty)
     assert effect_phrase(result) == (
-        "another ball: drag scaled by 1.050 ± 0.010 and lift by 0.930 ± 0.020 (its spin decay, 1.40 ± 0.10, these "
+        "another ball: drag scaled by 1.050 ± 0.010 and lift by 0.930 ± 0.020 (spin decay 1.40 ± 0.10, which these "
         "outcomes do not measure)"
     )
     assert service_settings([result], NOMINAL_CONTEXT).coefficient_scales == parameters

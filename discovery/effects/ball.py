@@ -38,7 +38,7 @@ def _describe(theta: np.ndarray, covariance: np.ndarray, context: Context) -> Re
 
 def _phrase(p: dict[str, float], u: dict[str, float]) -> str:
     drag, lift, decay = (plus_minus(p[k], u[k]) for k in KNOBS)
-    unmeasured = f"its spin decay, {decay}, these outcomes do not measure"
+    unmeasured = f"spin decay {decay}, which these outcomes do not measure"
     return f"another ball: drag scaled by {drag} and lift by {lift} ({unmeasured})"
 
 
