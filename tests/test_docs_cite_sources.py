@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from tests.test_imports import virtual_environments
+
 ROOT = Path(__file__).resolve().parents[1]
 SKIPPED_FOLDERS = {".git", "build", "dist", ".venv", "__pycache__", ".pytest_cache", ".hypothesis", "runs", "out"}
 """Folders that are not the repository's own files (build outputs, caches, .gitignore's entries)."""
@@ -18,10 +20,10 @@ NOTES_FILE, NOTES_SECTION = "NOTES" + ".md", "NOTES" + " §"
 
 def repository_files() -> list[Path]:
     """Every Markdown and Python file of the repository, outside SKIPPED_FOLDERS and egg-info folders."""
-    found = []
+    found, skipped = [], SKIPPED_FOLDERS | virtual_environments()
     for path in ROOT.rglob("*"):
         parts = path.relative_to(ROOT).parts
-        if any(part in SKIPPED_FOLDERS or part.endswith(".egg-info") for part in parts[:-1]):
+        if any(part in skipped or part.endswith(".egg-info") for part in parts[:-1]):
             continue
         if path.suffix in (".md", ".py") and path.is_file():
             found.append(path)

@@ -24,8 +24,15 @@ SKIPPED = {"tests", "build", ".git", "runs", ".venv"}
 """Folders whose modules are not the project's (tests start the app as a client would)."""
 
 
+def virtual_environments() -> set[str]:
+    """The checkout's top-level folders that are virtual environments, whatever their name (PEP 405: a pyvenv.cfg at
+    their root): a user's `python3 -m venv env` beside the code holds other projects' modules."""
+    return {path.parent.name for path in ROOT.glob("*/pyvenv.cfg")}
+
+
 def _modules() -> list[Path]:
-    return [path for path in sorted(ROOT.rglob("*.py")) if SKIPPED.isdisjoint(path.relative_to(ROOT).parts)]
+    skipped = SKIPPED | virtual_environments()
+    return [path for path in sorted(ROOT.rglob("*.py")) if skipped.isdisjoint(path.relative_to(ROOT).parts)]
 
 
 def imported(path: Path) -> set[str]:
