@@ -13,7 +13,6 @@ CLEAN_SETS = 40
 SHOTS = 300
 """Shots per concealed set (and per baseline session), unless a campaign is told otherwise."""
 
-
 Truth = Literal["model", "reference", "ferguson", "density-only", "density-only-rk4"]
 TRUTHS: tuple[Truth, ...] = ("model", "reference", "ferguson", "density-only", "density-only-rk4")
 """The worlds effects are hidden in: the diagnosed model's own flights, and those that differ from it in form (the

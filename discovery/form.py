@@ -229,8 +229,9 @@ def formed_model(model: FlightModel, form: LearnedForm) -> FlightModel:
 def with_form_uncertainty(problem: Problem, result: Fit, form: LearnedForm, rows: np.ndarray) -> Fit:
     """`result` (a fit against the model with `form` held) with the form's own uncertainty in its covariance: the
     form was estimated on the baseline and then held, so its error moves the new fit too, alike for every new shot,
-    which their scatter cannot show (`fit.held_nuisance_covariance`). How far the fit moves per unit of the form's weights is a ratio of sums over
-    the shots, read on the fit's `rows` (every shot up to `fit.MAX_FIT_SHOTS`). Fitted on the new shots alone, a
+    which their scatter cannot show (`fit.held_nuisance_covariance`). How far the fit moves per unit of the form's
+    weights is a ratio of sums over the shots, read on the fit's `rows` (every shot up to `fit.MAX_FIT_SHOTS`).
+    Fitted on the new shots alone, a
     launch-angle bias of -1.18 ± 0.019 deg came out for the hidden -1.25 (3.8 ± off); with the form's error counted,
     ± 0.040 (1.8 ± off; reference world, seed 0)."""
     if not result.k:
